@@ -1,0 +1,2 @@
+//! The `tofprobe` command.
+fn main() {}

@@ -1,0 +1,1 @@
+//! Bit-true pixel model. See docs/pixel-contract.md.

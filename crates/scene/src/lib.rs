@@ -1,0 +1,1 @@
+//! Scene motion δ(t) and the photon/TDC Monte Carlo.
