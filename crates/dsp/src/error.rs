@@ -22,6 +22,28 @@ pub enum DspError {
         len: usize,
         needed: usize,
     },
+    /// The ΣΔ modulator's state left its bound: the input amplitude is too large.
+    #[error(
+        "the sigma-delta modulator is unstable at input amplitude {amplitude}: a state reached          {state:.3e} (bound {bound:.0e}) at sample {sample}; lower the amplitude{hint}"
+    )]
+    Unstable {
+        amplitude: f64,
+        sample: u64,
+        state: f64,
+        bound: f64,
+        /// Extra advice, already formatted with a leading "; " (or empty).
+        hint: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("{path}: {message}")]
+    Io { path: String, message: String },
+    /// A ROM hex file or manifest that does not parse or does not match its manifest.
+    #[error("{path}: line {line}: {message}")]
+    RomFormat {
+        path: String,
+        line: usize,
+        message: String,
+    },
 }
 
 impl DspError {

@@ -3,9 +3,15 @@
 //! wavelets, closed-form noise/bandwidth/pile-up models, and the ΣΔ probe design that
 //! produces the chip's bitstream ROM.
 
+pub mod bins;
+pub mod closed_form;
+pub mod dft;
 pub mod error;
+pub mod haar;
+pub mod preprocess;
 pub mod rom;
 pub mod sd;
+pub mod stats;
 pub mod window;
 
 pub use error::DspError;

@@ -1,1 +1,36 @@
-//! Bit-true pixel model. See docs/pixel-contract.md.
+//! Bit-true model of the one-bit frequency-probing dToF pixel, at two fidelities that agree
+//! exactly: the [`TransactionModel`] (one call per laser pulse) and the [`CycleModel`] (one
+//! call per clock edge on the RTL's pins), both implementing the [`contract`] verbatim.
+//!
+//! - [`params`]: the validated parameters ([`PixelParams`]) and their derived sizes;
+//! - [`config`]: the `[pixel]` TOML section ([`PixelConfig`]) and its validation;
+//! - [`fixed`]: the fixed-width arithmetic both models share;
+//! - [`sequencer`]: the reference pin sequence the testbench and vectors drive;
+//! - [`sizing`]: register widths, readout bytes and compression from a scene.
+
+pub mod bench;
+pub mod config;
+pub mod cycle;
+pub mod error;
+pub mod fixed;
+pub mod params;
+pub mod readout;
+pub mod sequencer;
+pub mod sizing;
+pub mod transaction;
+
+/// The cycle-level contract between the models and the RTL (docs/pixel-contract.md).
+#[doc = include_str!("../../../docs/pixel-contract.md")]
+pub mod contract {}
+
+pub use config::{PixelConfig, PixelContext};
+pub use cycle::{CycleModel, PinsIn, PinsOut, RegWrite};
+pub use error::PixelError;
+pub use params::{Mode, PixelParams};
+pub use readout::{Readout, ReadoutCollector};
+pub use sequencer::Sequencer;
+pub use transaction::TransactionModel;
+
+/// Default prefilter fraction bits F (see `tests/numerics.rs` for the measurement that
+/// chose it).
+pub const DEFAULT_FRAC_BITS: u32 = 8;

@@ -1,1 +1,17 @@
 //! ΣΔ probe design: NTF synthesis, the modulator, probe waveforms and the ROM they fill.
+
+pub mod config;
+pub mod lanes;
+pub mod modulator;
+pub mod ntf;
+pub mod probe;
+pub mod probing;
+pub mod quality;
+pub mod realize;
+
+pub use config::{ProbeConfig, RomMode};
+pub use modulator::Modulator;
+pub use ntf::{Ntf, synthesize_ntf};
+pub use probe::{ProbeDesign, ProbeRom};
+pub use probing::{ProbeAccumulator, amplitudes_um, normalise, prefilter_response, probe_record};
+pub use realize::{Cifb, StateSpace, realize_cifb};

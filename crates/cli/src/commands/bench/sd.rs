@@ -1,0 +1,277 @@
+//! `tofprobe bench sd [--json] [--svg PATH]`: the ΣΔ probe design measured. The default
+//! modulator's maximum stable amplitude (DC, 1 kHz, 4.5 kHz, 50 kHz), the in-band SNR of
+//! orders 1–4 at OSR 8–128 against eq. 4, the default design's SNR at the 156 kHz band
+//! edge and the band edge where it reaches 12 bits, and the speed of a 16-bin ROM
+//! (32 bitstreams) for N = 10^7 on one thread and all threads (target ≤ 1 s). With
+//! `--svg`, the spectrum of a 50 kHz probe (the paper's Fig. 2: the noise shaping).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use plotters::prelude::*;
+use serde::Serialize;
+use tofprobe_dsp::sd::quality::{ToneSpectrum, eq4_snr_db, measured_snr_db};
+use tofprobe_dsp::sd::{Modulator, ProbeConfig, ProbeDesign, ProbeRom};
+
+use crate::error::CliError;
+
+/// Arguments of `tofprobe bench sd`.
+#[derive(Debug, Args)]
+pub struct SdBenchArgs {
+    /// Print one JSON object.
+    #[arg(long)]
+    json: bool,
+    /// Write the spectrum of a 50 kHz probe as SVG to this path.
+    #[arg(long)]
+    svg: Option<PathBuf>,
+    /// Also write the 16-bin ROM ($readmemh hex + TOML manifest) into this directory.
+    #[arg(long)]
+    rom_dir: Option<PathBuf>,
+}
+
+const FS_HZ: f64 = 10e6;
+const N_ROM: u64 = 10_000_000;
+const ROM_TARGET_S: f64 = 1.0;
+/// Samples of each SNR-table run (bin width 76 Hz at 10 MHz; the band of OSR 128 holds
+/// 512 bins).
+const N_SNR: usize = 1 << 17;
+/// Samples of the band-edge spectrum of the default design (bin width 9.5 Hz).
+const N_BAND: usize = 1 << 20;
+/// Peak SNR of 12 bits: 6.02·12 + 1.76 dB.
+const SNR_12_BITS_DB: f64 = 6.02 * 12.0 + 1.76;
+
+#[derive(Debug, Serialize)]
+struct SnrRow {
+    order: usize,
+    osr: f64,
+    /// Measured in-band SNR at amplitude 0.5 (−6 dBFS), dB.
+    measured_snr_db: f64,
+    /// Eq. 4 at the same amplitude, dB.
+    eq4_snr_db: f64,
+}
+
+#[derive(Debug, Serialize)]
+struct Report {
+    max_stable_amplitude_dc: f64,
+    max_stable_amplitude_1khz: f64,
+    max_stable_amplitude_4500hz: f64,
+    max_stable_amplitude_50khz: f64,
+    snr_table: Vec<SnrRow>,
+    /// Default design (order 3, OSR 32, H_inf 1.5), band edge 156.25 kHz.
+    snr_db_156khz_amplitude_0_5: f64,
+    snr_db_156khz_amplitude_0_7: f64,
+    eq4_snr_db_156khz_amplitude_0_7: f64,
+    /// Largest band edge with SNR ≥ 74 dB (12 bits), amplitude 0.7, Hz.
+    band_hz_12_bits_measured: f64,
+    /// The same read from eq. 4 (ideal modulator), Hz.
+    band_hz_12_bits_eq4: f64,
+    rom_bins: usize,
+    rom_pulses: u64,
+    rom_seconds_one_thread: f64,
+    rom_seconds_all_threads: f64,
+    rom_target_seconds: f64,
+    threads: usize,
+    modulator_samples_per_s_one_thread: f64,
+    modulator_samples_per_s_all_threads: f64,
+    svg: Option<String>,
+    pass: bool,
+}
+
+fn err(e: impl std::fmt::Display) -> CliError {
+    CliError::Option {
+        option: "bench sd".into(),
+        value: e.to_string(),
+        allowed: "an internal computation that succeeds".into(),
+    }
+}
+
+/// Runs the benchmark.
+pub fn run(args: &SdBenchArgs) -> Result<(), CliError> {
+    let cfg = ProbeConfig::default();
+    let design = ProbeDesign::new(&cfg, 1000.0 / FS_HZ).map_err(err)?;
+    let m = &design.modulator;
+    let amax = |f: f64| m.max_stable_amplitude(f / FS_HZ);
+
+    let mut snr_table = Vec::new();
+    for order in 1..=4 {
+        for osr in [8.0, 16.0, 32.0, 64.0, 128.0] {
+            let mm = Modulator::design(order, osr, false, 1.5).map_err(err)?;
+            snr_table.push(SnrRow {
+                order,
+                osr,
+                measured_snr_db: measured_snr_db(&mm, 0.5, N_SNR).map_err(err)?,
+                eq4_snr_db: eq4_snr_db(order, osr, 0.5),
+            });
+        }
+    }
+
+    // Band-edge view of the default design: one long record, a ≈ 1 kHz tone.
+    let band = 0.5 / cfg.osr;
+    let tone = 105;
+    let s05 = ToneSpectrum::measure(m, 0.5, tone, N_BAND).map_err(err)?;
+    let s07 = ToneSpectrum::measure(m, 0.7, tone, N_BAND).map_err(err)?;
+    // Eq. 4 inverted for the OSR where it gives 12 bits at amplitude 0.7.
+    let t = cfg.order as f64;
+    let d12 = (SNR_12_BITS_DB - eq4_snr_db(cfg.order, 1.0, 0.7)) / (3.01 * (2.0 * t + 1.0));
+    let band_eq4 = FS_HZ / (2.0 * 2f64.powf(d12));
+
+    // Speed: 16 bins spread over the band, N = 10^7, windowed mode.
+    let bins: Vec<u64> = (1..=16u64).map(|i| i * 9_700).collect();
+    let t0 = Instant::now();
+    let rom = ProbeRom::generate(&design, FS_HZ, N_ROM, &bins).map_err(err)?;
+    let all = t0.elapsed().as_secs_f64();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(err)?;
+    let t0 = Instant::now();
+    let one_rom = pool
+        .install(|| ProbeRom::generate(&design, FS_HZ, N_ROM, &bins))
+        .map_err(err)?;
+    let one = t0.elapsed().as_secs_f64();
+    if one_rom != rom {
+        return Err(err("the one-thread ROM differs from the all-thread ROM"));
+    }
+    drop(one_rom);
+    if let Some(dir) = &args.rom_dir {
+        rom.write(dir, "probe_rom").map_err(err)?;
+    }
+    let samples = (2 * bins.len()) as f64 * N_ROM as f64;
+
+    let svg = match &args.svg {
+        Some(p) => {
+            write_svg(m, p)?;
+            Some(p.display().to_string())
+        }
+        None => None,
+    };
+
+    let report = Report {
+        max_stable_amplitude_dc: amax(0.0),
+        max_stable_amplitude_1khz: design.max_stable_amplitude,
+        max_stable_amplitude_4500hz: amax(4500.0),
+        max_stable_amplitude_50khz: amax(50_000.0),
+        snr_table,
+        snr_db_156khz_amplitude_0_5: s05.snr_db(band),
+        snr_db_156khz_amplitude_0_7: s07.snr_db(band),
+        eq4_snr_db_156khz_amplitude_0_7: eq4_snr_db(cfg.order, cfg.osr, 0.7),
+        band_hz_12_bits_measured: s07.band_for_snr(SNR_12_BITS_DB) * FS_HZ,
+        band_hz_12_bits_eq4: band_eq4,
+        rom_bins: bins.len(),
+        rom_pulses: N_ROM,
+        rom_seconds_one_thread: one,
+        rom_seconds_all_threads: all,
+        rom_target_seconds: ROM_TARGET_S,
+        threads: rayon::current_num_threads(),
+        modulator_samples_per_s_one_thread: samples / one,
+        modulator_samples_per_s_all_threads: samples / all,
+        svg,
+        pass: all <= ROM_TARGET_S,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print_text(&report);
+    }
+    Ok(())
+}
+
+fn print_text(r: &Report) {
+    println!("sigma-delta probe design (order 3, OSR 32, H_inf 1.5, f_s = 10 MHz)");
+    println!(
+        "  max stable amplitude: DC {:.4}, 1 kHz {:.4}, 4.5 kHz {:.4}, 50 kHz {:.4} (probe limit 0.9x)",
+        r.max_stable_amplitude_dc,
+        r.max_stable_amplitude_1khz,
+        r.max_stable_amplitude_4500hz,
+        r.max_stable_amplitude_50khz
+    );
+    println!("  in-band SNR at amplitude 0.5 (-6 dBFS), measured / eq. 4, dB:");
+    print!("    order\\OSR");
+    for osr in [8, 16, 32, 64, 128] {
+        print!("{osr:>16}");
+    }
+    println!();
+    for order in 1..=4 {
+        print!("    {order:>9}");
+        for row in r.snr_table.iter().filter(|x| x.order == order) {
+            print!(
+                "{:>16}",
+                format!("{:.1} / {:.1}", row.measured_snr_db, row.eq4_snr_db)
+            );
+        }
+        println!();
+    }
+    println!(
+        "  band edge 156.25 kHz: {:.1} dB at A = 0.5, {:.1} dB at A = 0.7 (eq. 4: {:.1} dB)",
+        r.snr_db_156khz_amplitude_0_5,
+        r.snr_db_156khz_amplitude_0_7,
+        r.eq4_snr_db_156khz_amplitude_0_7
+    );
+    println!(
+        "  12 bits (74 dB) up to {:.0} kHz measured, {:.0} kHz by eq. 4",
+        r.band_hz_12_bits_measured / 1e3,
+        r.band_hz_12_bits_eq4 / 1e3
+    );
+    println!(
+        "  ROM {} bins x N = {}: {:.3} s on {} threads, {:.3} s on one ({:.3e} / {:.3e} modulator samples/s); target <= {} s: {}",
+        r.rom_bins,
+        r.rom_pulses,
+        r.rom_seconds_all_threads,
+        r.threads,
+        r.rom_seconds_one_thread,
+        r.modulator_samples_per_s_all_threads,
+        r.modulator_samples_per_s_one_thread,
+        r.rom_target_seconds,
+        if r.pass { "pass" } else { "FAIL" }
+    );
+    if let Some(p) = &r.svg {
+        println!("  spectrum of a 50 kHz probe: {p}");
+    }
+}
+
+/// The output spectrum of a 50 kHz, amplitude-0.5 probe (2^16 samples, Hann), dB vs
+/// log frequency, with the band edge f_s/(2·OSR) marked.
+fn write_svg(m: &Modulator, path: &std::path::Path) -> Result<(), CliError> {
+    let n = 1usize << 16;
+    let tone = (50_000.0 / FS_HZ * n as f64).round() as usize;
+    let sp = ToneSpectrum::measure(m, 0.5, tone, n).map_err(err)?;
+    let pts: Vec<(f64, f64)> = sp
+        .power
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, p)| (k as f64 * FS_HZ / n as f64, 10.0 * p.max(1e-20).log10()))
+        .collect();
+    let band = FS_HZ / (2.0 * m.osr);
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, (900, 500)).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                "Output spectrum of a 50 kHz probe (order 3, OSR 32, H_inf 1.5)",
+                ("sans-serif", 18),
+            )
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d((150.0f64..5e6).log_scale(), -160.0f64..0.0)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("frequency (Hz)")
+            .y_desc("power per bin (dB re full-scale sine)")
+            .draw()
+            .map_err(err)?;
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), &BLUE))
+            .map_err(err)?;
+        chart
+            .draw_series(LineSeries::new(vec![(band, -160.0), (band, 0.0)], &RED))
+            .map_err(err)?
+            .label("f_s / (2 OSR) = 156 kHz");
+        root.present().map_err(err)?;
+    }
+    tofprobe_dsp::rom::write_atomic(path, text.as_bytes()).map_err(err)
+}

@@ -1,0 +1,39 @@
+//! `tofprobe config`: print the embedded default configuration, or check a file.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use crate::config::{Config, DEFAULT_TOML};
+use crate::error::CliError;
+
+/// Arguments of `tofprobe config`.
+#[derive(Debug, Args)]
+pub struct ConfigArgs {
+    /// Print the embedded default configuration (TOML) and exit.
+    #[arg(long)]
+    print_default: bool,
+    /// A configuration file to validate (without it: the embedded default).
+    config: Option<PathBuf>,
+}
+
+/// Prints the default, or validates the configuration and reports its key numbers.
+pub fn run(args: &ConfigArgs) -> Result<(), CliError> {
+    if args.print_default {
+        print!("{DEFAULT_TOML}");
+        return Ok(());
+    }
+    let loaded = Config::load(args.config.as_deref())?;
+    let c = &loaded.config;
+    println!(
+        "{}: ok ({} pulses at {} Hz, {} TDC codes of {} ps = {} bits, jitter {} mm)",
+        loaded.origin,
+        c.pulses(),
+        c.sensor.laser_rate_hz,
+        c.sensor.tdc_codes(),
+        c.sensor.tdc_lsb_ps,
+        c.sensor.tdc_bits(),
+        c.sensor.jitter_mm()
+    );
+    Ok(())
+}

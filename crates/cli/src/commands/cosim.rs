@@ -1,0 +1,184 @@
+//! `tofprobe cosim [CONFIG]`: co-simulates the generated RTL (or `--rtl DIR`) against the
+//! reference model in Verilator and prints a one-line verdict with the throughput of
+//! Verilator, the cycle model and the transaction model side by side.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use serde::Serialize;
+use tofprobe_cosim::{BuildProfile, CosimOptions, CosimReport, cosim};
+use tofprobe_rtlgen::params::PixelParams;
+
+use crate::commands::rtl::rtl_params;
+use crate::error::CliError;
+
+/// Runs longer than this many cycles compare digests of this many pulses instead of every
+/// pulse's (a 10^7-pulse frame then has ~10^4 digest lines).
+const LONG_RUN_CYCLES: u64 = 2_000_000;
+const LONG_RUN_DIGEST_PULSES: u64 = 1024;
+
+/// Arguments of `tofprobe cosim`.
+#[derive(Debug, Args)]
+pub struct CosimArgs {
+    /// Configuration file (default: the embedded default).
+    pub config: Option<PathBuf>,
+    /// Co-simulate this RTL directory (e.g. a hand-edited ECO) instead of fresh RTL.
+    #[arg(long)]
+    pub rtl: Option<PathBuf>,
+    /// Frames to run.
+    #[arg(long, default_value_t = 1)]
+    pub frames: u64,
+    /// Stimulus seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Write a VCD (around the first mismatch, else of the first 10^5 cycles).
+    #[arg(long)]
+    pub trace: bool,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// Override N (pulses per frame).
+    #[arg(long)]
+    pub frame_pulses: Option<u64>,
+    /// Override L (ROM depth).
+    #[arg(long)]
+    pub rom_depth: Option<usize>,
+    /// Work directory for RTL, vectors and VCD.
+    #[arg(long, default_value = "cosim-out")]
+    pub out: PathBuf,
+    /// Also time the bare Verilator model (no checking) to measure the harness overhead.
+    #[arg(long)]
+    pub bare: bool,
+}
+
+#[derive(Debug, Serialize)]
+struct Json {
+    pass: bool,
+    frames: u64,
+    pulses: u64,
+    cycles: u64,
+    mismatches: u64,
+    first_mismatch_cycle: Option<u64>,
+    first_mismatch_pulse: Option<u64>,
+    first_mismatch_signal: Option<String>,
+    verilator_seconds: f64,
+    verilator_cycles_per_s: f64,
+    bare_verilator_seconds: Option<f64>,
+    harness_overhead_ratio: Option<f64>,
+    cycle_model_seconds: f64,
+    cycle_model_cycles_per_s: f64,
+    transaction_model_seconds: f64,
+    transaction_model_pulses_per_s: f64,
+    build_seconds: f64,
+    build_reused: bool,
+    vcd: Option<String>,
+}
+
+/// Times the pixel crate's transaction model on the same stimulus (seconds).
+pub fn time_transaction(p: &PixelParams, r: &CosimReport) -> f64 {
+    let pp = tofprobe_cosim::pixel_bridge::to_pixel(p);
+    let Ok(mut m) = tofprobe_pixel::TransactionModel::new(&pp) else {
+        return f64::NAN;
+    };
+    let words = p.registers().div_ceil(64);
+    let l = p.rom_depth.max(1);
+    let t0 = Instant::now();
+    for (i, d) in r.stimulus.iter().enumerate() {
+        let n = i as u64 % p.frame_pulses;
+        let a = (n as usize % l) * words;
+        let entry = r.rom.get(a..a + words).unwrap_or(&[]);
+        m.pulse(*d, entry);
+        if n + 1 == p.frame_pulses {
+            std::hint::black_box(m.readout());
+        }
+    }
+    t0.elapsed().as_secs_f64()
+}
+
+/// Co-simulation options for a configuration: digests for long runs, speed build for them.
+pub fn options(p: &PixelParams, a: &CosimArgs) -> CosimOptions {
+    let mut o = CosimOptions::new(&a.out);
+    o.frames = a.frames;
+    o.seed = a.seed;
+    o.rtl_dir = a.rtl.clone();
+    o.trace = a.trace;
+    o.measure_bare = a.bare;
+    let cycles = a.frames * p.frame_pulses * p.cycles_per_pulse as u64;
+    if cycles > LONG_RUN_CYCLES {
+        o.digest_pulses = LONG_RUN_DIGEST_PULSES;
+        o.profile = BuildProfile::Speed;
+    }
+    o
+}
+
+/// Runs `tofprobe cosim`.
+pub fn run(a: &CosimArgs) -> Result<(), CliError> {
+    if a.frames == 0 || a.frames > 1000 {
+        return Err(CliError::Option {
+            option: "frames".into(),
+            value: a.frames.to_string(),
+            allowed: "1..=1000".into(),
+        });
+    }
+    let p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
+    let r = cosim(&p, &options(&p, a))?;
+    let tx = time_transaction(&p, &r);
+    let rate = |n: u64, s: f64| if s > 0.0 { n as f64 / s } else { 0.0 };
+    let j = Json {
+        pass: r.pass,
+        frames: r.frames,
+        pulses: r.pulses,
+        cycles: r.cycles,
+        mismatches: r.outcome.mismatches,
+        first_mismatch_cycle: r.first.as_ref().map(|m| m.cycle),
+        first_mismatch_pulse: r.first.as_ref().map(|m| m.pulse),
+        first_mismatch_signal: r.first.as_ref().map(|m| m.signal.clone()),
+        verilator_seconds: r.verilator_seconds,
+        verilator_cycles_per_s: rate(r.cycles, r.verilator_seconds),
+        bare_verilator_seconds: r.bare_seconds,
+        harness_overhead_ratio: r.bare_seconds.filter(|b| *b > 0.0).map(|b| r.verilator_seconds / b),
+        cycle_model_seconds: r.model_seconds,
+        cycle_model_cycles_per_s: rate(r.cycles, r.model_seconds),
+        transaction_model_seconds: if tx.is_finite() { tx } else { 0.0 },
+        transaction_model_pulses_per_s: if tx.is_finite() { rate(r.pulses, tx) } else { 0.0 },
+        build_seconds: r.build.seconds,
+        build_reused: r.build.reused,
+        vcd: r.vcd.as_ref().map(|v| v.display().to_string()),
+    };
+    if a.json {
+        println!("{}", serde_json::to_string(&j)?);
+    } else {
+        let verdict = match &r.first {
+            None if r.pass => "PASS".to_string(),
+            None => format!("FAIL ({} mismatches)", r.outcome.mismatches),
+            Some(m) => format!(
+                "FAIL at cycle {} (pulse {}): {} expected {} actual {}",
+                m.cycle, m.pulse, m.signal, m.expected, m.actual
+            ),
+        };
+        println!(
+            "cosim {verdict}: {} frame(s), {} pulses, {} cycles, {} mismatches | verilator {:.2} Mcycles/s ({:.2} s{}), cycle model {:.2} Mcycles/s ({:.2} s), transaction model {:.2} Mpulses/s ({:.3} s){}{}",
+            j.frames,
+            j.pulses,
+            j.cycles,
+            j.mismatches,
+            j.verilator_cycles_per_s / 1e6,
+            j.verilator_seconds,
+            j.bare_verilator_seconds
+                .map(|b| format!(", bare model {b:.2} s"))
+                .unwrap_or_default(),
+            j.cycle_model_cycles_per_s / 1e6,
+            j.cycle_model_seconds,
+            j.transaction_model_pulses_per_s / 1e6,
+            j.transaction_model_seconds,
+            if j.build_reused { ", build reused" } else { ", built" },
+            j.vcd.as_ref().map(|v| format!(", VCD {v}")).unwrap_or_default(),
+        );
+    }
+    if r.pass {
+        Ok(())
+    } else {
+        std::process::exit(1)
+    }
+}

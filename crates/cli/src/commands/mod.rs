@@ -1,0 +1,56 @@
+//! The subcommands: one file each. To add one, add a variant to [`Command`] and a line to
+//! [`run`].
+
+pub mod bench;
+pub mod config;
+pub mod cosim;
+pub mod flow;
+pub mod reproduce;
+pub mod rtl;
+pub mod simulate;
+pub mod size;
+pub mod vectors;
+
+use clap::Subcommand;
+
+use crate::error::CliError;
+
+/// Every `tofprobe` subcommand.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run the photon/TDC Monte Carlo on a configuration and print a summary.
+    Simulate(simulate::SimulateArgs),
+    /// Print or check a configuration.
+    Config(config::ConfigArgs),
+    /// Measure the speed of one part of tofprobe.
+    Bench(bench::BenchArgs),
+    /// Re-measure the paper's numbers (Table 2, Fig. 4, eq. 12, 1NN bandwidths) against
+    /// the paper and the closed forms; exits 1 if a row misses.
+    Reproduce(reproduce::ReproduceArgs),
+    /// Sizing report: widths, readout, area (yosys), timing (OpenSTA), sky130, sweeps.
+    Size(size::SizeArgs),
+    /// Render the pixel, probe ROM and top into Verilog-2005 (atomic; never overwrites
+    /// files it did not generate).
+    Rtl(rtl::RtlArgs),
+    /// Write golden vectors (stimulus, ROM, readouts, write trace or digests, manifest).
+    Vectors(vectors::VectorsArgs),
+    /// Co-simulate the RTL against the model in Verilator: verdict and throughputs.
+    Cosim(cosim::CosimArgs),
+    /// The main flow: scene -> model -> RTL -> vectors -> co-simulation -> report.
+    Flow(flow::FlowArgs),
+}
+
+/// Runs one subcommand.
+pub fn run(command: Command) -> Result<(), CliError> {
+    match command {
+        Command::Simulate(a) => simulate::run(&a),
+        Command::Config(a) => config::run(&a),
+        Command::Bench(a) => bench::run(a),
+        Command::Reproduce(a) => reproduce::run(&a),
+        Command::Size(a) => size::run(&a),
+        Command::Rtl(a) => rtl::run(&a),
+        Command::Vectors(a) => vectors::run(&a),
+        Command::Cosim(a) => cosim::run(&a),
+        Command::Flow(a) => flow::run(&a),
+    }
+}

@@ -1,0 +1,117 @@
+//! `tofprobe rtl [CONFIG] --out DIR`: renders the pixel, probe ROM and top for the
+//! configuration's `[pixel]` into DIR, atomically, refusing to overwrite files it did not
+//! generate. Also the shared step "configuration → generator parameters" of the RTL
+//! commands (`vectors`, `cosim`, `flow`).
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use tofprobe_pixel::PixelContext;
+use tofprobe_rtlgen::params::PixelParams;
+use tofprobe_rtlgen::render::RenderOptions;
+use tofprobe_rtlgen::stimulus::sign_probe_rom;
+use tofprobe_rtlgen::write::write_generated;
+
+use crate::config::Config;
+use crate::error::CliError;
+
+/// ROM depth used when the configuration leaves L = N and N is a long frame: a periodic
+/// probe of this depth (bin spacing f_s/L), not a 10^7-entry ROM.
+pub const LONG_FRAME_ROM_DEPTH: usize = 4096;
+
+/// Arguments of `tofprobe rtl`.
+#[derive(Debug, Args)]
+pub struct RtlArgs {
+    /// Configuration file (default: the embedded default).
+    pub config: Option<PathBuf>,
+    /// Output directory.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Override the ROM depth L (default: the configuration's, 4096 when that exceeds 65536).
+    #[arg(long)]
+    pub rom_depth: Option<usize>,
+    /// Override the pulses per frame N (e.g. short frames for co-simulation).
+    #[arg(long)]
+    pub frame_pulses: Option<u64>,
+}
+
+/// The generator's parameters for a configuration file (or the embedded default), with
+/// optional overrides of N and L.
+pub fn rtl_params(
+    config: Option<&Path>,
+    frame_pulses: Option<u64>,
+    rom_depth: Option<usize>,
+) -> Result<PixelParams, CliError> {
+    let loaded = Config::load(config)?;
+    let c = &loaded.config;
+    let ctx = PixelContext::from_sensor(&c.sensor, loaded.config.pulses());
+    let resolved = c.pixel.resolve(&ctx).map_err(|e| CliError::Toml {
+        origin: loaded.origin.clone(),
+        message: format!("[pixel]: {e}"),
+    })?;
+    let mut p = tofprobe_cosim::pixel_bridge::from_pixel(&resolved);
+    if let Some(n) = frame_pulses {
+        p.frame_pulses = n;
+    }
+    p.rom_depth = match rom_depth {
+        Some(l) => l,
+        None if p.rom_depth > 65_536 => LONG_FRAME_ROM_DEPTH,
+        None => p.rom_depth,
+    };
+    if frame_pulses.is_some() && rom_depth.is_none() {
+        p.rom_depth = p.rom_depth.min(p.frame_pulses.max(1) as usize);
+    }
+    p.validate()?;
+    Ok(p)
+}
+
+/// The command line that regenerates `out` (recorded in every header).
+pub fn regen_command(a: &RtlArgs) -> String {
+    let mut s = String::from("tofprobe rtl");
+    if let Some(c) = &a.config {
+        s.push_str(&format!(" {}", c.display()));
+    }
+    s.push_str(&format!(" --out {}", a.out.display()));
+    if let Some(n) = a.frame_pulses {
+        s.push_str(&format!(" --frame-pulses {n}"));
+    }
+    if let Some(l) = a.rom_depth {
+        s.push_str(&format!(" --rom-depth {l}"));
+    }
+    s
+}
+
+/// Renders and writes; returns the file names.
+pub fn render_to(p: &PixelParams, out: &Path, command: String) -> Result<Vec<String>, CliError> {
+    let files = tofprobe_rtlgen::render(
+        p,
+        &sign_probe_rom(p),
+        &RenderOptions {
+            command,
+            mutation: None,
+        },
+    )?;
+    let pairs: Vec<(String, String)> = files.into_iter().map(|f| (f.name, f.contents)).collect();
+    write_generated(out, &pairs)?;
+    Ok(pairs.into_iter().map(|(n, _)| n).collect())
+}
+
+/// Runs `tofprobe rtl`.
+pub fn run(a: &RtlArgs) -> Result<(), CliError> {
+    let p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
+    let names = render_to(&p, &a.out, regen_command(a))?;
+    println!(
+        "rtl: {:?} pixel, {} registers x {} bits, {} adder(s), {} cycles/pulse, N = {}, L = {}, hash {} -> {} ({})",
+        p.mode,
+        p.registers(),
+        p.width,
+        p.adders,
+        p.cycles_per_pulse,
+        p.frame_pulses,
+        p.rom_depth,
+        p.config_hash(),
+        a.out.display(),
+        names.join(", ")
+    );
+    Ok(())
+}

@@ -1,0 +1,70 @@
+//! `tofprobe vectors [CONFIG] --out DIR`: golden vectors (testbench/README.md) for the
+//! configuration: stimulus, ROM image, expected readouts, the register-write trace (or, for
+//! long runs, per-window digests only) and a TOML manifest.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
+use tofprobe_rtlgen::vectors::{VectorOptions, golden_run, write_vectors};
+
+use crate::commands::rtl::rtl_params;
+use crate::error::CliError;
+
+/// Arguments of `tofprobe vectors`.
+#[derive(Debug, Args)]
+pub struct VectorsArgs {
+    /// Configuration file (default: the embedded default).
+    pub config: Option<PathBuf>,
+    /// Output directory.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Frames.
+    #[arg(long, default_value_t = 2)]
+    pub frames: u64,
+    /// Stimulus seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Override the pulses per frame N (short frames).
+    #[arg(long)]
+    pub frame_pulses: Option<u64>,
+    /// Override the ROM depth L.
+    #[arg(long)]
+    pub rom_depth: Option<usize>,
+    /// Pulses per digest window.
+    #[arg(long, default_value_t = 1)]
+    pub digest_pulses: u64,
+}
+
+/// Runs `tofprobe vectors`.
+pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
+    if a.frames == 0 || a.frames > 1000 {
+        return Err(CliError::Option {
+            option: "frames".into(),
+            value: a.frames.to_string(),
+            allowed: "1..=1000".into(),
+        });
+    }
+    let p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
+    let stim = random_stimulus(&p, a.frames * p.frame_pulses, a.seed);
+    let rom = sign_probe_rom(&p);
+    let o = VectorOptions {
+        frames: a.frames,
+        seed: a.seed,
+        digest_pulses: a.digest_pulses.max(1),
+        trace_window: None,
+    };
+    let (g, w) = golden_run(&p, &stim, &rom, &o);
+    let m = write_vectors(&a.out, &p, &stim, &rom, &g, w, &o)?;
+    println!(
+        "vectors: {} frames, {} pulses, {} cycles, {} trace events, {} digest windows, hash {} -> {}",
+        m.frames,
+        m.pulses,
+        m.cycles,
+        m.trace_events,
+        m.digest_windows,
+        m.config_hash,
+        a.out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,200 @@
+//! The experiments behind `tofprobe reproduce`: each family (Table 2, Fig. 4, the eq. 12
+//! prediction, the 1NN bandwidths) is one function that returns [`Row`]s, computed from
+//! data tables, never copied numbers. A row holds the paper's value, the measured value,
+//! an optional closed-form reference, and its tolerance test.
+//!
+//! Common assumptions (the paper does not state them): f_s = 10 MHz, TDC LSB 1 mm
+//! (6.667 ps), static depth δ0 at the centre of the timing window, 60 mm windows where
+//! background matters, wider windows (12·σ_s) for ρ_b = 0 rows so the window never clips
+//! the jitter. The DFT columns transform the raw held depth (1NN hold, no prefilter).
+
+pub mod bandwidth;
+pub mod fig4;
+pub mod plots;
+pub mod setup;
+pub mod table2;
+
+use serde::Serialize;
+use thiserror::Error;
+
+/// Errors of the reproduce experiments (all internal: the rows' parameters are fixed).
+#[derive(Debug, Error)]
+pub enum PaperError {
+    #[error(transparent)]
+    Dsp(#[from] tofprobe_dsp::DspError),
+    #[error(transparent)]
+    Scene(#[from] tofprobe_scene::SceneError),
+    #[error("cannot write `{path}`: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("plot `{path}`: {message}")]
+    Plot { path: String, message: String },
+}
+
+/// How a row is judged.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Tolerance {
+    /// |measured/reference − 1| ≤ rel, for the paper value and (if any) the closed form.
+    Relative { rel: f64 },
+    /// |paper − measured mean| ≤ k·spread (spread: seed-to-seed std of one draw, scaled
+    /// by sqrt(1 + 1/seeds) since the paper's value is itself one draw).
+    Spread { k: f64, spread: f64 },
+}
+
+/// One line of the reproduce table.
+#[derive(Debug, Clone, Serialize)]
+pub struct Row {
+    pub family: &'static str,
+    pub label: String,
+    pub unit: &'static str,
+    /// The paper's printed value (None where the paper has none).
+    pub paper: Option<f64>,
+    /// The corrected value where the independent re-check differs from the print.
+    pub design: Option<f64>,
+    pub measured: f64,
+    /// Closed-form prediction, where there is one.
+    pub closed_form: Option<f64>,
+    pub tolerance: Tolerance,
+    pub pass: bool,
+    /// Extra context shown in the table (e.g. the Blackman value, the ZOH approximation).
+    pub note: String,
+}
+
+impl Row {
+    /// Builds a row and evaluates its tolerance. The reference for the relative test is
+    /// the design value if given, else the paper's; the closed form is checked too.
+    #[allow(clippy::too_many_arguments)]
+    pub fn judge(
+        family: &'static str,
+        label: String,
+        unit: &'static str,
+        paper: Option<f64>,
+        design: Option<f64>,
+        measured: f64,
+        closed_form: Option<f64>,
+        tolerance: Tolerance,
+        note: String,
+    ) -> Row {
+        let ok_rel = |r: Option<f64>, rel: f64| r.is_none_or(|r| (measured / r - 1.0).abs() <= rel);
+        let pass = measured.is_finite()
+            && match tolerance {
+                Tolerance::Relative { rel } => {
+                    ok_rel(design.or(paper), rel) && ok_rel(closed_form, rel)
+                }
+                Tolerance::Spread { k, spread } => paper
+                    .or(design)
+                    .is_none_or(|p| (p - measured).abs() <= k * spread),
+            };
+        Row {
+            family,
+            label,
+            unit,
+            paper,
+            design,
+            measured,
+            closed_form,
+            tolerance,
+            pass,
+            note,
+        }
+    }
+}
+
+fn fmt_opt(v: Option<f64>) -> String {
+    v.map_or_else(|| "–".to_string(), |v| format!("{v:.4}"))
+}
+
+/// The Markdown table.
+pub fn markdown(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "| experiment | row | unit | paper | corrected | measured | closed form | tolerance | pass | note |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let tol = match r.tolerance {
+            Tolerance::Relative { rel } => format!("±{:.0}%", rel * 100.0),
+            Tolerance::Spread { k, spread } => format!("±{k}·{spread:.2}"),
+        };
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {:.4} | {} | {} | {} | {} |\n",
+            r.family,
+            r.label,
+            r.unit,
+            fmt_opt(r.paper),
+            fmt_opt(r.design),
+            r.measured,
+            fmt_opt(r.closed_form),
+            tol,
+            if r.pass { "pass" } else { "FAIL" },
+            r.note
+        );
+    }
+    s
+}
+
+/// Writes `bytes` to `path` atomically (temp file in the same directory, then rename).
+pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<(), PaperError> {
+    let io = |source| PaperError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let tmp = path.with_extension(format!(
+        "{}.tmp{}",
+        path.extension().and_then(|e| e.to_str()).unwrap_or(""),
+        std::process::id()
+    ));
+    std::fs::write(&tmp, bytes).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(io)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn judging() {
+        let r = Row::judge(
+            "t",
+            "x".into(),
+            "µm",
+            Some(2.25),
+            None,
+            2.30,
+            Some(2.21),
+            Tolerance::Relative { rel: 0.05 },
+            String::new(),
+        );
+        assert!(r.pass);
+        let r = Row::judge(
+            "t",
+            "x".into(),
+            "µm",
+            Some(2.25),
+            None,
+            2.30,
+            Some(2.0),
+            Tolerance::Relative { rel: 0.05 },
+            String::new(),
+        );
+        assert!(!r.pass, "closed form 15% off must fail");
+        let r = Row::judge(
+            "t",
+            "a".into(),
+            "µm",
+            Some(131.3),
+            None,
+            100.0,
+            None,
+            Tolerance::Spread {
+                k: 3.0,
+                spread: 10.0,
+            },
+            String::new(),
+        );
+        assert!(!r.pass, "31.3 > 3·10");
+        assert!(markdown(&[r]).contains("FAIL"));
+    }
+}

@@ -1,0 +1,132 @@
+//! `tofprobe size` end to end on a tiny pixel (B = 1, 4096-pulse frames): one JSON object
+//! on stdout with the documented schema, and clear errors for a missing liberty, a
+//! liberty without flops, and missing yosys / OpenSTA.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const DEFAULT: &str = include_str!("../../../scenes/default.toml");
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tofprobe-size-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+/// The default scene with a one-bin pixel and a 4096-pulse acquisition (a fast synthesis).
+fn tiny_config(dir: &Path) -> PathBuf {
+    let text = DEFAULT
+        .replacen("duration_s = 1.0", "pulses = 4096", 1)
+        .replacen("bins = 16", "bins = 1", 1);
+    assert!(
+        text.contains("pulses = 4096") && text.contains("bins = 1 "),
+        "default changed"
+    );
+    let p = dir.join("tiny.toml");
+    std::fs::write(&p, text).expect("write config");
+    p
+}
+
+fn size(args: &[&str], env: &[(&str, &str)], cache: &Path) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_tofprobe"));
+    c.arg("size").args(args).arg("--cache").arg(cache);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("run tofprobe")
+}
+
+fn fails_with(out: &Output, parts: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for p in parts {
+        assert!(err.contains(p), "`{p}` missing from: {err}");
+    }
+}
+
+#[test]
+fn tiny_pixel_json_report() {
+    let dir = scratch("json");
+    let cfg = tiny_config(&dir);
+    let cfg = cfg.to_str().unwrap();
+    let out = size(
+        &[cfg, "--no-sky130", "--json", "--sweep-bins", "1"],
+        &[],
+        &dir.join("cache"),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text.trim().lines().count(), 1, "exactly one JSON object");
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["schema"], "tofprobe-size-report/1");
+    assert_eq!(v["design"]["registers"], 2);
+    // 2 registers of W bits, found by the split, each W flops in the register file.
+    let w = v["design"]["width"].as_u64().unwrap();
+    assert_eq!(v["area"]["split"]["registers_found"], 2);
+    assert_eq!(
+        v["area"]["split"]["register_file"]["flops"].as_u64(),
+        Some(2 * w)
+    );
+    // Memory: 2·W bits → ⌈2W/8⌉ bytes; one frame per 4096 pulses at 10 MHz.
+    assert_eq!(
+        v["memory"]["bytes_per_pixel"].as_u64(),
+        Some((2 * w).div_ceil(8))
+    );
+    let fps = v["memory"]["frames_per_second"].as_f64().unwrap();
+    assert!((fps - 10e6 / 4096.0).abs() < 1e-9);
+    assert!(v["timing"]["sta"]["f_max_mhz"].as_f64().unwrap() > 0.0);
+    assert!(v["sky130"].is_null());
+}
+
+#[test]
+fn missing_liberty_and_flopless_liberty_are_clear_errors() {
+    let dir = scratch("lib");
+    let cfg = tiny_config(&dir);
+    let cfg = cfg.to_str().unwrap();
+    let out = size(
+        &[cfg, "--no-sky130", "--liberty", "/nonexistent/cells.lib"],
+        &[],
+        &dir,
+    );
+    fails_with(
+        &out,
+        &["/nonexistent/cells.lib", "qflow-tech-osu018", "--liberty"],
+    );
+    let lib = dir.join("noff.lib");
+    std::fs::write(
+        &lib,
+        "library (noff) { cell (INV) { area : 1 ; pin (Y) { direction : output ; function : \"!A\" ; } } }",
+    )
+    .unwrap();
+    let out = size(
+        &[cfg, "--no-sky130", "--liberty", lib.to_str().unwrap()],
+        &[],
+        &dir,
+    );
+    fails_with(&out, &["noff.lib", "flip-flop"]);
+}
+
+#[test]
+fn missing_tools_say_what_to_install() {
+    let dir = scratch("tools");
+    let cfg = tiny_config(&dir);
+    let cfg = cfg.to_str().unwrap();
+    let out = size(
+        &[cfg, "--no-sky130"],
+        &[("TOFPROBE_YOSYS", "/nonexistent/yosys")],
+        &dir,
+    );
+    fails_with(&out, &["`yosys`", "apt-get install yosys"]);
+    let args = [cfg, "--no-sky130", "--sweep-bins", "1"];
+    let out = size(
+        &args,
+        &[("TOFPROBE_STA", "/nonexistent/sta")],
+        &dir.join("cache"),
+    );
+    fails_with(&out, &["`sta`", "opensta"]);
+}

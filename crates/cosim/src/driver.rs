@@ -1,0 +1,237 @@
+//! One co-simulation: render (or take) the RTL, run the reference model through the
+//! contract's sequencer for the golden vectors, build the harness (cached), replay, and on
+//! a mismatch pin it down to the first cycle (re-running a digest window with its full
+//! trace) and write a VCD around it.
+
+use crate::error::CosimError;
+use crate::harness::{self, Mismatch, RunOutcome};
+use crate::verilator::{self, BuildProfile, HarnessBuild};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use tofprobe_rtlgen::model::Fault;
+use tofprobe_rtlgen::params::{Mode, PixelParams};
+use tofprobe_rtlgen::render::{RenderOptions, module_names};
+use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
+use tofprobe_rtlgen::vectors::{VectorOptions, golden_run, write_vectors};
+use tofprobe_rtlgen::write::write_generated;
+
+/// Cycles either side of a mismatch that the VCD covers.
+pub const VCD_MARGIN: u64 = 64;
+
+/// What to co-simulate.
+#[derive(Debug, Clone)]
+pub struct CosimOptions {
+    pub frames: u64,
+    pub seed: u64,
+    /// Co-simulate this RTL directory instead of freshly rendered RTL.
+    pub rtl_dir: Option<PathBuf>,
+    /// Where the RTL, vectors and VCD are written.
+    pub work_dir: PathBuf,
+    /// Write a VCD (of the mismatch window, or of the first cycles when all match).
+    pub trace: bool,
+    /// Write a VCD around a mismatch even without `trace`.
+    pub vcd_on_mismatch: bool,
+    /// Render deliberately broken RTL (mutation tests).
+    pub mutation: Option<Fault>,
+    /// Pulses per digest window.
+    pub digest_pulses: u64,
+    pub profile: BuildProfile,
+    /// Also time the bare Verilator model (no checking) for the overhead figure.
+    pub measure_bare: bool,
+    /// Per-pulse detections to replay (e.g. from the scene); `None` = random from `seed`.
+    pub stimulus: Option<Vec<Option<u32>>>,
+}
+
+impl CosimOptions {
+    /// Defaults for a short co-simulation in `work_dir`.
+    pub fn new(work_dir: impl Into<PathBuf>) -> Self {
+        CosimOptions {
+            frames: 2,
+            seed: 1,
+            rtl_dir: None,
+            work_dir: work_dir.into(),
+            trace: false,
+            vcd_on_mismatch: true,
+            mutation: None,
+            digest_pulses: 1,
+            profile: BuildProfile::Check,
+            measure_bare: false,
+            stimulus: None,
+        }
+    }
+}
+
+/// The result of a co-simulation.
+#[derive(Debug, Clone)]
+pub struct CosimReport {
+    pub pass: bool,
+    pub outcome: RunOutcome,
+    /// The first mismatch, refined to a cycle when only a digest differed.
+    pub first: Option<Mismatch>,
+    pub build: HarnessBuild,
+    pub pulses: u64,
+    pub cycles: u64,
+    pub frames: u64,
+    /// Seconds of the reference cycle model (golden run, digests included).
+    pub model_seconds: f64,
+    /// Seconds of the Verilator harness run.
+    pub verilator_seconds: f64,
+    pub bare_seconds: Option<f64>,
+    pub vcd: Option<PathBuf>,
+    pub rtl_dir: PathBuf,
+    pub vectors_dir: PathBuf,
+    /// The stimulus replayed and the ROM image used.
+    pub stimulus: Vec<Option<u32>>,
+    pub rom: Vec<u64>,
+    /// The golden readouts, per frame (R words then the status word, raw W bits).
+    pub readouts: Vec<Vec<u64>>,
+}
+
+/// Reads the probe ROM image back from an RTL directory (`$readmemh` file or case table).
+pub fn rom_from_rtl(p: &PixelParams, dir: &Path) -> Result<Vec<u64>, CosimError> {
+    if p.mode == Mode::Haar {
+        return Ok(Vec::new());
+    }
+    let (_, rom_name, _) = module_names(p);
+    let r = p.registers();
+    let words = r.div_ceil(64);
+    let mut rom = vec![0u64; p.rom_depth * words];
+    let put = |rom: &mut Vec<u64>, a: usize, hex: &str| {
+        for (i, ch) in hex.chars().rev().enumerate() {
+            let nib = u64::from(ch.to_digit(16).unwrap_or(0));
+            let bit = i * 4;
+            if bit < r && a < p.rom_depth {
+                rom[a * words + bit / 64] |= nib << (bit % 64);
+            }
+        }
+    };
+    let hex_path = dir.join(format!("{rom_name}.hex"));
+    if hex_path.is_file() {
+        let text = std::fs::read_to_string(&hex_path).map_err(|e| CosimError::io(&hex_path, e))?;
+        let lines = text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with("//"));
+        for (a, l) in lines.enumerate() {
+            put(&mut rom, a, l);
+        }
+        return Ok(rom);
+    }
+    let v_path = dir.join(format!("{rom_name}.v"));
+    let text = std::fs::read_to_string(&v_path).map_err(|e| CosimError::io(&v_path, e))?;
+    for l in text.lines() {
+        // `  6'd12: word = 32'h0f0f0f0f;`
+        let Some((lhs, rhs)) = l.split_once(": word = ") else { continue };
+        let Some(addr) = lhs.split("'d").nth(1).and_then(|a| a.trim().parse::<usize>().ok()) else {
+            continue;
+        };
+        if let Some(h) = rhs.split("'h").nth(1) {
+            put(&mut rom, addr, h.trim_end_matches(';').trim());
+        }
+    }
+    Ok(rom)
+}
+
+/// Renders the configuration's RTL (optionally with a fault) into `dir`.
+pub fn render_into(p: &PixelParams, dir: &Path, mutation: Option<Fault>) -> Result<(), CosimError> {
+    let rom = sign_probe_rom(p);
+    let files = tofprobe_rtlgen::render(
+        p,
+        &rom,
+        &RenderOptions {
+            mutation,
+            ..RenderOptions::default()
+        },
+    )?;
+    let pairs: Vec<(String, String)> = files.into_iter().map(|f| (f.name, f.contents)).collect();
+    write_generated(dir, &pairs)?;
+    Ok(())
+}
+
+/// Runs one co-simulation.
+pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimError> {
+    p.validate()?;
+    if p.registers() > 64 {
+        return Err(CosimError::TooManyRegisters {
+            value: p.registers(),
+        });
+    }
+    std::fs::create_dir_all(&o.work_dir).map_err(|e| CosimError::io(&o.work_dir, e))?;
+    let rtl_dir = match &o.rtl_dir {
+        Some(d) => d.clone(),
+        None => {
+            let d = o.work_dir.join("rtl");
+            render_into(p, &d, o.mutation)?;
+            d
+        }
+    };
+    let rtl_dir = std::fs::canonicalize(&rtl_dir).map_err(|e| CosimError::io(&rtl_dir, e))?;
+    let rom = rom_from_rtl(p, &rtl_dir)?;
+    let pulses = o.frames * p.frame_pulses;
+    let stim = match &o.stimulus {
+        Some(s) if s.len() as u64 >= pulses => s[..pulses as usize].to_vec(),
+        _ => random_stimulus(p, pulses, o.seed),
+    };
+    let vopts = VectorOptions {
+        frames: o.frames,
+        seed: o.seed,
+        digest_pulses: o.digest_pulses,
+        trace_window: None,
+    };
+    let t0 = Instant::now();
+    let (golden, window) = golden_run(p, &stim, &rom, &vopts);
+    let model_seconds = t0.elapsed().as_secs_f64();
+    let vec_dir = o.work_dir.join("vectors");
+    write_vectors(&vec_dir, p, &stim, &rom, &golden, window, &vopts)?;
+    let vec_dir = std::fs::canonicalize(&vec_dir).map_err(|e| CosimError::io(&vec_dir, e))?;
+    let (_, _, top) = module_names(p);
+    let build = verilator::build(&rtl_dir, &top, false, o.profile)?;
+    let outcome = harness::run(&build.exe, &rtl_dir, &vec_dir, None, None)?;
+    let mut first = outcome.first.clone();
+    if first.is_none()
+        && let Some(d) = outcome.digest
+    {
+        // Only a digest differed: regenerate that window's full trace and replay it.
+        let wopts = VectorOptions {
+            trace_window: Some((d.cycle_from, d.cycle_to)),
+            ..vopts.clone()
+        };
+        let (gw, ww) = golden_run(p, &stim, &rom, &wopts);
+        let wdir = o.work_dir.join("vectors-window");
+        write_vectors(&wdir, p, &stim, &rom, &gw, ww, &wopts)?;
+        let wdir = std::fs::canonicalize(&wdir).map_err(|e| CosimError::io(&wdir, e))?;
+        first = harness::run(&build.exe, &rtl_dir, &wdir, Some(ww), None)?.first;
+    }
+    let pass = outcome.mismatches == 0 && outcome.frames == o.frames && first.is_none();
+    let mut vcd = None;
+    if o.trace || (o.vcd_on_mismatch && !pass) {
+        let (lo, hi) = match &first {
+            Some(m) => (m.cycle.saturating_sub(VCD_MARGIN), m.cycle + VCD_MARGIN),
+            None => (0, golden.cycles.min(100_000)),
+        };
+        let tb = verilator::build(&rtl_dir, &top, true, o.profile)?;
+        let f = o.work_dir.join("cosim.vcd");
+        harness::run(&tb.exe, &rtl_dir, &vec_dir, None, Some((&f, lo, hi)))?;
+        vcd = Some(f);
+    }
+    let bare_seconds = if o.measure_bare {
+        Some(harness::run_bare(&build.exe, &rtl_dir, &vec_dir)?)
+    } else {
+        None
+    };
+    Ok(CosimReport {
+        pass,
+        verilator_seconds: outcome.seconds,
+        outcome,
+        first,
+        build,
+        pulses,
+        cycles: golden.cycles,
+        frames: o.frames,
+        model_seconds,
+        bare_seconds,
+        vcd,
+        rtl_dir,
+        vectors_dir: vec_dir,
+        readouts: golden.readouts,
+        stimulus: stim,
+        rom,
+    })
+}

@@ -1,0 +1,16 @@
+//! Co-simulation of the generated RTL against the cycle-accurate reference: a Verilator
+//! driver (cached builds, the C++ harness of `testbench/`), an Icarus driver for the plain
+//! self-checking testbench, and the first-mismatch report.
+
+pub mod driver;
+pub mod error;
+pub mod harness;
+pub mod icarus;
+pub mod pixel_bridge;
+pub mod tools;
+pub mod verilator;
+
+pub use driver::{CosimOptions, CosimReport, cosim, render_into, rom_from_rtl};
+pub use error::CosimError;
+pub use harness::{Mismatch, RunOutcome};
+pub use verilator::BuildProfile;

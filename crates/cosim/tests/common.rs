@@ -1,0 +1,36 @@
+//! Shared helpers of the co-simulation tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use tofprobe_rtlgen::params::{Mode, PixelParams};
+
+/// True when the tools exist; otherwise prints a loud SKIP line (CI installs them via
+/// scripts/test.sh, so there the tests always run).
+pub fn tools_or_skip(tools: &[&'static str], test: &str) -> bool {
+    for t in tools {
+        if let Err(e) = tofprobe_cosim::tools::require(t) {
+            eprintln!("\n*** SKIPPED {test}: {e} ***\n");
+            return false;
+        }
+    }
+    true
+}
+
+/// A fresh work directory under the cargo target dir.
+pub fn work_dir(name: &str) -> PathBuf {
+    let base = std::env::var_os("CARGO_TARGET_TMPDIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(std::env::temp_dir);
+    let d = base.join("cosim-tests").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// The default configuration with a short frame (CI-sized).
+pub fn short_default(mode: Mode) -> PixelParams {
+    let mut p = PixelParams::default();
+    p.mode = mode;
+    p.frame_pulses = 128;
+    p.rom_depth = 128;
+    p
+}

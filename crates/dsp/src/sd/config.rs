@@ -1,0 +1,140 @@
+//! The `[probe]` configuration section: which ΣΔ modulator designs the probe bitstreams,
+//! the window, the probe amplitude and how the ROM is organised.
+
+use super::ntf::validate_design;
+use crate::error::DspError;
+use crate::window::Window;
+use serde::{Deserialize, Serialize};
+
+/// How the ROM spans a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum RomMode {
+    /// One windowed period per frame: depth L = N, bins f_k = k·f_s/N.
+    #[default]
+    Windowed,
+    /// A rectangular periodic bitstream of depth L, bins f_k = k·f_s/L, a frame = M·L.
+    Periodic,
+}
+
+impl RomMode {
+    /// Name as used in configuration files and manifests.
+    pub fn name(self) -> &'static str {
+        match self {
+            RomMode::Windowed => "windowed",
+            RomMode::Periodic => "periodic",
+        }
+    }
+}
+
+/// `[probe]`: the ΣΔ probe design.
+///
+/// `amplitude` is the probe amplitude A_p relative to the quantiser level ±1. The default
+/// 0.5 is 65% of the default modulator's measured maximum stable amplitude (≈ 0.77), well
+/// inside the accepted limit of 0.9 × that maximum (see `modulator::SAFETY_MARGIN`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ProbeConfig {
+    /// Modulator order Θ (1..=6).
+    pub order: usize,
+    /// Oversampling ratio: probes must lie below f_s / (2·OSR).
+    pub osr: f64,
+    /// Out-of-band NTF gain (1 < H_inf < 2^order; 1.5 is the Lee criterion).
+    pub h_inf: f64,
+    /// NTF zeros spread over the band (toolbox opt = 1) instead of all at DC.
+    pub optimised_zeros: bool,
+    /// Probe window (windowed mode; periodic mode is rectangular).
+    pub window: Window,
+    /// Probe amplitude A_p (0 < A_p < 1, and below 0.9 × the max stable amplitude).
+    pub amplitude: f64,
+    /// ROM organisation.
+    pub rom_mode: RomMode,
+    /// ROM depth L for the periodic mode (windowed mode uses L = N and ignores it).
+    pub rom_depth: usize,
+}
+
+impl Default for ProbeConfig {
+    fn default() -> Self {
+        ProbeConfig {
+            order: 3,
+            osr: 32.0,
+            h_inf: 1.5,
+            optimised_zeros: false,
+            window: Window::Blackman,
+            amplitude: 0.5,
+            rom_mode: RomMode::Windowed,
+            rom_depth: 1 << 16,
+        }
+    }
+}
+
+impl ProbeConfig {
+    /// Checks every field against its range (the amplitude against the modulator's
+    /// measured stability limit is checked when a ROM is generated).
+    pub fn validate(&self) -> Result<(), DspError> {
+        validate_design(self.order, self.osr, self.h_inf)?;
+        if !(self.amplitude > 0.0 && self.amplitude < 1.0) {
+            return Err(DspError::out_of_range(
+                "probe.amplitude",
+                self.amplitude,
+                "0 < amplitude < 1",
+            )
+            .with_hint("0.5 suits the default order-3 design"));
+        }
+        if self.rom_mode == RomMode::Periodic && self.rom_depth < 16 {
+            return Err(DspError::out_of_range(
+                "probe.rom_depth",
+                self.rom_depth,
+                ">= 16 in periodic mode",
+            ));
+        }
+        Ok(())
+    }
+
+    /// ROM depth L for a frame of `frame_pulses` pulses.
+    pub fn depth(&self, frame_pulses: u64) -> usize {
+        match self.rom_mode {
+            RomMode::Windowed => frame_pulses as usize,
+            RomMode::Periodic => self.rom_depth,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_parse_and_unknown_fields_are_rejected() {
+        let c: ProbeConfig = toml::from_str("").unwrap();
+        assert_eq!(c, ProbeConfig::default());
+        c.validate().unwrap();
+        let c: ProbeConfig =
+            toml::from_str("rom_mode = \"periodic\"\nrom_depth = 4096\nwindow = \"hann\"").unwrap();
+        assert_eq!(c.rom_mode, RomMode::Periodic);
+        assert_eq!(c.depth(10_000_000), 4096);
+        assert!(toml::from_str::<ProbeConfig>("ordr = 3").is_err());
+    }
+
+    #[test]
+    fn validation_names_field_value_and_range() {
+        let bad = ProbeConfig {
+            amplitude: 1.2,
+            ..ProbeConfig::default()
+        };
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("probe.amplitude = 1.2") && e.contains("0 < amplitude < 1"),
+            "{e}"
+        );
+        let bad = ProbeConfig {
+            h_inf: 0.9,
+            ..ProbeConfig::default()
+        };
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("probe.h_inf = 0.9") && e.contains("1 < h_inf < 2^order = 8"),
+            "{e}"
+        );
+    }
+}

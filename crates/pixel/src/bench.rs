@@ -1,0 +1,146 @@
+//! Speed of the two fidelities (issue point 8), measured by `tofprobe bench pixel`: the
+//! transaction model's pulses per second at B = 16 with the ROM read for every pulse, and
+//! the cycle model's clock edges per second under the reference sequencer.
+
+use std::time::Instant;
+
+use tofprobe_dsp::RomImage;
+
+use crate::cycle::CycleModel;
+use crate::error::PixelError;
+use crate::params::PixelParams;
+use crate::sequencer::Sequencer;
+use crate::transaction::TransactionModel;
+
+/// Stimuli the benchmark feeds: a deterministic mix of detections (≈ 90 %) spread over the
+/// 80-code window and misses, so the hold and the prefilter do real work.
+pub fn synthetic_stimuli(pulses: usize, codes: u32) -> Vec<Option<u32>> {
+    let mut s = 0x2545_F491_4F6C_DD1Du64;
+    (0..pulses)
+        .map(|_| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            if s.is_multiple_of(10) {
+                None
+            } else {
+                Some(((s >> 8) % u64::from(codes.max(1))) as u32)
+            }
+        })
+        .collect()
+}
+
+/// A synthetic ROM of `depth` entries for `registers` bits: a square-wave sign pattern per
+/// register at a different period each, so every entry differs.
+pub fn synthetic_rom(depth: usize, registers: usize) -> RomImage {
+    RomImage::from_fn(depth, registers, |a, r| (a / (r + 1)) % 2 == 0)
+}
+
+/// CPU time this thread has run, in seconds, from Linux's /proc/thread-self/schedstat
+/// (nanoseconds on the CPU, excluding time waiting for it); `None` elsewhere. On a shared
+/// machine this measures the work "on one core" that wall time inflates by contention.
+pub fn thread_cpu_seconds() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: u64 = text.split_whitespace().next()?.parse().ok()?;
+    Some(ns as f64 * 1e-9)
+}
+
+/// Result of the transaction-model benchmark.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TransactionBench {
+    /// Pulses run.
+    pub pulses: u64,
+    /// Wall time of the frame, seconds.
+    pub seconds: f64,
+    /// CPU time of the frame on its thread, seconds (Linux; `None` elsewhere).
+    pub cpu_seconds: Option<f64>,
+    /// Pulses per second.
+    pub pulses_per_s: f64,
+    /// Real-time factor at `laser_rate_hz`: simulated time over wall time.
+    pub realtime_factor: f64,
+    /// Wall time of the same frame through `pulse` one call at a time, seconds.
+    pub per_pulse_seconds: f64,
+}
+
+/// Times one frame of `pulses` through [`TransactionModel::run`] at `params` (B bins), and
+/// the same through [`TransactionModel::pulse`]; checks both give the same readout.
+pub fn bench_transaction(
+    params: &PixelParams,
+    pulses: usize,
+    rom: &RomImage,
+    laser_rate_hz: f64,
+) -> Result<TransactionBench, PixelError> {
+    let stimuli = synthetic_stimuli(pulses, 80);
+    let mut tm = TransactionModel::new(params)?;
+    let c0 = thread_cpu_seconds();
+    let t0 = Instant::now();
+    // Stream in chunks as the simulator does (the source fills a chunk at a time).
+    for (i, chunk) in stimuli.chunks(1 << 16).enumerate() {
+        tm.run(chunk, Some(rom), (i << 16) as u64)?;
+    }
+    let fast = tm.readout();
+    let seconds = t0.elapsed().as_secs_f64();
+    let cpu_seconds = c0.zip(thread_cpu_seconds()).map(|(a, b)| b - a);
+
+    let mut one = TransactionModel::new(params)?;
+    let depth = rom.depth();
+    let t1 = Instant::now();
+    for (n, &d) in stimuli.iter().enumerate() {
+        one.pulse(d, rom.entry(n % depth));
+    }
+    let slow = one.readout();
+    let per_pulse_seconds = t1.elapsed().as_secs_f64();
+    if fast != slow {
+        return Err(PixelError::mismatch(
+            "benchmark readouts of run() and pulse()",
+            "different",
+            "identical",
+        ));
+    }
+    let seconds = seconds.max(1e-9);
+    Ok(TransactionBench {
+        pulses: pulses as u64,
+        seconds,
+        cpu_seconds,
+        pulses_per_s: pulses as f64 / seconds,
+        realtime_factor: pulses as f64 / laser_rate_hz / seconds,
+        per_pulse_seconds,
+    })
+}
+
+/// Result of the cycle-model benchmark.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CycleBench {
+    /// Clock edges stepped.
+    pub cycles: u64,
+    /// Wall time, seconds.
+    pub seconds: f64,
+    /// Edges per second.
+    pub cycles_per_s: f64,
+}
+
+/// Times the cycle model under the reference sequencer for `frames` frames.
+pub fn bench_cycle(
+    params: &PixelParams,
+    rom: &RomImage,
+    frames: usize,
+) -> Result<CycleBench, PixelError> {
+    let n = usize::try_from(params.frame_pulses).unwrap_or(usize::MAX);
+    let stimuli = synthetic_stimuli(n.saturating_mul(frames), 80);
+    let seq = Sequencer::new(params, &stimuli, Some(rom))?;
+    let mut cm = CycleModel::new(params)?;
+    let cycles = seq.total_cycles();
+    let t0 = Instant::now();
+    let mut sink = 0u64;
+    for pins in seq {
+        let o = cm.step(&pins);
+        sink = sink.wrapping_add(o.rd_data);
+    }
+    let seconds = t0.elapsed().as_secs_f64().max(1e-9);
+    std::hint::black_box(sink);
+    Ok(CycleBench {
+        cycles,
+        seconds,
+        cycles_per_s: cycles as f64 / seconds,
+    })
+}

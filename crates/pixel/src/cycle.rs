@@ -1,0 +1,331 @@
+//! The cycle-accurate model: one [`CycleModel::step`] per rising clock edge on the RTL's
+//! pins, implementing docs/pixel-contract.md line by line (accept rule, accumulate
+//! schedule, priming, readout protocol, reset). The state names follow the contract.
+//!
+//! A Verilator harness that does "set inputs, eval, sample outputs, clk 0→1, eval,
+//! clk 1→0" sees exactly what `step` returns, and the register writes of that edge are in
+//! [`CycleModel::writes`].
+
+use crate::error::PixelError;
+use crate::fixed::{haar_target, mask, prefilter_step, rom_bit, to_raw, wrap, zoomed};
+use crate::params::{Mode, PixelParams};
+
+/// The pixel's inputs during one clock cycle (sampled at its rising edge).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PinsIn<'a> {
+    /// Synchronous reset, active high; wins over everything.
+    pub rst: bool,
+    /// A laser pulse's detection result is presented this cycle.
+    pub pulse: bool,
+    /// With `pulse`: a photon was detected.
+    pub valid: bool,
+    /// With `pulse` and `valid`: the TDC code (only its low T bits are wired).
+    pub tdc: u32,
+    /// Fourier, with `pulse`: the packed ROM word, bit r = 1 adds to Y[r].
+    pub rom_word: &'a [u64],
+    /// Start the readout-and-clear of the register file.
+    pub readout: bool,
+}
+
+/// The pixel's outputs during one cycle, before its rising edge.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PinsOut {
+    /// Combinational: a `pulse` or `readout` this cycle would be accepted (Haar: a pulse
+    /// also needs the frame not to be full).
+    pub ready: bool,
+    /// Registered: `rd_data` holds readout word `rd_index`.
+    pub rd_valid: bool,
+    /// Registered: 0..R−1 a register, R the status word.
+    pub rd_index: u32,
+    /// Registered: the raw W-bit word.
+    pub rd_data: u64,
+}
+
+/// One register write made at a clock edge (a trace event).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RegWrite {
+    /// Register index r.
+    pub register: u32,
+    /// The new value, as its raw W-bit pattern.
+    pub value: u64,
+}
+
+/// The cycle-accurate pixel.
+#[derive(Debug, Clone)]
+pub struct CycleModel {
+    p: PixelParams,
+    r: usize,
+    k: usize,
+    // Contract state.
+    primed: bool,
+    held: i64,
+    x: i64,
+    op: i64,
+    bits: Vec<u64>,
+    n_lat: u64,
+    pcount: u64,
+    refused: u64,
+    acc_en: bool,
+    active: bool,
+    slot: usize,
+    rd_active: bool,
+    rd_ptr: usize,
+    y: Vec<i64>,
+    // Registered outputs.
+    rd_valid: bool,
+    rd_index: u32,
+    rd_data: u64,
+    // Bookkeeping (not hardware).
+    writes: Vec<RegWrite>,
+    cycle: u64,
+    accepted_last: bool,
+}
+
+impl CycleModel {
+    /// A pixel in its reset state. Fails if the parameters do not validate.
+    pub fn new(params: &PixelParams) -> Result<Self, PixelError> {
+        params.validate()?;
+        Ok(Self::fresh(params))
+    }
+
+    /// The reset state of validated parameters.
+    fn fresh(params: &PixelParams) -> Self {
+        let r = params.registers();
+        CycleModel {
+            p: params.clone(),
+            r,
+            k: params.slots(),
+            primed: false,
+            held: 0,
+            x: 0,
+            op: 0,
+            bits: vec![0; r.div_ceil(64)],
+            n_lat: 0,
+            pcount: 0,
+            refused: 0,
+            acc_en: false,
+            active: false,
+            slot: 0,
+            rd_active: false,
+            rd_ptr: 0,
+            y: vec![0; r],
+            rd_valid: false,
+            rd_index: 0,
+            rd_data: 0,
+            writes: Vec::new(),
+            cycle: 0,
+            accepted_last: false,
+        }
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &PixelParams {
+        &self.p
+    }
+
+    /// The register file, sign-extended from W bits.
+    pub fn registers(&self) -> &[i64] {
+        &self.y
+    }
+
+    /// The held depth.
+    pub fn held(&self) -> i64 {
+        self.held
+    }
+
+    /// The prefilter state x (units of 2^−F codes).
+    pub fn prefilter_state(&self) -> i64 {
+        self.x
+    }
+
+    /// Whether a first valid detection has been seen since reset.
+    pub fn primed(&self) -> bool {
+        self.primed
+    }
+
+    /// Accepted pulses since the last status word.
+    pub fn pcount(&self) -> u64 {
+        self.pcount
+    }
+
+    /// Refused strobes since the last status word.
+    pub fn refused(&self) -> u64 {
+        self.refused
+    }
+
+    /// Whether the accumulate pipeline is working on a pulse.
+    pub fn busy(&self) -> bool {
+        self.active || self.rd_active
+    }
+
+    /// Edges stepped since construction.
+    pub fn cycle(&self) -> u64 {
+        self.cycle
+    }
+
+    /// Whether the last edge accepted a pulse.
+    pub fn accepted_pulse(&self) -> bool {
+        self.accepted_last
+    }
+
+    /// Register writes made at the last edge, in adder order (readout clears included).
+    pub fn writes(&self) -> &[RegWrite] {
+        &self.writes
+    }
+
+    /// The pipeline is free at this edge (the contract's accept rule).
+    fn free(&self) -> bool {
+        !self.rd_active && (!self.active || self.slot == self.k - 1)
+    }
+
+    /// The outputs during the current cycle (before its edge).
+    pub fn outputs(&self) -> PinsOut {
+        PinsOut {
+            ready: self.free(),
+            rd_valid: self.rd_valid,
+            rd_index: self.rd_index,
+            rd_data: self.rd_data,
+        }
+    }
+
+    /// One clock cycle: returns the outputs as seen during the cycle, then applies the
+    /// rising edge with inputs `pins`.
+    pub fn step(&mut self, pins: &PinsIn) -> PinsOut {
+        let out = self.outputs();
+        self.writes.clear();
+        self.cycle += 1;
+        self.accepted_last = false;
+        if pins.rst {
+            self.reset();
+            return out;
+        }
+        let w = self.p.width;
+        let free = self.free();
+        let haar_room = self.p.mode == Mode::Fourier || self.pcount < self.p.frame_pulses;
+        let take_readout = pins.readout && free;
+        let take_pulse = pins.pulse && free && !pins.readout && haar_room;
+        let refuse_pulse = pins.pulse && !take_pulse;
+
+        // Accumulate one slot with the old op/bits/n_lat/acc_en.
+        if self.active {
+            if self.acc_en {
+                let p = self.p.ops_per_pulse();
+                for a in 0..self.p.adders {
+                    let j = self.slot * self.p.adders + a;
+                    if j >= p {
+                        break;
+                    }
+                    let (reg, add) = match self.p.mode {
+                        Mode::Fourier => (j, rom_bit(&self.bits, j)),
+                        Mode::Haar => haar_target(self.n_lat, j as u32, self.p.log2_frame()),
+                    };
+                    let v = if add {
+                        self.y[reg].wrapping_add(self.op)
+                    } else {
+                        self.y[reg].wrapping_sub(self.op)
+                    };
+                    self.y[reg] = wrap(v, w);
+                    self.writes.push(RegWrite {
+                        register: reg as u32,
+                        value: to_raw(self.y[reg], w),
+                    });
+                }
+            }
+            if self.slot == self.k - 1 {
+                self.active = false;
+            }
+            self.slot += 1;
+        }
+
+        // Readout progress; at every edge without it rd_valid falls.
+        let mut refused_next = self.refused;
+        if self.rd_active {
+            if self.rd_ptr < self.r {
+                self.rd_data = to_raw(self.y[self.rd_ptr], w);
+                self.rd_index = self.rd_ptr as u32;
+                self.rd_valid = true;
+                self.y[self.rd_ptr] = 0;
+                self.writes.push(RegWrite {
+                    register: self.rd_ptr as u32,
+                    value: 0,
+                });
+                self.rd_ptr += 1;
+            } else {
+                self.rd_data = self.refused & mask(w);
+                self.rd_index = self.r as u32;
+                self.rd_valid = true;
+                refused_next = 0;
+                self.pcount = 0;
+                self.rd_active = false;
+            }
+        } else {
+            self.rd_valid = false;
+        }
+        if refuse_pulse {
+            refused_next = (refused_next + 1).min(self.p.refused_max());
+        }
+        self.refused = refused_next;
+
+        if take_pulse {
+            self.accept(pins);
+        }
+        if take_readout {
+            self.rd_active = true;
+            self.rd_ptr = 0;
+        }
+        out
+    }
+
+    /// The state changes at the edge that accepts a pulse.
+    fn accept(&mut self, pins: &PinsIn) {
+        let p = &self.p;
+        let d = zoomed(pins.tdc, p.tdc_bits, p.zoom);
+        match p.mode {
+            Mode::Fourier => {
+                if self.primed {
+                    let x_new = prefilter_step(self.x, self.held, p.frac_bits, p.shift);
+                    self.x = x_new;
+                    self.op = x_new;
+                    self.acc_en = true;
+                } else {
+                    self.acc_en = false;
+                }
+                if pins.valid {
+                    self.held = d;
+                    if !self.primed {
+                        self.primed = true;
+                        self.x = d << p.frac_bits;
+                    }
+                }
+                for (i, b) in self.bits.iter_mut().enumerate() {
+                    *b = pins.rom_word.get(i).copied().unwrap_or(0);
+                }
+                // Only R bits are wired.
+                if let Some(last) = self.bits.last_mut() {
+                    let used = self.r - 64 * (self.r.div_ceil(64) - 1);
+                    *last &= mask(used as u32);
+                }
+            }
+            Mode::Haar => {
+                let h = if pins.valid { d } else { self.held };
+                self.held = h;
+                self.op = h;
+                self.acc_en = self.primed || pins.valid;
+                if pins.valid {
+                    self.primed = true;
+                }
+                self.n_lat = self.pcount;
+            }
+        }
+        self.pcount += 1;
+        self.active = true;
+        self.slot = 0;
+        self.accepted_last = true;
+    }
+
+    fn reset(&mut self) {
+        let cycle = self.cycle;
+        *self = Self::fresh(&self.p);
+        self.cycle = cycle;
+    }
+}

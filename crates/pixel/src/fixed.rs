@@ -1,0 +1,67 @@
+//! Fixed-width two's-complement arithmetic shared by both models, so the transaction and
+//! cycle models cannot differ in how they wrap, shift or extend a value.
+//!
+//! Registers are kept as `i64` holding the *sign-extended* W-bit value. Wrapping a sum to W
+//! bits is exact modulo 2^W, which is why the models may add in 64 bits and wrap later:
+//! (a + b) mod 2^W = ((a mod 2^W) + (b mod 2^W)) mod 2^W.
+
+/// Reduces `value` modulo 2^`width` and sign-extends the result (1 ≤ width ≤ 64).
+#[inline(always)]
+pub fn wrap(value: i64, width: u32) -> i64 {
+    let s = 64 - width;
+    (value << s) >> s
+}
+
+/// The raw W-bit pattern of a value (what the RTL's `rd_data` bus carries).
+#[inline(always)]
+pub fn to_raw(value: i64, width: u32) -> u64 {
+    (value as u64) & mask(width)
+}
+
+/// Sign-extends a raw W-bit pattern.
+#[inline(always)]
+pub fn sign_extend(raw: u64, width: u32) -> i64 {
+    let s = 64 - width;
+    ((raw << s) as i64) >> s
+}
+
+/// All-ones in the low `width` bits.
+#[inline(always)]
+pub fn mask(width: u32) -> u64 {
+    if width >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << width) - 1
+    }
+}
+
+/// The zoomed depth d = tdc − Z of a T-bit code (the code is truncated to its T pins, as the
+/// hardware sees it). The result lies in (−2^T, 2^T): T+1 signed bits, never wrapped.
+#[inline(always)]
+pub fn zoomed(tdc: u32, tdc_bits: u32, zoom: u32) -> i64 {
+    i64::from(tdc & (mask(tdc_bits) as u32)) - i64::from(zoom)
+}
+
+/// One step of the shift prefilter: x + (((held << F) − x) >>> S), `>>>` an arithmetic
+/// (floor) shift. The result lies between x and held·2^F inclusive, so it never needs more
+/// than T+1+F bits.
+#[inline(always)]
+pub fn prefilter_step(x: i64, held: i64, frac_bits: u32, shift: u32) -> i64 {
+    x + (((held << frac_bits) - x) >> shift)
+}
+
+/// Sign of the Haar wavelet at scale `u` for pulse `n` of a frame of 2^`log2_n` pulses and
+/// the register it updates: register 2^u − 1 + v with v = n >> (L − u); `true` (add) in the
+/// first half of the wavelet's support, i.e. when bit L − u − 1 of n is 0.
+#[inline(always)]
+pub fn haar_target(n: u64, u: u32, log2_n: u32) -> (usize, bool) {
+    let v = (n >> (log2_n - u)) as usize;
+    let add = (n >> (log2_n - u - 1)) & 1 == 0;
+    ((1usize << u) - 1 + v, add)
+}
+
+/// Bit r of a packed ROM word (bits beyond the supplied words read as 0).
+#[inline(always)]
+pub fn rom_bit(word: &[u64], r: usize) -> bool {
+    word.get(r / 64).is_some_and(|w| (w >> (r % 64)) & 1 == 1)
+}

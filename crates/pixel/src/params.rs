@@ -1,0 +1,288 @@
+//! `PixelParams`: the validated hardware parameters of one pixel (the contract's parameter
+//! table), with the quantities derived from them. Both models and the RTL generator take
+//! their sizes from here, so a configuration that passes [`PixelParams::validate`] is one
+//! the hardware can build.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::PixelError;
+
+/// What the register file computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// I/Q accumulation of the prefiltered depth with ROM (ΣΔ) signs: a DFT at B bins.
+    #[default]
+    Fourier,
+    /// Haar wavelet coefficients of the held depth, signs from the pulse counter.
+    Haar,
+}
+
+impl std::fmt::Display for Mode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Mode::Fourier => "fourier",
+            Mode::Haar => "haar",
+        })
+    }
+}
+
+/// Largest register width: the models hold registers in `i64` and the readout bus in `u64`.
+pub const MAX_WIDTH: u32 = 63;
+/// Largest TDC width the contract allows.
+pub const MAX_TDC_BITS: u32 = 16;
+/// Largest prefilter shift.
+pub const MAX_SHIFT: u32 = 15;
+/// Largest number of prefilter fraction bits.
+pub const MAX_FRAC_BITS: u32 = 16;
+
+/// The validated pixel parameters (letters as in docs/pixel-contract.md).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PixelParams {
+    /// `fourier` or `haar`.
+    pub mode: Mode,
+    /// B: Fourier bins (ignored in Haar mode).
+    pub bins: usize,
+    /// U: finest Haar scale (ignored in Fourier mode).
+    pub haar_scales: u32,
+    /// A: adders.
+    pub adders: usize,
+    /// C: clock cycles per laser pulse.
+    pub cycles_per_pulse: usize,
+    /// T: TDC width in bits (unsigned code).
+    pub tdc_bits: u32,
+    /// Z: zoom, the timing-window start in TDC codes, subtracted from every code.
+    pub zoom: u32,
+    /// S: prefilter shift, α = 2^−S (Fourier).
+    pub shift: u32,
+    /// F: prefilter fraction bits (Fourier; Haar has no prefilter and uses 0).
+    pub frac_bits: u32,
+    /// W: register width in bits, two's complement, wrapping.
+    pub width: u32,
+    /// N: pulses per frame (Haar: a power of two).
+    pub frame_pulses: u64,
+    /// L: ROM depth in entries (Fourier; the ROM is addressed by pulse index mod L).
+    pub rom_depth: usize,
+}
+
+impl PixelParams {
+    /// The contract's default Fourier pixel: B = 16, A = 2, C = 16, T = 7, S = 5, F =
+    /// [`crate::DEFAULT_FRAC_BITS`], with the given width, frame length and ROM depth.
+    pub fn fourier_default(width: u32, frame_pulses: u64, rom_depth: usize) -> Self {
+        PixelParams {
+            mode: Mode::Fourier,
+            bins: 16,
+            haar_scales: 4,
+            adders: 2,
+            cycles_per_pulse: 16,
+            tdc_bits: 7,
+            zoom: 0,
+            shift: 5,
+            frac_bits: crate::DEFAULT_FRAC_BITS,
+            width,
+            frame_pulses,
+            rom_depth,
+        }
+    }
+
+    /// R: registers, 2·B (Fourier) or 2^(U+1) − 1 (Haar).
+    pub fn registers(&self) -> usize {
+        match self.mode {
+            Mode::Fourier => 2 * self.bins,
+            Mode::Haar => (1usize << (self.haar_scales + 1)) - 1,
+        }
+    }
+
+    /// P: register operations per pulse, R (Fourier) or U + 1 (Haar).
+    pub fn ops_per_pulse(&self) -> usize {
+        match self.mode {
+            Mode::Fourier => self.registers(),
+            Mode::Haar => self.haar_scales as usize + 1,
+        }
+    }
+
+    /// K: schedule slots per pulse, ceil(P / A).
+    pub fn slots(&self) -> usize {
+        self.ops_per_pulse().div_ceil(self.adders.max(1))
+    }
+
+    /// Fraction bits actually used by the data path (0 in Haar mode).
+    pub fn effective_frac_bits(&self) -> u32 {
+        match self.mode {
+            Mode::Fourier => self.frac_bits,
+            Mode::Haar => 0,
+        }
+    }
+
+    /// Width of the operand added to the registers: T+1+F (Fourier x) or T+1 (Haar held).
+    pub fn operand_bits(&self) -> u32 {
+        self.tdc_bits + 1 + self.effective_frac_bits()
+    }
+
+    /// Width of the `rd_index` output: ceil(log2(R + 2)) (indices 0..R, R = status word).
+    pub fn rd_index_bits(&self) -> u32 {
+        ceil_log2(self.registers() as u64 + 2)
+    }
+
+    /// log2 N for Haar frames (N a power of two); for other N, floor(log2 N).
+    pub fn log2_frame(&self) -> u32 {
+        63 - self.frame_pulses.max(1).leading_zeros()
+    }
+
+    /// Largest value of the saturating `refused` counter, 2^W − 1.
+    pub fn refused_max(&self) -> u64 {
+        (1u64 << self.width) - 1
+    }
+
+    /// Checks every constraint of the contract's parameter table. The error names the
+    /// first violated one with the nearest value that would work.
+    pub fn validate(&self) -> Result<(), PixelError> {
+        let t = self.tdc_bits;
+        if !(1..=MAX_TDC_BITS).contains(&t) {
+            return Err(PixelError::invalid(
+                "tdc_bits",
+                t,
+                format!("the TDC width must be 1..={MAX_TDC_BITS} bits"),
+                t.clamp(1, MAX_TDC_BITS),
+            ));
+        }
+        if u64::from(self.zoom) >= 1u64 << t {
+            return Err(PixelError::invalid(
+                "zoom",
+                self.zoom,
+                format!(
+                    "the window start must be a {t}-bit code, 0..={}",
+                    (1u64 << t) - 1
+                ),
+                (1u64 << t) - 1,
+            ));
+        }
+        if self.frame_pulses == 0 {
+            return Err(PixelError::invalid(
+                "frame_pulses",
+                0,
+                "a frame needs at least one pulse",
+                1,
+            ));
+        }
+        match self.mode {
+            Mode::Fourier => {
+                if self.bins == 0 {
+                    return Err(PixelError::invalid(
+                        "bins",
+                        0,
+                        "Fourier mode needs at least one bin",
+                        1,
+                    ));
+                }
+                if self.shift > MAX_SHIFT {
+                    return Err(PixelError::invalid(
+                        "shift",
+                        self.shift,
+                        format!("the prefilter shift must be 0..={MAX_SHIFT}"),
+                        MAX_SHIFT,
+                    ));
+                }
+                if self.frac_bits > MAX_FRAC_BITS {
+                    return Err(PixelError::invalid(
+                        "frac_bits",
+                        self.frac_bits,
+                        format!("the prefilter fraction bits must be 0..={MAX_FRAC_BITS}"),
+                        MAX_FRAC_BITS,
+                    ));
+                }
+                if self.rom_depth == 0 {
+                    return Err(PixelError::invalid(
+                        "rom_depth",
+                        0,
+                        "Fourier mode reads one ROM entry per pulse, so the ROM needs at least one entry",
+                        1,
+                    ));
+                }
+            }
+            Mode::Haar => {
+                let n = self.frame_pulses;
+                if n < 2 || !n.is_power_of_two() {
+                    let up = n.max(2).checked_next_power_of_two().unwrap_or(1 << 63);
+                    let down = if n < 2 {
+                        2
+                    } else {
+                        1u64 << (63 - n.leading_zeros())
+                    };
+                    let nearest = if n < 2 || up - n >= n - down {
+                        down
+                    } else {
+                        up
+                    };
+                    return Err(PixelError::invalid(
+                        "frame_pulses",
+                        n,
+                        "Haar mode derives its signs from the pulse counter, so N must be a power of two ≥ 2",
+                        nearest,
+                    ));
+                }
+                let l = self.log2_frame();
+                if self.haar_scales > l - 1 {
+                    return Err(PixelError::invalid(
+                        "haar_scales",
+                        self.haar_scales,
+                        format!("the finest scale U must be 0..=log2(N) − 1 = {}", l - 1),
+                        l - 1,
+                    ));
+                }
+                // R = 2^(U+1) − 1 must be addressable; U ≤ 30 keeps every count in range.
+                if self.haar_scales > 30 {
+                    return Err(PixelError::invalid(
+                        "haar_scales",
+                        self.haar_scales,
+                        "at most 2^31 − 1 registers (U ≤ 30)",
+                        30,
+                    ));
+                }
+            }
+        }
+        let p = self.ops_per_pulse();
+        if self.adders == 0 || self.adders > p {
+            return Err(PixelError::invalid(
+                "adders",
+                self.adders,
+                format!("1 ≤ A ≤ P = {p} operations per pulse"),
+                self.adders.clamp(1, p),
+            ));
+        }
+        let k = self.slots();
+        if self.cycles_per_pulse < k {
+            return Err(PixelError::invalid(
+                "cycles_per_pulse",
+                self.cycles_per_pulse,
+                format!(
+                    "{p} operations on {} adder(s) need K = {k} schedule slots per pulse, so C ≥ {k}",
+                    self.adders
+                ),
+                k,
+            ));
+        }
+        let ob = self.operand_bits();
+        if self.width < ob || self.width > MAX_WIDTH {
+            return Err(PixelError::invalid(
+                "width",
+                self.width,
+                format!(
+                    "W must hold one operand (T+1{} = {ob} bits) and be at most {MAX_WIDTH}",
+                    if self.mode == Mode::Fourier { "+F" } else { "" }
+                ),
+                self.width.clamp(ob, MAX_WIDTH),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// ceil(log2(v)) for v ≥ 1 (0 for v = 1).
+pub fn ceil_log2(v: u64) -> u32 {
+    if v <= 1 {
+        0
+    } else {
+        64 - (v - 1).leading_zeros()
+    }
+}

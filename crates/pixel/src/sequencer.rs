@@ -1,0 +1,166 @@
+//! The contract's reference sequencer: the cycle-by-cycle pin stimulus that testbenches and
+//! golden vectors drive, generated lazily from per-pulse detections and the ROM.
+//!
+//! First `rst` high for 2 cycles. Then per frame: for each pulse n, one `pulse` cycle (with
+//! `valid`, `tdc` and ROM word n mod L) and C − 1 idle cycles; after the last pulse, one
+//! `readout` cycle and R + 1 idle cycles while the words come out.
+
+use tofprobe_dsp::RomImage;
+
+use crate::cycle::PinsIn;
+use crate::error::PixelError;
+use crate::params::{Mode, PixelParams};
+use crate::transaction::{check_rom, frame_len};
+
+/// Cycles of reset at the start.
+pub const RESET_CYCLES: u64 = 2;
+
+/// What a cycle of the reference sequence is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// Reset cycle.
+    Reset,
+    /// Pulse `pulse` of frame `frame` is presented.
+    Pulse {
+        /// Frame index.
+        frame: u64,
+        /// Pulse index in the frame.
+        pulse: u64,
+    },
+    /// Idle cycle after a pulse.
+    Idle,
+    /// The readout strobe of frame `frame`.
+    Readout {
+        /// Frame index.
+        frame: u64,
+    },
+    /// Idle cycle while the words come out.
+    Draining,
+}
+
+/// Iterator over the reference sequencer's [`PinsIn`], one per clock cycle.
+#[derive(Debug, Clone)]
+pub struct Sequencer<'a> {
+    stimuli: &'a [Option<u32>],
+    rom: Option<&'a RomImage>,
+    n: u64,
+    c: u64,
+    frame_cycles: u64,
+    total: u64,
+    cycle: u64,
+    rom_depth: u64,
+}
+
+impl<'a> Sequencer<'a> {
+    /// The sequence for `stimuli.len() / N` frames (the stimuli must be whole frames). A
+    /// Fourier pixel needs the ROM; a Haar pixel ignores it.
+    pub fn new(
+        params: &PixelParams,
+        stimuli: &'a [Option<u32>],
+        rom: Option<&'a RomImage>,
+    ) -> Result<Self, PixelError> {
+        params.validate()?;
+        let n = frame_len(params, stimuli.len())? as u64;
+        let rom = match params.mode {
+            Mode::Fourier => Some(check_rom(params, rom)?),
+            Mode::Haar => None,
+        };
+        let c = params.cycles_per_pulse as u64;
+        let frame_cycles = n * c + params.registers() as u64 + 2;
+        let frames = stimuli.len() as u64 / n;
+        Ok(Sequencer {
+            stimuli,
+            rom,
+            n,
+            c,
+            frame_cycles,
+            total: RESET_CYCLES + frames * frame_cycles,
+            cycle: 0,
+            rom_depth: params.rom_depth.max(1) as u64,
+        })
+    }
+
+    /// Total cycles of the sequence: 2 + frames·(N·C + R + 2).
+    pub fn total_cycles(&self) -> u64 {
+        self.total
+    }
+
+    /// Cycles per frame, N·C + R + 2.
+    pub fn frame_cycles(&self) -> u64 {
+        self.frame_cycles
+    }
+
+    /// What cycle `cycle` of the sequence does.
+    pub fn phase(&self, cycle: u64) -> Phase {
+        if cycle < RESET_CYCLES {
+            return Phase::Reset;
+        }
+        let t = cycle - RESET_CYCLES;
+        let frame = t / self.frame_cycles;
+        let within = t % self.frame_cycles;
+        let pulses = self.n * self.c;
+        if within < pulses {
+            if within.is_multiple_of(self.c) {
+                Phase::Pulse {
+                    frame,
+                    pulse: within / self.c,
+                }
+            } else {
+                Phase::Idle
+            }
+        } else if within == pulses {
+            Phase::Readout { frame }
+        } else {
+            Phase::Draining
+        }
+    }
+
+    /// The pins of cycle `cycle`.
+    pub fn pins(&self, cycle: u64) -> PinsIn<'a> {
+        match self.phase(cycle) {
+            Phase::Reset => PinsIn {
+                rst: true,
+                ..PinsIn::default()
+            },
+            Phase::Pulse { frame, pulse } => {
+                let det = self.stimuli[(frame * self.n + pulse) as usize];
+                let rom_word = self
+                    .rom
+                    .map(|rom| rom.entry((pulse % self.rom_depth) as usize))
+                    .unwrap_or(&[]);
+                PinsIn {
+                    pulse: true,
+                    valid: det.is_some(),
+                    tdc: det.unwrap_or(0),
+                    rom_word,
+                    ..PinsIn::default()
+                }
+            }
+            Phase::Readout { .. } => PinsIn {
+                readout: true,
+                ..PinsIn::default()
+            },
+            Phase::Idle | Phase::Draining => PinsIn::default(),
+        }
+    }
+}
+
+impl<'a> Iterator for Sequencer<'a> {
+    type Item = PinsIn<'a>;
+
+    fn next(&mut self) -> Option<PinsIn<'a>> {
+        if self.cycle >= self.total {
+            return None;
+        }
+        let pins = self.pins(self.cycle);
+        self.cycle += 1;
+        Some(pins)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = usize::try_from(self.total - self.cycle).unwrap_or(usize::MAX);
+        (left, Some(left))
+    }
+}
+
+impl ExactSizeIterator for Sequencer<'_> {}

@@ -1,0 +1,336 @@
+//! The transaction-level model: one call per laser pulse, integers only, the same state and
+//! arithmetic as the contract (docs/pixel-contract.md) without the clock. Sweeps use it.
+//!
+//! Two entry points compute the same thing:
+//! - [`TransactionModel::pulse`] updates the register file after every pulse (what the
+//!   equivalence tests compare cycle by cycle);
+//! - [`TransactionModel::run`] streams many pulses. Because Y[r] = Σₙ ±xₙ is linear and the
+//!   wrap is exact modulo 2^W, it may regroup the sum: for each byte of the ROM word it adds
+//!   x into one of 256 partial sums indexed by that byte's value (4 adds per pulse at
+//!   B = 16 instead of 32), and distributes the partial sums to the registers with their ±
+//!   signs only at the end of the call. Everything is 64-bit wrapping arithmetic, reduced to
+//!   W bits at the end, so the result is bit-identical to `pulse` (tested).
+
+use tofprobe_dsp::RomImage;
+
+use crate::error::PixelError;
+use crate::fixed::{haar_target, prefilter_step, wrap, zoomed};
+use crate::params::{Mode, PixelParams};
+use crate::readout::Readout;
+
+/// The transaction-level pixel.
+#[derive(Debug, Clone)]
+pub struct TransactionModel {
+    params: PixelParams,
+    regs: Vec<i64>,
+    primed: bool,
+    held: i64,
+    x: i64,
+    pcount: u64,
+    refused: u64,
+    /// Partial sums of [`TransactionModel::run`]: one table of 256 per ROM byte.
+    tables: Vec<[i64; 256]>,
+}
+
+impl TransactionModel {
+    /// A pixel just out of reset. Fails if the parameters do not validate.
+    pub fn new(params: &PixelParams) -> Result<Self, PixelError> {
+        params.validate()?;
+        Ok(TransactionModel {
+            params: params.clone(),
+            regs: vec![0; params.registers()],
+            primed: false,
+            held: 0,
+            x: 0,
+            pcount: 0,
+            refused: 0,
+            tables: Vec::new(),
+        })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &PixelParams {
+        &self.params
+    }
+
+    /// The register file, each value sign-extended from W bits.
+    pub fn registers(&self) -> &[i64] {
+        &self.regs
+    }
+
+    /// The held depth (last valid d = tdc − Z; 0 before the first detection).
+    pub fn held(&self) -> i64 {
+        self.held
+    }
+
+    /// The prefilter state x in units of 2^−F codes (Fourier; 0 in Haar mode).
+    pub fn prefilter_state(&self) -> i64 {
+        self.x
+    }
+
+    /// Whether a first valid detection has been seen since reset.
+    pub fn primed(&self) -> bool {
+        self.primed
+    }
+
+    /// Pulses accepted since the last readout.
+    pub fn pulses_in_frame(&self) -> u64 {
+        self.pcount
+    }
+
+    /// Pulses refused since the last readout (Haar: pulses beyond N).
+    pub fn refused(&self) -> u64 {
+        self.refused
+    }
+
+    /// Counts a refused pulse strobe (the hardware's saturating counter).
+    pub fn refuse(&mut self) {
+        self.refused = (self.refused + 1).min(self.params.refused_max());
+    }
+
+    /// One laser pulse: `detection` is the TDC code of a detected photon (`None`: no
+    /// detection), `rom_entry` the packed ROM word for this pulse (Fourier; bit r = 1 adds
+    /// to Y[r]; ignored in Haar mode). Returns whether the pulse was accepted: a Haar frame
+    /// that already has N pulses refuses (and counts) further pulses until read out.
+    pub fn pulse(&mut self, detection: Option<u32>, rom_entry: &[u64]) -> bool {
+        match self.params.mode {
+            Mode::Fourier => {
+                if let Some(x) = self.advance_fourier(detection) {
+                    let w = self.params.width;
+                    for (wi, chunk) in self.regs.chunks_mut(64).enumerate() {
+                        let bits = rom_entry.get(wi).copied().unwrap_or(0);
+                        for (i, y) in chunk.iter_mut().enumerate() {
+                            // m = 0 (bit 1: add) or −1 (bit 0: subtract); (x ^ m) − m = ±x.
+                            let m = ((bits >> i) & 1) as i64 - 1;
+                            *y = wrap(y.wrapping_add((x ^ m).wrapping_sub(m)), w);
+                        }
+                    }
+                }
+                self.pcount += 1;
+                true
+            }
+            Mode::Haar => self.pulse_haar(detection),
+        }
+    }
+
+    /// Prefilter and hold for one Fourier pulse; returns the operand if the pulse
+    /// contributes (the pixel was primed before it).
+    #[inline(always)]
+    fn advance_fourier(&mut self, detection: Option<u32>) -> Option<i64> {
+        let p = &self.params;
+        let op = if self.primed {
+            self.x = prefilter_step(self.x, self.held, p.frac_bits, p.shift);
+            Some(self.x)
+        } else {
+            None
+        };
+        if let Some(code) = detection {
+            self.held = zoomed(code, p.tdc_bits, p.zoom);
+            if !self.primed {
+                self.primed = true;
+                // The filter starts at the first depth, not at zero: no start transient.
+                self.x = self.held << p.frac_bits;
+            }
+        }
+        op
+    }
+
+    fn pulse_haar(&mut self, detection: Option<u32>) -> bool {
+        let p = &self.params;
+        if self.pcount >= p.frame_pulses {
+            self.refuse();
+            return false;
+        }
+        let valid = detection.is_some();
+        if let Some(code) = detection {
+            self.held = zoomed(code, p.tdc_bits, p.zoom);
+        }
+        if self.primed || valid {
+            let l = p.log2_frame();
+            for u in 0..=p.haar_scales {
+                let (r, add) = haar_target(self.pcount, u, l);
+                let v = if add { self.held } else { -self.held };
+                self.regs[r] = wrap(self.regs[r].wrapping_add(v), p.width);
+            }
+        }
+        self.primed |= valid;
+        self.pcount += 1;
+        true
+    }
+
+    /// Runs many pulses: pulse i reads ROM address (`first_address` + i) mod L. Same result
+    /// as calling [`TransactionModel::pulse`] for each, faster (see the module notes).
+    /// Fails if the ROM's depth or width does not match the parameters (Fourier).
+    pub fn run(
+        &mut self,
+        detections: &[Option<u32>],
+        rom: Option<&RomImage>,
+        first_address: u64,
+    ) -> Result<(), PixelError> {
+        if self.params.mode == Mode::Haar {
+            for &d in detections {
+                self.pulse_haar(d);
+            }
+            return Ok(());
+        }
+        let rom = check_rom(&self.params, rom)?;
+        let r = self.regs.len();
+        let nbytes = r.div_ceil(8);
+        let wpe = rom.words_per_entry();
+        let words = rom.words();
+        let depth = rom.depth();
+        let mut addr = (first_address % depth as u64) as usize;
+        // Until the first detection nothing accumulates (the priming rule): step singly.
+        let mut rest = detections;
+        while !self.primed && !rest.is_empty() {
+            self.advance_fourier(rest[0]);
+            rest = &rest[1..];
+            addr += 1;
+            if addr == depth {
+                addr = 0;
+            }
+        }
+        // Two table sets, for even and odd pulses: consecutive pulses often share a ROM byte,
+        // and alternating sets halves the store-to-load chains on one cell.
+        let mut tables = std::mem::take(&mut self.tables);
+        tables.clear();
+        tables.resize(2 * nbytes, [0; 256]);
+        let (even, odd) = tables.split_at_mut(nbytes);
+        let (f, s, t, z) = (
+            self.params.frac_bits,
+            self.params.shift,
+            self.params.tdc_bits,
+            self.params.zoom,
+        );
+        let (mut x, mut held) = (self.x, self.held);
+        for (i, &det) in rest.iter().enumerate() {
+            x = prefilter_step(x, held, f, s);
+            held = match det {
+                Some(code) => zoomed(code, t, z),
+                None => held,
+            };
+            let set = if i & 1 == 0 { &mut *even } else { &mut *odd };
+            if wpe == 1 {
+                // R ≤ 64 (B ≤ 32): one word per entry, the common case.
+                let mut word = words[addr];
+                for table in set.iter_mut() {
+                    let cell = &mut table[(word & 0xff) as usize];
+                    *cell = cell.wrapping_add(x);
+                    word >>= 8;
+                }
+            } else {
+                let entry = &words[addr * wpe..addr * wpe + wpe];
+                for (j, table) in set.iter_mut().enumerate() {
+                    let byte = (entry[j / 8] >> ((j % 8) * 8)) as u8;
+                    let cell = &mut table[byte as usize];
+                    *cell = cell.wrapping_add(x);
+                }
+            }
+            addr += 1;
+            if addr == depth {
+                addr = 0;
+            }
+        }
+        self.x = x;
+        self.held = held;
+        for j in 0..nbytes {
+            let (a, b) = tables.split_at_mut(nbytes);
+            for (ca, cb) in a[j].iter_mut().zip(b[j].iter_mut()) {
+                *ca = ca.wrapping_add(std::mem::take(cb));
+            }
+        }
+        tables.truncate(nbytes);
+        self.pcount += detections.len() as u64;
+        // Distribute: the pulses whose ROM byte j had value v added ±(their x sum) to the
+        // eight registers of that byte, with the sign of each bit of v.
+        let w = self.params.width;
+        for (j, table) in tables.iter_mut().enumerate() {
+            for (v, cell) in table.iter_mut().enumerate() {
+                let h = std::mem::take(cell);
+                if h == 0 {
+                    continue;
+                }
+                for b in 0..8 {
+                    let reg = 8 * j + b;
+                    if reg >= r {
+                        break;
+                    }
+                    let s = if (v >> b) & 1 == 1 {
+                        h
+                    } else {
+                        h.wrapping_neg()
+                    };
+                    self.regs[reg] = self.regs[reg].wrapping_add(s);
+                }
+            }
+        }
+        for y in &mut self.regs {
+            *y = wrap(*y, w);
+        }
+        self.tables = tables;
+        Ok(())
+    }
+
+    /// Reads the frame out and clears the registers and the frame counters. The depth
+    /// tracking (`primed`, held, x) continues across frames, as in the hardware.
+    pub fn readout(&mut self) -> Readout {
+        let words = self.regs.clone();
+        self.regs.iter_mut().for_each(|y| *y = 0);
+        let refused = std::mem::take(&mut self.refused);
+        self.pcount = 0;
+        Readout { words, refused }
+    }
+
+    /// Runs whole frames the way the reference sequencer drives them: frame after frame of
+    /// N pulses, pulse n of a frame reading ROM address n mod L, a readout after each.
+    pub fn run_frames(
+        &mut self,
+        stimuli: &[Option<u32>],
+        rom: Option<&RomImage>,
+    ) -> Result<Vec<Readout>, PixelError> {
+        let n = frame_len(&self.params, stimuli.len())?;
+        let mut out = Vec::with_capacity(stimuli.len() / n.max(1));
+        for frame in stimuli.chunks(n) {
+            self.run(frame, rom, 0)?;
+            out.push(self.readout());
+        }
+        Ok(out)
+    }
+}
+
+/// Checks that `rom` is there and fits (Fourier mode) and returns it.
+pub(crate) fn check_rom<'a>(
+    params: &PixelParams,
+    rom: Option<&'a RomImage>,
+) -> Result<&'a RomImage, PixelError> {
+    let rom = rom.ok_or_else(|| PixelError::mismatch("ROM", "none", "a ROM in Fourier mode"))?;
+    if rom.registers() < params.registers() {
+        return Err(PixelError::mismatch(
+            "ROM bits per entry",
+            rom.registers(),
+            format!("at least R = {}", params.registers()),
+        ));
+    }
+    if rom.depth() != params.rom_depth {
+        return Err(PixelError::mismatch(
+            "ROM depth",
+            rom.depth(),
+            format!("L = {}", params.rom_depth),
+        ));
+    }
+    Ok(rom)
+}
+
+/// N as a usize, checking that the stimuli are whole frames.
+pub(crate) fn frame_len(params: &PixelParams, len: usize) -> Result<usize, PixelError> {
+    let n = usize::try_from(params.frame_pulses)
+        .map_err(|_| PixelError::mismatch("frame length", params.frame_pulses, "N ≤ usize::MAX"))?;
+    if !len.is_multiple_of(n) {
+        return Err(PixelError::mismatch(
+            "stimulus length",
+            len,
+            format!("a whole number of frames of N = {n} pulses"),
+        ));
+    }
+    Ok(n)
+}

