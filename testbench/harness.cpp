@@ -294,7 +294,14 @@ int main(int argc, char** argv) {
             }
         }
         // Register writes made at this edge.
-        if (we != 0 || full) {
+        if (!full) {
+            // Hot path of long runs: fold the writes straight into the digest.
+            for (uint64_t m = we; m != 0; m &= m - 1) {
+                const uint32_t r = static_cast<uint32_t>(__builtin_ctzll(m));
+                dh = fold(dh, 1, c, r, static_cast<uint64_t>(PIX_Y[r]));
+                ++dcount;
+            }
+        } else {
             act_w.clear();
             for (uint64_t m = we; m != 0; m &= m - 1) {
                 uint32_t r = static_cast<uint32_t>(__builtin_ctzll(m));
@@ -303,7 +310,7 @@ int main(int argc, char** argv) {
                 dh = fold(dh, 1, c, r, v);
                 ++dcount;
             }
-            if (full) {
+            {
                 exp_w.clear();
                 while (tp < trace.size() && trace[tp].cycle == c) {
                     exp_w.push_back({trace[tp].reg, trace[tp].value});

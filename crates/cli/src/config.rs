@@ -8,6 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
+use tofprobe_pixel::{PixelContext, PixelParams};
 use tofprobe_scene::{AcquisitionConfig, PhotonSource, Scene, SceneConfig, SensorConfig};
 
 use crate::error::CliError;
@@ -18,6 +19,11 @@ pub const DEFAULT_TOML: &str = include_str!("../../../scenes/default.toml");
 
 /// Name used in messages for the embedded default.
 pub const DEFAULT_ORIGIN: &str = "<embedded default>";
+
+/// Jitter σ on each side of the scene's depth range that `width = "auto"` sizes for
+/// (a detection beyond 6σ has probability 2·10^−9, and the sizing already assumes every
+/// sample at the extreme code, which a real record's sum is far from).
+pub const SIZING_SIGMAS: f64 = 6.0;
 
 /// The configuration document.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -62,20 +68,70 @@ impl Config {
             Some(p) => (read_text(p)?, p.display().to_string()),
         };
         let config = Config::from_toml_str(&text, &origin)?;
-        config.validate().map_err(|source| CliError::Scene {
-            origin: origin.clone(),
-            source,
-        })?;
+        config.validate(&origin)?;
         Ok(Loaded { config, origin })
     }
 
-    /// Validates every section and their consistency (the window must contain the scene).
-    pub fn validate(&self) -> Result<(), tofprobe_scene::SceneError> {
-        self.sensor.validate()?;
-        let scene = Scene::new(&self.scene)?;
-        self.acquisition.validate(self.sensor.laser_rate_hz)?;
-        PhotonSource::new(&self.sensor, &scene, self.acquisition.seed)?;
+    /// Validates every section and their consistency (the window must contain the scene,
+    /// `[probe]` must be a valid design, `[pixel]` must resolve against the sensor, the
+    /// acquisition and the scene); `origin` names the file in the error.
+    pub fn validate(&self, origin: &str) -> Result<(), CliError> {
+        let scene_err = |source| CliError::Scene {
+            origin: origin.to_string(),
+            source,
+        };
+        self.sensor.validate().map_err(scene_err)?;
+        let scene = Scene::new(&self.scene).map_err(scene_err)?;
+        self.acquisition
+            .validate(self.sensor.laser_rate_hz)
+            .map_err(scene_err)?;
+        PhotonSource::new(&self.sensor, &scene, self.acquisition.seed).map_err(scene_err)?;
+        self.probe.validate().map_err(|source| CliError::Probe {
+            origin: origin.to_string(),
+            source,
+        })?;
+        self.pixel_params().map_err(|source| CliError::Pixel {
+            origin: origin.to_string(),
+            source,
+        })?;
         Ok(())
+    }
+
+    /// What the sensor, acquisition, probe design and scene tell the pixel: window codes,
+    /// laser rate, N, the scene's tones, the OSR and the codes its detections can take
+    /// (±[`SIZING_SIGMAS`] σ of jitter around its depth range; the whole window with
+    /// background photons).
+    pub fn pixel_context(&self) -> PixelContext {
+        let s = &self.sensor;
+        let ctx = PixelContext::from_sensor(s, self.pulses());
+        let Ok(scene) = Scene::new(&self.scene) else {
+            return ctx;
+        };
+        let (lo, hi) = scene.depth_range_mm();
+        let codes = tofprobe_pixel::sizing::scene_code_range(
+            lo,
+            hi,
+            s.jitter_mm(),
+            SIZING_SIGMAS,
+            s.window_start_mm(),
+            s.tdc_lsb_mm(),
+            s.tdc_codes(),
+            s.background_rate > 0.0,
+        );
+        ctx.with_scene(scene.tones(), self.probe.osr, codes)
+    }
+
+    /// The resolved `[pixel]`: its ROM depth defaults to the `[probe]` design's (L = N in
+    /// windowed mode, `probe.rom_depth` in periodic mode), so the pixel reads the ROM the
+    /// probe design generates.
+    pub fn pixel_params(&self) -> Result<PixelParams, tofprobe_pixel::PixelError> {
+        let ctx = self.pixel_context();
+        let mut px = self.pixel.clone();
+        if px.rom_depth.is_none() {
+            let n = px.frame_pulses.unwrap_or(ctx.pulses);
+            px.rom_depth = Some(self.probe.depth(n));
+        }
+        px.resolve(&ctx)
     }
 
     /// The number of pulses N of the acquisition.

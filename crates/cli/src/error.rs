@@ -50,6 +50,31 @@ pub enum CliError {
         /// What is wrong.
         source: tofprobe_scene::SceneError,
     },
+    /// The `[pixel]` section cannot be built (the message names the key, the reason and
+    /// the nearest valid value).
+    #[error("in configuration `{origin}`: [pixel]: {source}")]
+    Pixel {
+        /// The file name, or `<embedded default>`.
+        origin: String,
+        /// What is wrong.
+        source: tofprobe_pixel::PixelError,
+    },
+    /// The `[probe]` section or the probe ROM cannot be built.
+    #[error("in configuration `{origin}`: [probe]: {source}")]
+    Probe {
+        /// The file name, or `<embedded default>`.
+        origin: String,
+        /// What is wrong.
+        source: tofprobe_dsp::DspError,
+    },
+    /// An output file cannot be written.
+    #[error("cannot write `{path}`: {message}")]
+    Output {
+        /// The output path.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
     /// A command-line option out of range.
     #[error("--{option} = {value} is out of range: allowed {allowed}")]
     Option {

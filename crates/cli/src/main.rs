@@ -5,6 +5,7 @@ mod commands;
 mod config;
 mod error;
 mod paper;
+mod tradeoff;
 
 use std::process::ExitCode;
 

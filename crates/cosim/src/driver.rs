@@ -38,6 +38,9 @@ pub struct CosimOptions {
     pub profile: BuildProfile,
     /// Also time the bare Verilator model (no checking) for the overhead figure.
     pub measure_bare: bool,
+    /// Compare digests only (no full trace) even on a short run: exercises the long-frame
+    /// path, whose first digest mismatch is re-run with that window's full trace.
+    pub digest_only: bool,
     /// Per-pulse detections to replay (e.g. from the scene); `None` = random from `seed`.
     pub stimulus: Option<Vec<Option<u32>>>,
 }
@@ -57,6 +60,7 @@ impl CosimOptions {
             profile: BuildProfile::Check,
             measure_bare: false,
             stimulus: None,
+            digest_only: false,
         }
     }
 }
@@ -108,7 +112,10 @@ pub fn rom_from_rtl(p: &PixelParams, dir: &Path) -> Result<Vec<u64>, CosimError>
     let hex_path = dir.join(format!("{rom_name}.hex"));
     if hex_path.is_file() {
         let text = std::fs::read_to_string(&hex_path).map_err(|e| CosimError::io(&hex_path, e))?;
-        let lines = text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with("//"));
+        let lines = text
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty() && !l.starts_with("//"));
         for (a, l) in lines.enumerate() {
             put(&mut rom, a, l);
         }
@@ -118,8 +125,14 @@ pub fn rom_from_rtl(p: &PixelParams, dir: &Path) -> Result<Vec<u64>, CosimError>
     let text = std::fs::read_to_string(&v_path).map_err(|e| CosimError::io(&v_path, e))?;
     for l in text.lines() {
         // `  6'd12: word = 32'h0f0f0f0f;`
-        let Some((lhs, rhs)) = l.split_once(": word = ") else { continue };
-        let Some(addr) = lhs.split("'d").nth(1).and_then(|a| a.trim().parse::<usize>().ok()) else {
+        let Some((lhs, rhs)) = l.split_once(": word = ") else {
+            continue;
+        };
+        let Some(addr) = lhs
+            .split("'d")
+            .nth(1)
+            .and_then(|a| a.trim().parse::<usize>().ok())
+        else {
             continue;
         };
         if let Some(h) = rhs.split("'h").nth(1) {
@@ -154,10 +167,13 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         });
     }
     std::fs::create_dir_all(&o.work_dir).map_err(|e| CosimError::io(&o.work_dir, e))?;
+    // Absolute: the harness runs from the RTL directory (for `$readmemh`).
+    let work_dir =
+        std::fs::canonicalize(&o.work_dir).map_err(|e| CosimError::io(&o.work_dir, e))?;
     let rtl_dir = match &o.rtl_dir {
         Some(d) => d.clone(),
         None => {
-            let d = o.work_dir.join("rtl");
+            let d = work_dir.join("rtl");
             render_into(p, &d, o.mutation)?;
             d
         }
@@ -173,31 +189,34 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         frames: o.frames,
         seed: o.seed,
         digest_pulses: o.digest_pulses,
-        trace_window: None,
+        trace_window: o.digest_only.then_some((0, 0)),
     };
     let t0 = Instant::now();
     let (golden, window) = golden_run(p, &stim, &rom, &vopts);
     let model_seconds = t0.elapsed().as_secs_f64();
-    let vec_dir = o.work_dir.join("vectors");
+    let vec_dir = work_dir.join("vectors");
     write_vectors(&vec_dir, p, &stim, &rom, &golden, window, &vopts)?;
     let vec_dir = std::fs::canonicalize(&vec_dir).map_err(|e| CosimError::io(&vec_dir, e))?;
     let (_, _, top) = module_names(p);
     let build = verilator::build(&rtl_dir, &top, false, o.profile)?;
     let outcome = harness::run(&build.exe, &rtl_dir, &vec_dir, None, None)?;
     let mut first = outcome.first.clone();
-    if first.is_none()
-        && let Some(d) = outcome.digest
-    {
-        // Only a digest differed: regenerate that window's full trace and replay it.
+    if let Some(d) = outcome.digest {
+        // A digest differed: regenerate that window's full trace and replay it; the earlier
+        // of its first mismatch and any other reported one (e.g. a readout word) wins.
         let wopts = VectorOptions {
             trace_window: Some((d.cycle_from, d.cycle_to)),
             ..vopts.clone()
         };
         let (gw, ww) = golden_run(p, &stim, &rom, &wopts);
-        let wdir = o.work_dir.join("vectors-window");
+        let wdir = work_dir.join("vectors-window");
         write_vectors(&wdir, p, &stim, &rom, &gw, ww, &wopts)?;
         let wdir = std::fs::canonicalize(&wdir).map_err(|e| CosimError::io(&wdir, e))?;
-        first = harness::run(&build.exe, &rtl_dir, &wdir, Some(ww), None)?.first;
+        let refined = harness::run(&build.exe, &rtl_dir, &wdir, Some(ww), None)?.first;
+        first = match (first, refined) {
+            (Some(a), Some(b)) => Some(if b.cycle <= a.cycle { b } else { a }),
+            (a, b) => b.or(a),
+        };
     }
     let pass = outcome.mismatches == 0 && outcome.frames == o.frames && first.is_none();
     let mut vcd = None;
@@ -207,7 +226,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
             None => (0, golden.cycles.min(100_000)),
         };
         let tb = verilator::build(&rtl_dir, &top, true, o.profile)?;
-        let f = o.work_dir.join("cosim.vcd");
+        let f = work_dir.join("cosim.vcd");
         harness::run(&tb.exe, &rtl_dir, &vec_dir, None, Some((&f, lo, hi)))?;
         vcd = Some(f);
     }

@@ -19,7 +19,9 @@ pub enum CosimError {
     #[error("{tool} ended without its completion line; its output:\n{output}")]
     NoCompletion { tool: &'static str, output: String },
     /// The configuration does not fit the harness.
-    #[error("registers = {value} is out of range for co-simulation: allowed 1..=64 (the harness watches a 64-bit write-enable vector)")]
+    #[error(
+        "registers = {value} is out of range for co-simulation: allowed 1..=64 (the harness watches a 64-bit write-enable vector)"
+    )]
     TooManyRegisters { value: usize },
     /// Rendering or vector generation failed.
     #[error(transparent)]

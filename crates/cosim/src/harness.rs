@@ -98,7 +98,9 @@ pub fn run(
         cmd.args(["--window", &lo.to_string(), &hi.to_string()]);
     }
     if let Some((f, lo, hi)) = vcd {
-        cmd.arg("--vcd").arg(f).args([lo.to_string(), hi.to_string()]);
+        cmd.arg("--vcd")
+            .arg(f)
+            .args([lo.to_string(), hi.to_string()]);
     }
     let out = cmd.output().map_err(|e| CosimError::io(exe, e))?;
     parse_output(

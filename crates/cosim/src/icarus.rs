@@ -11,7 +11,12 @@ pub const TB_V: &str = include_str!("../../../testbench/tb.v");
 
 /// Compiles `tb.v` with the RTL of `rtl_dir` and the vectors of `vec_dir` (which holds
 /// `tb_params.vh`), runs it from `rtl_dir`, and parses its completion line.
-pub fn run(rtl_dir: &Path, vec_dir: &Path, top: &str, work: &Path) -> Result<RunOutcome, CosimError> {
+pub fn run(
+    rtl_dir: &Path,
+    vec_dir: &Path,
+    top: &str,
+    work: &Path,
+) -> Result<RunOutcome, CosimError> {
     let iverilog = require("iverilog")?;
     let vvp = require("vvp")?;
     std::fs::create_dir_all(work).map_err(|e| CosimError::io(work, e))?;

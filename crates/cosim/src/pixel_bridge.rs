@@ -64,7 +64,8 @@ pub fn compare_models(
     let pp = to_pixel(p);
     let words = p.registers().div_ceil(64);
     let image = RomImage::from_fn(p.rom_depth, p.registers(), |a, r| {
-        rom.get(a * words + r / 64).is_some_and(|w| (w >> (r % 64)) & 1 == 1)
+        rom.get(a * words + r / 64)
+            .is_some_and(|w| (w >> (r % 64)) & 1 == 1)
     });
     let pulses = (frames * p.frame_pulses) as usize;
     let stim = &stim[..pulses];
@@ -80,7 +81,12 @@ pub fn compare_models(
         if (pin.rst, pin.pulse, pin.valid, pin.tdc, pin.readout)
             != (mine.rst, mine.pulse, mine.valid, mine.tdc, mine.readout)
         {
-            return Ok(Some((c, "sequencer pins".into(), format!("{pin:?}"), format!("{mine:?}"))));
+            return Ok(Some((
+                c,
+                "sequencer pins".into(),
+                format!("{pin:?}"),
+                format!("{mine:?}"),
+            )));
         }
         let a = theirs.step(&pin);
         let b = ours.step(&mine);
@@ -96,9 +102,18 @@ pub fn compare_models(
         if c >= 1 && (pa != pb || a.rd_data != b.rd_data) {
             return Ok(Some((c, "pins".into(), format!("{a:?}"), format!("{b:?}"))));
         }
-        let wa: Vec<(u32, u64)> = theirs.writes().iter().map(|w| (w.register, w.value)).collect();
+        let wa: Vec<(u32, u64)> = theirs
+            .writes()
+            .iter()
+            .map(|w| (w.register, w.value))
+            .collect();
         if wa != ours.writes() {
-            return Ok(Some((c, "writes".into(), format!("{wa:x?}"), format!("{:x?}", ours.writes()))));
+            return Ok(Some((
+                c,
+                "writes".into(),
+                format!("{wa:x?}"),
+                format!("{:x?}", ours.writes()),
+            )));
         }
     }
     Ok(None)

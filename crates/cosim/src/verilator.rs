@@ -75,7 +75,11 @@ pub fn build(
     key.extend_from_slice(HARNESS_CPP.as_bytes());
     key.extend_from_slice(format!("{top} {trace} {profile:?} {VERILATOR_FLAGS:?}").as_bytes());
     for s in &sources {
-        key.extend_from_slice(s.file_name().map(|n| n.as_encoded_bytes()).unwrap_or_default());
+        key.extend_from_slice(
+            s.file_name()
+                .map(|n| n.as_encoded_bytes())
+                .unwrap_or_default(),
+        );
         key.extend_from_slice(&std::fs::read(s).map_err(|e| CosimError::io(s, e))?);
     }
     let hash = format!("{:016x}", fnv1a64(&key));
@@ -99,7 +103,11 @@ pub fn build(
          #define TOP_HEADER \"Vtop.h\"\n#define TOP_ROOT_HEADER \"Vtop___024root.h\"\n\
          #define TOP_CLASS Vtop\n#define PIX_WE (top->rootp->{pre}we)\n\
          #define PIX_Y (top->rootp->{pre}y)\n{}",
-        if trace { "#define TOFPROBE_TRACE 1\n" } else { "" }
+        if trace {
+            "#define TOFPROBE_TRACE 1\n"
+        } else {
+            ""
+        }
     );
     let cfg_path = tmp.join("tofprobe_harness_config.h");
     std::fs::write(&cfg_path, config).map_err(|e| CosimError::io(&cfg_path, e))?;

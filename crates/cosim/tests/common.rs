@@ -28,9 +28,10 @@ pub fn work_dir(name: &str) -> PathBuf {
 
 /// The default configuration with a short frame (CI-sized).
 pub fn short_default(mode: Mode) -> PixelParams {
-    let mut p = PixelParams::default();
-    p.mode = mode;
-    p.frame_pulses = 128;
-    p.rom_depth = 128;
-    p
+    PixelParams {
+        mode,
+        frame_pulses: 128,
+        rom_depth: 128,
+        ..PixelParams::default()
+    }
 }

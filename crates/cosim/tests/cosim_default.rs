@@ -4,7 +4,7 @@
 mod common;
 use common::*;
 use tofprobe_cosim::{CosimOptions, cosim};
-use tofprobe_rtlgen::params::Mode;
+use tofprobe_rtlgen::params::{Mode, PixelParams};
 
 #[test]
 fn default_fourier_and_haar_pass_in_verilator() {
@@ -23,4 +23,39 @@ fn default_fourier_and_haar_pass_in_verilator() {
         assert_eq!(r.outcome.cycles, c);
         assert_eq!(r.outcome.frames, 3);
     }
+}
+
+/// `--rtl DIR`: the committed short-frame default RTL co-simulates clean, and a second run
+/// reuses the cached Verilator build instead of re-verilating.
+#[test]
+fn committed_rtl_dir_passes_and_the_build_is_reused() {
+    if !tools_or_skip(
+        &["verilator"],
+        "committed_rtl_dir_passes_and_the_build_is_reused",
+    ) {
+        return;
+    }
+    let rtl =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testbench/default-short/rtl");
+    let p = PixelParams {
+        frame_pulses: 64,
+        rom_depth: 64,
+        ..PixelParams::default()
+    };
+    // The committed RTL records T, F and W resolved from the embedded default scene.
+    let p = PixelParams {
+        tdc_bits: 7,
+        frac_bits: 8,
+        width: 39,
+        ..p
+    };
+    let mut o = CosimOptions::new(work_dir("rtl-dir"));
+    o.rtl_dir = Some(rtl);
+    o.frames = 2;
+    let first = cosim(&p, &o).expect("runs");
+    assert!(first.pass, "{:?}", first.first);
+    let second = cosim(&p, &o).expect("runs again");
+    assert!(second.pass);
+    assert!(second.build.reused, "the second run re-verilated");
+    assert_eq!(first.build.exe, second.build.exe);
 }

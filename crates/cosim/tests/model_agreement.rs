@@ -11,13 +11,21 @@ fn check(p: &PixelParams, frames: u64, seed: u64) {
     let stim = random_stimulus(p, frames * p.frame_pulses, seed);
     let rom = sign_probe_rom(p);
     let d = compare_models(p, &stim, &rom, frames).expect("both models accept the configuration");
-    assert!(d.is_none(), "{p:?}: first difference (cycle, what, pixel crate, reference) {d:?}");
+    assert!(
+        d.is_none(),
+        "{p:?}: first difference (cycle, what, pixel crate, reference) {d:?}"
+    );
 }
 
 #[test]
 fn default_both_modes_agree() {
     for mode in [Mode::Fourier, Mode::Haar] {
-        let p = PixelParams { mode, frame_pulses: 256, rom_depth: 256, ..PixelParams::default() };
+        let p = PixelParams {
+            mode,
+            frame_pulses: 256,
+            rom_depth: 256,
+            ..PixelParams::default()
+        };
         check(&p, 3, 11);
     }
 }

@@ -57,9 +57,52 @@ fn every_fault_is_caught_at_its_first_cycle() {
         o.vcd_on_mismatch = false;
         let r = cosim(&p, &o).expect("mutated co-simulation runs");
         assert!(!r.pass, "{fault:?} was not caught");
-        let m = r.first.unwrap_or_else(|| panic!("{fault:?}: no first mismatch reported"));
-        assert_eq!(m.cycle, cycle, "{fault:?}: reported {m:?}, the model says cycle {cycle}");
+        let m = r
+            .first
+            .unwrap_or_else(|| panic!("{fault:?}: no first mismatch reported"));
+        assert_eq!(
+            m.cycle, cycle,
+            "{fault:?}: reported {m:?}, the model says cycle {cycle}"
+        );
         assert_eq!(m.pulse, pulse, "{fault:?}: pulse index");
-        eprintln!("{fault:?}: caught at cycle {} (pulse {}): {} expected {} actual {}", m.cycle, m.pulse, m.signal, m.expected, m.actual);
+        eprintln!(
+            "{fault:?}: caught at cycle {} (pulse {}): {} expected {} actual {}",
+            m.cycle, m.pulse, m.signal, m.expected, m.actual
+        );
     }
+}
+
+/// The long-frame path: with digests only (4 pulses per window), a fault is still pinned to
+/// its first cycle by re-running the first differing window with its full trace.
+#[test]
+fn digest_mismatch_is_refined_to_the_first_cycle() {
+    if !tools_or_skip(
+        &["verilator"],
+        "digest_mismatch_is_refined_to_the_first_cycle",
+    ) {
+        return;
+    }
+    let p = config();
+    let (seed, frames) = (7, 2);
+    let stim = random_stimulus(&p, frames * p.frame_pulses, seed);
+    let fault = Fault::LogicalShift;
+    let (cycle, pulse) =
+        first_divergence(&p, &stim, &sign_probe_rom(&p), frames, fault).expect("shows");
+    let mut o = CosimOptions::new(work_dir("mutation-digest"));
+    o.frames = frames;
+    o.seed = seed;
+    o.mutation = Some(fault);
+    o.vcd_on_mismatch = false;
+    o.digest_only = true;
+    o.digest_pulses = 4;
+    let r = cosim(&p, &o).expect("runs");
+    assert!(!r.pass);
+    let d = r.outcome.digest.expect("a digest window differs");
+    assert_eq!(
+        d.first_pulse,
+        pulse / 4 * 4,
+        "window of the first divergence"
+    );
+    let m = r.first.expect("refined to a cycle");
+    assert_eq!((m.cycle, m.pulse), (cycle, pulse), "{m:?}");
 }

@@ -7,9 +7,34 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::autobins::choose_bins;
 use crate::error::PixelError;
 use crate::params::{MAX_WIDTH, Mode, PixelParams, ceil_log2};
 use crate::sizing;
+
+/// The keyword `"auto"` of a `[pixel]` key that can be chosen from the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AutoWord {
+    /// Chosen from the scene.
+    Auto,
+}
+
+/// A `[pixel]` value given explicitly (`bins = 16`) or chosen from the scene
+/// (`bins = "auto"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Choice<T> {
+    /// An explicit value.
+    Value(T),
+    /// `"auto"`: chosen from the scene.
+    Auto(AutoWord),
+}
+
+impl<T> Choice<T> {
+    /// The keyword form.
+    pub const AUTO: Choice<T> = Choice::Auto(AutoWord::Auto);
+}
 
 /// The `[pixel]` section as written in a scene file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -17,8 +42,9 @@ use crate::sizing;
 pub struct PixelConfig {
     /// `"fourier"` (default) or `"haar"`.
     pub mode: Mode,
-    /// B: Fourier bins (default 16).
-    pub bins: usize,
+    /// B: Fourier bins (default 16), or `"auto"`: the scene's in-band tones plus
+    /// [`crate::autobins::AUTO_NOISE_BINS`] noise bins.
+    pub bins: Choice<usize>,
     /// Bin frequencies in Hz, one per bin; empty (default) = chosen from the scene by the
     /// probe design.
     pub frequencies_hz: Vec<f64>,
@@ -36,8 +62,9 @@ pub struct PixelConfig {
     pub shift: u32,
     /// F: prefilter fraction bits (default [`crate::DEFAULT_FRAC_BITS`]).
     pub frac_bits: u32,
-    /// W: register width in bits; default: the width the sizing requires.
-    pub width: Option<u32>,
+    /// W: register width in bits; default: what the whole timing window needs (safe with
+    /// any background); `"auto"`: what the scene's code range needs.
+    pub width: Option<Choice<u32>>,
     /// N: pulses per frame; default: the whole acquisition.
     pub frame_pulses: Option<u64>,
     /// L: ROM depth in entries; default N.
@@ -48,7 +75,7 @@ impl Default for PixelConfig {
     fn default() -> Self {
         PixelConfig {
             mode: Mode::Fourier,
-            bins: 16,
+            bins: Choice::Value(16),
             frequencies_hz: Vec::new(),
             haar_scales: 4,
             adders: 2,
@@ -64,6 +91,9 @@ impl Default for PixelConfig {
     }
 }
 
+/// The ΣΔ OSR assumed when the context does not name one (the default `[probe]`).
+pub const DEFAULT_OSR: f64 = 32.0;
+
 /// What the rest of the configuration tells the pixel: the sensor's window and rate, the
 /// acquisition length and, if known, the codes the depth can take.
 #[derive(Debug, Clone, PartialEq)]
@@ -74,9 +104,13 @@ pub struct PixelContext {
     pub laser_rate_hz: f64,
     /// Pulses in the acquisition (the default frame length).
     pub pulses: u64,
-    /// Codes the detections can take, inclusive; `None` = the whole window (the safe
-    /// choice whenever background photons or jitter tails can land anywhere).
+    /// Codes the detections can take, inclusive, for `width = "auto"`; `None` = unknown
+    /// (then `"auto"` is refused: it needs the scene).
     pub code_range: Option<(u32, u32)>,
+    /// The scene's tones (frequency Hz, amplitude mm), for `bins = "auto"`.
+    pub tones: Vec<(f64, f64)>,
+    /// The ΣΔ oversampling ratio: auto bins lie below f_s/(2·OSR).
+    pub osr: f64,
 }
 
 impl PixelConfig {
@@ -108,12 +142,25 @@ impl PixelConfig {
             Some(l) => l,
             None => usize::try_from(frame_pulses).unwrap_or(usize::MAX),
         };
+        let bins = match self.bins {
+            Choice::Value(b) => b,
+            Choice::Auto(_) if self.mode == Mode::Haar => 1,
+            Choice::Auto(_) => choose_bins(
+                &ctx.tones,
+                ctx.laser_rate_hz,
+                rom_depth as u64,
+                ctx.osr,
+                None,
+            )?
+            .all()
+            .len(),
+        };
         if self.mode == Mode::Fourier && !self.frequencies_hz.is_empty() {
-            if self.frequencies_hz.len() != self.bins {
+            if self.frequencies_hz.len() != bins {
                 return Err(PixelError::invalid(
                     "frequencies_hz",
                     format!("{} frequencies", self.frequencies_hz.len()),
-                    format!("one frequency per bin (bins = {})", self.bins),
+                    format!("one frequency per bin (bins = {bins})"),
                     format!("bins = {}", self.frequencies_hz.len()),
                 ));
             }
@@ -135,7 +182,7 @@ impl PixelConfig {
         }
         let mut params = PixelParams {
             mode: self.mode,
-            bins: self.bins,
+            bins,
             haar_scales: self.haar_scales,
             adders: self.adders,
             cycles_per_pulse: self.cycles_per_pulse,
@@ -149,7 +196,17 @@ impl PixelConfig {
         };
         // Everything but the width first, so the sizing below sees valid parameters.
         params.validate()?;
-        let (lo, hi) = ctx.code_range.unwrap_or((0, ctx.tdc_codes - 1));
+        let (lo, hi) = match self.width {
+            Some(Choice::Auto(_)) => ctx.code_range.ok_or_else(|| {
+                PixelError::invalid(
+                    "width",
+                    "auto",
+                    "sizing W from the scene needs the scene's code range",
+                    "an explicit width, or leave it out to size for the whole window",
+                )
+            })?,
+            _ => (0, ctx.tdc_codes - 1),
+        };
         let needed = sizing::required_width(&params, lo, hi, None);
         if needed > MAX_WIDTH {
             return Err(PixelError::invalid(
@@ -162,8 +219,8 @@ impl PixelConfig {
             ));
         }
         params.width = match self.width {
-            None => needed,
-            Some(w) if w < needed => {
+            None | Some(Choice::Auto(_)) => needed,
+            Some(Choice::Value(w)) if w < needed => {
                 return Err(PixelError::invalid(
                     "width",
                     w,
@@ -174,7 +231,7 @@ impl PixelConfig {
                     needed,
                 ));
             }
-            Some(w) => w,
+            Some(Choice::Value(w)) => w,
         };
         params.validate()?;
         Ok(params)
@@ -191,6 +248,100 @@ impl PixelContext {
             laser_rate_hz: sensor.laser_rate_hz,
             pulses,
             code_range: None,
+            tones: Vec::new(),
+            osr: DEFAULT_OSR,
         }
+    }
+
+    /// Adds what the scene tells: its tones, the ΣΔ OSR and the codes its detections can
+    /// take (for `bins = "auto"` and `width = "auto"`).
+    pub fn with_scene(mut self, tones: Vec<(f64, f64)>, osr: f64, codes: (u32, u32)) -> Self {
+        self.tones = tones;
+        self.osr = osr;
+        self.code_range = Some(codes);
+        self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ctx() -> PixelContext {
+        PixelContext {
+            tdc_codes: 80,
+            laser_rate_hz: 10e6,
+            pulses: 10_000_000,
+            code_range: None,
+            tones: Vec::new(),
+            osr: DEFAULT_OSR,
+        }
+    }
+
+    /// `"auto"` parses for bins and width; explicit values still do; anything else is a
+    /// parse error.
+    #[test]
+    fn auto_and_explicit_values_parse() {
+        let c: PixelConfig = toml::from_str("bins = \"auto\"\nwidth = \"auto\"").unwrap();
+        assert_eq!((c.bins, c.width), (Choice::AUTO, Some(Choice::AUTO)));
+        let c: PixelConfig = toml::from_str("bins = 8\nwidth = 40").unwrap();
+        assert_eq!(
+            (c.bins, c.width),
+            (Choice::Value(8), Some(Choice::Value(40)))
+        );
+        assert!(toml::from_str::<PixelConfig>("bins = \"many\"").is_err());
+        assert!(toml::from_str::<PixelConfig>("width = -3").is_err());
+    }
+
+    /// Fig. 8's tone (4.5 kHz, 30 mm ± 0.1 mm, no background) with σ = 0.75 mm: auto bins
+    /// are the tone plus 4 noise bins; auto width sizes codes 35..44 (±4σ at 0.75 mm)
+    /// instead of 0..79: 10^7·44·256 = 1.13·10^11 < 2^37 → 38 bits, one less than the
+    /// whole window's 39 (10^7·79·256 = 2.02·10^11 > 2^37).
+    #[test]
+    fn auto_bins_and_width_from_the_scene() {
+        let codes = crate::sizing::scene_code_range(29.9, 30.1, 0.75, 4.0, 0.0, 0.75, 80, false);
+        assert_eq!(codes, (35, 44));
+        let ctx = ctx().with_scene(vec![(4500.0, 0.1)], 32.0, codes);
+        let c = PixelConfig {
+            bins: Choice::AUTO,
+            cycles_per_pulse: 16,
+            width: Some(Choice::AUTO),
+            ..PixelConfig::default()
+        };
+        let p = c.resolve(&ctx).unwrap();
+        assert_eq!((p.bins, p.width), (5, 38));
+        let whole = PixelConfig::default().resolve(&ctx).unwrap();
+        assert_eq!(whole.width, 39);
+        // Without the scene, "auto" width is refused with what to do instead.
+        let e = c.resolve(&super::tests::ctx()).unwrap_err().to_string();
+        assert!(
+            e.contains("width = auto") && e.contains("explicit width"),
+            "{e}"
+        );
+    }
+
+    /// N = 2^27 through the sizing: codes 0..79 at F = 8 reach ±2^27·79·256 = ±2.7·10^12
+    /// < 2^42 = 4.4·10^12 → 43 bits; 42 is refused naming 43; 2^50 pulses need more than
+    /// the 63-bit maximum and are refused, never wrapped silently.
+    #[test]
+    fn n_2_27_sizes_and_one_bit_below_is_refused() {
+        let mut ctx = ctx();
+        ctx.pulses = 1 << 27;
+        assert_eq!(PixelConfig::default().resolve(&ctx).unwrap().width, 43);
+        let c = PixelConfig {
+            width: Some(Choice::Value(42)),
+            ..PixelConfig::default()
+        };
+        let e = c.resolve(&ctx).unwrap_err().to_string();
+        assert!(
+            e.contains("pixel.width = 42") && e.contains("nearest valid value: 43"),
+            "{e}"
+        );
+        ctx.pulses = 1 << 50;
+        let e = PixelConfig::default()
+            .resolve(&ctx)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("more than 63"), "{e}");
     }
 }

@@ -21,7 +21,7 @@ pub struct PinsIn<'a> {
     pub valid: bool,
     /// With `pulse` and `valid`: the TDC code (only its low T bits are wired).
     pub tdc: u32,
-    /// Fourier, with `pulse`: the packed ROM word, bit r = 1 adds to Y[r].
+    /// Fourier, with `pulse`: the packed ROM word, bit r = 1 adds to Y\[r\].
     pub rom_word: &'a [u64],
     /// Start the readout-and-clear of the register file.
     pub readout: bool,

@@ -6,8 +6,10 @@
 //! - [`config`]: the `[pixel]` TOML section ([`PixelConfig`]) and its validation;
 //! - [`fixed`]: the fixed-width arithmetic both models share;
 //! - [`sequencer`]: the reference pin sequence the testbench and vectors drive;
-//! - [`sizing`]: register widths, readout bytes and compression from a scene.
+//! - [`sizing`]: register widths, readout bytes and compression from a scene;
+//! - [`spectrum`]: the bit-true spectrum of a scene for `tofprobe simulate`.
 
+pub mod autobins;
 pub mod bench;
 pub mod config;
 pub mod cycle;
@@ -17,10 +19,14 @@ pub mod params;
 pub mod readout;
 pub mod sequencer;
 pub mod sizing;
+pub mod spectrum;
 pub mod transaction;
 
 /// The cycle-level contract between the models and the RTL (docs/pixel-contract.md).
+///
 #[doc = include_str!("../../../docs/pixel-contract.md")]
+// The contract writes x[n] and Y[r] as in the paper; they are not links.
+#[allow(rustdoc::broken_intra_doc_links)]
 pub mod contract {}
 
 pub use config::{PixelConfig, PixelContext};

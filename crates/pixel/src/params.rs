@@ -286,3 +286,33 @@ pub fn ceil_log2(v: u64) -> u32 {
         64 - (v - 1).leading_zeros()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Derived sizes of the default pixels, from the contract's formulas by hand.
+    #[test]
+    fn derived_quantities_of_the_default_pixels() {
+        let p = PixelParams::fourier_default(39, 10_000_000, 10_000_000);
+        p.validate().unwrap();
+        // R = 2·16, P = R, K = ceil(32/2), T+1+F = 7+1+8, ceil(log2(34)) = 6.
+        assert_eq!((p.registers(), p.ops_per_pulse(), p.slots()), (32, 32, 16));
+        assert_eq!((p.operand_bits(), p.rd_index_bits()), (16, 6));
+        let mut h = p.clone();
+        h.mode = Mode::Haar;
+        h.frame_pulses = 1 << 20;
+        h.validate().unwrap();
+        // R = 2^5 − 1, P = U + 1 = 5, K = ceil(5/2) = 3, operand T+1 = 8, ceil(log2 33) = 6.
+        assert_eq!((h.registers(), h.ops_per_pulse(), h.slots()), (31, 5, 3));
+        assert_eq!(
+            (h.operand_bits(), h.rd_index_bits(), h.log2_frame()),
+            (8, 6, 20)
+        );
+        assert_eq!(h.refused_max(), (1 << 39) - 1);
+        assert_eq!(
+            [1, 2, 3, 4, 5, 33, 34, 64, 65].map(ceil_log2),
+            [0, 1, 2, 2, 3, 6, 6, 6, 7]
+        );
+    }
+}

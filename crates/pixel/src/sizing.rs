@@ -82,16 +82,17 @@ pub fn operand_range(params: &PixelParams, code_min: u32, code_max: u32) -> (i64
     )
 }
 
-/// The register width the pixel needs so that every final register value of a frame is
-/// exact, for operands whose codes lie in [`code_min`, `code_max`]. With a ROM (Fourier),
-/// the exact per-register sign counts are used; Haar uses its exact counts (scale u adds
-/// and subtracts N/2^(u+1) times); without a ROM the any-sign bound is used.
-pub fn required_width(
+/// The width each register needs so that its final value of a frame is exact, for
+/// operands whose codes lie in [`code_min`, `code_max`] (register order). With a ROM
+/// (Fourier) the exact per-register sign counts are used; Haar uses its exact counts
+/// (scale u adds and subtracts N/2^(u+1) times, all its registers alike); without a ROM
+/// every register gets the any-sign bound.
+pub fn register_widths(
     params: &PixelParams,
     code_min: u32,
     code_max: u32,
     rom: Option<&RomImage>,
-) -> u32 {
+) -> Vec<u32> {
     let (a, b) = operand_range(params, code_min, code_max);
     let n = params.frame_pulses;
     let ranges: Vec<(i128, i128)> = match (params.mode, rom) {
@@ -99,20 +100,113 @@ pub fn required_width(
             .into_iter()
             .map(|(p, m)| signed_sum_range(a, b, p, m))
             .collect(),
-        (Mode::Fourier, None) => vec![any_sign_range(a, b, n)],
+        (Mode::Fourier, None) => vec![any_sign_range(a, b, n); params.registers()],
         (Mode::Haar, _) => (0..=params.haar_scales)
-            .map(|u| {
+            .flat_map(|u| {
                 let half = n >> (u + 1);
-                signed_sum_range(a, b, half, half)
+                std::iter::repeat_n(signed_sum_range(a, b, half, half), 1 << u)
             })
             .collect(),
     };
     ranges
         .into_iter()
-        .map(|(lo, hi)| twos_complement_bits(lo, hi))
+        .map(|(lo, hi)| twos_complement_bits(lo, hi).max(params.operand_bits()))
+        .collect()
+}
+
+/// The register width W the pixel needs: the largest of [`register_widths`] (and at least
+/// one operand).
+pub fn required_width(
+    params: &PixelParams,
+    code_min: u32,
+    code_max: u32,
+    rom: Option<&RomImage>,
+) -> u32 {
+    register_widths(params, code_min, code_max, rom)
+        .into_iter()
         .max()
         .unwrap_or(1)
         .max(params.operand_bits())
+}
+
+/// The TDC codes a scene's detections can take: the depth range [`depth_min_mm`,
+/// `depth_max_mm`] (static depth ± the motion's maximum amplitude) widened by `k_sigma`
+/// jitter σ, in codes of `lsb_mm` from the window start, clamped to the window's `codes`.
+/// With background photons (`background`), any code of the window can occur: the whole
+/// window.
+#[allow(clippy::too_many_arguments)]
+pub fn scene_code_range(
+    depth_min_mm: f64,
+    depth_max_mm: f64,
+    jitter_mm: f64,
+    k_sigma: f64,
+    window_start_mm: f64,
+    lsb_mm: f64,
+    codes: u32,
+    background: bool,
+) -> (u32, u32) {
+    let top = codes.saturating_sub(1);
+    if background || lsb_mm.is_nan() || lsb_mm <= 0.0 {
+        return (0, top);
+    }
+    let to_code = |mm: f64| ((mm - window_start_mm) / lsb_mm).floor();
+    let lo = to_code(depth_min_mm - k_sigma * jitter_mm);
+    let hi = to_code(depth_max_mm + k_sigma * jitter_mm);
+    let clamp = |c: f64| {
+        if c.is_nan() {
+            0
+        } else {
+            c.clamp(0.0, f64::from(top)) as u32
+        }
+    };
+    (clamp(lo), clamp(hi))
+}
+
+/// A pixel's sizing summary for one frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SizingReport {
+    /// Codes the operands were sized for (inclusive).
+    pub code_range: (u32, u32),
+    /// Width each register needs, register order.
+    pub register_widths: Vec<u32>,
+    /// The common width W (the largest).
+    pub width: u32,
+    /// Readout bytes per pixel (R words of W bits, status word excluded).
+    pub readout_bytes: f64,
+    /// Raw timestamp bytes for the same frame.
+    pub raw_bytes: f64,
+    /// raw_bytes / readout_bytes.
+    pub compression: f64,
+}
+
+impl SizingReport {
+    /// Sizes `params` for codes [`code_min`, `code_max`] (and the ROM if given) against raw
+    /// timestamps of `timestamp_bits` bits.
+    pub fn new(
+        params: &PixelParams,
+        code_min: u32,
+        code_max: u32,
+        rom: Option<&RomImage>,
+        timestamp_bits: u32,
+    ) -> Self {
+        let register_widths = register_widths(params, code_min, code_max, rom);
+        let width = register_widths
+            .iter()
+            .copied()
+            .max()
+            .unwrap_or(1)
+            .max(params.operand_bits());
+        let readout = readout_bytes(params.registers(), width, false);
+        let raw = raw_timestamp_bytes(params.frame_pulses, timestamp_bits);
+        SizingReport {
+            code_range: (code_min, code_max),
+            register_widths,
+            width,
+            readout_bytes: readout,
+            raw_bytes: raw,
+            compression: raw / readout,
+        }
+    }
 }
 
 /// Readout size of one pixel in bytes: R words of W bits plus the W-bit status word,

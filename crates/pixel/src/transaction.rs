@@ -4,7 +4,7 @@
 //! Two entry points compute the same thing:
 //! - [`TransactionModel::pulse`] updates the register file after every pulse (what the
 //!   equivalence tests compare cycle by cycle);
-//! - [`TransactionModel::run`] streams many pulses. Because Y[r] = Σₙ ±xₙ is linear and the
+//! - [`TransactionModel::run`] streams many pulses. Because Y\[r\] = Σₙ ±xₙ is linear and the
 //!   wrap is exact modulo 2^W, it may regroup the sum: for each byte of the ROM word it adds
 //!   x into one of 256 partial sums indexed by that byte's value (4 adds per pulse at
 //!   B = 16 instead of 32), and distributes the partial sums to the registers with their ±
@@ -90,7 +90,7 @@ impl TransactionModel {
 
     /// One laser pulse: `detection` is the TDC code of a detected photon (`None`: no
     /// detection), `rom_entry` the packed ROM word for this pulse (Fourier; bit r = 1 adds
-    /// to Y[r]; ignored in Haar mode). Returns whether the pulse was accepted: a Haar frame
+    /// to Y\[r\]; ignored in Haar mode). Returns whether the pulse was accepted: a Haar frame
     /// that already has N pulses refuses (and counts) further pulses until read out.
     pub fn pulse(&mut self, detection: Option<u32>, rom_entry: &[u64]) -> bool {
         match self.params.mode {

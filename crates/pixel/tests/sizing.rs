@@ -104,6 +104,8 @@ fn default_context() -> PixelContext {
         laser_rate_hz: 10e6,
         pulses: 10_000_000,
         code_range: None,
+        tones: Vec::new(),
+        osr: 32.0,
     }
 }
 
@@ -157,8 +159,14 @@ fn impossible_configurations_name_the_nearest_valid_value() {
         }),
         Err(("cycles_per_pulse", "32".into()))
     );
-    assert_eq!(with(&|c| c.width = Some(38)), Err(("width", "39".into())));
-    assert_eq!(with(&|c| c.width = Some(40)), Ok(()));
+    assert_eq!(
+        with(&|c| c.width = Some(tofprobe_pixel::config::Choice::Value(38))),
+        Err(("width", "39".into()))
+    );
+    assert_eq!(
+        with(&|c| c.width = Some(tofprobe_pixel::config::Choice::Value(40))),
+        Ok(())
+    );
     assert_eq!(
         with(&|c| c.tdc_bits = Some(6)),
         Err(("tdc_bits", "7".into()))
@@ -167,7 +175,10 @@ fn impossible_configurations_name_the_nearest_valid_value() {
     assert_eq!(with(&|c| c.shift = 16), Err(("shift", "15".into())));
     assert_eq!(with(&|c| c.frac_bits = 17), Err(("frac_bits", "16".into())));
     assert_eq!(with(&|c| c.adders = 33), Err(("adders", "32".into())));
-    assert_eq!(with(&|c| c.bins = 0), Err(("bins", "1".into())));
+    assert_eq!(
+        with(&|c| c.bins = tofprobe_pixel::config::Choice::Value(0)),
+        Err(("bins", "1".into()))
+    );
     assert_eq!(
         with(&|c| c.frequencies_hz = vec![1000.0, 2000.0]),
         Err(("frequencies_hz", "bins = 2".into()))
@@ -202,4 +213,61 @@ fn impossible_configurations_name_the_nearest_valid_value() {
         c.resolve(&ctx).map(|_| ()).map_err(nearest),
         Err(("width", "63".into()))
     );
+}
+
+/// The shipped default scene's `[pixel]` (scenes/default.toml) resolves against its own
+/// `[sensor]` and acquisition (1 s at 10 MHz): the explicit keys there equal the defaults,
+/// and the sized W = 39 holds every final value of codes 0..79 over the 10^7-pulse frame.
+#[test]
+fn shipped_default_scene_pixel_section_resolves() {
+    let text = include_str!("../../../scenes/default.toml");
+    let doc: toml::Table = toml::from_str(text).unwrap();
+    let pixel: PixelConfig = doc["pixel"].clone().try_into().unwrap();
+    assert_eq!(pixel, PixelConfig::default());
+    let sensor: tofprobe_scene::SensorConfig = doc["sensor"].clone().try_into().unwrap();
+    let ctx = PixelContext::from_sensor(&sensor, 10_000_000);
+    let p = pixel.resolve(&ctx).unwrap();
+    assert_eq!((p.tdc_bits, p.width, p.registers()), (7, 39, 32));
+    // Margin: the worst case 10^7·79·256 = 2.02·10^11 is 0.74 of 2^38.
+    let worst = 10_000_000f64 * 79.0 * 256.0;
+    assert!(worst < 2f64.powi(38) && worst > 2f64.powi(37));
+}
+
+/// Per-register widths, the scene's code range and the summary report.
+#[test]
+fn sizing_report_for_a_scene() {
+    use tofprobe_pixel::sizing::{SizingReport, register_widths, scene_code_range};
+    // 30 mm ± 0.1 mm, σ = 7.5 mm, ±4σ, 0.75 mm codes from 0 mm, 80 codes: codes
+    // floor((29.9 − 30)/0.75) = −1 → 0 and floor((30.1 + 30)/0.75) = 80 → 79.
+    assert_eq!(
+        scene_code_range(29.9, 30.1, 7.5, 4.0, 0.0, 0.75, 80, false),
+        (0, 79)
+    );
+    // σ = 0.75 mm: codes floor(26.9/0.75) = 35 to floor(33.1/0.75) = 44.
+    assert_eq!(
+        scene_code_range(29.9, 30.1, 0.75, 4.0, 0.0, 0.75, 80, false),
+        (35, 44)
+    );
+    // Background photons reach the whole window.
+    assert_eq!(
+        scene_code_range(29.9, 30.1, 0.75, 4.0, 0.0, 0.75, 80, true),
+        (0, 79)
+    );
+    // Balanced register 0 and all-ones register 1, codes 35..44, N = 10^6, F = 0, zoom 0:
+    // register 0 reaches ±(N/2)·44 − (N/2)·35 → [−4.5e6, 4.5e6] → 24 bits; register 1
+    // reaches 44·10^6 → 27 bits.
+    let mut p = PixelParams::fourier_default(30, 1_000_000, 2);
+    p.bins = 1;
+    p.frac_bits = 0;
+    let rom = RomImage::from_fn(2, 2, |a, r| r == 1 || a == 0);
+    assert_eq!(register_widths(&p, 35, 44, Some(&rom)), vec![24, 27]);
+    // Zoom to the centre (Z = 40: codes −5..4) brings the all-ones register to
+    // [−5·10^6, 4·10^6] → 24 bits: centring the depth is what shrinks the DC term.
+    p.zoom = 40;
+    assert_eq!(register_widths(&p, 35, 44, Some(&rom)), vec![24, 24]);
+    let r = SizingReport::new(&p, 35, 44, Some(&rom), 14);
+    assert_eq!(r.width, 24);
+    // 2 words × 24 bits = 6 bytes against 10^6 × 14 bits = 1.75 MB.
+    assert_eq!((r.readout_bytes, r.raw_bytes), (6.0, 1.75e6));
+    assert!((r.compression - 1.75e6 / 6.0).abs() < 1e-6);
 }

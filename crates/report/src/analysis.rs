@@ -97,12 +97,31 @@ pub fn analyse_point(
         delay_target_ps,
     };
     let synthesis = synthesise(&spec, &cache.join("synth"))?;
-    let split = split_area(
-        &synthesis.netlist_json,
-        &variant.top,
-        lib,
-        &BlockNames::contract(width),
-    )?;
+    // The split walks a multi-megabyte JSON netlist: cache it next to the synthesis
+    // (the name rules are fixed per crate version and W, both in the file name).
+    let split_path = synthesis
+        .netlist_json
+        .with_file_name(format!("split-v1-w{width}.json"));
+    let split = match std::fs::read_to_string(&split_path)
+        .ok()
+        .and_then(|t| serde_json::from_str::<AreaSplit>(&t).ok())
+    {
+        Some(s) => s,
+        None => {
+            let s = split_area(
+                &synthesis.netlist_json,
+                &variant.top,
+                lib,
+                &BlockNames::contract(width),
+            )?;
+            let json = serde_json::to_vec_pretty(&s).map_err(|e| ReportError::Json {
+                what: split_path.display().to_string(),
+                source: e,
+            })?;
+            write_atomic(&split_path, &json)?;
+            s
+        }
+    };
     let timing = if timing && lib.has_timing {
         let dir = synthesis
             .netlist_json

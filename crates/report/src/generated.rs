@@ -44,9 +44,12 @@ impl GeneratedPixel {
 
 impl RtlProvider for GeneratedPixel {
     fn rtl(&self, bins: u64, width: u32, dir: &Path) -> Result<RtlVariant> {
-        let p = self.variant_params(bins, width)?;
-        // The pixel does not depend on the ROM's contents (rom_word is a port): an
-        // all-zero image of the right shape is enough to render.
+        let mut p = self.variant_params(bins, width)?;
+        // The pixel module depends on neither the ROM's contents nor its depth L (rom_word
+        // is a port); rendering with L = 1 avoids building the chip-level ROM's N-entry
+        // table (10^7 lines at the default) just to throw it away. Only the header comment
+        // of the pixel file differs from `tofprobe rtl`'s.
+        p.rom_depth = 1;
         let rom = vec![0u64; p.rom_depth * p.registers().div_ceil(64)];
         let files =
             render(&p, &rom, &RenderOptions::default()).map_err(|e| ReportError::OutOfRange {

@@ -76,13 +76,65 @@ impl Default for PixelParams {
 
 /// Verilog-2005 keywords that a module prefix must not collide with.
 const KEYWORDS: &[&str] = &[
-    "always", "and", "assign", "begin", "buf", "case", "casex", "casez", "cell", "config",
-    "default", "defparam", "design", "disable", "edge", "else", "end", "endcase",
-    "endconfig", "endfunction", "endgenerate", "endmodule", "endtask", "event", "for",
-    "force", "forever", "fork", "function", "generate", "genvar", "if", "initial", "inout",
-    "input", "integer", "join", "localparam", "module", "nand", "negedge", "nor", "not", "or",
-    "output", "parameter", "posedge", "reg", "repeat", "signed", "specify", "task", "time",
-    "tri", "wait", "while", "wire", "xor", "xnor",
+    "always",
+    "and",
+    "assign",
+    "begin",
+    "buf",
+    "case",
+    "casex",
+    "casez",
+    "cell",
+    "config",
+    "default",
+    "defparam",
+    "design",
+    "disable",
+    "edge",
+    "else",
+    "end",
+    "endcase",
+    "endconfig",
+    "endfunction",
+    "endgenerate",
+    "endmodule",
+    "endtask",
+    "event",
+    "for",
+    "force",
+    "forever",
+    "fork",
+    "function",
+    "generate",
+    "genvar",
+    "if",
+    "initial",
+    "inout",
+    "input",
+    "integer",
+    "join",
+    "localparam",
+    "module",
+    "nand",
+    "negedge",
+    "nor",
+    "not",
+    "or",
+    "output",
+    "parameter",
+    "posedge",
+    "reg",
+    "repeat",
+    "signed",
+    "specify",
+    "task",
+    "time",
+    "tri",
+    "wait",
+    "while",
+    "wire",
+    "xor",
+    "xnor",
 ];
 
 fn range(field: &'static str, value: impl ToString, allowed: String, hint: String) -> RtlError {
@@ -129,7 +181,9 @@ impl PixelParams {
         };
         let file: File = toml::from_str(text).map_err(|e| parse(e.to_string()))?;
         let p: PixelParams = match file.pixel {
-            Some(v) => v.try_into().map_err(|e: toml::de::Error| parse(e.to_string()))?,
+            Some(v) => v
+                .try_into()
+                .map_err(|e: toml::de::Error| parse(e.to_string()))?,
             None => PixelParams::default(),
         };
         p.validate()?;
@@ -184,7 +238,12 @@ impl PixelParams {
     pub fn validate(&self) -> Result<(), RtlError> {
         let p = self;
         if !(1..=16).contains(&p.tdc_bits) {
-            return Err(range("tdc_bits", p.tdc_bits, "1..=16".into(), String::new()));
+            return Err(range(
+                "tdc_bits",
+                p.tdc_bits,
+                "1..=16".into(),
+                String::new(),
+            ));
         }
         if u64::from(p.zoom) >= 1u64 << p.tdc_bits {
             return Err(range(
@@ -214,7 +273,12 @@ impl PixelParams {
                     return Err(range("shift", p.shift, "0..=15".into(), String::new()));
                 }
                 if p.frac_bits > 16 {
-                    return Err(range("frac_bits", p.frac_bits, "0..=16".into(), String::new()));
+                    return Err(range(
+                        "frac_bits",
+                        p.frac_bits,
+                        "0..=16".into(),
+                        String::new(),
+                    ));
                 }
             }
             Mode::Haar => {
@@ -223,17 +287,17 @@ impl PixelParams {
                         "frame_pulses",
                         p.frame_pulses,
                         "a power of two ≥ 2 in Haar mode".into(),
-                        format!(
-                            " (e.g. {})",
-                            p.frame_pulses.max(2).next_power_of_two()
-                        ),
+                        format!(" (e.g. {})", p.frame_pulses.max(2).next_power_of_two()),
                     ));
                 }
                 if p.haar_scales + 1 > p.log2_frame() || p.haar_scales > 9 {
                     return Err(range(
                         "haar_scales",
                         p.haar_scales,
-                        format!("0..={} (log2(frame_pulses) − 1, at most 9)", (p.log2_frame() - 1).min(9)),
+                        format!(
+                            "0..={} (log2(frame_pulses) − 1, at most 9)",
+                            (p.log2_frame() - 1).min(9)
+                        ),
                         String::new(),
                     ));
                 }
@@ -241,7 +305,12 @@ impl PixelParams {
         }
         let ops = p.ops_per_pulse();
         if p.adders < 1 || p.adders > ops {
-            return Err(range("adders", p.adders, format!("1..={ops} (operations per pulse)"), String::new()));
+            return Err(range(
+                "adders",
+                p.adders,
+                format!("1..={ops} (operations per pulse)"),
+                String::new(),
+            ));
         }
         if p.cycles_per_pulse < p.slots() {
             return Err(range(
@@ -252,7 +321,12 @@ impl PixelParams {
             ));
         }
         if p.cycles_per_pulse > 1 << 16 {
-            return Err(range("cycles_per_pulse", p.cycles_per_pulse, "≤ 65536".into(), String::new()));
+            return Err(range(
+                "cycles_per_pulse",
+                p.cycles_per_pulse,
+                "≤ 65536".into(),
+                String::new(),
+            ));
         }
         let opw = p.operand_bits();
         if p.width < opw || p.width > 63 {
@@ -260,7 +334,7 @@ impl PixelParams {
                 "width",
                 p.width,
                 format!("{opw}..=63 (one operand is T+1+F = {opw} bits)"),
-                format!(" (e.g. {})", opw.max(32).min(63)),
+                format!(" (e.g. {})", opw.clamp(32, 63)),
             ));
         }
         validate_identifier("module_prefix", &p.module_prefix)?;

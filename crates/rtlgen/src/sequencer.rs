@@ -74,7 +74,7 @@ impl Iterator for Sequencer<'_> {
             let t = (cycle - 2) % self.frame_cycles();
             let pulse_phase = self.n * self.c;
             if t < pulse_phase {
-                if t % self.c == 0 {
+                if t.is_multiple_of(self.c) {
                     let n_in_frame = t / self.c;
                     let g = self.next_pulse;
                     self.next_pulse += 1;

@@ -32,7 +32,7 @@ pub fn random_stimulus(p: &PixelParams, pulses: u64, seed: u64) -> Vec<Option<u3
             if r & 3 == 0 {
                 None
             } else {
-                if (r >> 8) % 8 == 0 {
+                if (r >> 8).is_multiple_of(8) {
                     code = (r >> 16) % top;
                 } else {
                     let step = ((r >> 16) % 7) as i64 - 3;
@@ -76,11 +76,16 @@ pub fn random_rom(p: &PixelParams, seed: u64) -> Vec<u64> {
     }
     let r = p.registers();
     let words = r.div_ceil(64);
-    let mut rng = SplitMix64::new(seed ^ 0x5eed_0f_0e0b);
+    let mut rng = SplitMix64::new(seed ^ 0x005e_ed0f_0e0b);
     let mut rom = vec![0u64; p.rom_depth * words];
     for (i, w) in rom.iter_mut().enumerate() {
         let bits_here = (r - (i % words) * 64).min(64) as u32;
-        *w = rng.next_u64() & if bits_here == 64 { u64::MAX } else { (1u64 << bits_here) - 1 };
+        *w = rng.next_u64()
+            & if bits_here == 64 {
+                u64::MAX
+            } else {
+                (1u64 << bits_here) - 1
+            };
     }
     rom
 }

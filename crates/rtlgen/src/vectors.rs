@@ -165,6 +165,12 @@ pub fn write_vectors(
         ("registers", r as u64),
         ("width", u64::from(p.width)),
         ("tdc_bits", u64::from(p.tdc_bits)),
+        ("rd_index_bits", u64::from(p.rd_index_bits())),
+        (
+            "readout_words",
+            g.readouts.iter().map(|f| f.len() as u64).sum(),
+        ),
+        ("stimulus_lines", g.pulses.min(stim.len() as u64)),
         ("frames", o.frames),
         ("pulses", g.pulses),
         ("cycles", g.cycles),

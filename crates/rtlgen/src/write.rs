@@ -26,7 +26,10 @@ pub fn is_ours_or_absent(path: &Path) -> Result<bool, RtlError> {
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), RtlError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).map_err(|e| RtlError::io(dir, e))?;
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
     std::fs::write(&tmp, contents).map_err(|e| RtlError::io(&tmp, e))?;
     std::fs::rename(&tmp, path).map_err(|e| RtlError::io(path, e))

@@ -23,36 +23,69 @@ fn configs() -> Vec<(&'static str, PixelParams)> {
     let d = PixelParams::default();
     vec![
         ("default", d.clone()),
-        ("haar_default", PixelParams { mode: Mode::Haar, frame_pulses: 1 << 20, ..d.clone() }),
+        (
+            "haar_default",
+            PixelParams {
+                mode: Mode::Haar,
+                frame_pulses: 1 << 20,
+                ..d.clone()
+            },
+        ),
         (
             "odd_widths",
             PixelParams {
-                bins: 3, adders: 4, cycles_per_pulse: 2, tdc_bits: 5, zoom: 7, shift: 0,
-                frac_bits: 3, width: 17, frame_pulses: 1000, rom_depth: 37, ..d.clone()
+                bins: 3,
+                adders: 4,
+                cycles_per_pulse: 2,
+                tdc_bits: 5,
+                zoom: 7,
+                shift: 0,
+                frac_bits: 3,
+                width: 17,
+                frame_pulses: 1000,
+                rom_depth: 37,
+                ..d.clone()
             },
         ),
         (
             "f0_one_adder",
             PixelParams {
-                bins: 2, adders: 1, cycles_per_pulse: 5, tdc_bits: 3, shift: 15, frac_bits: 0,
-                width: 63, frame_pulses: 1, rom_depth: 1, ..d.clone()
+                bins: 2,
+                adders: 1,
+                cycles_per_pulse: 5,
+                tdc_bits: 3,
+                shift: 15,
+                frac_bits: 0,
+                width: 63,
+                frame_pulses: 1,
+                rom_depth: 1,
+                ..d.clone()
             },
         ),
         (
             "haar_a3",
             PixelParams {
-                mode: Mode::Haar, haar_scales: 3, adders: 3, cycles_per_pulse: 2, tdc_bits: 7,
-                zoom: 100, width: 11, frame_pulses: 64, ..d.clone()
+                mode: Mode::Haar,
+                haar_scales: 3,
+                adders: 3,
+                cycles_per_pulse: 2,
+                tdc_bits: 7,
+                zoom: 100,
+                width: 11,
+                frame_pulses: 64,
+                ..d.clone()
             },
         ),
     ]
 }
 
 fn render_to(name: &str, p: &PixelParams) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gates").join(name);
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("gates")
+        .join(name);
     let _ = std::fs::remove_dir_all(&dir);
-    let files = tofprobe_rtlgen::render(p, &sign_probe_rom(p), &RenderOptions::default())
-        .expect("renders");
+    let files =
+        tofprobe_rtlgen::render(p, &sign_probe_rom(p), &RenderOptions::default()).expect("renders");
     let pairs: Vec<(String, String)> = files.into_iter().map(|f| (f.name, f.contents)).collect();
     write_generated(&dir, &pairs).expect("writes");
     dir
@@ -82,7 +115,10 @@ fn verilator_lint_is_clean() {
             .output()
             .expect("verilator runs");
         let text = String::from_utf8_lossy(&out.stderr);
-        assert!(out.status.success() && text.trim().is_empty(), "{name}: {text}");
+        assert!(
+            out.status.success() && text.trim().is_empty(),
+            "{name}: {text}"
+        );
     }
 }
 
@@ -103,11 +139,18 @@ fn yosys_synthesises_without_latches() {
             .args(["-q", "-p", &script])
             .output()
             .expect("yosys runs");
-        let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
         assert!(out.status.success(), "{name}: {text}");
         // The only warning allowed: the register file array becomes flip-flops (intended).
         for line in text.lines().filter(|l| l.contains("Warning")) {
-            assert!(line.contains("Replacing memory \\y with list of registers"), "{name}: {line}");
+            assert!(
+                line.contains("Replacing memory \\y with list of registers"),
+                "{name}: {line}"
+            );
         }
         // Flip-flop count: at least the register file R·W (no register optimised away).
         let stat = std::fs::read_to_string(dir.join("stat.txt")).expect("yosys wrote stat.txt");
@@ -116,7 +159,10 @@ fn yosys_synthesises_without_latches() {
             .filter(|l| l.trim_start().starts_with("$_SDFF") || l.trim_start().starts_with("$_DFF"))
             .filter_map(|l| l.split_whitespace().last()?.parse::<u64>().ok())
             .sum();
-        assert!(dff >= (p.registers() as u64) * u64::from(p.width), "{name}: {dff} flip-flops");
+        assert!(
+            dff >= (p.registers() as u64) * u64::from(p.width),
+            "{name}: {dff} flip-flops"
+        );
     }
 }
 
@@ -129,7 +175,14 @@ fn iverilog_compiles() {
         let dir = render_to(&format!("iverilog-{name}"), &p);
         let out = Command::new("iverilog")
             .current_dir(&dir)
-            .args(["-g2005", "-Wall", "-o", "/dev/null", "-s", &module_names(&p).2])
+            .args([
+                "-g2005",
+                "-Wall",
+                "-o",
+                "/dev/null",
+                "-s",
+                &module_names(&p).2,
+            ])
             .args(sources(&dir))
             .output()
             .expect("iverilog runs");

@@ -137,11 +137,18 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
         verilator_seconds: r.verilator_seconds,
         verilator_cycles_per_s: rate(r.cycles, r.verilator_seconds),
         bare_verilator_seconds: r.bare_seconds,
-        harness_overhead_ratio: r.bare_seconds.filter(|b| *b > 0.0).map(|b| r.verilator_seconds / b),
+        harness_overhead_ratio: r
+            .bare_seconds
+            .filter(|b| *b > 0.0)
+            .map(|b| r.verilator_seconds / b),
         cycle_model_seconds: r.model_seconds,
         cycle_model_cycles_per_s: rate(r.cycles, r.model_seconds),
         transaction_model_seconds: if tx.is_finite() { tx } else { 0.0 },
-        transaction_model_pulses_per_s: if tx.is_finite() { rate(r.pulses, tx) } else { 0.0 },
+        transaction_model_pulses_per_s: if tx.is_finite() {
+            rate(r.pulses, tx)
+        } else {
+            0.0
+        },
         build_seconds: r.build.seconds,
         build_reused: r.build.reused,
         vcd: r.vcd.as_ref().map(|v| v.display().to_string()),
@@ -172,8 +179,15 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
             j.cycle_model_seconds,
             j.transaction_model_pulses_per_s / 1e6,
             j.transaction_model_seconds,
-            if j.build_reused { ", build reused" } else { ", built" },
-            j.vcd.as_ref().map(|v| format!(", VCD {v}")).unwrap_or_default(),
+            if j.build_reused {
+                ", build reused"
+            } else {
+                ", built"
+            },
+            j.vcd
+                .as_ref()
+                .map(|v| format!(", VCD {v}"))
+                .unwrap_or_default(),
         );
     }
     if r.pass {

@@ -46,7 +46,11 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
         });
     }
     let loaded = Config::load(a.config.as_deref())?;
-    let n_override = if a.full_frame { a.frame_pulses } else { Some(a.frame_pulses.unwrap_or(65_536)) };
+    let n_override = if a.full_frame {
+        a.frame_pulses
+    } else {
+        Some(a.frame_pulses.unwrap_or(65_536))
+    };
     let p = rtl_params(a.config.as_deref(), n_override, None)?;
     // Scene → TDC stream.
     let source = loaded.config.photon_source().map_err(|e| loaded.error(e))?;
@@ -85,7 +89,10 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
         r.verilator_seconds,
         r.first
             .as_ref()
-            .map(|m| format!(" First mismatch: cycle {} pulse {} {} expected {} actual {}.", m.cycle, m.pulse, m.signal, m.expected, m.actual))
+            .map(|m| format!(
+                " First mismatch: cycle {} pulse {} {} expected {} actual {}.",
+                m.cycle, m.pulse, m.signal, m.expected, m.actual
+            ))
             .unwrap_or_default()
     );
     let _ = writeln!(md, "## Register widths\n");
@@ -102,8 +109,14 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
     );
     if let Some(f) = r.readouts.first() {
         if p.mode == Mode::Fourier {
-            let _ = writeln!(md, "## Spectrum at the bins (frame 0, sign probes: bin k at (k+1)·f_s/L)\n");
-            let _ = writeln!(md, "| bin | f (Hz) | I | Q | 2/N·|Y| (mm) |\n|---|---|---|---|---|");
+            let _ = writeln!(
+                md,
+                "## Spectrum at the bins (frame 0, sign probes: bin k at (k+1)·f_s/L)\n"
+            );
+            let _ = writeln!(
+                md,
+                "| bin | f (Hz) | I | Q | 2/N·abs(Y) (mm) |\n|---|---|---|---|---|"
+            );
             let fs = loaded.config.sensor.laser_rate_hz;
             for k in 0..p.bins {
                 let i = sext(f[2 * k], p.width) as f64;
@@ -114,7 +127,10 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
             }
         } else {
             let _ = writeln!(md, "## Haar coefficients (frame 0)\n");
-            let words: Vec<String> = f[..p.registers()].iter().map(|w| sext(*w, p.width).to_string()).collect();
+            let words: Vec<String> = f[..p.registers()]
+                .iter()
+                .map(|w| sext(*w, p.width).to_string())
+                .collect();
             let _ = writeln!(md, "{}", words.join(" "));
         }
     }
@@ -127,5 +143,9 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
         r.outcome.mismatches,
         path.display()
     );
-    if r.pass { Ok(()) } else { std::process::exit(1) }
+    if r.pass {
+        Ok(())
+    } else {
+        std::process::exit(1)
+    }
 }

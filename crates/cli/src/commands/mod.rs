@@ -9,6 +9,8 @@ pub mod reproduce;
 pub mod rtl;
 pub mod simulate;
 pub mod size;
+pub mod spectrum_svg;
+pub mod tradeoff;
 pub mod vectors;
 
 use clap::Subcommand;
@@ -38,6 +40,8 @@ pub enum Command {
     Cosim(cosim::CosimArgs),
     /// The main flow: scene -> model -> RTL -> vectors -> co-simulation -> report.
     Flow(flow::FlowArgs),
+    /// The speed/accuracy trade: every fidelity level timed and scored per scene.
+    Tradeoff(tradeoff::TradeoffArgs),
 }
 
 /// Runs one subcommand.
@@ -52,5 +56,6 @@ pub fn run(command: Command) -> Result<(), CliError> {
         Command::Vectors(a) => vectors::run(&a),
         Command::Cosim(a) => cosim::run(&a),
         Command::Flow(a) => flow::run(&a),
+        Command::Tradeoff(a) => tradeoff::run(&a),
     }
 }

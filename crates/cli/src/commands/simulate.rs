@@ -1,5 +1,8 @@
-//! `tofprobe simulate [CONFIG] [--json]`: run the photon/TDC Monte Carlo and summarise the
-//! record (pulses, detections, background wins, mean and σ of the measured depth, run time).
+//! `tofprobe simulate [CONFIG] [--json] [--svg PATH]`: run the photon/TDC Monte Carlo and
+//! summarise the record (pulses, detections, background wins, mean and σ of the measured
+//! depth, run time), then run one frame through the bit-true pixel (transaction model) and
+//! print its spectrum at the configured bins (amplitude µm, phase, the noise estimate);
+//! `--svg` plots that spectrum.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -8,6 +11,7 @@ use std::time::{Duration, Instant};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
+use tofprobe_pixel::spectrum::BitTrueSpectrum;
 use tofprobe_scene::{FillCounts, PhotonSource};
 
 use crate::config::Config;
@@ -24,6 +28,45 @@ pub struct SimulateArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
+    /// Write an SVG plot of the bit-true spectrum here (atomically).
+    #[arg(long, value_name = "PATH")]
+    svg: Option<PathBuf>,
+}
+
+/// One bin of the bit-true spectrum, as printed.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct BinOut {
+    /// Probe frequency, Hz.
+    pub frequency_hz: f64,
+    /// Amplitude, µm.
+    pub amplitude_um: f64,
+    /// Phase, degrees.
+    pub phase_deg: f64,
+}
+
+/// The bit-true part of the output.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct BitTrueOut {
+    /// Register width W used.
+    pub width_bits: u32,
+    /// Pulses in the frame.
+    pub frame_pulses: u64,
+    /// One entry per bin, ROM order.
+    pub bins: Vec<BinOut>,
+    /// Median amplitude over the bins, µm (noise estimate when most bins hold no tone).
+    pub noise_estimate_um: f64,
+    /// Wall time of ROM generation (s).
+    pub rom_seconds: f64,
+    /// Wall time of the transaction-model frame (s).
+    pub model_seconds: f64,
+}
+
+/// The JSON object of `simulate --json`: the record summary plus the bit-true spectrum.
+#[derive(Debug, Clone, Serialize)]
+struct Output<'a> {
+    #[serde(flatten)]
+    summary: &'a Summary,
+    bit_true: Option<&'a BitTrueOut>,
 }
 
 /// The summary of one simulated record.
@@ -112,8 +155,25 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let pulses = loaded.config.pulses();
     let progress = !args.json && std::io::stderr().is_terminal();
     let s = summarise(&source, pulses, progress);
+    let bit_true = bit_true(&loaded.config, &loaded.origin, &source)?;
+    if let (Some(path), Some((_, spectrum))) = (&args.svg, &bit_true) {
+        super::spectrum_svg::write_svg(
+            path,
+            &format!("bit-true spectrum: {}", loaded.origin),
+            spectrum,
+        )?;
+    } else if let Some(path) = &args.svg {
+        return Err(CliError::Output {
+            path: path.clone(),
+            message: "the spectrum plot needs pixel.mode = \"fourier\"".into(),
+        });
+    }
     if args.json {
-        println!("{}", serde_json::to_string(&s)?);
+        let out = Output {
+            summary: &s,
+            bit_true: bit_true.as_ref().map(|b| &b.0),
+        };
+        println!("{}", serde_json::to_string(&out)?);
     } else {
         println!("configuration      {}", loaded.origin);
         println!("pulses             {}", s.pulses);
@@ -129,6 +189,64 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             s.seconds,
             s.pulses as f64 / s.seconds.max(1e-9) / 1e6
         );
+        match &bit_true {
+            None => println!("bit-true spectrum  (Haar mode: no spectrum)"),
+            Some((b, _)) => {
+                println!(
+                    "bit-true spectrum  W = {} bits, N = {} pulses (ROM {:.2} s, model {:.2} s)",
+                    b.width_bits, b.frame_pulses, b.rom_seconds, b.model_seconds
+                );
+                println!("  frequency Hz   amplitude um    phase deg");
+                for bin in &b.bins {
+                    println!(
+                        "  {:>12.2} {:>14.4} {:>12.2}",
+                        bin.frequency_hz, bin.amplitude_um, bin.phase_deg
+                    );
+                }
+                println!(
+                    "  noise estimate {:.4} um (median over bins)",
+                    b.noise_estimate_um
+                );
+            }
+        }
+        if let Some(p) = &args.svg {
+            println!("spectrum plot      {}", p.display());
+        }
     }
     Ok(())
+}
+
+/// Runs the bit-true pixel over one frame (Fourier mode; `None` in Haar mode).
+fn bit_true(
+    config: &Config,
+    origin: &str,
+    source: &PhotonSource,
+) -> Result<Option<(BitTrueOut, BitTrueSpectrum)>, CliError> {
+    if config.pixel.mode != tofprobe_pixel::Mode::Fourier {
+        return Ok(None);
+    }
+    let t0 = Instant::now();
+    let setup = super::spectrum_svg::setup(config, origin)?;
+    let rom_seconds = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let spectrum =
+        super::spectrum_svg::run_spectrum(&setup, source, config.sensor.tdc_lsb_mm(), origin)?;
+    let model_seconds = t1.elapsed().as_secs_f64();
+    let out = BitTrueOut {
+        width_bits: setup.params.width,
+        frame_pulses: setup.params.frame_pulses,
+        bins: spectrum
+            .bins
+            .iter()
+            .map(|b| BinOut {
+                frequency_hz: b.frequency_hz,
+                amplitude_um: b.amplitude_um,
+                phase_deg: b.phase_deg,
+            })
+            .collect(),
+        noise_estimate_um: spectrum.median_amplitude_um,
+        rom_seconds,
+        model_seconds,
+    };
+    Ok(Some((out, spectrum)))
 }

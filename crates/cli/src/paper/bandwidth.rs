@@ -106,7 +106,10 @@ pub fn rows(n: u64) -> Result<Vec<Row>, PaperError> {
                 (!quick).then_some(design),
                 f / 1e3,
                 exact,
-                Tolerance::Relative { rel: 0.05 },
+                // Short (--quick) records hold only ≈ 2000 detections at ρ = 0.001: 15%.
+                Tolerance::Relative {
+                    rel: if quick { 0.15 } else { 0.05 },
+                },
                 format!(
                     "ZOH approx. 0.44/((2/ρ+1)T_s) = {:.1} kHz",
                     zoh_hold_f3db(rho, FS_HZ) / 1e3
@@ -114,4 +117,19 @@ pub fn rows(n: u64) -> Result<Vec<Row>, PaperError> {
             )
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// ρ_s = 0.1 on a 2^20-pulse record (≈ 500 Bartlett frames of 2^11): the fitted corner
+    /// is within 5% of the exact 167.8 kHz (the fit's scatter over ≈ 70 bins with 4.5%
+    /// per-bin error is ≈ 1%).
+    #[test]
+    fn measured_corner_matches_exact_hold() {
+        let f = measure(0.1, 1 << 20, 3).unwrap();
+        let exact = hold_bandwidth_hz(0.1, FS_HZ).unwrap();
+        assert!((f / exact - 1.0).abs() < 0.05, "{f} vs {exact}");
+    }
 }

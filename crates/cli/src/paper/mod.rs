@@ -55,7 +55,7 @@ pub struct Row {
     /// The corrected value where the independent re-check differs from the print.
     pub design: Option<f64>,
     pub measured: f64,
-    /// Closed-form prediction, where there is one.
+    /// Closed-form prediction, where there is one (for Spread rows: shown, not tested).
     pub closed_form: Option<f64>,
     pub tolerance: Tolerance,
     pub pass: bool,

@@ -109,7 +109,10 @@ pub fn write_all(dir: &Path, results: &[RowResult]) -> Result<Vec<String>, Paper
     written.push(p.display().to_string());
 
     type Sel = fn(&RowResult) -> bool;
-    let families: [(&str, &str, &str, Sel, fn(&RowResult) -> f64); 2] = [
+    type Abscissa = fn(&RowResult) -> f64;
+    /// (file, title, x label, which rows, x of a row)
+    type Family = (&'static str, &'static str, &'static str, Sel, Abscissa);
+    let families: [Family; 2] = [
         (
             "noise_vs_sigma.svg",
             "Noise floor vs σ_s (ρ_s = 1, no tone, N = 10^7, Blackman)",

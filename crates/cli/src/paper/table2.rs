@@ -12,7 +12,9 @@
 use rayon::prelude::*;
 use tofprobe_dsp::Window;
 use tofprobe_dsp::bins::SelectedBins;
-use tofprobe_dsp::closed_form::{MixtureParams, first_arrival, hold_noise_factor, noise_floor_mm};
+use tofprobe_dsp::closed_form::{
+    MixtureParams, first_arrival, hold_noise_factor, hold_response_sq, mixture_gain, noise_floor_mm,
+};
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_dsp::preprocess::{FrontEnd, FrontEndOutput};
 use tofprobe_dsp::stats::{NoiseBand, interpolate_peak, noise_floor};
@@ -227,6 +229,26 @@ pub fn closed_form_noise_um(spec: &Spec, n: usize) -> Result<f64, PaperError> {
     Ok(noise_floor_mm(sigma, n_eff) * mean_sqrt_f * 1e3)
 }
 
+/// The expected tone amplitude (µm): the mixture's mean follows the signal with gain
+/// g = ∂μ/∂t_s, and the hold's mean response at f0 is |H(ρ_v, ω0)|.
+pub fn closed_form_amp_um(spec: &Spec) -> Result<Option<f64>, PaperError> {
+    let Some(a) = spec.amp_um else {
+        return Ok(None);
+    };
+    let setup = spec.setup();
+    let p = MixtureParams {
+        signal_rate: spec.rho_s,
+        background_rate: spec.rho_b,
+        signal_depth_mm: setup.depth_mm(),
+        jitter_mm: setup.jitter_mm()?,
+        window_mm: setup.window_mm,
+    };
+    let g = mixture_gain(&p)?;
+    let rho_v = first_arrival(&p)?.valid_rate.min(1.0);
+    let w0 = 2.0 * std::f64::consts::PI * F0_HZ / FS_HZ;
+    Ok(Some(a * g * hold_response_sq(rho_v, w0).sqrt()))
+}
+
 /// Everything measured for one row.
 #[derive(Debug, Clone)]
 pub struct RowResult {
@@ -236,6 +258,8 @@ pub struct RowResult {
     /// Amplitudes of all seeds (DFT), µm.
     pub amps_um: Vec<f64>,
     pub closed_form_um: f64,
+    /// Closed-form expected amplitude g·|H(ρ_v, ω0)|·A (µm), tone rows.
+    pub amp_closed_um: Option<f64>,
     /// Seed-0 spectrum, decimated for plotting: (Hz, µm).
     pub spectrum: Vec<(f64, f64)>,
 }
@@ -275,6 +299,7 @@ pub fn run_row(spec: &Spec, n: u64) -> Result<RowResult, PaperError> {
         columns,
         amps_um,
         closed_form_um: closed_form_noise_um(spec, n as usize)?,
+        amp_closed_um: closed_form_amp_um(spec)?,
         spectrum: plot,
     })
 }
@@ -348,7 +373,7 @@ pub fn rows_of(r: &RowResult, quick: bool) -> Vec<Row> {
             r.spec.paper_amp_um,
             None,
             m,
-            None,
+            r.amp_closed_um,
             Tolerance::Spread { k: 3.0, spread },
             format!(
                 "mean of {} seeds, std {s:.2}; seed 0 {:.2}",
@@ -363,6 +388,28 @@ pub fn rows_of(r: &RowResult, quick: bool) -> Vec<Row> {
 /// Runs every row (rayon across rows).
 pub fn run_all(n: u64) -> Result<Vec<RowResult>, PaperError> {
     ROWS.par_iter().map(|s| run_row(s, n)).collect()
+}
+
+/// The eq. 12 row: the paper's 2.21 µm prediction beside its 2.25 µm simulation, at
+/// σ_s = 3 mm, N = 10^7, Blackman (the first row of [`ROWS`]).
+pub fn eq12_row(results: &[RowResult], n: u64, quick: bool) -> Option<Row> {
+    let r = results.iter().find(|r| r.spec == ROWS[0])?;
+    let n_eff = n as f64 * WINDOW.effective_length_factor();
+    let predicted = noise_floor_mm(r.spec.sigma_s_mm, n_eff) * 1e3;
+    Some(Row::judge(
+        "eq. 12",
+        "σ_s=3 mm, Blackman: simulation vs prediction".into(),
+        "µm",
+        (!quick).then_some(2.25),
+        None,
+        r.columns[0].1.noise_um,
+        Some(predicted),
+        Tolerance::Relative { rel: NOISE_REL },
+        format!(
+            "paper predicts 2.21; sqrt(π σ²/N_eff) with N_eff = {:.4}·N = {predicted:.3}",
+            WINDOW.effective_length_factor()
+        ),
+    ))
 }
 
 #[cfg(test)]
@@ -386,26 +433,4 @@ mod tests {
         );
         assert_eq!(r.amps_um.len(), SEEDS as usize);
     }
-}
-
-/// The eq. 12 row: the paper's 2.21 µm prediction beside its 2.25 µm simulation, at
-/// σ_s = 3 mm, N = 10^7, Blackman (the first row of [`ROWS`]).
-pub fn eq12_row(results: &[RowResult], n: u64, quick: bool) -> Option<Row> {
-    let r = results.iter().find(|r| r.spec == ROWS[0])?;
-    let n_eff = n as f64 * WINDOW.effective_length_factor();
-    let predicted = noise_floor_mm(r.spec.sigma_s_mm, n_eff) * 1e3;
-    Some(Row::judge(
-        "eq. 12",
-        "σ_s=3 mm, Blackman: simulation vs prediction".into(),
-        "µm",
-        (!quick).then_some(2.25),
-        None,
-        r.columns[0].1.noise_um,
-        Some(predicted),
-        Tolerance::Relative { rel: NOISE_REL },
-        format!(
-            "paper predicts 2.21; sqrt(π σ²/N_eff) with N_eff = {:.4}·N = {predicted:.3}",
-            WINDOW.effective_length_factor()
-        ),
-    ))
 }

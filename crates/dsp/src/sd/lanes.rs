@@ -144,7 +144,8 @@ impl LaneGroup {
         // diagonal, and only the last state feeds the quantiser. Exploiting it halves the
         // work of a dense N×N product; the order of the additions equals the dense
         // reference's with its zero terms dropped, so the bits are identical.
-        debug_assert!((0..N).all(|r| (0..N).all(|j| r.abs_diff(j) <= 1 || ss.a[r * N + j] == 0.0)));
+        let tridiagonal = |r: usize| (0..N).all(|j| r.abs_diff(j) <= 1 || ss.a[r * N + j] == 0.0);
+        debug_assert!((0..N).all(tridiagonal));
         debug_assert!((0..N).all(|r| ss.a[r * N + r] == 1.0));
         let mut sub = [0.0; N];
         let mut sup = [0.0; N];

@@ -13,7 +13,11 @@
 //! second on, the wrap mismatch max|x(end) − x(start)| is measured, and the first period
 //! whose mismatch is ≤ [`WRAP_TOLERANCE`] is kept (a limit cycle locked to the period).
 //! If none of [`MAX_PERIODS`] periods locks, the period with the smallest mismatch is
-//! kept; either way the mismatch travels with the ROM (`wrap_mismatch`).
+//! kept; either way the mismatch travels with the ROM (`wrap_mismatch`). Measured: the
+//! default order-3 loop does not lock (best mismatch 0.15–0.27 for L = 4096…2^18, states
+//! being ≈ 1), so the wrap is "clean" in the sense that it is the least-disturbed of the
+//! periods run; the transient it starts decays with the NTF poles within tens of samples,
+//! and the test shows one period, wrap included, still reads A_p to < 1%.
 
 use super::config::{ProbeConfig, RomMode};
 use super::lanes::{LANES, LaneGroup, LaneProbe};
@@ -218,6 +222,11 @@ impl ProbeRom {
     }
 }
 
+/// The bin index k nearest to `f_hz` for a ROM of depth L (f_k = k·f_s/L).
+pub fn nearest_bin(f_hz: f64, sample_rate_hz: f64, depth: usize) -> u64 {
+    (f_hz / sample_rate_hz * depth as f64).round().max(0.0) as u64
+}
+
 impl ProbeRom {
     /// The manifest describing this ROM (hash, depth and width are filled in on write).
     pub fn manifest(&self) -> RomManifest {
@@ -385,18 +394,44 @@ mod tests {
         );
     }
 
+    /// A periodic ROM is replayed M times; what matters is that one period, wrap
+    /// included, still carries the probe: correlating the ±1 stream of each register with
+    /// the ideal cos/sin over the period must give A_p (in-band quantisation noise and the
+    /// wrap's transient leave ≈ 1e-3), and a bin it does not probe must read ≈ 0.
     #[test]
     fn periodic_rom_wraps_cleanly_or_reports_the_mismatch() {
+        let l = 4096usize;
         let cfg = ProbeConfig {
             rom_mode: RomMode::Periodic,
-            rom_depth: 4096,
+            rom_depth: l,
             ..ProbeConfig::default()
         };
         let d = design(&cfg);
         let rom = ProbeRom::generate(&d, 10e6, 1 << 20, &[7, 50]).unwrap();
-        assert_eq!(rom.depth(), 4096);
+        assert_eq!(rom.depth(), l);
         assert_eq!(rom.window, Window::Rectangular);
-        assert!(rom.wrap_mismatch.is_finite());
         assert!((rom.bins[0] - 7.0 * 10e6 / 4096.0).abs() < 1e-9);
+        assert_eq!(nearest_bin(rom.bins[1], 10e6, l), 50);
+        // The two-level loop does not lock onto the period (see the module docs): the
+        // kept period's mismatch is recorded, and finite.
+        assert!(rom.wrap_mismatch.is_finite() && rom.wrap_mismatch < 1.0);
+        for (b, &k) in rom.bin_indices.iter().enumerate() {
+            for q in 0..2 {
+                let corr = |kk: u64| {
+                    (0..l)
+                        .map(|a| {
+                            let th = 2.0 * std::f64::consts::PI * (kk * a as u64) as f64 / l as f64;
+                            let p = if q == 0 { th.cos() } else { th.sin() };
+                            if rom.image.bit(a, 2 * b + q) { p } else { -p }
+                        })
+                        .sum::<f64>()
+                        * 2.0
+                        / l as f64
+                };
+                let a = corr(k);
+                assert!((a - 0.5).abs() < 0.005, "bin {k} q {q}: {a}");
+                assert!(corr(k + 3).abs() < 0.005, "leak at bin {}", k + 3);
+            }
+        }
     }
 }

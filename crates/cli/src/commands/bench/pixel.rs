@@ -50,6 +50,7 @@ struct Report {
     pulses: u64,
     transaction_seconds: f64,
     transaction_cpu_seconds: Option<f64>,
+    cpu_realtime_factor: Option<f64>,
     transaction_pulses_per_s: f64,
     realtime_factor: f64,
     pulse_by_pulse_seconds: f64,
@@ -109,6 +110,9 @@ pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
         pulses: t.pulses,
         transaction_seconds: t.seconds,
         transaction_cpu_seconds: t.cpu_seconds,
+        cpu_realtime_factor: t
+            .cpu_seconds
+            .map(|cpu| t.pulses as f64 / rate / cpu.max(1e-9)),
         transaction_pulses_per_s: t.pulses_per_s,
         realtime_factor: t.realtime_factor,
         pulse_by_pulse_seconds: t.per_pulse_seconds,
@@ -134,10 +138,9 @@ pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
             report.realtime_factor,
             report.target_seconds
         );
-        if let Some(cpu) = report.transaction_cpu_seconds {
+        if let (Some(cpu), Some(f)) = (report.transaction_cpu_seconds, report.cpu_realtime_factor) {
             println!(
-                "  on its core      {cpu:.4} s of CPU time ({:.1}x real time; wall time includes waiting for a shared core)",
-                report.pulses as f64 / rate / cpu.max(1e-9)
+                "  on its core      {cpu:.4} s of CPU time ({f:.1}x real time; wall time includes waiting for a shared core)"
             );
         }
         println!(

@@ -1,0 +1,295 @@
+//! The speed/accuracy trade (issue 8): one configuration measured at every fidelity level
+//! on the same photon record — closed form, float full DFT, float selected-bin DFT, float
+//! ΣΔ probing, bit-true transaction model, cycle-accurate model (shortened frame,
+//! extrapolated) — each with its wall time per simulated second and its accuracy: the
+//! tone amplitude and the noise floor (mean amplitude over the noise bins) against the
+//! float full DFT and against the scene's true amplitude.
+
+pub mod plot;
+
+use std::time::Instant;
+
+use serde::Serialize;
+use tofprobe_dsp::bins::SelectedBins;
+use tofprobe_dsp::closed_form::{noise_floor_mm, sigma_total_mm};
+use tofprobe_dsp::dft::amplitude_spectrum;
+use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_record};
+use tofprobe_pixel::autobins::choose_bins;
+use tofprobe_pixel::bench::bench_cycle;
+use tofprobe_pixel::spectrum::bit_true_spectrum;
+
+use crate::commands::spectrum_svg::{BitTrueSetup, setup};
+use crate::config::Config;
+use crate::error::CliError;
+
+/// Pulses of the shortened frame the cycle-accurate model is timed on.
+pub const CYCLE_FRAME: u64 = 1 << 14;
+
+/// One fidelity level's measurement.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct LevelResult {
+    /// Level name.
+    pub level: String,
+    /// Wall seconds per simulated second of sensor time (f_s pulses).
+    pub seconds_per_sim_second: f64,
+    /// True when the time was measured on a shortened frame and scaled up.
+    pub extrapolated: bool,
+    /// Tone amplitude read, µm (`None` for a scene without an in-band tone).
+    pub amplitude_um: Option<f64>,
+    /// Noise floor: mean amplitude over the noise bins, µm.
+    pub noise_um: f64,
+    /// |amplitude − float DFT amplitude|, µm.
+    pub amplitude_err_vs_dft_um: Option<f64>,
+    /// |amplitude − true amplitude|, µm.
+    pub amplitude_err_vs_true_um: Option<f64>,
+    /// Noise floor relative to the float DFT's, minus 1.
+    pub noise_rel_err_vs_dft: f64,
+}
+
+/// All levels of one configuration.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SceneResult {
+    /// Where the configuration came from.
+    pub origin: String,
+    /// Pulses N.
+    pub pulses: u64,
+    /// True amplitude of the scene's strongest in-band tone, µm.
+    pub true_amplitude_um: Option<f64>,
+    /// One row per level.
+    pub levels: Vec<LevelResult>,
+}
+
+/// The levels' raw readings before scoring: (name, wall s, extrapolated, tone µm, noise µm).
+type Reading = (&'static str, f64, bool, Option<f64>, f64);
+
+/// Measures every level on `config` (Fourier pixel; the float levels use its ROM's bins).
+pub fn measure(config: &Config, origin: &str) -> Result<SceneResult, CliError> {
+    let scene_err = |source| CliError::Scene {
+        origin: origin.to_string(),
+        source,
+    };
+    let source = config.photon_source().map_err(scene_err)?;
+    let su: BitTrueSetup = setup(config, origin)?;
+    let n = su.params.frame_pulses;
+    let fs = config.sensor.laser_rate_hz;
+    let sim_seconds = n as f64 / fs;
+    let lsb_mm = config.sensor.tdc_lsb_mm();
+    let ctx = config.pixel_context();
+    let choice = choose_bins(
+        &ctx.tones,
+        fs,
+        su.params.rom_depth as u64,
+        config.probe.osr,
+        Some(su.params.bins),
+    )
+    .map_err(|source| CliError::Pixel {
+        origin: origin.to_string(),
+        source,
+    })?;
+    let tone_bin = choice.tones.first().copied();
+    let true_amp = tone_bin.and_then(|k| {
+        ctx.tones
+            .iter()
+            .filter(|(f, _)| (f * su.params.rom_depth as f64 / fs).round() as u64 == k)
+            .map(|(_, a)| a.abs() * 1000.0)
+            .reduce(f64::max)
+    });
+    let noise_idx: Vec<usize> = (0..su.rom.bins.len())
+        .filter(|&i| Some(su.rom.bin_indices[i]) != tone_bin)
+        .collect();
+    let tone_idx = tone_bin.and_then(|k| su.rom.bin_indices.iter().position(|&b| b == k));
+    let score = |amps: &[f64]| -> (Option<f64>, f64) {
+        let noise = if noise_idx.is_empty() {
+            0.0
+        } else {
+            noise_idx.iter().map(|&i| amps[i]).sum::<f64>() / noise_idx.len() as f64
+        };
+        (tone_idx.map(|i| amps[i]), noise)
+    };
+    let mut readings: Vec<Reading> = Vec::new();
+
+    // The held depth record (mm), as the pixel sees it: last valid detection, the first
+    // detection before the first one (the float references' priming convention).
+    let t0 = Instant::now();
+    let mut codes = vec![None; usize::try_from(n).unwrap_or(usize::MAX)];
+    source.fill_counted(0, &mut codes);
+    let first = codes.iter().flatten().next().copied().unwrap_or(0);
+    let mut held = source.code_to_depth_mm(first);
+    let depths: Vec<f64> = codes
+        .iter()
+        .map(|c| {
+            if let Some(c) = c {
+                held = source.code_to_depth_mm(*c);
+            }
+            held
+        })
+        .collect();
+    let record_s = t0.elapsed().as_secs_f64();
+
+    // Closed form: eq. 12 with the window's N_eff; the amplitude is the truth itself.
+    let t = Instant::now();
+    // The ROM's window (rectangular in periodic mode), so every level weighs alike.
+    let window = su.rom.window;
+    let sigma = sigma_total_mm(config.sensor.jitter_mm(), lsb_mm);
+    let n_eff = n as f64 * window.effective_length_factor();
+    let cf_noise = noise_floor_mm(sigma, n_eff) * 1000.0;
+    readings.push((
+        "closed form",
+        t.elapsed().as_secs_f64(),
+        false,
+        true_amp,
+        cf_noise,
+    ));
+
+    // Float full DFT (rustfft over the whole record).
+    let t = Instant::now();
+    let spec = amplitude_spectrum(&depths, window).map_err(|source| CliError::Probe {
+        origin: origin.to_string(),
+        source,
+    })?;
+    let amps: Vec<f64> = su
+        .rom
+        .bin_indices
+        .iter()
+        .map(|&k| spec.get(k as usize).copied().unwrap_or(0.0) * 1000.0)
+        .collect();
+    let (a, nz) = score(&amps);
+    readings.push((
+        "float full DFT",
+        record_s + t.elapsed().as_secs_f64(),
+        false,
+        a,
+        nz,
+    ));
+    drop(spec);
+
+    // Float selected-bin DFT (streamed, only the B bins).
+    let t = Instant::now();
+    let bins: Vec<usize> = su.rom.bin_indices.iter().map(|&k| k as usize).collect();
+    let dsp_err = |source| CliError::Probe {
+        origin: origin.to_string(),
+        source,
+    };
+    let mut sel = SelectedBins::new(n, &bins, window).map_err(dsp_err)?;
+    for chunk in depths.chunks(1 << 16) {
+        sel.push(chunk).map_err(dsp_err)?;
+    }
+    let amps: Vec<f64> = sel
+        .amplitudes()
+        .map_err(dsp_err)?
+        .iter()
+        .map(|a| a * 1000.0)
+        .collect();
+    let (a, nz) = score(&amps);
+    readings.push((
+        "float selected-bin DFT",
+        record_s + t.elapsed().as_secs_f64(),
+        false,
+        a,
+        nz,
+    ));
+
+    // Float ΣΔ probing (same ROM, float prefilter α = 2^−S).
+    let t = Instant::now();
+    let alpha = 1.0 / f64::from(1u32 << su.params.shift);
+    let sums = probe_record(&su.rom, depths.iter().copied(), Some(alpha));
+    let amps = amplitudes_um(&normalise(&su.rom, &sums, n, Some(alpha)));
+    let (a, nz) = score(&amps);
+    readings.push((
+        "float ΣΔ probing",
+        record_s + t.elapsed().as_secs_f64(),
+        false,
+        a,
+        nz,
+    ));
+    drop(depths);
+
+    // Bit-true transaction model (streams the photon source itself).
+    let t = Instant::now();
+    let bt = bit_true_spectrum(&su.params, &su.rom, &source, lsb_mm).map_err(|source| {
+        CliError::Pixel {
+            origin: origin.to_string(),
+            source,
+        }
+    })?;
+    let amps: Vec<f64> = bt.bins.iter().map(|b| b.amplitude_um).collect();
+    let (a, nz) = score(&amps);
+    readings.push((
+        "bit-true transaction",
+        t.elapsed().as_secs_f64(),
+        false,
+        a,
+        nz,
+    ));
+
+    // Cycle-accurate model: timed on a shortened frame (same registers, schedule and
+    // C cycles per pulse) and scaled to N; its registers equal the transaction model's
+    // after every pulse (crates/pixel/tests/equivalence.rs), so its accuracy is the
+    // transaction model's.
+    let mut short = su.params.clone();
+    short.frame_pulses = CYCLE_FRAME.min(n);
+    short.rom_depth = short.rom_depth.min(short.frame_pulses as usize);
+    let rom = tofprobe_pixel::bench::synthetic_rom(short.rom_depth, short.registers());
+    let cb = bench_cycle(&short, &rom, 1).map_err(|source| CliError::Pixel {
+        origin: origin.to_string(),
+        source,
+    })?;
+    let per_pulse = cb.seconds / short.frame_pulses as f64;
+    readings.push(("cycle-accurate", per_pulse * n as f64, true, a, nz));
+
+    let dft = readings[1];
+    let levels = readings
+        .iter()
+        .map(|&(name, secs, extrapolated, amp, noise)| LevelResult {
+            level: name.to_string(),
+            seconds_per_sim_second: secs / sim_seconds,
+            extrapolated,
+            amplitude_um: amp,
+            noise_um: noise,
+            amplitude_err_vs_dft_um: amp.zip(dft.3).map(|(x, d)| (x - d).abs()),
+            amplitude_err_vs_true_um: amp.zip(true_amp).map(|(x, t)| (x - t).abs()),
+            noise_rel_err_vs_dft: if dft.4 > 0.0 {
+                noise / dft.4 - 1.0
+            } else {
+                0.0
+            },
+        })
+        .collect();
+    Ok(SceneResult {
+        origin: origin.to_string(),
+        pulses: n,
+        true_amplitude_um: true_amp,
+        levels,
+    })
+}
+
+/// The Markdown table of one scene.
+pub fn markdown(r: &SceneResult) -> String {
+    let mut s = format!(
+        "### {} (N = {}, true amplitude {})\n\n| level | wall s per simulated s | amplitude µm | err vs DFT µm | err vs true µm | noise µm | noise vs DFT |\n|---|---|---|---|---|---|---|\n",
+        r.origin,
+        r.pulses,
+        r.true_amplitude_um
+            .map(|a| format!("{a:.2} µm"))
+            .unwrap_or_else(|| "–".into())
+    );
+    let f = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "–".into());
+    for l in &r.levels {
+        s.push_str(&format!(
+            "| {}{} | {:.3e} | {} | {} | {} | {:.3} | {:+.1}% |\n",
+            l.level,
+            if l.extrapolated {
+                " (extrapolated)"
+            } else {
+                ""
+            },
+            l.seconds_per_sim_second,
+            f(l.amplitude_um),
+            f(l.amplitude_err_vs_dft_um),
+            f(l.amplitude_err_vs_true_um),
+            l.noise_um,
+            l.noise_rel_err_vs_dft * 100.0
+        ));
+    }
+    s
+}
