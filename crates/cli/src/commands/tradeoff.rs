@@ -1,4 +1,4 @@
-//! `tofprobe tradeoff [CONFIG...] [--json] [--out DIR]`: every fidelity level on each
+//! `tofprobe tradeoff [CONFIG...] [--json] [--out DIR] [--verilator]`: every fidelity level on each
 //! configuration (the embedded default without one), timed per simulated second and
 //! scored against the float DFT and the scene's truth; a Markdown table on stdout (or one
 //! JSON object), and with `--out` the table (`tradeoff.md`) and the Pareto plot
@@ -22,6 +22,10 @@ pub struct TradeoffArgs {
     /// Print one JSON object instead of the table.
     #[arg(long)]
     json: bool,
+    /// Also time the Verilator RTL on a shortened frame (builds the harness; needs
+    /// verilator).
+    #[arg(long)]
+    verilator: bool,
     /// Write tradeoff.md and pareto.svg into this directory.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -42,7 +46,7 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     let mut scenes = Vec::new();
     for p in paths {
         let loaded = Config::load(p)?;
-        scenes.push(measure(&loaded.config, &loaded.origin)?);
+        scenes.push(measure(&loaded.config, &loaded.origin, args.verilator)?);
     }
     let table: String = scenes.iter().map(markdown).collect::<Vec<_>>().join("\n");
     if let Some(dir) = &args.out {

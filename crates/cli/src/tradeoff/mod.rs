@@ -11,7 +11,9 @@ use std::time::Instant;
 
 use serde::Serialize;
 use tofprobe_dsp::bins::SelectedBins;
-use tofprobe_dsp::closed_form::{noise_floor_mm, sigma_total_mm};
+use tofprobe_dsp::closed_form::{
+    hold_response_sq, noise_floor_hold_mm, noise_floor_mm, sigma_total_mm,
+};
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_record};
 use tofprobe_pixel::autobins::choose_bins;
@@ -62,8 +64,9 @@ pub struct SceneResult {
 /// The levels' raw readings before scoring: (name, wall s, extrapolated, tone µm, noise µm).
 type Reading = (&'static str, f64, bool, Option<f64>, f64);
 
-/// Measures every level on `config` (Fourier pixel; the float levels use its ROM's bins).
-pub fn measure(config: &Config, origin: &str) -> Result<SceneResult, CliError> {
+/// Measures every level on `config` (Fourier pixel; the float levels use its ROM's bins);
+/// with `verilator`, also the Verilator RTL on a shortened frame (builds the harness).
+pub fn measure(config: &Config, origin: &str, verilator: bool) -> Result<SceneResult, CliError> {
     let scene_err = |source| CliError::Scene {
         origin: origin.to_string(),
         source,
@@ -126,18 +129,34 @@ pub fn measure(config: &Config, origin: &str) -> Result<SceneResult, CliError> {
         .collect();
     let record_s = t0.elapsed().as_secs_f64();
 
-    // Closed form: eq. 12 with the window's N_eff; the amplitude is the truth itself.
+    // Closed form: eq. 12 with the window's N_eff and the 1NN hold at ρ = ρ_s (noise factor
+    // F(ρ, ω) averaged over the noise bins; the tone scaled by the hold's mean response
+    // |H(ω)|). Background pile-up is not modelled here.
     let t = Instant::now();
     // The ROM's window (rectangular in periodic mode), so every level weighs alike.
     let window = su.rom.window;
     let sigma = sigma_total_mm(config.sensor.jitter_mm(), lsb_mm);
     let n_eff = n as f64 * window.effective_length_factor();
-    let cf_noise = noise_floor_mm(sigma, n_eff) * 1000.0;
+    let rho = config.sensor.signal_rate;
+    let omega = |i: usize| 2.0 * std::f64::consts::PI * su.rom.bins[i] / fs;
+    let cf_noise = if noise_idx.is_empty() {
+        noise_floor_mm(sigma, n_eff) * 1000.0
+    } else {
+        noise_idx
+            .iter()
+            .map(|&i| noise_floor_hold_mm(sigma, rho, omega(i), n_eff) * 1000.0)
+            .sum::<f64>()
+            / noise_idx.len() as f64
+    };
+    let cf_amp = true_amp.map(|a| {
+        let w = tone_idx.map(omega).unwrap_or(0.0);
+        a * hold_response_sq(rho, w).sqrt()
+    });
     readings.push((
         "closed form",
         t.elapsed().as_secs_f64(),
         false,
-        true_amp,
+        cf_amp,
         cf_noise,
     ));
 
@@ -147,11 +166,17 @@ pub fn measure(config: &Config, origin: &str) -> Result<SceneResult, CliError> {
         origin: origin.to_string(),
         source,
     })?;
-    let amps: Vec<f64> = su
+    // ROM bin k is f = k·f_s/L; in the N-point DFT that is k·N/L (equal in windowed mode,
+    // the nearest bin in periodic mode when L does not divide N).
+    let dft_bins: Vec<usize> = su
         .rom
         .bin_indices
         .iter()
-        .map(|&k| spec.get(k as usize).copied().unwrap_or(0.0) * 1000.0)
+        .map(|&k| (k as f64 * n as f64 / su.params.rom_depth as f64).round() as usize)
+        .collect();
+    let amps: Vec<f64> = dft_bins
+        .iter()
+        .map(|&k| spec.get(k).copied().unwrap_or(0.0) * 1000.0)
         .collect();
     let (a, nz) = score(&amps);
     readings.push((
@@ -165,7 +190,7 @@ pub fn measure(config: &Config, origin: &str) -> Result<SceneResult, CliError> {
 
     // Float selected-bin DFT (streamed, only the B bins).
     let t = Instant::now();
-    let bins: Vec<usize> = su.rom.bin_indices.iter().map(|&k| k as usize).collect();
+    let bins = dft_bins;
     let dsp_err = |source| CliError::Probe {
         origin: origin.to_string(),
         source,
@@ -236,6 +261,34 @@ pub fn measure(config: &Config, origin: &str) -> Result<SceneResult, CliError> {
     })?;
     let per_pulse = cb.seconds / short.frame_pulses as f64;
     readings.push(("cycle-accurate", per_pulse * n as f64, true, a, nz));
+
+    // Verilator RTL: the generated RTL co-simulated against the cycle model on a shortened
+    // frame of the scene's own detections; the bare harness time (no checking) scaled to
+    // N. A passing co-simulation is bit-exact, so its accuracy is the model's.
+    if verilator {
+        let mut rtl = tofprobe_cosim::pixel_bridge::from_pixel(&short);
+        rtl.rom_depth = rtl.rom_depth.min(rtl.frame_pulses as usize);
+        let mut stim = vec![None; short.frame_pulses as usize];
+        source.fill_counted(0, &mut stim);
+        let work =
+            std::env::temp_dir().join(format!("tofprobe-tradeoff-rtl-{}", std::process::id()));
+        let mut o = tofprobe_cosim::CosimOptions::new(&work);
+        o.frames = 1;
+        o.measure_bare = true;
+        o.profile = tofprobe_cosim::BuildProfile::Speed;
+        o.stimulus = Some(stim);
+        let rep = tofprobe_cosim::cosim(&rtl, &o)?;
+        if !rep.pass {
+            return Err(CliError::Output {
+                path: work,
+                message: "Verilator co-simulation mismatched the model; run `tofprobe cosim`"
+                    .into(),
+            });
+        }
+        let secs = rep.bare_seconds.unwrap_or(rep.verilator_seconds);
+        let per_pulse = secs / rep.pulses.max(1) as f64;
+        readings.push(("Verilator RTL", per_pulse * n as f64, true, a, nz));
+    }
 
     let dft = readings[1];
     let levels = readings
