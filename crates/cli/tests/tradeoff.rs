@@ -1,6 +1,9 @@
 //! `tofprobe tradeoff` on a short frame: every level is reported with finite numbers, the
 //! slow levels are marked as extrapolated, the float levels agree with each other and the
 //! bit-true level with the float ΣΔ probing; `--out` writes the table and the Pareto plot.
+//! `--knobs --skips` on a tiny frame: the knob table covers every knob, W obeys the wrap
+//! property and its sizing, settings change what they name, and the skip timings are
+//! consistent.
 
 use std::process::Command;
 
@@ -73,4 +76,153 @@ fn tradeoff_reports_every_level() {
     assert!(md.contains("| cycle-accurate (extrapolated) |"), "{md}");
     let svg = std::fs::read_to_string(dir.join("pareto.svg")).expect("plot");
     assert!(svg.starts_with("<svg"));
+}
+
+/// The default scene shortened to `n` pulses with a 1 mm tone on bin 30, B = 4 (C = 4).
+fn tiny_config(dir: &std::path::Path, n: u64) -> std::path::PathBuf {
+    let out = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .args(["config", "--print-default"])
+        .output()
+        .expect("run");
+    let f = 30.0 * 10e6 / n as f64;
+    let text = String::from_utf8(out.stdout)
+        .expect("utf-8")
+        .replacen("duration_s = 1.0", &format!("pulses = {n}"), 1)
+        .replacen("amplitude_mm = 0.1", "amplitude_mm = 1.0", 1)
+        .replacen("frequency_hz = 4500.0", &format!("frequency_hz = {f}"), 1)
+        .replacen("bins = 16", "bins = 4", 1)
+        .replacen("cycles_per_pulse = 16", "cycles_per_pulse = 4", 1);
+    std::fs::create_dir_all(dir).expect("dir");
+    let cfg = dir.join("tiny.toml");
+    std::fs::write(&cfg, text).expect("write");
+    cfg
+}
+
+#[test]
+fn tradeoff_knob_table_and_skips_on_a_tiny_frame() {
+    let dir = std::env::temp_dir().join(format!("tofprobe-knobs-{}", std::process::id()));
+    let n: u64 = 1 << 12;
+    let cfg = tiny_config(&dir, n);
+    let run = || {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_tofprobe"));
+        // Only the knobs whose settings share one ΣΔ design (a design's stability sweep
+        // takes seconds in a debug build); the others are the same code path with other
+        // overrides, and the sweep's list is checked in the unit tests.
+        c.args(["tradeoff", cfg.to_str().unwrap(), "--knobs", "--skips"])
+            .args(["--sweep-pulses", &n.to_string(), "--reps", "1"])
+            .args(["--knob", "W", "--knob", "F", "--knob", "S", "--knob", "B"])
+            .arg("--out")
+            .arg(&dir);
+        c.arg("--json");
+        let res = c.output().expect("run");
+        assert!(
+            res.status.success(),
+            "{}",
+            String::from_utf8_lossy(&res.stderr)
+        );
+        res.stdout
+    };
+    let v: serde_json::Value = serde_json::from_slice(&run()).expect("one JSON object");
+    let sweep = &v["knobs"][0];
+    assert_eq!(sweep["pulses"].as_u64(), Some(n));
+    assert_eq!(sweep["shortened"].as_bool(), Some(false));
+    let rows = sweep["rows"].as_array().expect("rows");
+    for knob in ["baseline", "W", "F", "S", "B"] {
+        assert!(
+            rows.iter().any(|r| r["knob"] == knob),
+            "knob {knob} missing"
+        );
+    }
+    let row = |knob: &str, value: &str| {
+        rows.iter()
+            .find(|r| r["knob"] == knob && r["value"] == value)
+            .unwrap_or_else(|| panic!("row {knob} = {value}"))
+    };
+    let num = |r: &serde_json::Value, key: &str| {
+        r[key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{key} in {r}: {}", r["rejected"]))
+    };
+
+    // The baseline is the scene as configured at the same N, so its bit-true and float DFT
+    // readings are the levels table's, to the last bit (same deterministic computation).
+    let levels = v["scenes"][0]["levels"].as_array().expect("levels");
+    let level_amp = |name: &str| {
+        levels.iter().find(|l| l["level"] == name).expect("level")["amplitude_um"]
+            .as_f64()
+            .expect("amplitude")
+    };
+    let base = row("baseline", "as configured");
+    assert_eq!(num(base, "amplitude_um"), level_amp("bit-true transaction"));
+    assert_eq!(
+        num(base, "float_dft_amplitude_um"),
+        level_amp("float full DFT")
+    );
+    // The error columns are what they say: |bit-true − DFT| and |bit-true − 1000 µm|.
+    let a = num(base, "amplitude_um");
+    assert!(
+        (num(base, "amplitude_err_vs_dft_um") - (a - level_amp("float full DFT")).abs()).abs()
+            < 1e-12
+    );
+    assert!((num(base, "amplitude_err_vs_true_um") - (a - 1000.0).abs()).abs() < 1e-9);
+
+    // W: any width at or above the sizing is bit-exact (two's-complement wrap), one bit
+    // below it is refused with the width that would work.
+    let w_auto = row("W", "auto (the sizing)");
+    let w_wide = row("W", "sizing + 12");
+    assert_eq!(
+        w_wide["width_bits"].as_u64().expect("W"),
+        w_auto["width_bits"].as_u64().expect("W") + 12
+    );
+    assert_eq!(num(w_wide, "amplitude_um"), num(w_auto, "amplitude_um"));
+    assert_eq!(num(w_wide, "noise_um"), num(w_auto, "noise_um"));
+    let narrow = row("W", "sizing − 1");
+    let why = narrow["rejected"]
+        .as_str()
+        .expect("W below the sizing is refused");
+    assert!(why.contains("nearest valid value"), "{why}");
+    assert!(narrow["amplitude_um"].is_null());
+
+    // The knobs change what they name: B and C, F (W grows by F: the prefilter's fraction
+    // bits ride in the accumulators), and S leaves the float DFT reference alone.
+    assert_eq!(row("B", "32 (C = 32)")["bins"].as_u64(), Some(32));
+    assert_eq!(row("B", "4 (C = 4)")["bins"].as_u64(), Some(4));
+    assert_eq!(
+        row("F", "12")["width_bits"].as_u64().expect("W")
+            - row("F", "4")["width_bits"].as_u64().expect("W"),
+        8
+    );
+    assert_eq!(
+        num(row("S", "3"), "float_dft_amplitude_um"),
+        num(base, "float_dft_amplitude_um")
+    );
+    for r in rows.iter().filter(|r| r["rejected"].is_null()) {
+        let t = num(r, "bit_true_seconds_per_sim_second");
+        assert!(t.is_finite() && t > 0.0, "{r}");
+        assert!(num(r, "noise_um").is_finite(), "{r}");
+    }
+
+    // Skips: four stages, ratio = without / with, and the full DFT only adds time.
+    let stages = v["skips"][0]["stages"].as_array().expect("stages");
+    assert_eq!(stages.len(), 4);
+    for s in stages {
+        let (w, wo) = (num(s, "seconds_with_skip"), num(s, "seconds_without_skip"));
+        assert!(w > 0.0 && wo > 0.0, "{s}");
+        assert!(
+            (num(s, "speedup_ratio") - wo / w).abs() < 1e-9 * wo / w,
+            "{s}"
+        );
+    }
+    let full = stages
+        .iter()
+        .find(|s| s["stage"] == "full DFT (not asked)")
+        .expect("full DFT stage");
+    assert!(num(full, "speedup_ratio") > 1.0);
+
+    // The Markdown tables carry the same rows.
+    assert!(rows.iter().all(|r| r["knob"] != "OSR"), "--knob filters");
+    let md = std::fs::read_to_string(dir.join("tradeoff.md")).expect("table");
+    assert!(md.contains("### Knobs within the bit-true level"), "{md}");
+    assert!(md.contains("| W | sizing − 1 | rejected: "), "{md}");
+    assert!(md.contains("| full DFT (not asked) |"), "{md}");
 }

@@ -1,10 +1,11 @@
-//! One co-simulation: render (or take) the RTL, run the reference model through the
-//! contract's sequencer for the golden vectors, build the harness (cached), replay, and on
+//! One co-simulation: render (or take) the RTL, run the pixel crate's cycle model (the
+//! judge) through the contract's sequencer for the golden vectors, build the harness (cached), replay, and on
 //! a mismatch pin it down to the first cycle (re-running a digest window with its full
 //! trace) and write a VCD around it.
 
 use crate::error::CosimError;
 use crate::harness::{self, Mismatch, RunOutcome};
+use crate::pixel_bridge::golden_run;
 use crate::verilator::{self, BuildProfile, HarnessBuild};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -12,7 +13,7 @@ use tofprobe_rtlgen::model::Fault;
 use tofprobe_rtlgen::params::{Mode, PixelParams};
 use tofprobe_rtlgen::render::{RenderOptions, module_names};
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
-use tofprobe_rtlgen::vectors::{VectorOptions, golden_run, write_vectors};
+use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
 use tofprobe_rtlgen::write::write_generated;
 
 /// Cycles either side of a mismatch that the VCD covers.
@@ -43,6 +44,10 @@ pub struct CosimOptions {
     pub digest_only: bool,
     /// Per-pulse detections to replay (e.g. from the scene); `None` = random from `seed`.
     pub stimulus: Option<Vec<Option<u32>>>,
+    /// Probe ROM image to render (L × ceil(R/64) words, e.g. the configuration's ΣΔ ROM);
+    /// `None` = the sign-of-cosine probe of `stimulus::sign_probe_rom`. Ignored with
+    /// `rtl_dir` (the ROM is read back from the given RTL).
+    pub rom: Option<Vec<u64>>,
 }
 
 impl CosimOptions {
@@ -61,6 +66,7 @@ impl CosimOptions {
             measure_bare: false,
             stimulus: None,
             digest_only: false,
+            rom: None,
         }
     }
 }
@@ -142,12 +148,22 @@ pub fn rom_from_rtl(p: &PixelParams, dir: &Path) -> Result<Vec<u64>, CosimError>
     Ok(rom)
 }
 
-/// Renders the configuration's RTL (optionally with a fault) into `dir`.
+/// Renders the configuration's RTL (optionally with a fault) into `dir`, with the
+/// sign-of-cosine probe ROM.
 pub fn render_into(p: &PixelParams, dir: &Path, mutation: Option<Fault>) -> Result<(), CosimError> {
-    let rom = sign_probe_rom(p);
+    render_with_rom(p, &sign_probe_rom(p), dir, mutation)
+}
+
+/// Renders the configuration's RTL with the given probe ROM image (L × ceil(R/64) words).
+pub fn render_with_rom(
+    p: &PixelParams,
+    rom: &[u64],
+    dir: &Path,
+    mutation: Option<Fault>,
+) -> Result<(), CosimError> {
     let files = tofprobe_rtlgen::render(
         p,
-        &rom,
+        rom,
         &RenderOptions {
             mutation,
             ..RenderOptions::default()
@@ -174,7 +190,10 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         Some(d) => d.clone(),
         None => {
             let d = work_dir.join("rtl");
-            render_into(p, &d, o.mutation)?;
+            match &o.rom {
+                Some(rom) => render_with_rom(p, rom, &d, o.mutation)?,
+                None => render_into(p, &d, o.mutation)?,
+            }
             d
         }
     };
@@ -192,7 +211,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         trace_window: o.digest_only.then_some((0, 0)),
     };
     let t0 = Instant::now();
-    let (golden, window) = golden_run(p, &stim, &rom, &vopts);
+    let (golden, window) = golden_run(p, &stim, &rom, &vopts).map_err(CosimError::Judge)?;
     let model_seconds = t0.elapsed().as_secs_f64();
     let vec_dir = work_dir.join("vectors");
     write_vectors(&vec_dir, p, &stim, &rom, &golden, window, &vopts)?;
@@ -208,7 +227,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
             trace_window: Some((d.cycle_from, d.cycle_to)),
             ..vopts.clone()
         };
-        let (gw, ww) = golden_run(p, &stim, &rom, &wopts);
+        let (gw, ww) = golden_run(p, &stim, &rom, &wopts).map_err(CosimError::Judge)?;
         let wdir = work_dir.join("vectors-window");
         write_vectors(&wdir, p, &stim, &rom, &gw, ww, &wopts)?;
         let wdir = std::fs::canonicalize(&wdir).map_err(|e| CosimError::io(&wdir, e))?;

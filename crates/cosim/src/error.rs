@@ -26,6 +26,10 @@ pub enum CosimError {
     /// Rendering or vector generation failed.
     #[error(transparent)]
     Rtl(#[from] tofprobe_rtlgen::RtlError),
+    /// The pixel crate's cycle model (the judge of the golden vectors) rejects the
+    /// parameters the generator accepted.
+    #[error("the pixel crate's cycle model rejects the configuration: {0}")]
+    Judge(String),
     /// File-system error, with the path.
     #[error("{path}: {source}")]
     Io {

@@ -10,7 +10,7 @@ pub mod pixel_bridge;
 pub mod tools;
 pub mod verilator;
 
-pub use driver::{CosimOptions, CosimReport, cosim, render_into, rom_from_rtl};
+pub use driver::{CosimOptions, CosimReport, cosim, render_into, render_with_rom, rom_from_rtl};
 pub use error::CosimError;
 pub use harness::{Mismatch, RunOutcome};
 pub use verilator::BuildProfile;

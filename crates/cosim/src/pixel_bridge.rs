@@ -1,12 +1,79 @@
 //! The bridge to the pixel crate: its `PixelParams` converted to the generator's, and its
 //! cycle-accurate model run through its own sequencer and compared, cycle by cycle, with
-//! the generator's reference model (so the golden vectors are the pixel crate's too).
+//! the generator's reference model; and [`PixelJudge`], the pixel crate's `CycleModel` as
+//! the model the golden vectors are recorded from ([`golden_run`]).
 
 use tofprobe_dsp::rom::RomImage;
-use tofprobe_rtlgen::golden::pack_pins;
+use tofprobe_rtlgen::golden::{Golden, StepModel, pack_pins};
 use tofprobe_rtlgen::model::{CycleModel as RefModel, PinsIn as RefPins};
 use tofprobe_rtlgen::params::{Mode, PixelParams};
 use tofprobe_rtlgen::sequencer::Sequencer as RefSequencer;
+use tofprobe_rtlgen::vectors::{VectorOptions, golden_run_with};
+
+/// The pixel crate's cycle-accurate model driven by the generator's sequencer pins: the
+/// ROM word of `rom_addr` is looked up in the image, as the chip's ROM does (the pins of
+/// both sequencers are checked equal cycle by cycle in `compare_models`).
+#[derive(Debug, Clone)]
+pub struct PixelJudge {
+    model: tofprobe_pixel::CycleModel,
+    rom: Vec<u64>,
+    words: usize,
+    writes: Vec<(u32, u64)>,
+}
+
+impl PixelJudge {
+    /// The judge for `p` with the ROM image `rom` (L × ceil(R/64) words; empty for Haar).
+    pub fn new(p: &PixelParams, rom: &[u64]) -> Result<Self, String> {
+        Ok(PixelJudge {
+            model: tofprobe_pixel::CycleModel::new(&to_pixel(p)).map_err(|e| e.to_string())?,
+            rom: rom.to_vec(),
+            words: p.registers().div_ceil(64),
+            writes: Vec::with_capacity(p.registers()),
+        })
+    }
+}
+
+impl StepModel for PixelJudge {
+    fn step(&mut self, i: &RefPins) -> tofprobe_rtlgen::PinsOut {
+        let a = i.rom_addr * self.words;
+        let word = if i.pulse {
+            self.rom.get(a..a + self.words).unwrap_or(&[])
+        } else {
+            &[]
+        };
+        let o = self.model.step(&tofprobe_pixel::PinsIn {
+            rst: i.rst,
+            pulse: i.pulse,
+            valid: i.valid,
+            tdc: i.tdc,
+            rom_word: word,
+            readout: i.readout,
+        });
+        self.writes.clear();
+        self.writes
+            .extend(self.model.writes().iter().map(|w| (w.register, w.value)));
+        tofprobe_rtlgen::PinsOut {
+            ready: o.ready,
+            rd_valid: o.rd_valid,
+            rd_index: o.rd_index,
+            rd_data: o.rd_data,
+        }
+    }
+    fn writes(&self) -> &[(u32, u64)] {
+        &self.writes
+    }
+}
+
+/// The golden vectors' data recorded from the pixel crate's `CycleModel` (the judge), with
+/// the effective trace window; an error when the pixel crate rejects the parameters.
+pub fn golden_run(
+    p: &PixelParams,
+    stim: &[Option<u32>],
+    rom: &[u64],
+    o: &VectorOptions,
+) -> Result<(Golden, (u64, u64)), String> {
+    Ok(golden_run_with(PixelJudge::new(p, rom)?, p, stim, o))
+}
 
 /// The generator's parameters for a pixel-crate configuration (same fields, same meaning).
 pub fn from_pixel(p: &tofprobe_pixel::PixelParams) -> PixelParams {

@@ -5,10 +5,11 @@
 //! the CLI.)
 
 use std::path::{Path, PathBuf};
+use tofprobe_cosim::pixel_bridge::golden_run;
 use tofprobe_rtlgen::params::{Mode, PixelParams};
 use tofprobe_rtlgen::render::{RenderOptions, render};
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
-use tofprobe_rtlgen::vectors::{VectorOptions, golden_run, write_vectors};
+use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -108,7 +109,8 @@ fn committed_vectors_are_current() {
     };
     let stim = random_stimulus(&p, o.frames * p.frame_pulses, o.seed);
     let rom = sign_probe_rom(&p);
-    let (g, w) = golden_run(&p, &stim, &rom, &o);
+    // The judge: the pixel crate's cycle model.
+    let (g, w) = golden_run(&p, &stim, &rom, &o).expect("pixel model accepts");
     let tmp = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("committed-vectors");
     let _ = std::fs::remove_dir_all(&tmp);
     write_vectors(&tmp, &p, &stim, &rom, &g, w, &o).expect("writes");

@@ -12,7 +12,7 @@
 //! window of its last pulse. Pins are compared from cycle 1 on (before the first reset edge
 //! the RTL's state is undefined); cycle 1's pins are always an event.
 
-use crate::model::{CycleModel, Fault, PinsOut};
+use crate::model::{CycleModel, Fault, PinsIn, PinsOut};
 use crate::params::PixelParams;
 use crate::sequencer::Sequencer;
 
@@ -58,9 +58,38 @@ pub struct GoldenOptions {
     pub trace_window: (u64, u64),
 }
 
-/// Runs the model and records the golden data.
+/// A cycle-accurate model the golden run can replay: the judge of the vectors. The
+/// co-simulation driver passes the pixel crate's `CycleModel` (crates/cosim
+/// `pixel_bridge::PixelJudge`); this crate's own [`CycleModel`] implements it too, for the
+/// mutation tests' fault model and for callers without the pixel crate.
+pub trait StepModel {
+    /// One clock cycle: the pins seen before the edge, then the edge.
+    fn step(&mut self, pins: &PinsIn) -> PinsOut;
+    /// The register writes (register, raw W-bit value) of the last edge, in adder order.
+    fn writes(&self) -> &[(u32, u64)];
+}
+
+impl StepModel for CycleModel {
+    fn step(&mut self, pins: &PinsIn) -> PinsOut {
+        CycleModel::step(self, pins)
+    }
+    fn writes(&self) -> &[(u32, u64)] {
+        CycleModel::writes(self)
+    }
+}
+
+/// Runs this crate's reference model and records the golden data.
 pub fn run(p: &PixelParams, stim: &[Option<u32>], rom: &[u64], o: &GoldenOptions) -> Golden {
-    let mut model = CycleModel::new(p, rom, None);
+    run_with(CycleModel::new(p, rom, None), p, stim, o)
+}
+
+/// Runs `model` through the contract's sequencer and records the golden data.
+pub fn run_with<M: StepModel>(
+    mut model: M,
+    p: &PixelParams,
+    stim: &[Option<u32>],
+    o: &GoldenOptions,
+) -> Golden {
     let seq = Sequencer::new(p, stim, o.frames);
     let mut g = Golden {
         cycles: seq.total_cycles(),

@@ -65,12 +65,23 @@ pub struct Manifest {
     pub files: BTreeMap<String, String>,
 }
 
-/// Runs the golden model for `stim`/`rom` and returns the data plus the effective trace
-/// window.
+/// Runs this crate's reference model for `stim`/`rom` and returns the data plus the
+/// effective trace window.
 pub fn golden_run(
     p: &PixelParams,
     stim: &[Option<u32>],
     rom: &[u64],
+    o: &VectorOptions,
+) -> (Golden, (u64, u64)) {
+    golden_run_with(crate::model::CycleModel::new(p, rom, None), p, stim, o)
+}
+
+/// Runs `model` (the judge: the pixel crate's cycle model in `tofprobe vectors`/`cosim`)
+/// for `stim` and returns the data plus the effective trace window.
+pub fn golden_run_with<M: golden::StepModel>(
+    model: M,
+    p: &PixelParams,
+    stim: &[Option<u32>],
     o: &VectorOptions,
 ) -> (Golden, (u64, u64)) {
     let total = Sequencer::new(p, stim, o.frames).total_cycles();
@@ -79,10 +90,10 @@ pub fn golden_run(
     } else {
         (0, 0)
     });
-    let g = golden::run(
+    let g = golden::run_with(
+        model,
         p,
         stim,
-        rom,
         &GoldenOptions {
             frames: o.frames,
             digest_pulses: o.digest_pulses.max(1),

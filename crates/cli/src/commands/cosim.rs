@@ -10,7 +10,9 @@ use serde::Serialize;
 use tofprobe_cosim::{BuildProfile, CosimOptions, CosimReport, cosim};
 use tofprobe_rtlgen::params::PixelParams;
 
+use crate::commands::probe_rom::rtl_rom;
 use crate::commands::rtl::rtl_params;
+use crate::config::Config;
 use crate::error::CliError;
 
 /// Runs longer than this many cycles compare digests of this many pulses instead of every
@@ -41,7 +43,7 @@ pub struct CosimArgs {
     /// Override N (pulses per frame).
     #[arg(long)]
     pub frame_pulses: Option<u64>,
-    /// Override L (ROM depth).
+    /// Override L (ROM depth; forces the sign-of-cosine probe ROM).
     #[arg(long)]
     pub rom_depth: Option<usize>,
     /// Work directory for RTL, vectors and VCD.
@@ -73,6 +75,7 @@ struct Json {
     build_seconds: f64,
     build_reused: bool,
     vcd: Option<String>,
+    rom: String,
 }
 
 /// Times the pixel crate's transaction model on the same stimulus (seconds).
@@ -121,8 +124,20 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
             allowed: "1..=1000".into(),
         });
     }
-    let p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
-    let r = cosim(&p, &options(&p, a))?;
+    let mut p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
+    let mut rom_note = "sign-of-cosine probe ROM (--rom-depth given)".to_string();
+    let mut sd_rom = None;
+    if a.rtl.is_some() {
+        rom_note = "ROM read back from --rtl".into();
+    } else if a.rom_depth.is_none() {
+        let loaded = Config::load(a.config.as_deref())?;
+        let r = rtl_rom(&loaded.config, &loaded.origin, &mut p)?;
+        rom_note = r.note;
+        sd_rom = Some(r.words);
+    }
+    let mut o = options(&p, a);
+    o.rom = sd_rom;
+    let r = cosim(&p, &o)?;
     let tx = time_transaction(&p, &r);
     let rate = |n: u64, s: f64| if s > 0.0 { n as f64 / s } else { 0.0 };
     let j = Json {
@@ -152,6 +167,7 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
         build_seconds: r.build.seconds,
         build_reused: r.build.reused,
         vcd: r.vcd.as_ref().map(|v| v.display().to_string()),
+        rom: rom_note,
     };
     if a.json {
         println!("{}", serde_json::to_string(&j)?);
@@ -165,7 +181,7 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
             ),
         };
         println!(
-            "cosim {verdict}: {} frame(s), {} pulses, {} cycles, {} mismatches | verilator {:.2} Mcycles/s ({:.2} s{}), cycle model {:.2} Mcycles/s ({:.2} s), transaction model {:.2} Mpulses/s ({:.3} s){}{}",
+            "cosim {verdict}: {} frame(s), {} pulses, {} cycles, {} mismatches | verilator {:.2} Mcycles/s ({:.2} s{}), cycle model {:.2} Mcycles/s ({:.2} s), transaction model {:.2} Mpulses/s ({:.3} s){}{}; {}",
             j.frames,
             j.pulses,
             j.cycles,
@@ -188,6 +204,7 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
                 .as_ref()
                 .map(|v| format!(", VCD {v}"))
                 .unwrap_or_default(),
+            j.rom,
         );
     }
     if r.pass {

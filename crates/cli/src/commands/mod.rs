@@ -5,6 +5,7 @@ pub mod bench;
 pub mod config;
 pub mod cosim;
 pub mod flow;
+pub mod probe_rom;
 pub mod reproduce;
 pub mod rtl;
 pub mod simulate;

@@ -1,8 +1,11 @@
-//! `tofprobe tradeoff [CONFIG...] [--json] [--out DIR] [--verilator]`: every fidelity level on each
-//! configuration (the embedded default without one), timed per simulated second and
-//! scored against the float DFT and the scene's truth; a Markdown table on stdout (or one
-//! JSON object), and with `--out` the table (`tradeoff.md`) and the Pareto plot
-//! (`pareto.svg`), written atomically.
+//! `tofprobe tradeoff [CONFIG...] [--json] [--out DIR] [--verilator] [--knobs] [--skips]`:
+//! every fidelity level on each configuration (the embedded default without one), timed
+//! per simulated second and scored against the float DFT and the scene's truth; with
+//! `--knobs` the bit-true knob sweep ([`crate::tradeoff::knobs::DEFAULT_SWEEP`]) and with
+//! `--skips` the skipped-stage speedups, both on a frame of at most `--sweep-pulses` and
+//! timed as the median of `--reps` runs. Markdown tables on stdout (or one JSON object),
+//! and with `--out` the tables (`tradeoff.md`) and the Pareto plot (`pareto.svg`),
+//! written atomically.
 
 use std::path::PathBuf;
 
@@ -12,6 +15,8 @@ use serde::Serialize;
 use crate::commands::spectrum_svg::write_atomic;
 use crate::config::Config;
 use crate::error::CliError;
+use crate::tradeoff::knobs::{self, DEFAULT_SWEEP, KnobSweep};
+use crate::tradeoff::skips::{self, SkipReport, measure_skips};
 use crate::tradeoff::{SceneResult, markdown, measure, plot::pareto_svg};
 
 /// Arguments of `tofprobe tradeoff`.
@@ -26,6 +31,23 @@ pub struct TradeoffArgs {
     /// verilator).
     #[arg(long)]
     verilator: bool,
+    /// Also sweep the bit-true knobs (W, F, S, ROM mode and L, ΣΔ order, OSR, B).
+    #[arg(long)]
+    knobs: bool,
+    /// With `--knobs`: sweep only this knob (repeatable; names as in the table: W, F, S,
+    /// "ROM mode, L", "ΣΔ order", OSR, B); the baseline row is always run.
+    #[arg(long = "knob", value_name = "NAME")]
+    only_knobs: Vec<String>,
+    /// Also time the skipped stages (background, hold, selected bins, full DFT).
+    #[arg(long)]
+    skips: bool,
+    /// Pulses per frame of the knob sweep and the skip timings (scenes with more are
+    /// shortened; 10^6 = 0.1 s at 10 MHz, so the default 4.5 kHz tone sits on a bin).
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(64..))]
+    sweep_pulses: u64,
+    /// Timing runs per knob setting and per skip measurement (the median is reported).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..=100))]
+    reps: u64,
     /// Write tradeoff.md and pareto.svg into this directory.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -34,6 +56,10 @@ pub struct TradeoffArgs {
 #[derive(Serialize)]
 struct JsonOut<'a> {
     scenes: &'a [SceneResult],
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    knobs: &'a [KnobSweep],
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    skips: &'a [SkipReport],
 }
 
 /// Runs the command.
@@ -43,12 +69,43 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     } else {
         args.configs.iter().map(|p| Some(p.as_path())).collect()
     };
+    let reps = usize::try_from(args.reps).unwrap_or(1);
+    if let Some(bad) = args
+        .only_knobs
+        .iter()
+        .find(|k| !DEFAULT_SWEEP.iter().any(|s| s.knob == k.as_str()))
+    {
+        let mut names: Vec<&str> = DEFAULT_SWEEP.iter().map(|s| s.knob).collect();
+        names.dedup();
+        return Err(CliError::Option {
+            option: "knob".into(),
+            value: bad.clone(),
+            allowed: names.join(", "),
+        });
+    }
     let mut scenes = Vec::new();
+    let mut sweeps = Vec::new();
+    let mut skip_reports = Vec::new();
+    let mut tables = Vec::new();
     for p in paths {
         let loaded = Config::load(p)?;
-        scenes.push(measure(&loaded.config, &loaded.origin, args.verilator)?);
+        let (cfg, origin) = (&loaded.config, &loaded.origin);
+        let scene = measure(cfg, origin, args.verilator)?;
+        tables.push(markdown(&scene));
+        scenes.push(scene);
+        if args.knobs {
+            let settings = knobs::select(DEFAULT_SWEEP, &args.only_knobs);
+            let sw = knobs::sweep(cfg, origin, &settings, args.sweep_pulses, reps);
+            tables.push(knobs::markdown(&sw));
+            sweeps.push(sw);
+        }
+        if args.skips {
+            let sk = measure_skips(cfg, origin, args.sweep_pulses, reps)?;
+            tables.push(skips::markdown(&sk));
+            skip_reports.push(sk);
+        }
     }
-    let table: String = scenes.iter().map(markdown).collect::<Vec<_>>().join("\n");
+    let table = tables.join("\n");
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir).map_err(|e| CliError::Output {
             path: dir.clone(),
@@ -58,7 +115,14 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
         pareto_svg(&dir.join("pareto.svg"), &scenes)?;
     }
     if args.json {
-        println!("{}", serde_json::to_string(&JsonOut { scenes: &scenes })?);
+        println!(
+            "{}",
+            serde_json::to_string(&JsonOut {
+                scenes: &scenes,
+                knobs: &sweeps,
+                skips: &skip_reports,
+            })?
+        );
     } else {
         print!("{table}");
     }

@@ -1,14 +1,18 @@
 //! `tofprobe vectors [CONFIG] --out DIR`: golden vectors (testbench/README.md) for the
 //! configuration: stimulus, ROM image, expected readouts, the register-write trace (or, for
-//! long runs, per-window digests only) and a TOML manifest.
+//! long runs, per-window digests only) and a TOML manifest. The ROM is the configuration's
+//! ΣΔ probe ROM when the simulated frame can hold it, else the sign probe (`probe_rom`).
 
 use std::path::PathBuf;
 
 use clap::Args;
+use tofprobe_cosim::pixel_bridge::golden_run;
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
-use tofprobe_rtlgen::vectors::{VectorOptions, golden_run, write_vectors};
+use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
 
+use crate::commands::probe_rom::rtl_rom;
 use crate::commands::rtl::rtl_params;
+use crate::config::Config;
 use crate::error::CliError;
 
 /// Arguments of `tofprobe vectors`.
@@ -28,7 +32,7 @@ pub struct VectorsArgs {
     /// Override the pulses per frame N (short frames).
     #[arg(long)]
     pub frame_pulses: Option<u64>,
-    /// Override the ROM depth L.
+    /// Override the ROM depth L (forces the sign-of-cosine probe ROM).
     #[arg(long)]
     pub rom_depth: Option<usize>,
     /// Pulses per digest window.
@@ -45,19 +49,28 @@ pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
             allowed: "1..=1000".into(),
         });
     }
-    let p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
+    let mut p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
+    let (rom, note) = if a.rom_depth.is_some() {
+        (
+            sign_probe_rom(&p),
+            "sign-of-cosine probe ROM (--rom-depth given)".to_string(),
+        )
+    } else {
+        let loaded = Config::load(a.config.as_deref())?;
+        let r = rtl_rom(&loaded.config, &loaded.origin, &mut p)?;
+        (r.words, r.note)
+    };
     let stim = random_stimulus(&p, a.frames * p.frame_pulses, a.seed);
-    let rom = sign_probe_rom(&p);
     let o = VectorOptions {
         frames: a.frames,
         seed: a.seed,
         digest_pulses: a.digest_pulses.max(1),
         trace_window: None,
     };
-    let (g, w) = golden_run(&p, &stim, &rom, &o);
+    let (g, w) = golden_run(&p, &stim, &rom, &o).map_err(tofprobe_cosim::CosimError::Judge)?;
     let m = write_vectors(&a.out, &p, &stim, &rom, &g, w, &o)?;
     println!(
-        "vectors: {} frames, {} pulses, {} cycles, {} trace events, {} digest windows, hash {} -> {}",
+        "vectors: {} frames, {} pulses, {} cycles, {} trace events, {} digest windows, hash {} -> {}; {note}",
         m.frames,
         m.pulses,
         m.cycles,

@@ -12,6 +12,7 @@ pub mod bandwidth;
 pub mod fig4;
 pub mod plots;
 pub mod setup;
+pub mod sigma_delta;
 pub mod table2;
 
 use serde::Serialize;
@@ -24,6 +25,8 @@ pub enum PaperError {
     Dsp(#[from] tofprobe_dsp::DspError),
     #[error(transparent)]
     Scene(#[from] tofprobe_scene::SceneError),
+    #[error(transparent)]
+    Pixel(#[from] tofprobe_pixel::PixelError),
     #[error("cannot write `{path}`: {source}")]
     Io {
         path: String,
@@ -42,6 +45,13 @@ pub enum Tolerance {
     /// |paper − measured mean| ≤ k·spread (spread: seed-to-seed std of one draw, scaled
     /// by sqrt(1 + 1/seeds) since the paper's value is itself one draw).
     Spread { k: f64, spread: f64 },
+    /// |measured/reference − 1| ≤ rel against the reference (shown in the closed-form
+    /// column) only; the paper's value is shown, not tested (e.g. other bins).
+    Reference { rel: f64 },
+    /// measured ≥ min (the paper's value, if any, is shown, not tested).
+    AtLeast { min: f64 },
+    /// A derived error bound (stated in the note), checked by the caller.
+    Bound,
 }
 
 /// One line of the reproduce table.
@@ -87,6 +97,10 @@ impl Row {
                 Tolerance::Spread { k, spread } => paper
                     .or(design)
                     .is_none_or(|p| (p - measured).abs() <= k * spread),
+                Tolerance::Reference { rel } => closed_form.is_some() && ok_rel(closed_form, rel),
+                Tolerance::AtLeast { min } => measured >= min,
+                // Evaluated by the caller (sets `pass`); judged true here.
+                Tolerance::Bound => true,
             };
         Row {
             family,
@@ -110,13 +124,16 @@ fn fmt_opt(v: Option<f64>) -> String {
 /// The Markdown table.
 pub fn markdown(rows: &[Row]) -> String {
     let mut s = String::from(
-        "| experiment | row | unit | paper | corrected | measured | closed form | tolerance | pass | note |\n\
+        "| experiment | row | unit | paper | corrected | measured | closed form / reference | tolerance | pass | note |\n\
          |---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let tol = match r.tolerance {
             Tolerance::Relative { rel } => format!("±{:.0}%", rel * 100.0),
             Tolerance::Spread { k, spread } => format!("±{k}·{spread:.2}"),
+            Tolerance::Reference { rel } => format!("±{:.3}% of ref", rel * 100.0),
+            Tolerance::AtLeast { min } => format!("≥ {min}"),
+            Tolerance::Bound => "derived bound".to_string(),
         };
         s += &format!(
             "| {} | {} | {} | {} | {} | {:.4} | {} | {} | {} | {} |\n",
@@ -196,5 +213,48 @@ mod tests {
         );
         assert!(!r.pass, "31.3 > 3·10");
         assert!(markdown(&[r]).contains("FAIL"));
+        // Reference rows test only the reference; the paper value is shown.
+        let r = Row::judge(
+            "t",
+            "sd".into(),
+            "µm",
+            Some(2.26),
+            None,
+            1.96,
+            Some(1.93),
+            Tolerance::Reference { rel: 0.03 },
+            String::new(),
+        );
+        assert!(
+            r.pass,
+            "1.96 is 1.6% from 1.93 (and 13% from the shown 2.26)"
+        );
+        let r = Row::judge(
+            "t",
+            "sd".into(),
+            "µm",
+            None,
+            None,
+            2.0,
+            Some(1.93),
+            Tolerance::Reference { rel: 0.03 },
+            String::new(),
+        );
+        assert!(!r.pass, "3.6% > 3%");
+        let at_least = |m: f64| {
+            Row::judge(
+                "t",
+                "raw".into(),
+                "×",
+                None,
+                Some(6.0),
+                m,
+                None,
+                Tolerance::AtLeast { min: 3.0 },
+                String::new(),
+            )
+            .pass
+        };
+        assert!(at_least(5.5) && !at_least(2.9));
     }
 }

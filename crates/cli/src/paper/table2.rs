@@ -6,8 +6,11 @@
 //! Blackman FFT → noise floor (mean |Y| over 1–10 kHz, DC and ±8 bins around the tone
 //! excluded) and the interpolated peak. Seeds 1.. stream the record through the
 //! selected-bin DFT on the three bins around the tone (O(1) memory), for the seed-to-seed
-//! spread of the amplitude. Further columns (float ΣΔ, bit-true pixel) are added as
-//! [`Column`]s: a function from a row's record to (noise, amplitude).
+//! spread of the amplitude. Every column is a [`Column`]: a function from a row's record to
+//! (noise, amplitude) plus, for the probe columns, phasors at the shared probe bins. The
+//! float ΣΔ (with and without prefilter) and bit-true columns and their rows are in
+//! `super::sigma_delta`; the DFT column also reads its spectrum at those probe bins so the
+//! ΣΔ columns are compared with the DFT of the same record on the same bins.
 
 use rayon::prelude::*;
 use tofprobe_dsp::Window;
@@ -15,12 +18,13 @@ use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::closed_form::{
     MixtureParams, first_arrival, hold_noise_factor, hold_response_sq, mixture_gain, noise_floor_mm,
 };
-use tofprobe_dsp::dft::amplitude_spectrum;
+use tofprobe_dsp::dft::{amplitude_scale, amplitude_spectrum, windowed_dft_half};
 use tofprobe_dsp::preprocess::{FrontEnd, FrontEndOutput};
 use tofprobe_dsp::stats::{NoiseBand, interpolate_peak, noise_floor};
 use tofprobe_scene::PhotonSource;
 
 use super::setup::{FS_HZ, LSB_MM, Setup};
+use super::sigma_delta::{self, Phasor, ProbeSetup};
 use super::{PaperError, Row, Tolerance};
 
 /// The analysis window of Table 2.
@@ -46,6 +50,8 @@ pub struct Spec {
     pub paper_noise_um: f64,
     /// The paper's DFT measured amplitude (µm).
     pub paper_amp_um: Option<f64>,
+    /// The paper's ΣΔ noise floor (µm), where it prints one.
+    pub paper_sd_noise_um: Option<f64>,
 }
 
 const fn row(s: f64, rs: f64, rb: f64, a: f64, noise: f64, meas: f64) -> Spec {
@@ -56,15 +62,23 @@ const fn row(s: f64, rs: f64, rb: f64, a: f64, noise: f64, meas: f64) -> Spec {
         amp_um: if a > 0.0 { Some(a) } else { None },
         paper_noise_um: noise,
         paper_amp_um: if a > 0.0 { Some(meas) } else { None },
+        paper_sd_noise_um: None,
     }
+}
+
+/// A row whose ΣΔ noise the paper prints beside the DFT one.
+const fn row_sd(s: f64, noise: f64, sd: f64) -> Spec {
+    let mut r = row(s, 1.0, 0.0, 0.0, noise, 0.0);
+    r.paper_sd_noise_um = Some(sd);
+    r
 }
 
 /// Every DFT row of Table 2 (DESIGN.md, "Numbers to reproduce").
 pub const ROWS: &[Spec] = &[
-    row(3.0, 1.0, 0.0, 0.0, 2.25, 0.0),
-    row(7.5, 1.0, 0.0, 0.0, 5.47, 0.0),
-    row(15.0, 1.0, 0.0, 0.0, 10.85, 0.0),
-    row(30.0, 1.0, 0.0, 0.0, 22.24, 0.0),
+    row_sd(3.0, 2.25, 2.26),
+    row_sd(7.5, 5.47, 5.49),
+    row_sd(15.0, 10.85, 10.88),
+    row_sd(30.0, 22.24, 22.32),
     row(3.0, 1.0, 0.0, 10.0, 2.26, 8.27),
     row(3.0, 1.0, 0.0, 30.0, 2.23, 30.49),
     row(3.0, 1.0, 0.0, 100.0, 2.19, 97.65),
@@ -105,13 +119,21 @@ impl Spec {
 }
 
 /// What a column measures on one record: noise floor and (tone rows) amplitude, µm.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Columns that read the shared probe bins also return their phasors there (tone bin
+/// first, mm) so that the table can compare columns bin by bin on the same record.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Measurement {
     pub noise_um: f64,
     pub amp_um: Option<f64>,
+    /// Phasors at the probe bins of [`ProbeSetup`] (mm), empty if not measured.
+    pub phasors: Vec<Phasor>,
+    /// Bit-true column: its check against the float ΣΔ.
+    pub bit_true: Option<sigma_delta::BitTrue>,
 }
 
-/// The data a column sees: the row, its source, the detections of the whole record.
+/// The data a column sees: the row, its source, the detections of the whole record. The
+/// ΣΔ columns take the probe ROM shared by all rows of the same N from
+/// [`ProbeSetup::shared`].
 #[derive(Debug)]
 pub struct RowRecord<'a> {
     pub spec: &'a Spec,
@@ -119,18 +141,39 @@ pub struct RowRecord<'a> {
     pub detections: &'a [Option<u32>],
 }
 
-/// A column of the table: a name and a function from a row's record to a measurement.
+/// A column of the table: a name and a function from a row's record to a measurement
+/// (`None`: the column does not apply to this row).
 #[derive(Debug, Clone, Copy)]
 pub struct Column {
     pub name: &'static str,
-    pub measure: fn(&RowRecord<'_>) -> Result<Measurement, PaperError>,
+    pub measure: fn(&RowRecord<'_>) -> Result<Option<Measurement>, PaperError>,
 }
 
-/// The columns measured from seed 0 of every row (later issues append theirs).
-pub const COLUMNS: &[Column] = &[Column {
-    name: "DFT",
-    measure: dft_column,
-}];
+/// Column names.
+pub const DFT: &str = "DFT";
+pub const SD: &str = "ΣΔ";
+pub const SD_RAW: &str = "ΣΔ no prefilter";
+pub const BIT_TRUE: &str = "bit-true";
+
+/// The columns measured from seed 0 of every row.
+pub const COLUMNS: &[Column] = &[
+    Column {
+        name: DFT,
+        measure: dft_column,
+    },
+    Column {
+        name: SD,
+        measure: sd_column,
+    },
+    Column {
+        name: SD_RAW,
+        measure: sd_raw_column,
+    },
+    Column {
+        name: BIT_TRUE,
+        measure: bit_true_column,
+    },
+];
 
 /// Bin of the tone in an N-point record.
 fn tone_bin(n: usize) -> usize {
@@ -147,12 +190,77 @@ pub fn held_record(rec: &RowRecord<'_>) -> Result<Vec<f64>, PaperError> {
         .collect())
 }
 
-/// The full-FFT column: noise floor over the band, peak by quadratic interpolation.
-pub fn dft_column(rec: &RowRecord<'_>) -> Result<Measurement, PaperError> {
+/// The full-FFT column: noise floor over the band, peak by quadratic interpolation, and
+/// the normalised complex bins 2/(N·G)·X[k] at the probe bins.
+pub fn dft_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, PaperError> {
     let held = held_record(rec)?;
-    let spectrum = amplitude_spectrum(&held, WINDOW)?;
     let n = held.len();
-    measure_spectrum(&spectrum, n, rec.spec.amp_um.is_some())
+    let half = windowed_dft_half(&held, WINDOW)?;
+    drop(held);
+    let phasors = sigma_delta::probe_bins(n as u64)
+        .iter()
+        .map(|&k| {
+            let y = half[k as usize] * amplitude_scale(k as usize, n, WINDOW);
+            [y.re, y.im]
+        })
+        .collect();
+    let spectrum: Vec<f64> = half
+        .iter()
+        .enumerate()
+        .map(|(k, c)| c.norm() * amplitude_scale(k, n, WINDOW))
+        .collect();
+    drop(half);
+    let mut m = measure_spectrum(&spectrum, n, rec.spec.amp_um.is_some())?;
+    m.phasors = phasors;
+    Ok(Some(m))
+}
+
+/// Measurement of a probe readout: noise = mean magnitude of the noise bins, amplitude =
+/// magnitude of the tone bin (tone rows).
+fn probe_measurement(rec: &RowRecord<'_>, phasors: Vec<Phasor>) -> Measurement {
+    Measurement {
+        noise_um: sigma_delta::noise_um(&phasors),
+        amp_um: rec.spec.amp_um.map(|_| sigma_delta::norm(phasors[0]) * 1e3),
+        phasors,
+        bit_true: None,
+    }
+}
+
+/// Float ΣΔ probing of the held record, prefiltered (α = 2^−S).
+fn sd_probe(rec: &RowRecord<'_>, alpha: Option<f64>) -> Result<Measurement, PaperError> {
+    let probe = ProbeSetup::shared(rec.detections.len() as u64)?;
+    let held = held_record(rec)?;
+    let sums = tofprobe_dsp::sd::probe_record(&probe.rom, held.iter().copied(), alpha);
+    Ok(probe_measurement(rec, probe.phasors(&sums, alpha)))
+}
+
+/// The float ΣΔ column: the held record prefiltered (α = 1/32) and probed by the ROM.
+pub fn sd_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, PaperError> {
+    sd_probe(rec, Some(sigma_delta::alpha())).map(Some)
+}
+
+/// The float ΣΔ column without the prefilter: the paper's observation that its error is
+/// several times the floor. Run on the ρ_s = 1, ρ_b = 0 rows only (the setting of the
+/// paper's remark; it costs a full probing pass per row).
+pub fn sd_raw_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, PaperError> {
+    if rec.spec.rho_s < 1.0 || rec.spec.rho_b > 0.0 {
+        return Ok(None);
+    }
+    sd_probe(rec, None).map(Some)
+}
+
+/// The bit-true column: the record's TDC codes through the transaction model.
+pub fn bit_true_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, PaperError> {
+    let codes = (rec.spec.setup().window_mm / LSB_MM).ceil() as u32;
+    let probe = ProbeSetup::shared(rec.detections.len() as u64)?;
+    let bt = sigma_delta::bit_true(&probe, rec.detections, codes)?;
+    // Codes are 1 mm (LSB_MM), so the phasors are already in mm.
+    let mut m = probe_measurement(
+        rec,
+        bt.phasors.iter().map(|p| p.map(|v| v * LSB_MM)).collect(),
+    );
+    m.bit_true = Some(bt);
+    Ok(Some(m))
 }
 
 /// Noise floor and amplitude of a one-sided amplitude spectrum (mm) → µm.
@@ -168,6 +276,8 @@ pub fn measure_spectrum(spectrum: &[f64], n: usize, tone: bool) -> Result<Measur
     Ok(Measurement {
         noise_um: noise * 1e3,
         amp_um: amp,
+        phasors: Vec::new(),
+        bit_true: None,
     })
 }
 
@@ -276,7 +386,9 @@ pub fn run_row(spec: &Spec, n: u64) -> Result<RowResult, PaperError> {
     };
     let mut columns = Vec::new();
     for c in COLUMNS {
-        columns.push((c.name, (c.measure)(&rec)?));
+        if let Some(m) = (c.measure)(&rec)? {
+            columns.push((c.name, m));
+        }
     }
     // The seed-0 spectrum again for the plot (cheap next to the Monte Carlo; keeps
     // the column functions pure).
@@ -329,7 +441,7 @@ fn mean_std(v: &[f64]) -> (f64, f64) {
 /// The table rows of one row result: noise (paper + closed form) and amplitude (spread).
 pub fn rows_of(r: &RowResult, quick: bool) -> Vec<Row> {
     let mut out = Vec::new();
-    let dft = r.columns[0].1;
+    let dft = &r.columns[0].1;
     // A quick (short) record has a larger floor: compare with the closed form only.
     let paper = (!quick).then_some(r.spec.paper_noise_um);
     // Short records: ≈ 900 band bins instead of 9000, so 10% (≈ 3σ) instead of 5%.
@@ -349,19 +461,7 @@ pub fn rows_of(r: &RowResult, quick: bool) -> Vec<Row> {
             r.spec.setup().jitter_mm().unwrap_or(f64::NAN)
         ),
     ));
-    for (name, m) in r.columns.iter().skip(1) {
-        out.push(Row::judge(
-            "Table 2 noise",
-            format!("{} [{name}]", r.spec.label()),
-            "µm",
-            paper,
-            None,
-            m.noise_um,
-            Some(r.closed_form_um),
-            Tolerance::Relative { rel },
-            String::new(),
-        ));
-    }
+    out.extend(sigma_delta::rows(r));
     if r.amps_um.len() >= 2 {
         let (m, s) = mean_std(&r.amps_um);
         let n = r.amps_um.len() as f64;
@@ -385,7 +485,7 @@ pub fn rows_of(r: &RowResult, quick: bool) -> Vec<Row> {
     out
 }
 
-/// Runs every row (rayon across rows).
+/// Runs every row (rayon across rows), all sharing one probe ROM built for `n`.
 pub fn run_all(n: u64) -> Result<Vec<RowResult>, PaperError> {
     ROWS.par_iter().map(|s| run_row(s, n)).collect()
 }
@@ -424,7 +524,7 @@ mod tests {
         let spec = ROWS[9];
         let n = 1u64 << 18;
         let r = run_row(&spec, n).unwrap();
-        let m = r.columns[0].1;
+        let m = &r.columns[0].1;
         assert!(
             (m.noise_um / r.closed_form_um - 1.0).abs() < 0.15,
             "{} vs {}",

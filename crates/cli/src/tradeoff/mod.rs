@@ -5,7 +5,12 @@
 //! tone amplitude and the noise floor (mean amplitude over the noise bins) against the
 //! float full DFT and against the scene's true amplitude.
 
+pub mod design_cache;
+pub mod knobs;
+pub mod overrides;
 pub mod plot;
+pub mod skips;
+pub mod timing;
 
 use std::time::Instant;
 
@@ -19,6 +24,7 @@ use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_record};
 use tofprobe_pixel::autobins::choose_bins;
 use tofprobe_pixel::bench::bench_cycle;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
+use tofprobe_scene::PhotonSource;
 
 use crate::commands::spectrum_svg::{BitTrueSetup, setup};
 use crate::config::Config;
@@ -67,12 +73,24 @@ type Reading = (&'static str, f64, bool, Option<f64>, f64);
 /// Measures every level on `config` (Fourier pixel; the float levels use its ROM's bins);
 /// with `verilator`, also the Verilator RTL on a shortened frame (builds the harness).
 pub fn measure(config: &Config, origin: &str, verilator: bool) -> Result<SceneResult, CliError> {
+    let su: BitTrueSetup = setup(config, origin)?;
+    measure_setup(config, origin, &su, verilator)
+}
+
+/// [`measure`] with the pixel already resolved and its ROM generated (`su` from
+/// [`setup`] on the same `config`), so a caller that also times the bit-true model on its
+/// own generates the ROM once.
+pub fn measure_setup(
+    config: &Config,
+    origin: &str,
+    su: &BitTrueSetup,
+    verilator: bool,
+) -> Result<SceneResult, CliError> {
     let scene_err = |source| CliError::Scene {
         origin: origin.to_string(),
         source,
     };
     let source = config.photon_source().map_err(scene_err)?;
-    let su: BitTrueSetup = setup(config, origin)?;
     let n = su.params.frame_pulses;
     let fs = config.sensor.laser_rate_hz;
     let sim_seconds = n as f64 / fs;
@@ -114,19 +132,7 @@ pub fn measure(config: &Config, origin: &str, verilator: bool) -> Result<SceneRe
     // The held depth record (mm), as the pixel sees it: last valid detection, the first
     // detection before the first one (the float references' priming convention).
     let t0 = Instant::now();
-    let mut codes = vec![None; usize::try_from(n).unwrap_or(usize::MAX)];
-    source.fill_counted(0, &mut codes);
-    let first = codes.iter().flatten().next().copied().unwrap_or(0);
-    let mut held = source.code_to_depth_mm(first);
-    let depths: Vec<f64> = codes
-        .iter()
-        .map(|c| {
-            if let Some(c) = c {
-                held = source.code_to_depth_mm(*c);
-            }
-            held
-        })
-        .collect();
+    let depths = held_record(&source, n);
     let record_s = t0.elapsed().as_secs_f64();
 
     // Closed form: eq. 12 with the window's N_eff and the 1NN hold at ρ = ρ_s (noise factor
@@ -168,12 +174,7 @@ pub fn measure(config: &Config, origin: &str, verilator: bool) -> Result<SceneRe
     })?;
     // ROM bin k is f = k·f_s/L; in the N-point DFT that is k·N/L (equal in windowed mode,
     // the nearest bin in periodic mode when L does not divide N).
-    let dft_bins: Vec<usize> = su
-        .rom
-        .bin_indices
-        .iter()
-        .map(|&k| (k as f64 * n as f64 / su.params.rom_depth as f64).round() as usize)
-        .collect();
+    let dft_bins = dft_bins(&su.rom.bin_indices, n, su.params.rom_depth);
     let amps: Vec<f64> = dft_bins
         .iter()
         .map(|&k| spec.get(k).copied().unwrap_or(0.0) * 1000.0)
@@ -314,6 +315,34 @@ pub fn measure(config: &Config, origin: &str, verilator: bool) -> Result<SceneRe
         true_amplitude_um: true_amp,
         levels,
     })
+}
+
+/// The held depth record (mm) of `n` pulses as the pixel sees it: the last valid
+/// detection, the first detection before the first one (the float references' priming
+/// convention).
+pub fn held_record(source: &PhotonSource, n: u64) -> Vec<f64> {
+    let mut codes = vec![None; usize::try_from(n).unwrap_or(usize::MAX)];
+    source.fill_counted(0, &mut codes);
+    let first = codes.iter().flatten().next().copied().unwrap_or(0);
+    let mut held = source.code_to_depth_mm(first);
+    codes
+        .iter()
+        .map(|c| {
+            if let Some(c) = c {
+                held = source.code_to_depth_mm(*c);
+            }
+            held
+        })
+        .collect()
+}
+
+/// The ROM's bins k·f_s/L as indices of the N-point DFT (equal in windowed mode, the
+/// nearest bin in periodic mode when L does not divide N).
+pub fn dft_bins(rom_bins: &[u64], n: u64, rom_depth: usize) -> Vec<usize> {
+    rom_bins
+        .iter()
+        .map(|&k| (k as f64 * n as f64 / rom_depth as f64).round() as usize)
+        .collect()
 }
 
 /// The Markdown table of one scene.
