@@ -374,8 +374,14 @@ pub struct RowResult {
     pub spectrum: Vec<(f64, f64)>,
 }
 
-/// Runs one row: seed 0 in full (all columns), seeds 1.. streamed for the amplitude.
-pub fn run_row(spec: &Spec, n: u64) -> Result<RowResult, PaperError> {
+/// Runs one row with the given columns ([`COLUMNS`] for the full table; the first must be
+/// the DFT column, which seeds the amplitude spread): seed 0 in full, seeds 1.. streamed
+/// for the amplitude. `bench dsp` times the DFT rows alone this way.
+pub fn run_row_with(
+    spec: &Spec,
+    n: u64,
+    columns_to_run: &[Column],
+) -> Result<RowResult, PaperError> {
     let setup = spec.setup();
     let source = setup.source(0)?;
     let detections = source.record(n);
@@ -385,7 +391,7 @@ pub fn run_row(spec: &Spec, n: u64) -> Result<RowResult, PaperError> {
         detections: &detections,
     };
     let mut columns = Vec::new();
-    for c in COLUMNS {
+    for c in columns_to_run {
         if let Some(m) = (c.measure)(&rec)? {
             columns.push((c.name, m));
         }
@@ -487,7 +493,14 @@ pub fn rows_of(r: &RowResult, quick: bool) -> Vec<Row> {
 
 /// Runs every row (rayon across rows), all sharing one probe ROM built for `n`.
 pub fn run_all(n: u64) -> Result<Vec<RowResult>, PaperError> {
-    ROWS.par_iter().map(|s| run_row(s, n)).collect()
+    run_all_with(n, COLUMNS)
+}
+
+/// [`run_all`] with a chosen set of columns (see [`run_row_with`]).
+pub fn run_all_with(n: u64, columns: &[Column]) -> Result<Vec<RowResult>, PaperError> {
+    ROWS.par_iter()
+        .map(|s| run_row_with(s, n, columns))
+        .collect()
 }
 
 /// The eq. 12 row: the paper's 2.21 µm prediction beside its 2.25 µm simulation, at
@@ -523,7 +536,7 @@ mod tests {
     fn short_row_matches_closed_form() {
         let spec = ROWS[9];
         let n = 1u64 << 18;
-        let r = run_row(&spec, n).unwrap();
+        let r = run_row_with(&spec, n, COLUMNS).unwrap();
         let m = &r.columns[0].1;
         assert!(
             (m.noise_um / r.closed_form_um - 1.0).abs() < 0.15,
