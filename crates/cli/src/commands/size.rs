@@ -13,7 +13,6 @@ use tofprobe_report::memory::{
 };
 use tofprobe_report::report::{Design, SizeReport, SizeRequest, build};
 use tofprobe_report::{markdown, plot, sky130};
-use tofprobe_rtlgen::PixelParams;
 use tofprobe_scene::{AcquisitionConfig, Scene, SceneConfig, SensorConfig};
 
 use crate::config::{DEFAULT_ORIGIN, DEFAULT_TOML, read_text};
@@ -61,28 +60,6 @@ struct Doc {
     acquisition: AcquisitionConfig,
     #[serde(default)]
     pixel: PixelConfig,
-}
-
-/// The pixel crate's resolved parameters in the generator's form (field for field).
-fn rtl_params(p: &tofprobe_pixel::PixelParams) -> PixelParams {
-    PixelParams {
-        mode: match p.mode {
-            tofprobe_pixel::Mode::Fourier => tofprobe_rtlgen::Mode::Fourier,
-            tofprobe_pixel::Mode::Haar => tofprobe_rtlgen::Mode::Haar,
-        },
-        bins: p.bins,
-        haar_scales: p.haar_scales,
-        adders: p.adders,
-        cycles_per_pulse: p.cycles_per_pulse,
-        tdc_bits: p.tdc_bits,
-        zoom: p.zoom,
-        shift: p.shift,
-        frac_bits: p.frac_bits,
-        width: p.width,
-        frame_pulses: p.frame_pulses,
-        rom_depth: p.rom_depth,
-        ..PixelParams::default()
-    }
 }
 
 fn cache_dir(arg: Option<&Path>) -> PathBuf {
@@ -133,7 +110,7 @@ pub fn report(a: &SizeArgs) -> Result<SizeReport, CliError> {
         origin: origin.clone(),
         message: format!("[pixel]: {e}"),
     })?;
-    let pixel = rtl_params(&resolved);
+    let pixel = tofprobe_cosim::pixel_bridge::from_pixel(&resolved);
     if !(a.node_nm.is_finite() && a.node_nm > 0.0 && a.node_nm <= 1000.0) {
         return Err(option_err("node-nm", a.node_nm, "0 < node ≤ 1000 (nm)"));
     }
