@@ -22,9 +22,7 @@
 mod common;
 
 use common::Rng;
-use tofprobe_dsp::sd::{
-    Modulator, ProbeAccumulator, ProbeConfig, ProbeDesign, ProbeRom, normalise,
-};
+use tofprobe_dsp::sd::{ProbeAccumulator, ProbeConfig, ProbeDesign, ProbeRom, normalise};
 use tofprobe_pixel::sizing::required_width;
 use tofprobe_pixel::{PixelParams, TransactionModel};
 
@@ -52,19 +50,7 @@ fn check(rho_s: f64, seed: u64) {
     let bins = [15u64, 100, 400];
     // The default design without its stability sweep (seconds in a debug build): the
     // modulator is the same, and A_p = 0.5 is well inside its measured limit of ≈ 0.77.
-    let config = ProbeConfig::default();
-    let design = ProbeDesign {
-        modulator: Modulator::design(
-            config.order,
-            config.osr,
-            config.optimised_zeros,
-            config.h_inf,
-        )
-        .unwrap(),
-        config,
-        max_stable_amplitude: 0.77,
-        limit_f_norm: 1e-4,
-    };
+    let design = ProbeDesign::with_known_limit(&ProbeConfig::default(), 0.77, 1e-4).unwrap();
     let rom: ProbeRom = ProbeRom::generate(&design, 10e6, n as u64, &bins).unwrap();
     let mut p = PixelParams::fourier_default(63, n as u64, rom.depth());
     p.bins = bins.len();
@@ -162,19 +148,7 @@ fn bit_true_equals_float_sd_within_the_derived_bound_rho_03() {
 fn bit_true_spectrum_reads_a_tone() {
     use tofprobe_pixel::spectrum::spectrum_from_readout;
     let n: usize = 1 << 15;
-    let config = ProbeConfig::default();
-    let design = ProbeDesign {
-        modulator: Modulator::design(
-            config.order,
-            config.osr,
-            config.optimised_zeros,
-            config.h_inf,
-        )
-        .unwrap(),
-        config,
-        max_stable_amplitude: 0.77,
-        limit_f_norm: 1e-4,
-    };
+    let design = ProbeDesign::with_known_limit(&ProbeConfig::default(), 0.77, 1e-4).unwrap();
     let rom = ProbeRom::generate(&design, 10e6, n as u64, &[15, 200]).unwrap();
     let mut p = PixelParams::fourier_default(63, n as u64, n);
     p.bins = 2;
@@ -213,19 +187,7 @@ fn streamed_bit_true_spectrum_equals_the_whole_record() {
     let source = PhotonSource::new(&sensor, &scene, 5).unwrap();
     // 150,000 pulses: more than two 2^16 chunks, not a multiple of them.
     let n = 150_000usize;
-    let config = ProbeConfig::default();
-    let design = ProbeDesign {
-        modulator: Modulator::design(
-            config.order,
-            config.osr,
-            config.optimised_zeros,
-            config.h_inf,
-        )
-        .unwrap(),
-        config,
-        max_stable_amplitude: 0.77,
-        limit_f_norm: 1e-4,
-    };
+    let design = ProbeDesign::with_known_limit(&ProbeConfig::default(), 0.77, 1e-4).unwrap();
     let rom = ProbeRom::generate(&design, 10e6, n as u64, &[68, 300]).unwrap();
     let mut p = PixelParams::fourier_default(63, n as u64, n);
     p.bins = 2;

@@ -126,20 +126,7 @@ impl ProbeSetup {
     /// (`ProbeSetup::new` checks it in every `reproduce` run).
     #[cfg(test)]
     pub fn for_tests(n: u64) -> Self {
-        use tofprobe_dsp::sd::Modulator;
-        let config = ProbeConfig::default();
-        let design = ProbeDesign {
-            modulator: Modulator::design(
-                config.order,
-                config.osr,
-                config.optimised_zeros,
-                config.h_inf,
-            )
-            .unwrap(),
-            config,
-            max_stable_amplitude: 0.77,
-            limit_f_norm: 1e-4,
-        };
+        let design = ProbeDesign::with_known_limit(&ProbeConfig::default(), 0.77, 1e-4).unwrap();
         Self::with_design(n, &design).unwrap()
     }
 

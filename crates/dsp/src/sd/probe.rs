@@ -51,14 +51,39 @@ impl ProbeDesign {
     /// [`SAFETY_MARGIN`] × the maximum stable amplitude measured at `f_norm` (use the
     /// lowest probe frequency: the limit is lowest towards DC, ≈ 0.77 vs 0.86 at 50 kHz).
     pub fn new(config: &ProbeConfig, f_norm: f64) -> Result<Self, DspError> {
+        let modulator = Self::design_modulator(config)?;
+        let a_max = modulator.max_stable_amplitude(f_norm);
+        Self::checked(config, modulator, a_max, f_norm)
+    }
+
+    /// The same design with a stability limit already known (measured by [`Self::new`]
+    /// elsewhere): skips the sweep, which takes seconds in a debug build, and still checks
+    /// the probe amplitude against the safety margin of that limit.
+    pub fn with_known_limit(
+        config: &ProbeConfig,
+        max_stable_amplitude: f64,
+        f_norm: f64,
+    ) -> Result<Self, DspError> {
+        let modulator = Self::design_modulator(config)?;
+        Self::checked(config, modulator, max_stable_amplitude, f_norm)
+    }
+
+    fn design_modulator(config: &ProbeConfig) -> Result<Modulator, DspError> {
         config.validate()?;
-        let modulator = Modulator::design(
+        Modulator::design(
             config.order,
             config.osr,
             config.optimised_zeros,
             config.h_inf,
-        )?;
-        let a_max = modulator.max_stable_amplitude(f_norm);
+        )
+    }
+
+    fn checked(
+        config: &ProbeConfig,
+        modulator: Modulator,
+        a_max: f64,
+        f_norm: f64,
+    ) -> Result<Self, DspError> {
         let limit = SAFETY_MARGIN * a_max;
         if config.amplitude > limit {
             return Err(DspError::out_of_range(
