@@ -21,7 +21,13 @@ fn scratch(name: &str) -> PathBuf {
 /// The default configuration with each `(from, to)` replaced (each must occur).
 fn edited(edits: &[(&str, &str)]) -> String {
     let out = tofprobe(&["config", "--print-default"]);
-    let mut text = String::from_utf8(out.stdout).expect("utf-8");
+    // These checks are about a short windowed frame (L = N, bins k·f_s/N): the default's
+    // periodic ROM (L = 20,000) is switched back to windowed first.
+    let mut text = String::from_utf8(out.stdout).expect("utf-8").replacen(
+        "rom_mode = \"periodic\"",
+        "rom_mode = \"windowed\"",
+        1,
+    );
     for (from, to) in edits {
         assert!(text.contains(from), "default lacks `{from}`");
         text = text.replacen(from, to, 1);

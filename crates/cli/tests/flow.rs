@@ -1,7 +1,8 @@
 //! `tofprobe flow` and the RTL commands' probe ROM, end to end on the embedded default:
-//! the flow renders the configuration's ΣΔ ROM (L = N, the short frame that puts the
-//! 4.5 kHz tone on bin 27), co-simulates clean and reports the normalised spectrum; a frame
-//! too short for the ΣΔ band falls back to the sign probe and says so.
+//! the flow renders the configuration's ΣΔ ROM (periodic, L = 20,000: the 4.5 kHz tone on
+//! bin 9), co-simulates clean on a 60,000-pulse frame (three ROM periods) and reports the
+//! normalised spectrum; a windowed frame too short for the ΣΔ band falls back to the sign
+//! probe and says so.
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -47,25 +48,35 @@ fn flow_on_the_default_uses_the_sigma_delta_rom_and_passes() {
     assert!(stdout.contains("flow PASS: N = 60000"), "{stdout}");
     assert!(stdout.contains("sizing skipped (--no-size)"), "{stdout}");
     let md = std::fs::read_to_string(dir.join("report.md")).expect("report");
-    assert!(md.contains("ΣΔ probe ROM (windowed blackman"), "{md}");
-    assert!(md.contains("| 0 | 27 | 4500.0 |"), "{md}");
-    // The rendered ROM image is L = N = 60000 entries deep (one `$readmemh` line each).
+    assert!(md.contains("ΣΔ probe ROM (periodic rectangular"), "{md}");
+    assert!(md.contains("wrap clean"), "{md}");
+    assert!(md.contains("| 0 | 9 | 4500.0 |"), "{md}");
+    // The rendered ROM image is L = 20,000 entries deep (one `$readmemh` line each).
     let hex = std::fs::read_to_string(dir.join("rtl/tofprobe_probe_rom.hex")).expect("rom");
     let lines = hex
         .lines()
         .filter(|l| !l.is_empty() && !l.starts_with("//"))
         .count();
-    assert_eq!(lines, 60_000);
+    assert_eq!(lines, 20_000);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn vectors_on_a_frame_too_short_for_the_band_fall_back_to_the_sign_probe() {
     let dir = scratch("short");
+    // A windowed ROM is one frame deep: L = N = 64 (the default's periodic ROM would stay
+    // 20,000 deep and the frame read its first 64 entries).
+    let text = String::from_utf8(tofprobe(&["config", "--print-default"]).stdout)
+        .expect("utf-8")
+        .replacen("rom_mode = \"periodic\"", "rom_mode = \"windowed\"", 1);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let cfg = dir.join("windowed.toml");
+    std::fs::write(&cfg, text).expect("write");
     let out = tofprobe(&[
         "vectors",
+        cfg.to_str().unwrap(),
         "--out",
-        dir.to_str().unwrap(),
+        dir.join("v").to_str().unwrap(),
         "--frame-pulses",
         "64",
         "--frames",

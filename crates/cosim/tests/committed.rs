@@ -1,14 +1,16 @@
-//! The committed generated files are current: the configuration recorded in each header is
-//! re-rendered with the recorded command and compared byte for byte (rtl/ and
-//! testbench/default-short/), and the committed short-frame vectors are regenerated from
-//! their manifest's seed and frame count. (scripts/check-generated.sh does the same through
-//! the CLI.)
+//! The committed generated files are consistent: the configuration recorded in each header
+//! is re-rendered with the recorded command and the committed probe ROM and compared byte
+//! for byte (rtl/ and testbench/default-short/), and the committed short-frame vectors are
+//! regenerated from their manifest's seed and frame count with the pixel model as judge.
+//! The ROM's own content is regenerated from the configuration by the CLI's test
+//! (crates/cli/tests/committed.rs) and scripts/check-generated.sh.
 
 use std::path::{Path, PathBuf};
+use tofprobe_cosim::driver::rom_from_rtl;
 use tofprobe_cosim::pixel_bridge::golden_run;
 use tofprobe_rtlgen::params::{Mode, PixelParams};
 use tofprobe_rtlgen::render::{RenderOptions, render};
-use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
+use tofprobe_rtlgen::stimulus::random_stimulus;
 use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
 
 fn root() -> PathBuf {
@@ -61,12 +63,19 @@ fn from_header(text: &str) -> (String, PixelParams) {
 fn check_rtl_dir(dir: &Path) -> PixelParams {
     let top = std::fs::read_to_string(dir.join("tofprobe_top.v")).expect("committed top");
     let (command, p) = from_header(&top);
+    let rom_note = top
+        .lines()
+        .find_map(|l| l.strip_prefix("// Probe ROM: "))
+        .unwrap_or("")
+        .to_string();
+    let rom = rom_from_rtl(&p, dir).expect("committed ROM reads");
     let files = render(
         &p,
-        &sign_probe_rom(&p),
+        &rom,
         &RenderOptions {
             command,
             mutation: None,
+            rom_note,
         },
     )
     .expect("renders");
@@ -93,7 +102,10 @@ fn check_rtl_dir(dir: &Path) -> PixelParams {
 #[test]
 fn committed_rtl_is_current() {
     let p = check_rtl_dir(&root().join("rtl"));
-    assert_eq!((p.frame_pulses, p.registers()), (10_000_000, 32));
+    assert_eq!(
+        (p.frame_pulses, p.registers(), p.rom_depth),
+        (10_000_000, 32, 20_000)
+    );
     check_rtl_dir(&root().join("testbench/default-short/rtl"));
 }
 
@@ -108,7 +120,7 @@ fn committed_vectors_are_current() {
         ..VectorOptions::default()
     };
     let stim = random_stimulus(&p, o.frames * p.frame_pulses, o.seed);
-    let rom = sign_probe_rom(&p);
+    let rom = rom_from_rtl(&p, &base.join("rtl")).expect("committed ROM reads");
     // The judge: the pixel crate's cycle model.
     let (g, w) = golden_run(&p, &stim, &rom, &o).expect("pixel model accepts");
     let tmp = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("committed-vectors");

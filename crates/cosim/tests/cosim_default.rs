@@ -37,9 +37,10 @@ fn committed_rtl_dir_passes_and_the_build_is_reused() {
     }
     let rtl =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testbench/default-short/rtl");
+    // The default's periodic ΣΔ ROM (L = 20,000) of which a 64-pulse frame reads the start.
     let p = PixelParams {
         frame_pulses: 64,
-        rom_depth: 64,
+        rom_depth: 20_000,
         ..PixelParams::default()
     };
     // The committed RTL records T, F and W resolved from the embedded default scene.

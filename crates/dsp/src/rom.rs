@@ -264,6 +264,16 @@ pub struct RomManifest {
     pub coherent_gain: f64,
     /// Largest modulator state mismatch at the periodic wrap (0 for windowed ROMs).
     pub wrap_mismatch: f64,
+    /// Worst bitstream's wrap transient in-band energy over its period's in-band error
+    /// (0 for windowed ROMs; see `sd::wrap`).
+    #[serde(default)]
+    pub wrap_error_ratio: f64,
+    /// Whether that ratio is within `sd::probe::WRAP_TOLERANCE`.
+    #[serde(default)]
+    pub wrap_clean: bool,
+    /// Periods run after the warm-up to find the cuts (0 for windowed ROMs).
+    #[serde(default)]
+    pub wrap_periods: usize,
 }
 
 impl RomManifest {
@@ -401,6 +411,9 @@ mod tests {
             window: "blackman".into(),
             coherent_gain: 0.42,
             wrap_mismatch: 0.0,
+            wrap_error_ratio: 0.0,
+            wrap_clean: true,
+            wrap_periods: 0,
         };
         let path = m.write(&rom, &dir, "probe").unwrap();
         let first = std::fs::read(dir.join("probe.hex")).unwrap();

@@ -18,6 +18,9 @@ pub struct RenderOptions {
     pub command: String,
     /// A deliberate fault, for the mutation tests only.
     pub mutation: Option<Fault>,
+    /// One line on what the probe ROM holds (its design, bins, content hash), recorded in
+    /// each header; empty for none.
+    pub rom_note: String,
 }
 
 impl Default for RenderOptions {
@@ -25,6 +28,7 @@ impl Default for RenderOptions {
         RenderOptions {
             command: "tofprobe rtl --out rtl".to_string(),
             mutation: None,
+            rom_note: String::new(),
         }
     }
 }
@@ -73,6 +77,15 @@ fn header(p: &PixelParams, template: &str, o: &RenderOptions) -> String {
         p.frame_pulses,
         p.rom_depth
     );
+    if !o.rom_note.is_empty() {
+        // One comment line whatever the note holds: no line break can end the comment.
+        let note: String = o
+            .rom_note
+            .chars()
+            .map(|c| if c.is_control() { ' ' } else { c })
+            .collect();
+        h.push_str(&format!("// Probe ROM: {note}\n"));
+    }
     if let Some(f) = o.mutation {
         h.push_str(&format!(
             "// DELIBERATELY BROKEN ({}) for the co-simulation mutation tests.\n",

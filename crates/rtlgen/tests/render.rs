@@ -80,6 +80,7 @@ fn headers_name_generator_template_command_hash() {
     let o = RenderOptions {
         command: "tofprobe rtl --out here".into(),
         mutation: None,
+        rom_note: String::new(),
     };
     let files = render(&p, &sign_probe_rom(&p), &o).expect("renders");
     assert_eq!(files.len(), 3, "case-table ROM: pixel, rom, top");

@@ -6,7 +6,8 @@
 //! of a few hundred pulses at least (the committed 64-pulse short frame has none), and a
 //! windowed ROM is N entries deep, so frames beyond [`MAX_SD_ROM_DEPTH`] keep the short
 //! periodic sign probe rather than a ROM file of more than 2^24 lines. `tofprobe rtl`
-//! itself (and the committed `rtl/`) keeps the sign probe: see testbench/README.md.
+//! itself renders the same ROM (the committed `rtl/` holds the default's): see
+//! testbench/README.md.
 
 use tofprobe_dsp::sd::{ProbeDesign, ProbeRom};
 use tofprobe_pixel::autobins::{band_limit, choose_bins};
@@ -104,15 +105,31 @@ pub fn rtl_rom(config: &Config, origin: &str, p: &mut PixelParams) -> Result<Rtl
     let rom = ProbeRom::generate(&design, fs, p.frame_pulses, &bins).map_err(probe_err)?;
     p.rom_depth = rom.depth();
     p.validate()?;
+    let wrap = if rom.mode == tofprobe_dsp::sd::RomMode::Periodic {
+        format!(
+            ", wrap {} (in-band wrap error {:.1e} of the quantisation error, {} period(s) searched)",
+            if rom.wrap_clean() {
+                "clean"
+            } else {
+                "NOT clean"
+            },
+            rom.wrap_error_ratio,
+            rom.wrap_periods
+        )
+    } else {
+        String::new()
+    };
     let note = format!(
-        "ΣΔ probe ROM ({} {}, order {}, OSR {}, A_p {}), L = {}, bins k = {:?}",
+        "ΣΔ probe ROM ({} {}, order {}, OSR {}, A_p {}, window gain {}), L = {}, bins k = {:?} (f_k = k·f_s/L){wrap}, content hash {:016x}",
         rom.mode.name(),
         rom.window.name(),
         rom.order,
         rom.osr,
         rom.amplitude,
+        rom.coherent_gain,
         rom.depth(),
-        rom.bin_indices
+        rom.bin_indices,
+        rom.image.content_hash()
     );
     Ok(RtlRom {
         words: rom.image.words().to_vec(),

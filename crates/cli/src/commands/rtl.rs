@@ -1,7 +1,11 @@
 //! `tofprobe rtl [CONFIG] --out DIR`: renders the pixel, probe ROM and top for the
 //! configuration's `[pixel]` into DIR, atomically, refusing to overwrite files it did not
-//! generate. Also the shared step "configuration → generator parameters" of the RTL
-//! commands (`vectors`, `cosim`, `flow`).
+//! generate. The probe ROM is the configuration's ΣΔ ROM (`probe_rom::rtl_rom`: for the
+//! default, periodic L = 20,000, 32 bitstreams) whenever it is at most
+//! [`MAX_RENDERED_SD_DEPTH`] deep; a windowed ROM of a long frame (L = N) or `--rom-depth`
+//! renders the sign-of-cosine probe instead, and the command says which. Also the shared
+//! step "configuration → generator parameters" of the RTL commands (`vectors`, `cosim`,
+//! `flow`).
 
 use std::path::{Path, PathBuf};
 
@@ -12,12 +16,17 @@ use tofprobe_rtlgen::render::RenderOptions;
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 use tofprobe_rtlgen::write::write_generated;
 
+use crate::commands::probe_rom::rtl_rom;
 use crate::config::Config;
 use crate::error::CliError;
 
 /// ROM depth used when the configuration leaves L = N and N is a long frame: a periodic
 /// probe of this depth (bin spacing f_s/L), not a 10^7-entry ROM.
 pub const LONG_FRAME_ROM_DEPTH: usize = 4096;
+
+/// Deepest ΣΔ ROM `tofprobe rtl` renders into a chip ROM (2^16 entries; deeper is a
+/// windowed long-frame ROM, which no chip would store).
+pub const MAX_RENDERED_SD_DEPTH: usize = 1 << 16;
 
 /// Arguments of `tofprobe rtl`.
 #[derive(Debug, Args)]
@@ -27,7 +36,8 @@ pub struct RtlArgs {
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
-    /// Override the ROM depth L (default: the configuration's, 4096 when that exceeds 65536).
+    /// Override the ROM depth L and render the sign-of-cosine probe ROM instead of the ΣΔ
+    /// ROM (default: the configuration's ΣΔ ROM; 4096 sign entries when that exceeds 65536).
     #[arg(long)]
     pub rom_depth: Option<usize>,
     /// Override the pulses per frame N (e.g. short frames for co-simulation).
@@ -58,7 +68,10 @@ pub fn rtl_params(
         None if p.rom_depth > 65_536 => LONG_FRAME_ROM_DEPTH,
         None => p.rom_depth,
     };
-    if frame_pulses.is_some() && rom_depth.is_none() {
+    // A periodic chip ROM stays L deep for a short frame (the frame reads its first N
+    // entries); a windowed ROM is one frame deep by definition.
+    let windowed = c.probe.rom_mode == tofprobe_dsp::sd::RomMode::Windowed;
+    if frame_pulses.is_some() && rom_depth.is_none() && windowed {
         p.rom_depth = p.rom_depth.min(p.frame_pulses.max(1) as usize);
     }
     p.validate()?;
@@ -81,14 +94,44 @@ pub fn regen_command(a: &RtlArgs) -> String {
     s
 }
 
+/// The probe ROM `tofprobe rtl` renders for `p` (setting `p.rom_depth` to its depth), and
+/// a line saying which it is.
+pub fn chip_rom(a: &RtlArgs, p: &mut PixelParams) -> Result<(Vec<u64>, String), CliError> {
+    let loaded = Config::load(a.config.as_deref())?;
+    let sd_depth = loaded.config.probe.depth(p.frame_pulses);
+    if a.rom_depth.is_some() || sd_depth > MAX_RENDERED_SD_DEPTH {
+        let why = if a.rom_depth.is_some() {
+            "--rom-depth given".to_string()
+        } else {
+            format!(
+                "the {} ΣΔ ROM would be {sd_depth} entries deep (> {MAX_RENDERED_SD_DEPTH})",
+                loaded.config.probe.rom_mode.name()
+            )
+        };
+        return Ok((
+            sign_probe_rom(p),
+            format!("sign-of-cosine probe ROM (L = {}): {why}", p.rom_depth),
+        ));
+    }
+    let r = rtl_rom(&loaded.config, &loaded.origin, p)?;
+    Ok((r.words, r.note))
+}
+
 /// Renders and writes; returns the file names.
-pub fn render_to(p: &PixelParams, out: &Path, command: String) -> Result<Vec<String>, CliError> {
+pub fn render_to(
+    p: &PixelParams,
+    rom: &[u64],
+    out: &Path,
+    command: String,
+    rom_note: String,
+) -> Result<Vec<String>, CliError> {
     let files = tofprobe_rtlgen::render(
         p,
-        &sign_probe_rom(p),
+        rom,
         &RenderOptions {
             command,
             mutation: None,
+            rom_note,
         },
     )?;
     let pairs: Vec<(String, String)> = files.into_iter().map(|f| (f.name, f.contents)).collect();
@@ -98,10 +141,11 @@ pub fn render_to(p: &PixelParams, out: &Path, command: String) -> Result<Vec<Str
 
 /// Runs `tofprobe rtl`.
 pub fn run(a: &RtlArgs) -> Result<(), CliError> {
-    let p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
-    let names = render_to(&p, &a.out, regen_command(a))?;
+    let mut p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
+    let (rom, note) = chip_rom(a, &mut p)?;
+    let names = render_to(&p, &rom, &a.out, regen_command(a), note.clone())?;
     println!(
-        "rtl: {:?} pixel, {} registers x {} bits, {} adder(s), {} cycles/pulse, N = {}, L = {}, hash {} -> {} ({})",
+        "rtl: {:?} pixel, {} registers x {} bits, {} adder(s), {} cycles/pulse, N = {}, L = {}, hash {} -> {} ({}); {note}",
         p.mode,
         p.registers(),
         p.width,

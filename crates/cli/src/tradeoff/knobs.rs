@@ -79,6 +79,11 @@ pub const DEFAULT_SWEEP: &[KnobSetting] = &[
             ("probe.rom_depth", "20000"),
         ],
     ),
+    k(
+        "ROM mode, L",
+        "windowed, N",
+        &[("probe.rom_mode", "\"windowed\"")],
+    ),
     k("ΣΔ order", "2", &[("probe.order", "2")]),
     k("ΣΔ order", "4", &[("probe.order", "4")]),
     k("OSR", "16", &[("probe.osr", "16.0")]),

@@ -29,6 +29,10 @@ impl RomMode {
 
 /// `[probe]`: the ΣΔ probe design.
 ///
+/// The struct's default is the paper's windowed frame (L = N, Blackman), which
+/// `reproduce` and the float references use; the embedded default configuration
+/// (scenes/default.toml) stores the chip's periodic ROM instead (L = 20,000, rectangular).
+///
 /// `amplitude` is the probe amplitude A_p relative to the quantiser level ±1. The default
 /// 0.5 is 65% of the default modulator's measured maximum stable amplitude (≈ 0.77), well
 /// inside the accepted limit of 0.9 × that maximum (see `modulator::SAFETY_MARGIN`).

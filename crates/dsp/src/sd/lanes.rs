@@ -60,7 +60,7 @@ impl LaneGroup {
     }
 
     /// Fills `u[t][lane]` for samples n0 .. n0 + u.len() (u.len() ≤ ANCHOR).
-    fn inputs(&self, n0: u64, u: &mut [[f64; LANES]]) {
+    pub(crate) fn inputs(&self, n0: u64, u: &mut [[f64; LANES]]) {
         let l = self.period;
         let two_pi_over_l = 2.0 * PI / l as f64;
         let mut c = [0.0; LANES];

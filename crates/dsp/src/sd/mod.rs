@@ -8,6 +8,7 @@ pub mod probe;
 pub mod probing;
 pub mod quality;
 pub mod realize;
+pub mod wrap;
 
 pub use config::{ProbeConfig, RomMode};
 pub use modulator::Modulator;
@@ -15,3 +16,4 @@ pub use ntf::{Ntf, synthesize_ntf};
 pub use probe::{ProbeDesign, ProbeRom, nearest_bin};
 pub use probing::{ProbeAccumulator, amplitudes_um, normalise, prefilter_response, probe_record};
 pub use realize::{Cifb, StateSpace, realize_cifb};
+pub use wrap::WrapMetric;

@@ -320,12 +320,18 @@ fn write_svg(m: &Modulator, path: &std::path::Path) -> Result<(), CliError> {
 mod tests {
     use super::*;
 
-    /// The embedded default's `[probe]` section is the documented default design, and it
-    /// validates (its amplitude 0.5 is below 0.9 × the measured ≈ 0.77).
+    /// The embedded default's `[probe]` section is the documented default design with the
+    /// chip's periodic ROM (L = 20,000: 4.5 kHz on the 500 Hz grid), and it validates (its
+    /// amplitude 0.5 is below 0.9 × the measured ≈ 0.77).
     #[test]
     fn default_probe_section_is_the_default_design() {
         let loaded = crate::config::Config::load(None).expect("default loads");
-        assert_eq!(loaded.config.probe, ProbeConfig::default());
+        let periodic = ProbeConfig {
+            rom_mode: tofprobe_dsp::sd::RomMode::Periodic,
+            rom_depth: 20_000,
+            ..ProbeConfig::default()
+        };
+        assert_eq!(loaded.config.probe, periodic);
         loaded.config.probe.validate().expect("valid");
     }
 
