@@ -23,6 +23,15 @@ fn configs() -> Vec<(&'static str, PixelParams)> {
     let d = PixelParams::default();
     vec![
         ("default", d.clone()),
+        // The committed rtl/'s shape: a periodic ROM of 20,000 entries, not a power of two,
+        // loaded by $readmemh (yosys maps it in ≈ 40 s).
+        (
+            "default_periodic_rom",
+            PixelParams {
+                rom_depth: 20_000,
+                ..d.clone()
+            },
+        ),
         (
             "haar_default",
             PixelParams {
