@@ -90,6 +90,13 @@ impl Config {
             origin: origin.to_string(),
             source,
         })?;
+        let frame = self.pixel.frame_pulses.unwrap_or(self.pulses());
+        self.probe
+            .check_frame(frame)
+            .map_err(|source| CliError::Probe {
+                origin: origin.to_string(),
+                source,
+            })?;
         self.pixel_params().map_err(|source| CliError::Pixel {
             origin: origin.to_string(),
             source,

@@ -89,6 +89,7 @@ fn tiny_config(dir: &std::path::Path, n: u64) -> std::path::PathBuf {
     let f = 30.0 * 10e6 / n as f64;
     let text = String::from_utf8(out.stdout)
         .expect("utf-8")
+        .replacen("rom_mode = \"periodic\"", "rom_mode = \"windowed\"", 1)
         .replacen("duration_s = 1.0", &format!("pulses = {n}"), 1)
         .replacen("amplitude_mm = 0.1", "amplitude_mm = 1.0", 1)
         .replacen("frequency_hz = 4500.0", &format!("frequency_hz = {f}"), 1)

@@ -65,10 +65,10 @@ pub const DEFAULT_SWEEP: &[KnobSetting] = &[
     k("S", "7", &[("pixel.shift", "7")]),
     k(
         "ROM mode, L",
-        "periodic, 65536",
+        "periodic, 62500",
         &[
             ("probe.rom_mode", "\"periodic\""),
-            ("probe.rom_depth", "65536"),
+            ("probe.rom_depth", "62500"),
         ],
     ),
     k(

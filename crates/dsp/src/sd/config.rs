@@ -95,6 +95,33 @@ impl ProbeConfig {
         Ok(())
     }
 
+    /// A periodic ROM restarts at address 0 every frame (docs/pixel-contract.md), so a frame
+    /// must be a whole number of periods: otherwise every frame boundary is a phase jump
+    /// of the probe and its bins are no longer orthogonal over the frame. The error gives
+    /// the largest depth ≤ L that divides N and the nearest whole-period frame.
+    pub fn check_frame(&self, frame_pulses: u64) -> Result<(), DspError> {
+        let l = self.rom_depth as u64;
+        if self.rom_mode != RomMode::Periodic || l == 0 || frame_pulses.is_multiple_of(l) {
+            return Ok(());
+        }
+        let divisor = (16..=l.min(frame_pulses))
+            .rev()
+            .find(|&d| frame_pulses.is_multiple_of(d));
+        let periods = ((frame_pulses as f64 / l as f64).round() as u64).max(1);
+        let mut hint = format!("a frame of {} pulses ({periods} period(s))", periods * l);
+        if let Some(d) = divisor {
+            hint = format!("rom_depth = {d} (divides N), or {hint}");
+        }
+        Err(DspError::out_of_range(
+            "probe.rom_depth",
+            self.rom_depth,
+            format!(
+                "a divisor of the frame N = {frame_pulses} pulses in periodic mode (the ROM address restarts every frame)"
+            ),
+        )
+        .with_hint(hint))
+    }
+
     /// ROM depth L for a frame of `frame_pulses` pulses.
     pub fn depth(&self, frame_pulses: u64) -> usize {
         match self.rom_mode {
@@ -107,6 +134,26 @@ impl ProbeConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_periodic_frame_must_be_whole_periods() {
+        let c = ProbeConfig {
+            rom_mode: RomMode::Periodic,
+            rom_depth: 20_000,
+            ..ProbeConfig::default()
+        };
+        c.check_frame(10_000_000).unwrap();
+        c.check_frame(60_000).unwrap();
+        let e = c.check_frame(65_536).unwrap_err().to_string();
+        // 65536 = 2^16: its largest divisor ≤ 20000 is 16384; 65536/20000 ≈ 3 periods.
+        assert!(e.contains("probe.rom_depth = 20000"), "{e}");
+        assert!(
+            e.contains("rom_depth = 16384") && e.contains("60000 pulses"),
+            "{e}"
+        );
+        // Windowed ROMs are one frame deep by construction.
+        ProbeConfig::default().check_frame(65_536).unwrap();
+    }
 
     #[test]
     fn defaults_parse_and_unknown_fields_are_rejected() {
