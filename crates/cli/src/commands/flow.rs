@@ -4,10 +4,12 @@
 //! named together with scripts/install-tools.sh.
 //!
 //! The ROM is the configuration's ΣΔ probe ROM (`probe_rom`); its bins come from the scene
-//! (`autobins`) for the frame actually simulated. The default short frame is chosen so
-//! that the scene's strongest in-band tone sits exactly on a bin (see [`short_frame`]):
-//! a windowed readout off a bin loses up to the window's scalloping (≈ 12 % for Blackman
-//! at half a bin), which would hide whether the chain reads the right amplitude.
+//! (`autobins`) for the frame actually simulated. The default short frame is whole periods
+//! of a periodic ROM ([`periodic_short_frame`]: the default's 60,000 = 3 × 20,000), and for
+//! a windowed ROM is chosen so that the scene's strongest in-band tone sits exactly on a
+//! bin (see [`short_frame`]): a windowed readout off a bin loses up to the window's
+//! scalloping (≈ 12 % for Blackman at half a bin), which would hide whether the chain
+//! reads the right amplitude.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -77,6 +79,12 @@ pub fn short_frame(tones: &[(f64, f64)], sample_rate_hz: f64, band_hz: f64) -> u
         .unwrap_or(SHORT_FRAME)
 }
 
+/// The flow's default frame for a periodic ROM of depth L: the most whole periods that fit
+/// in [`SHORT_FRAME`], at least one (the default's L = 20,000 gives 60,000).
+pub fn periodic_short_frame(l: u64) -> u64 {
+    (SHORT_FRAME / l.max(1)).max(1) * l.max(1)
+}
+
 /// Runs `tofprobe flow`.
 pub fn run(a: &FlowArgs) -> Result<(), CliError> {
     if a.frames == 0 || a.frames > 100 {
@@ -95,8 +103,14 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
         let band = fs / (2.0 * loaded.config.probe.osr);
         // Haar frames must be a power of two and have no bins to align.
         let haar = loaded.config.pixel.mode == tofprobe_pixel::Mode::Haar;
+        let probe = &loaded.config.probe;
+        let periodic = probe.rom_mode == tofprobe_dsp::sd::RomMode::Periodic;
         Some(if haar {
             a.frame_pulses.unwrap_or(SHORT_FRAME)
+        } else if periodic {
+            // The bins are already on the ROM's grid: whole periods, as many as fit.
+            a.frame_pulses
+                .unwrap_or_else(|| periodic_short_frame(probe.rom_depth as u64))
         } else {
             a.frame_pulses
                 .unwrap_or_else(|| short_frame(&loaded.config.pixel_context().tones, fs, band))
@@ -362,6 +376,14 @@ mod tests {
     use super::*;
     use tofprobe_dsp::sd::{ProbeConfig, ProbeDesign, ProbeRom};
     use tofprobe_rtlgen::params::PixelParams;
+
+    #[test]
+    fn periodic_short_frame_is_whole_periods() {
+        assert_eq!(periodic_short_frame(20_000), 60_000);
+        assert_eq!(periodic_short_frame(65_536), 65_536);
+        assert_eq!(periodic_short_frame(100_000), 100_000);
+        assert_eq!(periodic_short_frame(7), 65_534);
+    }
 
     #[test]
     fn short_frame_puts_the_strongest_tone_on_a_bin() {
