@@ -231,3 +231,21 @@ fn toml_errors_keep_line_and_column() {
     );
     fails_with(&["simulate", &path], &["saw", "line"]);
 }
+
+/// `tofprobe … | head`: a reader that has gone away is not an error. The reader here
+/// (`true`) exits before tofprobe starts writing, so the write meets a closed pipe; the
+/// command must exit with the shell's SIGPIPE status (141) and no panic report.
+#[test]
+fn a_closed_stdout_pipe_exits_quietly() {
+    let script = format!(
+        "{{ sleep 0.3; '{}' config --print-default; echo \"status=$?\" >&2; }} | true",
+        env!("CARGO_BIN_EXE_tofprobe")
+    );
+    let out = Command::new("sh")
+        .args(["-c", &script])
+        .output()
+        .expect("sh runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.contains("status=141"), "{err}");
+}
