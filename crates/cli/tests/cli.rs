@@ -129,6 +129,14 @@ fn simulate_json_summary() {
     let sigma = v["sigma_depth_mm"].as_f64().expect("sigma");
     assert!(sigma > 7.5 && sigma < 17.3, "sigma {sigma}");
     assert!(v["seconds"].as_f64().expect("seconds") >= 0.0);
+    // 200,000 = 10 periods of the default's periodic ROM, whose wrap is clean (1.8e-2 of
+    // the in-band quantisation error, limit 0.05).
+    let bt = &v["bit_true"];
+    assert_eq!(bt["rom_mode"].as_str(), Some("periodic"));
+    assert_eq!(bt["rom_depth"].as_u64(), Some(20_000));
+    assert_eq!(bt["rom_wrap_clean"].as_bool(), Some(true));
+    let ratio = bt["rom_wrap_error_ratio"].as_f64().expect("ratio");
+    assert!(ratio > 0.0 && ratio <= 0.05, "{ratio}");
 }
 
 #[test]

@@ -57,6 +57,15 @@ pub struct BitTrueOut {
     pub noise_estimate_um: f64,
     /// Wall time of ROM generation (s).
     pub rom_seconds: f64,
+    /// ROM organisation: "windowed" or "periodic".
+    pub rom_mode: String,
+    /// ROM depth L.
+    pub rom_depth: usize,
+    /// Periodic ROM: worst stream's in-band wrap error over its in-band quantisation
+    /// error (0 for windowed; clean at ≤ 0.05).
+    pub rom_wrap_error_ratio: f64,
+    /// Whether the wrap is clean (always true for windowed).
+    pub rom_wrap_clean: bool,
     /// Wall time of the transaction-model frame (s).
     pub model_seconds: f64,
 }
@@ -196,6 +205,20 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                     "bit-true spectrum  W = {} bits, N = {} pulses (ROM {:.2} s, model {:.2} s)",
                     b.width_bits, b.frame_pulses, b.rom_seconds, b.model_seconds
                 );
+                let wrap = if b.rom_mode == "periodic" {
+                    format!(
+                        ", wrap {} ({:.1e} of the in-band quantisation error)",
+                        if b.rom_wrap_clean {
+                            "clean"
+                        } else {
+                            "NOT clean"
+                        },
+                        b.rom_wrap_error_ratio
+                    )
+                } else {
+                    String::new()
+                };
+                println!("  probe ROM {} L = {}{wrap}", b.rom_mode, b.rom_depth);
                 println!("  frequency Hz   amplitude um    phase deg");
                 for bin in &b.bins {
                     println!(
@@ -246,6 +269,10 @@ fn bit_true(
             .collect(),
         noise_estimate_um: spectrum.median_amplitude_um,
         rom_seconds,
+        rom_mode: setup.rom.mode.name().to_string(),
+        rom_depth: setup.rom.depth(),
+        rom_wrap_error_ratio: setup.rom.wrap_error_ratio,
+        rom_wrap_clean: setup.rom.wrap_clean(),
         model_seconds,
     };
     Ok(Some((out, spectrum)))
