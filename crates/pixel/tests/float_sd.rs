@@ -1,23 +1,23 @@
 //! Accuracy against float ΣΔ probing (issue point 7): on Table 2 scenes the bit-true
-//! registers equal the float ΣΔ probing of crates/dsp (`ProbeAccumulator`, α = 2^−S) on the
-//! same held depths within a bound derived from F and S, with W from the sizing (so nothing
-//! wraps).
+//! registers equal the float ΣΔ probing of crates/dsp under the pixel's rules
+//! (`ProbeAccumulator::push_detections`, α = 2^−S: the same hold and priming, in f64) on
+//! the same detections within a bound derived from F and S, with W from the sizing (so
+//! nothing wraps).
 //!
-//! The bound. Both start the filter at the first depth, so they agree at pulse 1. After
+//! The bound. Both prime the filter at the first detection (pulse 0 here) and add nothing
+//! for it, so they agree at pulse 1. After
 //! that the integer filter differs from the float one only by its floor residues:
 //! x̃ₙ = x̃ₙ₋₁ + α(hₙ₋₁ − x̃ₙ₋₁) − φₙ·2^−F with φₙ ∈ [0, 1) (x̃ = x/2^F in codes), so the
 //! error eₙ = x̃ₙ − xₙ obeys eₙ = (1−α)eₙ₋₁ − φₙ2^−F and lies in (−2^(S−F), 0]. Writing
 //! eₙ = −c + uₙ with c = 2^(S−F−1) and |uₙ| ≤ c, the register error over pulses 1..N−1 is
-//! |Σ sₙeₙ| ≤ c·(N − 1 + |Σ sₙ|) (sₙ the register's ±1 ROM signs, counted exactly). The
-//! float also adds the priming pulse's s₀·h₀, which the pixel does not (the contract's
-//! priming rule); that term is exact and removed from the float before comparing. Hence,
+//! |Σ sₙeₙ| ≤ c·(N − 1 + |Σ sₙ|) (sₙ the register's ±1 ROM signs, counted exactly). Hence,
 //! per register, in codes:
-//!     |Y_bit·2^−F − (Y_float − s₀h₀)| ≤ 2^(S−F−1)·(N − 1 + |Σₙ₌₁ sₙ|).
+//!     |Y_bit·2^−F − Y_float| ≤ 2^(S−F−1)·(N − 1 + |Σₙ₌₁ sₙ|).
 //! W only enters through the sizing: with W from `required_width` nothing wraps.
 //! This worst case is loose: the measured error is ~0.1 % of it, because e is nearly the
 //! constant −c whose projection c·Σsₙ is tiny for a balanced ΣΔ probe (Σsₙ = ±1 here).
-//! Uncorrected, the priming term alone is ±h₀ ≈ 40 codes per register: 12–32 µm at
-//! N = 2^15, shrinking as 1/N (≈ 0.04 µm at N = 10^7).
+//! The textbook float path (`push`, which also adds the priming sample) would differ by
+//! ±h₀ ≈ 40 codes per register: 12–32 µm at N = 2^15, shrinking as 1/N.
 
 mod common;
 
@@ -66,19 +66,10 @@ fn check(rho_s: f64, seed: u64) {
         .remove(0)
         .words;
 
-    // The float path on the same held depths (codes).
-    let mut held = 0.0;
-    let depths: Vec<f64> = stimuli
-        .iter()
-        .map(|d| {
-            if let Some(c) = d {
-                held = f64::from(*c);
-            }
-            held
-        })
-        .collect();
+    // The float path under the pixel's rules on the same detections (codes).
+    let detections: Vec<Option<f64>> = stimuli.iter().map(|d| d.map(f64::from)).collect();
     let mut acc = ProbeAccumulator::new(&rom, Some(1.0 / f64::from(1u32 << p.shift)));
-    acc.push(&depths);
+    acc.push_detections(&detections);
     let float: Vec<f64> = acc.sums().into_iter().flat_map(|(i, q)| [i, q]).collect();
 
     let c = f64::from(1u32 << p.shift) / f64::from(1u32 << p.frac_bits) / 2.0;
@@ -88,11 +79,8 @@ fn check(rho_s: f64, seed: u64) {
         let sum_s: i64 = (1..n)
             .map(|i| if rom.image.bit(i, r) { 1 } else { -1 })
             .sum();
-        // The priming pulse: the float adds s₀·h₀, the pixel nothing. Exactly.
-        let s0 = if rom.image.bit(0, r) { 1.0 } else { -1.0 };
-        let primed_float = fl - s0 * depths[0];
         let bound = c * ((n - 1) as f64 + sum_s.unsigned_abs() as f64);
-        let err = (y as f64 / scale - primed_float).abs();
+        let err = (y as f64 / scale - fl).abs();
         assert!(
             err <= bound,
             "register {r}: |bit-true − float| = {err} codes > bound {bound}"
@@ -103,24 +91,14 @@ fn check(rho_s: f64, seed: u64) {
     // bound of 2048 (0.11 %) on these seeds; 1 % leaves room without making it vacuous.
     assert!(worst_ratio < 0.01, "error / bound = {worst_ratio}");
 
-    // In the normalised spectrum (µm, 0.75 mm codes), priming term removed from the float:
-    // measured ≤ 0.6 µm at N = 2^15 where the noise floor is ≈ 96 µm.
+    // In the normalised spectrum (µm, 0.75 mm codes): measured ≤ 0.6 µm at N = 2^15 where
+    // the noise floor is ≈ 96 µm.
     let alpha = Some(1.0 / f64::from(1u32 << p.shift));
     let bit: Vec<(f64, f64)> = words
         .chunks(2)
         .map(|c| (c[0] as f64 / scale, c[1] as f64 / scale))
         .collect();
-    let fl: Vec<(f64, f64)> = float
-        .chunks(2)
-        .enumerate()
-        .map(|(k, c)| {
-            let s0 = |r: usize| if rom.image.bit(0, r) { 1.0 } else { -1.0 };
-            (
-                c[0] - s0(2 * k) * depths[0],
-                c[1] - s0(2 * k + 1) * depths[0],
-            )
-        })
-        .collect();
+    let fl = acc.sums();
     let yb = normalise(&rom, &bit, n as u64, alpha);
     let yf = normalise(&rom, &fl, n as u64, alpha);
     for k in 0..bins.len() {

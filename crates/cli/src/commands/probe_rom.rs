@@ -10,7 +10,7 @@
 //! testbench/README.md.
 
 use tofprobe_dsp::sd::{ProbeDesign, ProbeRom};
-use tofprobe_pixel::autobins::{band_limit, choose_bins};
+use tofprobe_pixel::autobins::band_limit;
 use tofprobe_rtlgen::params::{Mode, PixelParams};
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 
@@ -36,19 +36,7 @@ pub struct RtlRom {
 /// ROM bin indices for depth `depth`: `frequencies_hz` rounded to k·f_s/L, else the
 /// scene's in-band tones then noise bins, B in all (as `tofprobe simulate` chooses them).
 pub fn sd_bins(config: &Config, bins: usize, depth: usize) -> Result<Vec<u64>, String> {
-    let fs = config.sensor.laser_rate_hz;
-    if !config.pixel.frequencies_hz.is_empty() {
-        return Ok(config
-            .pixel
-            .frequencies_hz
-            .iter()
-            .map(|f| (f * depth as f64 / fs).round().max(1.0) as u64)
-            .collect());
-    }
-    let ctx = config.pixel_context();
-    choose_bins(&ctx.tones, fs, depth as u64, config.probe.osr, Some(bins))
-        .map(|c| c.all())
-        .map_err(|e| e.to_string())
+    super::spectrum_svg::bin_indices(config, bins, depth as u64).map_err(|e| e.to_string())
 }
 
 /// Chooses the ROM for `p` (the frame actually simulated) and sets `p.rom_depth` to its

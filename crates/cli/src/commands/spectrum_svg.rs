@@ -24,11 +24,10 @@ pub struct BitTrueSetup {
     pub rom: ProbeRom,
 }
 
-/// The ROM bin indices of a configuration: `frequencies_hz` rounded to k·f_s/L, else the
-/// scene's in-band tones then noise bins, B in all.
-pub fn bin_indices(config: &Config, params: &PixelParams) -> Result<Vec<u64>, PixelError> {
+/// The ROM bin indices of a configuration for B bins and depth L: `frequencies_hz`
+/// rounded to k·f_s/L, else the scene's in-band tones then noise bins, B in all.
+pub fn bin_indices(config: &Config, bins: usize, depth: u64) -> Result<Vec<u64>, PixelError> {
     let fs = config.sensor.laser_rate_hz;
-    let depth = params.rom_depth as u64;
     if !config.pixel.frequencies_hz.is_empty() {
         return Ok(config
             .pixel
@@ -38,16 +37,14 @@ pub fn bin_indices(config: &Config, params: &PixelParams) -> Result<Vec<u64>, Pi
             .collect());
     }
     let ctx = config.pixel_context();
-    Ok(choose_bins(&ctx.tones, fs, depth, config.probe.osr, Some(params.bins))?.all())
+    Ok(choose_bins(&ctx.tones, fs, depth, config.probe.osr, Some(bins))?.all())
 }
 
-/// Resolves the pixel and generates its ROM (Fourier mode only).
-pub fn setup(config: &Config, origin: &str) -> Result<BitTrueSetup, CliError> {
+/// What a bit-true setup needs before the ROM: the resolved pixel (Fourier mode only), its
+/// bin indices and the lowest bin's f/f_s, where the probe amplitude's stability limit is
+/// checked (it is lowest towards DC).
+pub fn resolve(config: &Config, origin: &str) -> Result<(PixelParams, Vec<u64>, f64), CliError> {
     let pixel_err = |source| CliError::Pixel {
-        origin: origin.to_string(),
-        source,
-    };
-    let probe_err = |source| CliError::Probe {
         origin: origin.to_string(),
         source,
     };
@@ -59,10 +56,20 @@ pub fn setup(config: &Config, origin: &str) -> Result<BitTrueSetup, CliError> {
             "fourier",
         )));
     }
-    let bins = bin_indices(config, &params).map_err(pixel_err)?;
-    let fs = config.sensor.laser_rate_hz;
+    let bins = bin_indices(config, params.bins, params.rom_depth as u64).map_err(pixel_err)?;
     let lowest = bins.iter().copied().min().unwrap_or(1).max(1);
     let f_norm = lowest as f64 / params.rom_depth as f64;
+    Ok((params, bins, f_norm))
+}
+
+/// Resolves the pixel and generates its ROM (Fourier mode only).
+pub fn setup(config: &Config, origin: &str) -> Result<BitTrueSetup, CliError> {
+    let probe_err = |source| CliError::Probe {
+        origin: origin.to_string(),
+        source,
+    };
+    let (params, bins, f_norm) = resolve(config, origin)?;
+    let fs = config.sensor.laser_rate_hz;
     let design = ProbeDesign::new(&config.probe, f_norm).map_err(probe_err)?;
     let rom = ProbeRom::generate(&design, fs, params.frame_pulses, &bins).map_err(probe_err)?;
     Ok(BitTrueSetup { params, rom })

@@ -188,8 +188,8 @@ impl ProbeSetup {
 pub struct BitTrue {
     /// Normalised phasors of the pixel's readout (mm: codes of 1 mm).
     pub phasors: Vec<Phasor>,
-    /// The float ΣΔ on the same held codes, primed terms removed, normalised the same way
-    /// (what the bit-true readout must equal up to the integer filter's floor residues).
+    /// The float ΣΔ under the pixel's rules on the same detections, normalised the same
+    /// way (what the bit-true readout must equal up to the integer filter's floor residues).
     pub float_phasors: Vec<Phasor>,
     /// Largest |bit-true − float| / bound over the registers (≤ 1 required).
     pub worst_ratio: f64,
@@ -204,14 +204,11 @@ pub struct BitTrue {
 }
 
 /// Runs the record's detections through the transaction model and checks every register
-/// against the float ΣΔ (ProbeAccumulator, α = 2^−S) on the same held codes, within the
-/// bound of crates/pixel/tests/float_sd.rs:
-///     |Y_bit·2^−F − (Y_float − primed terms)| ≤ 2^(S−F−1)·(N − 1 − m + |Σ_{n>m} sₙ|),
-/// m the first detected pulse. The pixel accumulates nothing up to and including pulse m
-/// (priming); the float is fed h_m (the first held code) for pulses 0..m, so its filter is
-/// already at h_m when the pixel primes, and its pulses 0..=m add exactly h_m·Σ_{n≤m} sₙ,
-/// which is removed before comparing. After that the two filters differ only by the
-/// integer filter's floor residues, which the bound covers.
+/// against the float ΣΔ under the pixel's rules (`ProbeAccumulator::push_detections`,
+/// α = 2^−S: nothing before the first detection m, which primes and adds nothing, then the
+/// held codes) within the bound of crates/pixel/tests/float_sd.rs:
+///     |Y_bit·2^−F − Y_float| ≤ 2^(S−F−1)·(N − 1 − m + |Σ_{n>m} sₙ|):
+/// after priming the two filters differ only by the integer filter's floor residues.
 pub fn bit_true(
     setup: &ProbeSetup,
     detections: &[Option<u32>],
@@ -230,37 +227,29 @@ pub fn bit_true(
         .collect();
     let phasors = setup.phasors(&bit_sums, Some(alpha()));
 
-    // The float reference on the pixel's held codes, back-filled with h_m before pulse m.
+    // The float reference under the pixel's rules on the same detections.
     let m = detections.iter().position(Option::is_some);
     let mut worst_ratio = 0.0f64;
     let (mut worst_codes, mut bound_codes) = (0.0, 0.0);
     let mut float_ref = vec![0.0; words.len()];
     if let Some(m) = m {
-        let h_m = f64::from(detections[m].unwrap_or(0));
-        let mut held = h_m;
         let mut acc = tofprobe_dsp::sd::ProbeAccumulator::new(&setup.rom, Some(alpha()));
         let mut buf = Vec::with_capacity(1 << 16);
         for chunk in detections.chunks(1 << 16) {
             buf.clear();
-            buf.extend(chunk.iter().map(|d| {
-                if let Some(c) = d {
-                    held = f64::from(*c);
-                }
-                held
-            }));
-            acc.push(&buf);
+            buf.extend(chunk.iter().map(|d| d.map(f64::from)));
+            acc.push_detections(&buf);
         }
-        let float: Vec<f64> = acc.sums().into_iter().flat_map(|(i, q)| [i, q]).collect();
+        float_ref = acc.sums().into_iter().flat_map(|(i, q)| [i, q]).collect();
         let c = f64::from(1u32 << p.shift) / scale / 2.0;
         let n = setup.n;
         let sign = |a: usize, r: usize| if setup.rom.image.bit(a, r) { 1i64 } else { -1 };
-        for (r, (&y, &fl)) in words.iter().zip(&float).enumerate() {
+        for (r, (&y, &fl)) in words.iter().zip(&float_ref).enumerate() {
             let primed: i64 = (0..=m).map(|a| sign(a, r)).sum();
             let (np, nm) = setup.sign_counts[r];
             let after = np as i64 - nm as i64 - primed;
             let bound = c * ((n - 1 - m as u64) as f64 + after.unsigned_abs() as f64);
-            float_ref[r] = fl - h_m * primed as f64;
-            let err = (y as f64 / scale - float_ref[r]).abs();
+            let err = (y as f64 / scale - fl).abs();
             let ratio = err / bound;
             if ratio > worst_ratio || !ratio.is_finite() {
                 worst_ratio = if ratio.is_finite() {

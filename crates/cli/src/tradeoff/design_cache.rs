@@ -1,12 +1,11 @@
 //! The bit-true setup of many knob settings with the ΣΔ probe design shared: the design's
 //! stability sweep is the expensive part of a setup (seconds in a debug build) and depends
 //! only on `[probe]` and the lowest normalised bin, which most knob settings (W, F, S, B)
-//! leave alone. Mirrors [`crate::commands::spectrum_svg::setup`] otherwise.
+//! leave alone. Resolves like [`crate::commands::spectrum_svg::setup`] (its `resolve`).
 
 use tofprobe_dsp::sd::{ProbeDesign, ProbeRom};
-use tofprobe_pixel::{Mode, PixelError};
 
-use crate::commands::spectrum_svg::{BitTrueSetup, bin_indices};
+use crate::commands::spectrum_svg::{BitTrueSetup, resolve};
 use crate::config::Config;
 use crate::error::CliError;
 
@@ -19,25 +18,11 @@ pub struct DesignCache {
 impl DesignCache {
     /// Resolves the pixel of `config` and generates its ROM, reusing a cached design.
     pub fn setup(&mut self, config: &Config, origin: &str) -> Result<BitTrueSetup, CliError> {
-        let pixel_err = |source| CliError::Pixel {
-            origin: origin.to_string(),
-            source,
-        };
         let probe_err = |source| CliError::Probe {
             origin: origin.to_string(),
             source,
         };
-        let params = config.pixel_params().map_err(pixel_err)?;
-        if params.mode != Mode::Fourier {
-            return Err(pixel_err(PixelError::mismatch(
-                "bit-true spectrum mode",
-                params.mode,
-                "fourier",
-            )));
-        }
-        let bins = bin_indices(config, &params).map_err(pixel_err)?;
-        let lowest = bins.iter().copied().min().unwrap_or(1).max(1);
-        let f_norm = lowest as f64 / params.rom_depth as f64;
+        let (params, bins, f_norm) = resolve(config, origin)?;
         let key = format!("{:?}", config.probe);
         let pos = self
             .designs

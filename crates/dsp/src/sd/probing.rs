@@ -6,6 +6,14 @@
 //! windowed DFT of δ at bin k: a tone A·cos(ω_k n + φ) reads A·e^{jφ}. The prefilter is
 //! there because the ±1 probe carries large shaped quantisation noise out of band; it
 //! mixes with broadband depth noise into the bin unless the depth is lowpassed first.
+//!
+//! Two ways in. [`ProbeAccumulator::push`] takes a depth per sample and is the textbook
+//! float ΣΔ: the first sample primes the filter *and* is added. [`ProbeAccumulator::
+//! push_detections`] takes the pixel's input — a detection or none per pulse — and follows
+//! the pixel contract's rules in f64: nothing happens before the first detection, the first
+//! detection primes the hold and the filter and adds nothing, a missed pulse repeats the
+//! held depth (1NN hold). It is the float twin of the bit-true pixel, so the two differ
+//! only by the integer filter's floor residues (crates/pixel/tests/float_sd.rs).
 
 use super::probe::ProbeRom;
 use rustfft::num_complex::Complex64;
@@ -22,6 +30,10 @@ pub struct ProbeAccumulator<'a> {
     prev: f64,
     /// acc[r]: register r (2k = I, 2k+1 = Q).
     acc: Vec<f64>,
+    /// Pixel rules: a detection has been seen (hold and filter primed).
+    primed: bool,
+    /// Pixel rules: the held depth.
+    held: f64,
 }
 
 impl<'a> ProbeAccumulator<'a> {
@@ -34,13 +46,55 @@ impl<'a> ProbeAccumulator<'a> {
             x: 0.0,
             prev: 0.0,
             acc: vec![0.0; rom.image.registers()],
+            primed: false,
+            held: 0.0,
         }
+    }
+
+    /// Consumes one pulse each under the pixel's rules (see the module docs): `None` = no
+    /// detection. Do not mix with [`Self::push`] on one accumulator.
+    pub fn push_detections(&mut self, detections: &[Option<f64>]) {
+        for &d in detections {
+            if let Some(v) = d {
+                self.held = v;
+                if !self.primed {
+                    // The priming pulse: hold and filter start here, no register moves.
+                    self.primed = true;
+                    self.x = v;
+                    self.prev = v;
+                    self.n += 1;
+                    continue;
+                }
+            } else if !self.primed {
+                self.n += 1;
+                continue;
+            }
+            let x = match self.alpha {
+                Some(a) => {
+                    self.x += a * (self.prev - self.x);
+                    self.prev = self.held;
+                    self.x
+                }
+                None => self.held,
+            };
+            self.accumulate(x);
+        }
+    }
+
+    /// Adds ±x to every register by the ROM bits at the current sample and advances it.
+    fn accumulate(&mut self, x: f64) {
+        let l = self.rom.image.depth() as u64;
+        let entry = self.rom.image.entry((self.n % l) as usize);
+        for (r, acc) in self.acc.iter_mut().enumerate() {
+            let bit = (entry[r / 64] >> (r % 64)) & 1;
+            // ±x without a branch: bit 1 → +x, 0 → −x.
+            *acc += x * (2.0 * bit as f64 - 1.0);
+        }
+        self.n += 1;
     }
 
     /// Consumes depth samples (any unit; the readout is in the same unit).
     pub fn push(&mut self, depths: &[f64]) {
-        let l = self.rom.image.depth() as u64;
-        let regs = self.rom.image.registers();
         for &d in depths {
             let x = match self.alpha {
                 Some(a) => {
@@ -55,13 +109,7 @@ impl<'a> ProbeAccumulator<'a> {
                 }
                 None => d,
             };
-            let entry = self.rom.image.entry((self.n % l) as usize);
-            for (r, acc) in self.acc.iter_mut().enumerate().take(regs) {
-                let bit = (entry[r / 64] >> (r % 64)) & 1;
-                // ±x without a branch: bit 1 → +x, 0 → −x.
-                *acc += x * (2.0 * bit as f64 - 1.0);
-            }
-            self.n += 1;
+            self.accumulate(x);
         }
     }
 
@@ -250,5 +298,63 @@ mod tests {
         }
         assert_eq!(acc.sums(), whole);
         assert_eq!(acc.samples(), 10_000);
+    }
+
+    /// The pixel-rule path against its definition written out: m the first detection,
+    /// h the held depth, x_m = h_m, x_n = x_{n−1} + α(h_{n−1} − x_{n−1}) for n > m, and
+    /// register r = Σ_{n>m} s_r(n)·x_n. Same operations in the same order, so equal to
+    /// rounding (1e-9 relative). With every pulse detected it is the textbook path minus
+    /// the priming sample's s_r(0)·δ₀, and chunking does not matter.
+    #[test]
+    fn pixel_rules_follow_hold_and_priming() {
+        let rom = rom(4096, &[3, 17]);
+        let d = gaussian(6000, 1.0, 11);
+        let mut s = 5u64;
+        let det: Vec<Option<f64>> = d
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (i >= 37 && !(s >> 33).is_multiple_of(3)).then_some(v)
+            })
+            .collect();
+        let alpha = 1.0 / 32.0;
+        let mut acc = ProbeAccumulator::new(&rom, Some(alpha));
+        for c in det.chunks(500) {
+            acc.push_detections(c);
+        }
+        assert_eq!(acc.samples(), 6000);
+        let m = det.iter().position(Option::is_some).unwrap();
+        let regs = rom.image.registers();
+        let mut want = vec![0.0; regs];
+        let (mut h, mut x) = (det[m].unwrap(), det[m].unwrap());
+        for (n, dn) in det.iter().enumerate().skip(m + 1) {
+            x += alpha * (h - x);
+            if let Some(v) = dn {
+                h = *v;
+            }
+            for (r, w) in want.iter_mut().enumerate() {
+                *w += if rom.image.bit(n % 4096, r) { x } else { -x };
+            }
+        }
+        let got: Vec<f64> = acc.sums().into_iter().flat_map(|(i, q)| [i, q]).collect();
+        for r in 0..regs {
+            assert!(
+                (got[r] - want[r]).abs() <= 1e-9 * want[r].abs().max(1.0),
+                "r {r}"
+            );
+        }
+        // Every pulse detected: the textbook sums minus the priming sample.
+        let all: Vec<Option<f64>> = d.iter().map(|&v| Some(v)).collect();
+        let mut px = ProbeAccumulator::new(&rom, Some(alpha));
+        px.push_detections(&all);
+        let text = probe_record(&rom, d.iter().copied(), Some(alpha));
+        for (k, ((pi, pq), (ti, tq))) in px.sums().into_iter().zip(text).enumerate() {
+            let s0 = |r: usize| if rom.image.bit(0, r) { d[0] } else { -d[0] };
+            assert!((pi - (ti - s0(2 * k))).abs() < 1e-9, "I {k}");
+            assert!((pq - (tq - s0(2 * k + 1))).abs() < 1e-9, "Q {k}");
+        }
     }
 }
