@@ -338,10 +338,17 @@ mod tests {
             "{e}"
         );
         ctx.pulses = 1 << 50;
+        // A periodic ROM (a windowed one, L = N = 2^50, is refused first: L ≤ 2^32).
+        let periodic = PixelConfig {
+            rom_depth: Some(1 << 16),
+            ..PixelConfig::default()
+        };
+        let e = periodic.resolve(&ctx).unwrap_err().to_string();
+        assert!(e.contains("more than 63"), "{e}");
         let e = PixelConfig::default()
             .resolve(&ctx)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("more than 63"), "{e}");
+        assert!(e.contains("rom_depth") && e.contains("4294967296"), "{e}");
     }
 }

@@ -35,6 +35,15 @@ pub const MAX_TDC_BITS: u32 = 16;
 pub const MAX_SHIFT: u32 = 15;
 /// Largest number of prefilter fraction bits.
 pub const MAX_FRAC_BITS: u32 = 16;
+/// Largest number of Fourier bins (R = 1024 registers): the generator renders every
+/// configuration this crate accepts, and a register file beyond that is no pixel.
+pub const MAX_BINS: usize = 512;
+/// Largest finest Haar scale (R = 1023 registers), for the same reason.
+pub const MAX_HAAR_SCALES: u32 = 9;
+/// Largest number of clock cycles per laser pulse (a 16-bit cycle counter).
+pub const MAX_CYCLES_PER_PULSE: usize = 1 << 16;
+/// Largest probe ROM depth (a 32-bit ROM address).
+pub const MAX_ROM_DEPTH: usize = 1 << 32;
 
 /// The validated pixel parameters (letters as in docs/pixel-contract.md).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -167,12 +176,12 @@ impl PixelParams {
         }
         match self.mode {
             Mode::Fourier => {
-                if self.bins == 0 {
+                if self.bins == 0 || self.bins > MAX_BINS {
                     return Err(PixelError::invalid(
                         "bins",
-                        0,
-                        "Fourier mode needs at least one bin",
-                        1,
+                        self.bins,
+                        format!("Fourier mode needs 1..={MAX_BINS} bins"),
+                        self.bins.clamp(1, MAX_BINS),
                     ));
                 }
                 if self.shift > MAX_SHIFT {
@@ -191,12 +200,14 @@ impl PixelParams {
                         MAX_FRAC_BITS,
                     ));
                 }
-                if self.rom_depth == 0 {
+                if self.rom_depth == 0 || self.rom_depth > MAX_ROM_DEPTH {
                     return Err(PixelError::invalid(
                         "rom_depth",
-                        0,
-                        "Fourier mode reads one ROM entry per pulse, so the ROM needs at least one entry",
-                        1,
+                        self.rom_depth,
+                        format!(
+                            "Fourier mode reads one ROM entry per pulse: 1..={MAX_ROM_DEPTH} entries (a 32-bit address)"
+                        ),
+                        self.rom_depth.clamp(1, MAX_ROM_DEPTH),
                     ));
                 }
             }
@@ -230,13 +241,15 @@ impl PixelParams {
                         l - 1,
                     ));
                 }
-                // R = 2^(U+1) − 1 must be addressable; U ≤ 30 keeps every count in range.
-                if self.haar_scales > 30 {
+                if self.haar_scales > MAX_HAAR_SCALES {
                     return Err(PixelError::invalid(
                         "haar_scales",
                         self.haar_scales,
-                        "at most 2^31 − 1 registers (U ≤ 30)",
-                        30,
+                        format!(
+                            "at most {} registers (U ≤ {MAX_HAAR_SCALES})",
+                            (1u32 << (MAX_HAAR_SCALES + 1)) - 1
+                        ),
+                        MAX_HAAR_SCALES,
                     ));
                 }
             }
@@ -260,6 +273,14 @@ impl PixelParams {
                     self.adders
                 ),
                 k,
+            ));
+        }
+        if self.cycles_per_pulse > MAX_CYCLES_PER_PULSE {
+            return Err(PixelError::invalid(
+                "cycles_per_pulse",
+                self.cycles_per_pulse,
+                format!("C ≤ {MAX_CYCLES_PER_PULSE} (a 16-bit cycle counter)"),
+                MAX_CYCLES_PER_PULSE,
             ));
         }
         let ob = self.operand_bits();

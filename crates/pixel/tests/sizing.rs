@@ -206,9 +206,11 @@ fn impossible_configurations_name_the_nearest_valid_value() {
     assert_eq!((p.registers(), p.slots()), (31, 3));
     // Scale 0: ±2^19·79 → 2^19·79 < 2^26 → 27 bits.
     assert_eq!(p.width, 27);
-    // A frame too long for 63-bit registers.
+    // A frame too long for 63-bit registers (periodic ROM: a windowed one, L = N, would be
+    // refused first for its depth beyond 2^32).
     c.mode = Mode::Fourier;
     c.frame_pulses = Some(1 << 50);
+    c.rom_depth = Some(1 << 16);
     assert_eq!(
         c.resolve(&ctx).map(|_| ()).map_err(nearest),
         Err(("width", "63".into()))

@@ -256,16 +256,17 @@ impl PixelParams {
         if p.frame_pulses < 1 {
             return Err(range("frame_pulses", 0, "≥ 1".into(), String::new()));
         }
-        if p.rom_depth < 1 || p.rom_depth > 1 << 24 {
-            return Err(range(
-                "rom_depth",
-                p.rom_depth,
-                "1..=16777216".into(),
-                String::new(),
-            ));
-        }
         match p.mode {
             Mode::Fourier => {
+                // A 32-bit ROM address (Haar mode has no ROM).
+                if p.rom_depth < 1 || p.rom_depth > 1 << 32 {
+                    return Err(range(
+                        "rom_depth",
+                        p.rom_depth,
+                        "1..=4294967296".into(),
+                        String::new(),
+                    ));
+                }
                 if p.bins < 1 || p.bins > 512 {
                     return Err(range("bins", p.bins, "1..=512".into(), String::new()));
                 }
