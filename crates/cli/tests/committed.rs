@@ -107,5 +107,19 @@ fn committed_rtl_and_short_vectors_regenerate_byte_for_byte() {
         .collect();
     assert_eq!(entries.len(), 20_000);
     assert!(entries.iter().all(|e| e.len() == 8));
+    // Its manifest loads the committed image (content hash checked) and carries what a
+    // readout needs to be normalised.
+    let (m, image) =
+        tofprobe_dsp::rom::RomManifest::read(&root().join("rtl/tofprobe_probe_rom.toml"))
+            .expect("the committed ROM manifest reads");
+    assert_eq!((image.depth(), image.registers()), (20_000, 32));
+    assert_eq!(
+        (m.mode.as_str(), m.window.as_str()),
+        ("periodic", "rectangular")
+    );
+    assert_eq!(m.bin_indices.len(), 16);
+    assert_eq!((m.bin_indices[0], m.bin_frequencies_hz[0]), (9, 4500.0));
+    assert_eq!((m.amplitude, m.coherent_gain), (0.5, 1.0));
+    assert!(m.wrap_clean && m.wrap_error_ratio > 0.0 && m.wrap_error_ratio <= 0.05);
     let _ = std::fs::remove_dir_all(&tmp);
 }

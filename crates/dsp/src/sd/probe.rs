@@ -270,7 +270,9 @@ impl ProbeRom {
             h_inf: cfg.h_inf,
             optimised_zeros: cfg.optimised_zeros,
             wrap_mismatch: wrap.mismatch,
-            wrap_error_ratio: wrap.ratio,
+            // Three significant digits: the ratio goes through an FFT whose last bits
+            // depend on the CPU's SIMD path, and it is written into committed files.
+            wrap_error_ratio: round_significant(wrap.ratio, 3),
             wrap_periods: wrap.periods,
         })
     }
@@ -312,6 +314,15 @@ impl ProbeRom {
     pub fn write(&self, dir: &Path, stem: &str) -> Result<PathBuf, DspError> {
         self.manifest().write(&self.image, dir, stem)
     }
+}
+
+/// `v` rounded to `digits` significant decimal digits (0 stays 0).
+fn round_significant(v: f64, digits: i32) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let scale = 10f64.powi(digits - 1 - v.abs().log10().floor() as i32);
+    (v * scale).round() / scale
 }
 
 /// What the periodic search kept for a group (zeros for a windowed ROM).
@@ -608,8 +619,9 @@ mod tests {
                     })
                     .fold(f64::INFINITY, f64::min);
                 assert!(ratio <= WRAP_TOLERANCE, "register {reg}: ratio {ratio}");
+                // The ROM's figure is the worst stream's, to 3 significant digits (≤ 0.5%).
                 assert!(
-                    ratio <= rom.wrap_error_ratio * (1.0 + 1e-9),
+                    ratio <= rom.wrap_error_ratio * (1.0 + 5e-3),
                     "register {reg}"
                 );
                 let corr = |kk: u64| {
