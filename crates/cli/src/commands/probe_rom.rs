@@ -3,7 +3,8 @@
 //! `frequencies_hz` or the scene via `autobins`) whenever that ROM can exist for the frame
 //! actually simulated, else the sign-of-cosine probe of `stimulus::sign_probe_rom` with
 //! the reason stated. The ΣΔ ROM needs its bins inside the band f_s/(2·OSR), i.e. a depth
-//! of a few hundred pulses at least (the committed 64-pulse short frame has none), and a
+//! of a few hundred pulses at least (a windowed ROM of a 64-pulse frame has none; the
+//! default's periodic ROM keeps its 20,000 entries however short the frame), and a
 //! windowed ROM is N entries deep, so frames beyond [`MAX_SD_ROM_DEPTH`] keep the short
 //! periodic sign probe rather than a ROM file of more than 2^24 lines. `tofprobe rtl`
 //! itself renders the same ROM (the committed `rtl/` holds the default's): see
