@@ -2,15 +2,10 @@
 //! a tone's amplitude, `--svg` writes a plot, and a bad `[pixel]` section is an error at
 //! load time that names the key and the value that would work.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
-fn tofprobe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .args(args)
-        .output()
-        .expect("run tofprobe")
-}
+use common::{edit, short_tone_frame, tofprobe, windowed_default};
+use std::path::PathBuf;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("tofprobe-bt-{}-{name}", std::process::id()));
@@ -18,21 +13,10 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// The default configuration with each `(from, to)` replaced (each must occur).
+/// The windowed default (the checks are about short frames, L = N) with each `(from, to)`
+/// replaced (each must occur).
 fn edited(edits: &[(&str, &str)]) -> String {
-    let out = tofprobe(&["config", "--print-default"]);
-    // These checks are about a short windowed frame (L = N, bins k·f_s/N): the default's
-    // periodic ROM (L = 20,000) is switched back to windowed first.
-    let mut text = String::from_utf8(out.stdout).expect("utf-8").replacen(
-        "rom_mode = \"periodic\"",
-        "rom_mode = \"windowed\"",
-        1,
-    );
-    for (from, to) in edits {
-        assert!(text.contains(from), "default lacks `{from}`");
-        text = text.replacen(from, to, 1);
-    }
-    text
+    edit(windowed_default(), edits)
 }
 
 /// A 1 mm tone exactly on bin 30 of a 2^16-pulse frame (30·10 MHz/65536 Hz), σ = 7.5 mm.
@@ -44,13 +28,7 @@ fn edited(edits: &[(&str, &str)]) -> String {
 fn simulate_prints_the_bit_true_spectrum_and_plots_it() {
     let dir = scratch("spectrum");
     let f = 30.0 * 10e6 / 65536.0;
-    let text = edited(&[
-        ("duration_s = 1.0", "pulses = 65536"),
-        ("amplitude_mm = 0.1", "amplitude_mm = 1.0"),
-        ("frequency_hz = 4500.0", &format!("frequency_hz = {f}")),
-        ("bins = 16", "bins = 4"),
-        ("cycles_per_pulse = 16", "cycles_per_pulse = 4"),
-    ]);
+    let text = short_tone_frame(65536);
     let cfg = dir.join("tone.toml");
     std::fs::write(&cfg, text).expect("write");
     let svg = dir.join("spectrum.svg");

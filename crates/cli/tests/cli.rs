@@ -2,15 +2,11 @@
 //! checked against closed forms, and every kind of bad input (clear `error:` message,
 //! exit status 2, never a panic).
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
-fn tofprobe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .args(args)
-        .output()
-        .expect("run tofprobe")
-}
+use common::{default_text, edit, tofprobe};
+use std::path::PathBuf;
+use std::process::Command;
 
 /// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {
@@ -21,10 +17,7 @@ fn scratch(name: &str) -> PathBuf {
 
 /// The default configuration with `from` replaced by `to` (must occur).
 fn edited_default(from: &str, to: &str) -> String {
-    let out = tofprobe(&["config", "--print-default"]);
-    let text = String::from_utf8(out.stdout).expect("utf-8");
-    assert!(text.contains(from), "default lacks `{from}`");
-    text.replacen(from, to, 1)
+    edit(default_text(), &[(from, to)])
 }
 
 /// Runs `args` and asserts a clean failure whose message contains every part.

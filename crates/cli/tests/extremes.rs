@@ -9,16 +9,11 @@
 //! (≈ 3 s in release) with a periodic ROM of depth 2^14 on the same bin grid: a windowed
 //! 2^27-entry ROM would be 512 MiB, the periodic one is 2^14 entries.
 
-use std::process::{Command, Output};
+mod common;
+
+use common::{tofprobe, windowed_default};
 
 const N: u64 = 1 << 14;
-
-fn tofprobe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .args(args)
-        .output()
-        .expect("run tofprobe")
-}
 
 fn bin_hz(k: f64) -> f64 {
     k * 10e6 / N as f64
@@ -26,15 +21,10 @@ fn bin_hz(k: f64) -> f64 {
 
 /// Runs `simulate --json` on the base config with `edits`; Ok(json) or Err(stderr).
 fn run(name: &str, edits: &[(&str, String)]) -> Result<serde_json::Value, String> {
-    let out = tofprobe(&["config", "--print-default"]);
-    let mut text = String::from_utf8(out.stdout).expect("utf-8");
-    // Short windowed frames (L = N): the default's periodic ROM is switched first, so the
-    // tones sit on k·f_s/N; the 2^27 case switches back to periodic.
+    // Short windowed frames (L = N), so the tones sit on k·f_s/N; the 2^27 case switches
+    // back to periodic.
+    let mut text = windowed_default();
     let base = [
-        (
-            "rom_mode = \"periodic\"",
-            "rom_mode = \"windowed\"".to_string(),
-        ),
         ("duration_s = 1.0", format!("pulses = {N}")),
         ("bins = 16", "bins = 4".to_string()),
         ("cycles_per_pulse = 16", "cycles_per_pulse = 4".to_string()),

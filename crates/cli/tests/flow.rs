@@ -4,15 +4,11 @@
 //! normalised spectrum; a windowed frame too short for the ΣΔ band falls back to the sign
 //! probe and says so.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
-fn tofprobe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .args(args)
-        .output()
-        .expect("run tofprobe")
-}
+use common::{tofprobe, windowed_default};
+use std::path::PathBuf;
+use std::process::Command;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("tofprobe-flow-{}-{name}", std::process::id()));
@@ -66,9 +62,7 @@ fn vectors_on_a_frame_too_short_for_the_band_fall_back_to_the_sign_probe() {
     let dir = scratch("short");
     // A windowed ROM is one frame deep: L = N = 64 (the default's periodic ROM would stay
     // 20,000 deep and the frame read its first 64 entries).
-    let text = String::from_utf8(tofprobe(&["config", "--print-default"]).stdout)
-        .expect("utf-8")
-        .replacen("rom_mode = \"periodic\"", "rom_mode = \"windowed\"", 1);
+    let text = windowed_default();
     std::fs::create_dir_all(&dir).expect("dir");
     let cfg = dir.join("windowed.toml");
     std::fs::write(&cfg, text).expect("write");

@@ -5,26 +5,16 @@
 //! property and its sizing, settings change what they name, and the skip timings are
 //! consistent.
 
+mod common;
+
+use common::short_tone_frame;
 use std::process::Command;
 
 #[test]
 fn tradeoff_reports_every_level() {
-    let out = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .args(["config", "--print-default"])
-        .output()
-        .expect("run");
     let n: u64 = 1 << 16;
-    // A 1 mm tone on bin 30 of the 2^16-pulse frame, B = 4 (C = 4).
-    let f = 30.0 * 10e6 / n as f64;
-    let text = String::from_utf8(out.stdout)
-        .expect("utf-8")
-        // A short windowed frame (L = N), not the default's periodic L = 20,000 ROM.
-        .replacen("rom_mode = \"periodic\"", "rom_mode = \"windowed\"", 1)
-        .replacen("duration_s = 1.0", &format!("pulses = {n}"), 1)
-        .replacen("amplitude_mm = 0.1", "amplitude_mm = 1.0", 1)
-        .replacen("frequency_hz = 4500.0", &format!("frequency_hz = {f}"), 1)
-        .replacen("bins = 16", "bins = 4", 1)
-        .replacen("cycles_per_pulse = 16", "cycles_per_pulse = 4", 1);
+    // A 1 mm tone on bin 30 of the 2^16-pulse windowed frame, B = 4 (C = 4).
+    let text = short_tone_frame(n);
     let dir = std::env::temp_dir().join(format!("tofprobe-tradeoff-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("dir");
     let cfg = dir.join("short.toml");
@@ -82,19 +72,7 @@ fn tradeoff_reports_every_level() {
 
 /// The default scene shortened to `n` pulses with a 1 mm tone on bin 30, B = 4 (C = 4).
 fn tiny_config(dir: &std::path::Path, n: u64) -> std::path::PathBuf {
-    let out = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .args(["config", "--print-default"])
-        .output()
-        .expect("run");
-    let f = 30.0 * 10e6 / n as f64;
-    let text = String::from_utf8(out.stdout)
-        .expect("utf-8")
-        .replacen("rom_mode = \"periodic\"", "rom_mode = \"windowed\"", 1)
-        .replacen("duration_s = 1.0", &format!("pulses = {n}"), 1)
-        .replacen("amplitude_mm = 0.1", "amplitude_mm = 1.0", 1)
-        .replacen("frequency_hz = 4500.0", &format!("frequency_hz = {f}"), 1)
-        .replacen("bins = 16", "bins = 4", 1)
-        .replacen("cycles_per_pulse = 16", "cycles_per_pulse = 4", 1);
+    let text = short_tone_frame(n);
     std::fs::create_dir_all(dir).expect("dir");
     let cfg = dir.join("tiny.toml");
     std::fs::write(&cfg, text).expect("write");

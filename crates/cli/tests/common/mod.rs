@@ -1,0 +1,53 @@
+//! Helpers shared by the CLI's integration tests: the built binary, the embedded default's
+//! text and its edits, and the short windowed frame with a tone on a bin that several
+//! tests run on. Each test binary uses a subset.
+#![allow(dead_code)]
+
+use std::process::{Command, Output};
+
+/// Runs the built `tofprobe` with `args`.
+pub fn tofprobe(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .args(args)
+        .output()
+        .expect("run tofprobe")
+}
+
+/// The embedded default configuration's text (`config --print-default`).
+pub fn default_text() -> String {
+    String::from_utf8(tofprobe(&["config", "--print-default"]).stdout).expect("utf-8")
+}
+
+/// `text` with each `(from, to)` replaced once; each `from` must occur.
+pub fn edit(mut text: String, edits: &[(&str, &str)]) -> String {
+    for (from, to) in edits {
+        assert!(text.contains(from), "configuration lacks `{from}`");
+        text = text.replacen(from, to, 1);
+    }
+    text
+}
+
+/// The default with its periodic ROM (L = 20,000) switched to windowed (L = N): what the
+/// short-frame tests need, whose bins lie on k·f_s/N.
+pub fn windowed_default() -> String {
+    edit(
+        default_text(),
+        &[("rom_mode = \"periodic\"", "rom_mode = \"windowed\"")],
+    )
+}
+
+/// The windowed default shortened to `n` pulses, the tone made 1 mm and moved onto bin 30
+/// (30·f_s/n), B = 4 bins (C = 4).
+pub fn short_tone_frame(n: u64) -> String {
+    let f = 30.0 * 10e6 / n as f64;
+    edit(
+        windowed_default(),
+        &[
+            ("duration_s = 1.0", &format!("pulses = {n}")),
+            ("amplitude_mm = 0.1", "amplitude_mm = 1.0"),
+            ("frequency_hz = 4500.0", &format!("frequency_hz = {f}")),
+            ("bins = 16", "bins = 4"),
+            ("cycles_per_pulse = 16", "cycles_per_pulse = 4"),
+        ],
+    )
+}
