@@ -94,20 +94,10 @@ pub fn rtl_rom(config: &Config, origin: &str, p: &mut PixelParams) -> Result<Rtl
     let rom = ProbeRom::generate(&design, fs, p.frame_pulses, &bins).map_err(probe_err)?;
     p.rom_depth = rom.depth();
     p.validate()?;
-    let wrap = if rom.mode == tofprobe_dsp::sd::RomMode::Periodic {
-        format!(
-            ", wrap {} (in-band wrap error {:.1e} of the quantisation error, {} period(s) searched)",
-            if rom.wrap_clean() {
-                "clean"
-            } else {
-                "NOT clean"
-            },
-            rom.wrap_error_ratio,
-            rom.wrap_periods
-        )
-    } else {
-        String::new()
-    };
+    let wrap = rom
+        .wrap_summary()
+        .map(|w| format!(", {w}"))
+        .unwrap_or_default();
     let note = format!(
         "ΣΔ probe ROM ({} {}, order {}, OSR {}, A_p {}, window gain {}), L = {}, bins k = {:?} (f_k = k·f_s/L){wrap}, content hash {:016x}",
         rom.mode.name(),

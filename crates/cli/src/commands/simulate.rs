@@ -66,6 +66,9 @@ pub struct BitTrueOut {
     pub rom_wrap_error_ratio: f64,
     /// Whether the wrap is clean (always true for windowed).
     pub rom_wrap_clean: bool,
+    /// The ROM's wrap phrase for the text output (`ProbeRom::wrap_summary`).
+    #[serde(skip)]
+    pub rom_wrap_summary: Option<String>,
     /// Wall time of the transaction-model frame (s).
     pub model_seconds: f64,
 }
@@ -205,19 +208,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                     "bit-true spectrum  W = {} bits, N = {} pulses (ROM {:.2} s, model {:.2} s)",
                     b.width_bits, b.frame_pulses, b.rom_seconds, b.model_seconds
                 );
-                let wrap = if b.rom_mode == "periodic" {
-                    format!(
-                        ", wrap {} ({:.1e} of the in-band quantisation error)",
-                        if b.rom_wrap_clean {
-                            "clean"
-                        } else {
-                            "NOT clean"
-                        },
-                        b.rom_wrap_error_ratio
-                    )
-                } else {
-                    String::new()
-                };
+                let wrap = b
+                    .rom_wrap_summary
+                    .as_ref()
+                    .map(|w| format!(", {w}"))
+                    .unwrap_or_default();
                 println!("  probe ROM {} L = {}{wrap}", b.rom_mode, b.rom_depth);
                 println!("  frequency Hz   amplitude um    phase deg");
                 for bin in &b.bins {
@@ -273,6 +268,7 @@ fn bit_true(
         rom_depth: setup.rom.depth(),
         rom_wrap_error_ratio: setup.rom.wrap_error_ratio,
         rom_wrap_clean: setup.rom.wrap_clean(),
+        rom_wrap_summary: setup.rom.wrap_summary(),
         model_seconds,
     };
     Ok(Some((out, spectrum)))

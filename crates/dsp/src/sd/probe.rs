@@ -163,6 +163,20 @@ impl ProbeRom {
         self.wrap_error_ratio <= WRAP_TOLERANCE
     }
 
+    /// One phrase on the wrap for reports and headers (`None` for a windowed ROM), e.g.
+    /// "wrap clean (in-band wrap error 1.8e-2 of the quantisation error, 1 period(s)
+    /// searched)".
+    pub fn wrap_summary(&self) -> Option<String> {
+        (self.mode == RomMode::Periodic).then(|| {
+            format!(
+                "wrap {} (in-band wrap error {:.1e} of the quantisation error, {} period(s) searched)",
+                if self.wrap_clean() { "clean" } else { "NOT clean" },
+                self.wrap_error_ratio,
+                self.wrap_periods
+            )
+        })
+    }
+
     /// Generates the ROM for bin indices `bins` (f_k = k·f_s/L, L from the config and
     /// `frame_pulses`). Bins must be distinct, ≥ 1 and below f_s/(2·OSR).
     pub fn generate(
