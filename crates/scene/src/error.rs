@@ -51,6 +51,19 @@ pub enum SceneError {
         /// What was given, in words.
         given: String,
     },
+    /// A time-tagged record file (PicoQuant PTU, Becker & Hickl SPC) could not be read or
+    /// replayed: the file, where in it, what the reader expected and what it found.
+    #[error("{file}: {at}: expected {expected}, found {found}")]
+    Tttr {
+        /// The file as given.
+        file: String,
+        /// Where: `header tag 12 (TTResult_NumberOfRecords)`, `record 1234 (byte 5800)`, …
+        at: String,
+        /// What the reader expected there (and, for options, the value that would work).
+        expected: String,
+        /// What it found.
+        found: String,
+    },
 }
 
 impl SceneError {

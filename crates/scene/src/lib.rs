@@ -11,6 +11,7 @@ mod motion;
 mod scene;
 mod sensor;
 mod source;
+pub mod tttr;
 
 pub use acquisition::AcquisitionConfig;
 pub use error::SceneError;
