@@ -210,7 +210,7 @@ impl<R: Read> TttrReader<R> {
             format: RecordFormat::BeckerHicklSpc,
             records: records.unwrap_or(0),
             resolution_s: None,
-            global_resolution_s: Some(f64::from(clock) * 1e-10),
+            global_resolution_s: Some(f64::from(clock) / 1e10),
             sync_rate_hz: None,
             acquisition_time_s: None,
             header_bytes: 4,
