@@ -9,3 +9,4 @@ scripts/install-tools.sh
 cargo fmt --all --check
 cargo clippy --workspace --all-targets -- -D warnings
 cargo test --workspace --release
+scripts/users-tools.sh

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The users'-tools checks (issue 21): the FuseSoC core (lint, sim) and the cocotb
+# testbench on the committed default, in one cached Python venv (scripts/py-venv.sh).
+# Prints one result line; skips (exit 0, saying so) only when python3 is missing.
+# (The PTU/SPC decoder's cross-check with ptufile runs as a cargo test:
+# crates/scene/tests/tttr_crosscheck.rs.)
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+if ! command -v python3 >/dev/null 2>&1; then
+  echo "users-tools: SKIPPED (python3 not found): fusesoc and cocotb checks did not run"
+  exit 0
+fi
+start=$(date +%s)
+"$root/scripts/fusesoc-check.sh"
+"$root/scripts/cocotb-check.sh"
+echo "users-tools: ok (fusesoc lint+sim, cocotb) in $(( $(date +%s) - start )) s"
