@@ -30,6 +30,15 @@
 //! α₁ = 1 − (1 − α)^(1/K) (exact for independent coefficients: with ρ = 1 the Haar basis
 //! is orthogonal and white Gaussian noise gives independent coefficients), two-sided:
 //! z = Φ⁻¹(1 − α₁/2). α = 1%, K = 127: α₁ = 7.9e-5, z = 3.95.
+//!
+//! # Validity (measured, crates/dsp/tests/haar_noise.rs)
+//! The sd of every scale matches simulation within ≈ 1 % for ρ_s = 1, 0.3, 0.03 and with
+//! background. The *tail* is Gaussian only when each half-wavelet holds many independent
+//! detections, M·ρ/(2 − ρ) ≫ 1: with the random hold a coefficient is a Gaussian scale
+//! mixture (the run lengths vary), whose tails are heavier. At ρ_s = 1 the stated rate
+//! holds (220 of 20,000 static frames of 2^12 pulses at α = 1 %, expected 200); at
+//! N = 2^14, U = 6 (M = 128 at the finest scale) the false-event rate is 1.5× the stated
+//! one at ρ_s = 0.3, 2.2× with ρ_b = 0.1 as well, and 4.5× at ρ_s = 0.03 (M·ρ/2 ≈ 2).
 
 use tofprobe_scene::SensorConfig;
 
