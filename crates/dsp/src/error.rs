@@ -34,6 +34,9 @@ pub enum DspError {
         /// Extra advice, already formatted with a leading "; " (or empty).
         hint: String,
     },
+    /// A scene or sensor the analysis simulates was rejected by the scene crate.
+    #[error(transparent)]
+    Scene(#[from] tofprobe_scene::SceneError),
     /// Reading or writing a file failed.
     #[error("{path}: {message}")]
     Io { path: String, message: String },

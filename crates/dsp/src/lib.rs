@@ -3,6 +3,7 @@
 //! wavelets, closed-form noise/bandwidth/pile-up models, and the ΣΔ probe design that
 //! produces the chip's bitstream ROM.
 
+pub mod analysis_mode;
 pub mod bins;
 pub mod closed_form;
 pub mod dft;

@@ -12,6 +12,7 @@ pub mod memory;
 pub mod plot;
 pub mod report;
 pub mod scaling;
+pub mod scalogram;
 pub mod sky130;
 pub mod split;
 pub mod sta;

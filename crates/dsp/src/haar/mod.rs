@@ -13,6 +13,25 @@
 //! Two forms: [`haar_sums`] is the un-normalised integer form (Σ of + samples − Σ of −
 //! samples), which the pixel's integer registers must equal exactly; [`haar_coefficients`]
 //! divides by the wavelet's length (its number of samples).
+//!
+//! The transient analysis built on them lives in the submodules: [`analysis`] turns the
+//! pixel's Haar registers into typed coefficients in mm (the scalogram), [`noise`] gives
+//! each coefficient's noise in closed form and the detection thresholds, [`events`] turns
+//! the coefficients that stand out of the noise into events with a ramp-rate estimate,
+//! [`checks`] validates Haar frames and notes transients outside them, [`montecarlo`]
+//! checks the noise model by simulation, and [`paper`] computes the paper's Fig. 3 and
+//! Fig. 12 results.
+
+pub mod analysis;
+pub mod checks;
+pub mod events;
+pub mod montecarlo;
+pub mod noise;
+pub mod paper;
+
+pub use analysis::{Coefficient, Scalogram, held_codes};
+pub use events::{Event, EventReport, detect_events};
+pub use noise::{HaarNoise, Thresholds, inverse_normal_cdf};
 
 use crate::error::DspError;
 
@@ -121,6 +140,47 @@ pub fn haar_sums(x: &[i64], u_max: u32) -> Result<Vec<i64>, DspError> {
     let mut acc = HaarAccumulator::<i64>::new(x.len(), u_max)?;
     acc.push(x)?;
     acc.finish()
+}
+
+/// Un-normalised sums by prefix sums, O(N + 2^U) instead of O(N·U): each coefficient is
+/// 2·P[mid] − P[start] − P[end] over the running sum P. The fast path of the simulations;
+/// [`haar_sums`] (the streaming form, sample by sample) is its reference.
+pub fn haar_sums_prefix(x: &[i64], u_max: u32) -> Result<Vec<i64>, DspError> {
+    check_scales(x.len(), u_max)?;
+    let n = x.len();
+    let mut prefix = Vec::with_capacity(n + 1);
+    let mut acc = 0i64;
+    prefix.push(0);
+    for &v in x {
+        acc = acc.wrapping_add(v);
+        prefix.push(acc);
+    }
+    let mut out = Vec::with_capacity(register_count(u_max));
+    for u in 0..=u_max {
+        for v in 0..(1usize << u) {
+            let (s, m, e) = support(n, u, v);
+            out.push(
+                prefix[m]
+                    .wrapping_mul(2)
+                    .wrapping_sub(prefix[s])
+                    .wrapping_sub(prefix[e]),
+            );
+        }
+    }
+    Ok(out)
+}
+
+/// Sample boundaries (start, mid, end) of wavelet (u, v) in an N-sample record: the +
+/// half is start..mid, the − half mid..end (start = ⌈vN/2^u⌉, mid = ⌈(2v+1)N/2^(u+1)⌉,
+/// end = ⌈(v+1)N/2^u⌉, the same rule as [`wavelet_of`]).
+pub fn support(n_total: usize, u: u32, v: usize) -> (usize, usize, usize) {
+    let n = n_total as u128;
+    let ceil = |num: u128, den_log2: u32| num.div_ceil(1u128 << den_log2) as usize;
+    (
+        ceil(v as u128 * n, u),
+        ceil((2 * v as u128 + 1) * n, u + 1),
+        ceil((v as u128 + 1) * n, u),
+    )
 }
 
 /// Number of samples in the support of wavelet (u, v).
@@ -276,6 +336,35 @@ mod tests {
         let e = ramp_rate(&c, 4, n as f64 / fs).unwrap();
         assert_eq!((e.u, e.v), (0, 0));
         assert!((e.rate_per_s - r).abs() / r < 1e-9, "{}", e.rate_per_s);
+    }
+
+    /// The prefix-sum fast path equals the streaming reference, powers of two or not, and
+    /// the support boundaries agree with the per-sample rule.
+    #[test]
+    fn prefix_sums_match_the_streaming_reference() {
+        for n in [2usize, 7, 64, 100, 1000, 4096] {
+            let x: Vec<i64> = (0..n as i64).map(|i| (i * 7919 % 101) - 50).collect();
+            let u = n.ilog2() - 1;
+            assert_eq!(
+                haar_sums_prefix(&x, u).unwrap(),
+                haar_sums(&x, u).unwrap(),
+                "n {n}"
+            );
+            for uu in 0..=u {
+                for v in 0..(1usize << uu) {
+                    let (s, m, e) = support(n, uu, v);
+                    for i in s..e {
+                        assert_eq!(wavelet_of(i, n, uu), (v, i < m), "n {n} u {uu} v {v} i {i}");
+                    }
+                    assert_eq!(e - s, wavelet_len(n, uu, v));
+                }
+            }
+        }
+        // A deliberately broken input fails the check: one sample changed changes a sum.
+        let x: Vec<i64> = (0..64).collect();
+        let mut y = x.clone();
+        y[5] += 1;
+        assert_ne!(haar_sums_prefix(&y, 5).unwrap(), haar_sums(&x, 5).unwrap());
     }
 
     #[test]
