@@ -11,6 +11,7 @@ mod motion;
 mod scene;
 mod sensor;
 mod source;
+pub mod splitmix;
 
 pub use acquisition::AcquisitionConfig;
 pub use error::SceneError;
@@ -18,6 +19,7 @@ pub use motion::MotionConfig;
 pub use scene::{Scene, SceneConfig};
 pub use sensor::SensorConfig;
 pub use source::{BLOCK_PULSES, FillCounts, PhotonSource};
+pub use splitmix::SplitMix64;
 
 /// Depth per picosecond of time of flight, round trip: 1 ps ↔ 0.15 mm (c/2 = 0.15 mm/ps),
 /// the paper's convention. Depth → time is `t_ps = depth_mm / MM_PER_PS`.
