@@ -69,27 +69,11 @@ impl Datapath {
     /// `None` when it contributes nothing (the contract's priming rule).
     #[inline(always)]
     pub fn pulse(&mut self, valid: bool, tdc: u32, fault: Option<Fault>) -> Option<i64> {
-        let d = zoomed(tdc, self.tdc_bits, self.zoom);
-        let take = valid || fault == Some(Fault::HoldInvalid);
         match self.mode {
-            Mode::Fourier => {
-                let op = if self.primed {
-                    self.x = self.prefilter(fault);
-                    Some(self.x)
-                } else {
-                    None
-                };
-                if take {
-                    self.held = d;
-                }
-                if valid && !self.primed {
-                    self.primed = true;
-                    // The filter starts at the first depth, not at zero: no start transient.
-                    self.x = d << self.frac_bits;
-                }
-                op
-            }
+            Mode::Fourier => self.fourier_pulse(valid, tdc, fault),
             Mode::Haar => {
+                let d = zoomed(tdc, self.tdc_bits, self.zoom);
+                let take = valid || fault == Some(Fault::HoldInvalid);
                 if take {
                     self.held = d;
                 }
@@ -98,6 +82,27 @@ impl Datapath {
                 op
             }
         }
+    }
+
+    /// [`Datapath::pulse`] of a Fourier pixel (prefiltered operand), without the mode
+    /// test: the transaction model's streaming loop calls it directly.
+    #[inline(always)]
+    pub fn fourier_pulse(&mut self, valid: bool, tdc: u32, fault: Option<Fault>) -> Option<i64> {
+        let op = if self.primed {
+            self.x = self.prefilter(fault);
+            Some(self.x)
+        } else {
+            None
+        };
+        if valid || fault == Some(Fault::HoldInvalid) {
+            self.held = zoomed(tdc, self.tdc_bits, self.zoom);
+        }
+        if valid && !self.primed {
+            self.primed = true;
+            // The filter starts at the first depth, not at zero: no start transient.
+            self.x = self.held << self.frac_bits;
+        }
+        op
     }
 
     /// x + (((held << F) − x) >>> S).

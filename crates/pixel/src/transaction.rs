@@ -178,7 +178,9 @@ impl TransactionModel {
         let mut dp = self.dp;
         for (i, &det) in rest.iter().enumerate() {
             // Primed: every pulse contributes its operand.
-            let x = dp.pulse(det.is_some(), det.unwrap_or(0), None).unwrap_or(0);
+            let x = dp
+                .fourier_pulse(det.is_some(), det.unwrap_or(0), None)
+                .unwrap_or(0);
             let set = if i & 1 == 0 { &mut *even } else { &mut *odd };
             if wpe == 1 {
                 // R ≤ 64 (B ≤ 32): one word per entry, the common case.
