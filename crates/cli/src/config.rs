@@ -20,10 +20,9 @@ pub const DEFAULT_TOML: &str = include_str!("../../../scenes/default.toml");
 /// Name used in messages for the embedded default.
 pub const DEFAULT_ORIGIN: &str = "<embedded default>";
 
-/// Jitter σ on each side of the scene's depth range that `width = "auto"` sizes for
-/// (a detection beyond 6σ has probability 2·10^−9, and the sizing already assumes every
-/// sample at the extreme code, which a real record's sum is far from).
-pub const SIZING_SIGMAS: f64 = 6.0;
+/// Jitter σ on each side of the scene's depth range that `width = "auto"` sizes for (the
+/// pixel crate's one sizing rule, also used by `tofprobe size`).
+pub use tofprobe_pixel::sizing::SIZING_SIGMAS;
 
 /// The configuration document.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

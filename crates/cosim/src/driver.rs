@@ -5,16 +5,15 @@
 
 use crate::error::CosimError;
 use crate::harness::{self, Mismatch, RunOutcome};
-use crate::pixel_bridge::golden_run;
 use crate::verilator::{self, BuildProfile, HarnessBuild};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use tofprobe_rtlgen::model::Fault;
-use tofprobe_rtlgen::params::{Mode, PixelParams};
-use tofprobe_rtlgen::render::{RenderOptions, module_names};
+use tofprobe_pixel::{Fault, Mode, PixelParams};
+use tofprobe_rtlgen::render::RenderOptions;
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
-use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
+use tofprobe_rtlgen::vectors::{VectorOptions, golden_run, write_vectors};
 use tofprobe_rtlgen::write::write_generated;
+use tofprobe_rtlgen::{DEFAULT_MODULE_PREFIX, module_names};
 
 /// Cycles either side of a mismatch that the VCD covers.
 pub const VCD_MARGIN: u64 = 64;
@@ -102,7 +101,7 @@ pub fn rom_from_rtl(p: &PixelParams, dir: &Path) -> Result<Vec<u64>, CosimError>
     if p.mode == Mode::Haar {
         return Ok(Vec::new());
     }
-    let (_, rom_name, _) = module_names(p);
+    let (_, rom_name, _) = module_names(DEFAULT_MODULE_PREFIX);
     let r = p.registers();
     let words = r.div_ceil(64);
     let mut rom = vec![0u64; p.rom_depth * words];
@@ -211,12 +210,12 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         trace_window: o.digest_only.then_some((0, 0)),
     };
     let t0 = Instant::now();
-    let (golden, window) = golden_run(p, &stim, &rom, &vopts).map_err(CosimError::Judge)?;
+    let (golden, window) = golden_run(p, &stim, &rom, &vopts)?;
     let model_seconds = t0.elapsed().as_secs_f64();
     let vec_dir = work_dir.join("vectors");
     write_vectors(&vec_dir, p, &stim, &rom, &golden, window, &vopts)?;
     let vec_dir = std::fs::canonicalize(&vec_dir).map_err(|e| CosimError::io(&vec_dir, e))?;
-    let (_, _, top) = module_names(p);
+    let (_, _, top) = module_names(DEFAULT_MODULE_PREFIX);
     let build = verilator::build(&rtl_dir, &top, false, o.profile)?;
     let outcome = harness::run(&build.exe, &rtl_dir, &vec_dir, None, None)?;
     let mut first = outcome.first.clone();
@@ -227,7 +226,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
             trace_window: Some((d.cycle_from, d.cycle_to)),
             ..vopts.clone()
         };
-        let (gw, ww) = golden_run(p, &stim, &rom, &wopts).map_err(CosimError::Judge)?;
+        let (gw, ww) = golden_run(p, &stim, &rom, &wopts)?;
         let wdir = work_dir.join("vectors-window");
         write_vectors(&wdir, p, &stim, &rom, &gw, ww, &wopts)?;
         let wdir = std::fs::canonicalize(&wdir).map_err(|e| CosimError::io(&wdir, e))?;

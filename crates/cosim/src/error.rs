@@ -26,10 +26,9 @@ pub enum CosimError {
     /// Rendering or vector generation failed.
     #[error(transparent)]
     Rtl(#[from] tofprobe_rtlgen::RtlError),
-    /// The pixel crate's cycle model (the judge of the golden vectors) rejects the
-    /// parameters the generator accepted.
-    #[error("the pixel crate's cycle model rejects the configuration: {0}")]
-    Judge(String),
+    /// The pixel rejects the parameters (the one validation).
+    #[error(transparent)]
+    Pixel(#[from] tofprobe_pixel::PixelError),
     /// File-system error, with the path.
     #[error("{path}: {source}")]
     Io {

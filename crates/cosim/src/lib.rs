@@ -6,7 +6,6 @@ pub mod driver;
 pub mod error;
 pub mod harness;
 pub mod icarus;
-pub mod pixel_bridge;
 pub mod tools;
 pub mod verilator;
 

@@ -7,7 +7,7 @@ use crate::tools::require;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
-use tofprobe_rtlgen::params::fnv1a64;
+use tofprobe_io::fnv1a64;
 
 /// The harness source, embedded so the binary works outside the source tree.
 pub const HARNESS_CPP: &str = include_str!("../../../testbench/harness.cpp");

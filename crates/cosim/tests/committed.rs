@@ -7,10 +7,10 @@
 
 use std::path::{Path, PathBuf};
 use tofprobe_cosim::driver::rom_from_rtl;
-use tofprobe_cosim::pixel_bridge::golden_run;
-use tofprobe_rtlgen::params::{Mode, PixelParams};
+use tofprobe_pixel::{Mode, PixelParams};
 use tofprobe_rtlgen::render::{RenderOptions, render};
 use tofprobe_rtlgen::stimulus::random_stimulus;
+use tofprobe_rtlgen::vectors::golden_run;
 use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
 
 fn root() -> PathBuf {
@@ -74,8 +74,8 @@ fn check_rtl_dir(dir: &Path) -> PixelParams {
         &rom,
         &RenderOptions {
             command,
-            mutation: None,
             rom_note,
+            ..RenderOptions::default()
         },
     )
     .expect("renders");

@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use std::path::PathBuf;
-use tofprobe_rtlgen::params::{Mode, PixelParams};
+use tofprobe_pixel::{Mode, PixelParams};
 
 /// True when the tools exist; otherwise prints a loud SKIP line (CI installs them via
 /// scripts/test.sh, so there the tests always run).

@@ -4,7 +4,7 @@
 mod common;
 use common::*;
 use tofprobe_cosim::{CosimOptions, cosim};
-use tofprobe_rtlgen::params::{Mode, PixelParams};
+use tofprobe_pixel::{Mode, PixelParams};
 
 #[test]
 fn default_fourier_and_haar_pass_in_verilator() {

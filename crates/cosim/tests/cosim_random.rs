@@ -7,7 +7,7 @@ use common::*;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestRunner};
 use tofprobe_cosim::{CosimOptions, cosim};
-use tofprobe_rtlgen::params::{Mode, PixelParams};
+use tofprobe_pixel::{Mode, PixelParams};
 
 fn config() -> impl Strategy<Value = (PixelParams, u64)> {
     (
@@ -30,7 +30,6 @@ fn config() -> impl Strategy<Value = (PixelParams, u64)> {
                 width: 8,
                 frame_pulses: 1 << ln,
                 rom_depth: l,
-                ..PixelParams::default()
             };
             p.adders = a.min(p.ops_per_pulse());
             p.cycles_per_pulse = p.slots() + ec;

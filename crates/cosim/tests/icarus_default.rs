@@ -4,14 +4,14 @@
 mod common;
 use common::*;
 use std::path::Path;
-use tofprobe_cosim::pixel_bridge::golden_run;
 use tofprobe_cosim::{icarus, render_into};
+use tofprobe_pixel::Fault;
+use tofprobe_pixel::{Mode, PixelParams};
 use tofprobe_rtlgen::golden::first_divergence;
-use tofprobe_rtlgen::model::Fault;
-use tofprobe_rtlgen::params::{Mode, PixelParams};
-use tofprobe_rtlgen::render::module_names;
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
+use tofprobe_rtlgen::vectors::golden_run;
 use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
+use tofprobe_rtlgen::{DEFAULT_MODULE_PREFIX, module_names};
 
 fn run(
     p: &PixelParams,
@@ -34,7 +34,13 @@ fn run(
     write_vectors(&vec, p, &stim, &rom, &g, w, &o).expect("writes vectors");
     let rtl = std::fs::canonicalize(rtl).expect("rtl dir");
     let vec = std::fs::canonicalize(vec).expect("vec dir");
-    icarus::run(&rtl, &vec, &module_names(p).2, &dir.join("icarus")).expect("icarus runs")
+    icarus::run(
+        &rtl,
+        &vec,
+        &module_names(DEFAULT_MODULE_PREFIX).2,
+        &dir.join("icarus"),
+    )
+    .expect("icarus runs")
 }
 
 #[test]
@@ -65,8 +71,9 @@ fn icarus_catches_a_sign_flip_at_its_first_cycle() {
     p.frame_pulses = 32;
     p.rom_depth = 32;
     let stim = random_stimulus(&p, p.frame_pulses, 3);
-    let (cycle, pulse) =
-        first_divergence(&p, &stim, &sign_probe_rom(&p), 1, Fault::SignFlip).expect("shows");
+    let (cycle, pulse) = first_divergence(&p, &stim, &sign_probe_rom(&p), 1, Fault::SignFlip)
+        .expect("the model accepts the configuration")
+        .expect("shows");
     let out = run(&p, &work_dir("icarus-signflip"), Some(Fault::SignFlip), 1);
     let m = out.first.expect("a mismatch is reported");
     assert_eq!((m.cycle, m.pulse), (cycle, pulse), "{m:?}");

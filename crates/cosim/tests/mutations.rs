@@ -1,14 +1,15 @@
 //! The co-simulation can fail: each deliberately broken RTL variant is caught, at exactly
-//! the cycle where the same fault, injected into the reference model, first changes an
-//! observable (a register write or an output pin). That cycle is computed by the model
-//! alone (`first_divergence`), independently of the simulator.
+//! the cycle where the same fault, injected through the hooks of the pixel crate's one
+//! cycle model, first changes an observable (a register write or an output pin). That
+//! cycle is computed by the model alone (`first_divergence`), independently of the
+//! simulator.
 
 mod common;
 use common::*;
 use tofprobe_cosim::{CosimOptions, cosim};
+use tofprobe_pixel::Fault;
+use tofprobe_pixel::{Mode, PixelParams};
 use tofprobe_rtlgen::golden::first_divergence;
-use tofprobe_rtlgen::model::Fault;
-use tofprobe_rtlgen::params::{Mode, PixelParams};
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
 
 /// Small enough to verilate quickly; W = operand + 1 so register 0 overflows W−1 bits
@@ -49,6 +50,7 @@ fn every_fault_is_caught_at_its_first_cycle() {
     assert!(clean.pass, "clean RTL must pass: {:?}", clean.first);
     for fault in Fault::ALL {
         let (cycle, pulse) = first_divergence(&p, &stim, &rom, frames, fault)
+            .expect("the model accepts the configuration")
             .unwrap_or_else(|| panic!("{fault:?} never shows on this stimulus"));
         let mut o = CosimOptions::new(work_dir(&format!("mutation-{}", fault.name())));
         o.frames = frames;
@@ -86,8 +88,9 @@ fn digest_mismatch_is_refined_to_the_first_cycle() {
     let (seed, frames) = (7, 2);
     let stim = random_stimulus(&p, frames * p.frame_pulses, seed);
     let fault = Fault::LogicalShift;
-    let (cycle, pulse) =
-        first_divergence(&p, &stim, &sign_probe_rom(&p), frames, fault).expect("shows");
+    let (cycle, pulse) = first_divergence(&p, &stim, &sign_probe_rom(&p), frames, fault)
+        .expect("the model accepts the configuration")
+        .expect("shows");
     let mut o = CosimOptions::new(work_dir("mutation-digest"));
     o.frames = frames;
     o.seed = seed;

@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use tofprobe_cosim::{CosimOptions, cosim};
 use tofprobe_dsp::sd::{ProbeConfig, ProbeDesign, ProbeRom};
-use tofprobe_rtlgen::params::PixelParams;
+use tofprobe_pixel::PixelParams;
 
 #[test]
 fn sigma_delta_rom_is_rendered_and_cosimulates() {

@@ -7,7 +7,6 @@
 
 use crate::error::DspError;
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// A bit-packed probe ROM: `depth` entries of `registers` bits.
@@ -117,43 +116,15 @@ impl RomImage {
     }
 }
 
-/// FNV-1a, 64 bit: the ROM's content hash (small, dependency-free, stable across
-/// platforms; it identifies a ROM, it is not a cryptographic digest).
-pub fn fnv1a64(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
-}
+pub use tofprobe_io::fnv1a64;
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, flushed,
-/// then renamed over the target, so a reader never sees a half-written file.
+/// Writes `bytes` to `path` whole or not at all ([`tofprobe_io::write_atomic`]), with the
+/// path in the error.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), DspError> {
-    let io = |e: std::io::Error| DspError::Io {
+    tofprobe_io::write_atomic(path, bytes).map_err(|e| DspError::Io {
         path: path.display().to_string(),
         message: e.to_string(),
-    };
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
-    if let Some(d) = dir {
-        std::fs::create_dir_all(d).map_err(io)?;
-    }
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(io)
+    })
 }
 
 impl RomImage {

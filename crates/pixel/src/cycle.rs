@@ -5,10 +5,18 @@
 //! A Verilator harness that does "set inputs, eval, sample outputs, clk 0→1, eval,
 //! clk 1→0" sees exactly what `step` returns, and the register writes of that edge are in
 //! [`CycleModel::writes`].
+//!
+//! The arithmetic is the one [`Datapath`]'s, the slot order the one [`Schedule`]'s. The
+//! golden vectors are recorded from this model (tofprobe-rtlgen), and the mutation tests
+//! run it with a [`Fault`] ([`CycleModel::with_fault`]) to predict where a broken RTL
+//! first differs.
 
+use crate::datapath::Datapath;
 use crate::error::PixelError;
-use crate::fixed::{haar_target, mask, prefilter_step, rom_bit, to_raw, wrap, zoomed};
+use crate::fault::Fault;
+use crate::fixed::{mask, to_raw, wrap};
 use crate::params::{Mode, PixelParams};
+use crate::schedule::Schedule;
 
 /// The pixel's inputs during one clock cycle (sampled at its rising edge).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -56,10 +64,11 @@ pub struct CycleModel {
     p: PixelParams,
     r: usize,
     k: usize,
-    // Contract state.
-    primed: bool,
-    held: i64,
-    x: i64,
+    schedule: Schedule,
+    log2_n: u32,
+    fault: Option<Fault>,
+    // Contract state (`primed`, `held` and `x` in the datapath).
+    dp: Datapath,
     op: i64,
     bits: Vec<u64>,
     n_lat: u64,
@@ -79,25 +88,34 @@ pub struct CycleModel {
     writes: Vec<RegWrite>,
     cycle: u64,
     accepted_last: bool,
+    /// ScheduleLate fault: the writes computed at the last edge, applied at this one.
+    late: Vec<RegWrite>,
 }
 
 impl CycleModel {
     /// A pixel in its reset state. Fails if the parameters do not validate.
     pub fn new(params: &PixelParams) -> Result<Self, PixelError> {
+        Self::with_fault(params, None)
+    }
+
+    /// A pixel carrying a deliberate fault (`None`: the correct pixel), for the mutation
+    /// tests: the same model with the fault's hook switched on.
+    pub fn with_fault(params: &PixelParams, fault: Option<Fault>) -> Result<Self, PixelError> {
         params.validate()?;
-        Ok(Self::fresh(params))
+        Ok(Self::fresh(params, fault))
     }
 
     /// The reset state of validated parameters.
-    fn fresh(params: &PixelParams) -> Self {
+    fn fresh(params: &PixelParams, fault: Option<Fault>) -> Self {
         let r = params.registers();
         CycleModel {
             p: params.clone(),
             r,
             k: params.slots(),
-            primed: false,
-            held: 0,
-            x: 0,
+            schedule: Schedule::new(params),
+            log2_n: params.log2_frame(),
+            fault,
+            dp: Datapath::new(params),
             op: 0,
             bits: vec![0; r.div_ceil(64)],
             n_lat: 0,
@@ -112,9 +130,10 @@ impl CycleModel {
             rd_valid: false,
             rd_index: 0,
             rd_data: 0,
-            writes: Vec::new(),
+            writes: Vec::with_capacity(r),
             cycle: 0,
             accepted_last: false,
+            late: Vec::new(),
         }
     }
 
@@ -130,17 +149,22 @@ impl CycleModel {
 
     /// The held depth.
     pub fn held(&self) -> i64 {
-        self.held
+        self.dp.held()
     }
 
     /// The prefilter state x (units of 2^−F codes).
     pub fn prefilter_state(&self) -> i64 {
-        self.x
+        self.dp.prefilter_state()
     }
 
     /// Whether a first valid detection has been seen since reset.
     pub fn primed(&self) -> bool {
-        self.primed
+        self.dp.primed()
+    }
+
+    /// The fault this model carries (`None`: the correct pixel).
+    pub fn fault(&self) -> Option<Fault> {
+        self.fault
     }
 
     /// Accepted pulses since the last status word.
@@ -206,29 +230,17 @@ impl CycleModel {
         let take_pulse = pins.pulse && free && !pins.readout && haar_room;
         let refuse_pulse = pins.pulse && !take_pulse;
 
-        // Accumulate one slot with the old op/bits/n_lat/acc_en.
+        // Accumulate one slot with the old op/bits/n_lat/acc_en: the schedule selects the
+        // register and sign, the datapath adds.
         if self.active {
             if self.acc_en {
-                let p = self.p.ops_per_pulse();
-                for a in 0..self.p.adders {
-                    let j = self.slot * self.p.adders + a;
-                    if j >= p {
+                for i in 0..self.p.adders {
+                    let Some(operation) = self.schedule.at(self.slot, i) else {
                         break;
-                    }
-                    let (reg, add) = match self.p.mode {
-                        Mode::Fourier => (j, rom_bit(&self.bits, j)),
-                        Mode::Haar => haar_target(self.n_lat, j as u32, self.p.log2_frame()),
                     };
-                    let v = if add {
-                        self.y[reg].wrapping_add(self.op)
-                    } else {
-                        self.y[reg].wrapping_sub(self.op)
-                    };
-                    self.y[reg] = wrap(v, w);
-                    self.writes.push(RegWrite {
-                        register: reg as u32,
-                        value: to_raw(self.y[reg], w),
-                    });
+                    let (reg, add) = operation.target(self.n_lat, self.log2_n, &self.bits);
+                    let v = self.dp.accumulate(self.y[reg], self.op, add, self.fault);
+                    self.write(reg, v);
                 }
             }
             if self.slot == self.k - 1 {
@@ -244,11 +256,7 @@ impl CycleModel {
                 self.rd_data = to_raw(self.y[self.rd_ptr], w);
                 self.rd_index = self.rd_ptr as u32;
                 self.rd_valid = true;
-                self.y[self.rd_ptr] = 0;
-                self.writes.push(RegWrite {
-                    register: self.rd_ptr as u32,
-                    value: 0,
-                });
+                self.write(self.rd_ptr, 0);
                 self.rd_ptr += 1;
             } else {
                 self.rd_data = self.refused & mask(w);
@@ -273,30 +281,66 @@ impl CycleModel {
             self.rd_active = true;
             self.rd_ptr = 0;
         }
+        if self.fault == Some(Fault::ScheduleLate) {
+            self.apply_late();
+        }
         out
     }
 
-    /// The state changes at the edge that accepts a pulse.
+    /// A register write of this edge (a trace event).
+    #[inline(always)]
+    fn write(&mut self, reg: usize, v: i64) {
+        if self.fault.is_some() {
+            return self.write_faulty(reg, v);
+        }
+        self.y[reg] = v;
+        self.writes.push(RegWrite {
+            register: reg as u32,
+            value: to_raw(v, self.p.width),
+        });
+    }
+
+    /// The register-file faults: register 0 one bit narrow, or every write one edge late.
+    #[cold]
+    fn write_faulty(&mut self, reg: usize, v: i64) {
+        let w = self.p.width;
+        let v = if self.fault == Some(Fault::NarrowRegister) && reg == 0 {
+            wrap(v, w - 1)
+        } else {
+            v
+        };
+        let event = RegWrite {
+            register: reg as u32,
+            value: to_raw(v, w),
+        };
+        if self.fault != Some(Fault::ScheduleLate) {
+            self.y[reg] = v;
+        }
+        self.writes.push(event);
+    }
+
+    /// ScheduleLate: the writes computed at this edge wait; those of the previous edge
+    /// land now (and are this edge's trace events).
+    #[cold]
+    fn apply_late(&mut self) {
+        let computed = std::mem::take(&mut self.writes);
+        let landing = std::mem::replace(&mut self.late, computed);
+        for e in &landing {
+            self.y[e.register as usize] = wrap(e.value as i64, self.p.width);
+        }
+        self.writes = landing;
+    }
+
+    /// The state changes at the edge that accepts a pulse: the datapath's zoom, hold and
+    /// prefilter select the operand; the ROM word or pulse index is latched for the slots.
     fn accept(&mut self, pins: &PinsIn) {
-        let p = &self.p;
-        let d = zoomed(pins.tdc, p.tdc_bits, p.zoom);
-        match p.mode {
+        let operand = self.dp.pulse(pins.valid, pins.tdc, self.fault);
+        self.acc_en = operand.is_some();
+        if let Some(op) = operand {
+            self.op = op;
+        }
+        match self.p.mode {
             Mode::Fourier => {
-                if self.primed {
-                    let x_new = prefilter_step(self.x, self.held, p.frac_bits, p.shift);
-                    self.x = x_new;
-                    self.op = x_new;
-                    self.acc_en = true;
-                } else {
-                    self.acc_en = false;
-                }
-                if pins.valid {
-                    self.held = d;
-                    if !self.primed {
-                        self.primed = true;
-                        self.x = d << p.frac_bits;
-                    }
-                }
                 for (i, b) in self.bits.iter_mut().enumerate() {
                     *b = pins.rom_word.get(i).copied().unwrap_or(0);
                 }
@@ -306,16 +350,7 @@ impl CycleModel {
                     *last &= mask(used as u32);
                 }
             }
-            Mode::Haar => {
-                let h = if pins.valid { d } else { self.held };
-                self.held = h;
-                self.op = h;
-                self.acc_en = self.primed || pins.valid;
-                if pins.valid {
-                    self.primed = true;
-                }
-                self.n_lat = self.pcount;
-            }
+            Mode::Haar => self.n_lat = self.pcount,
         }
         self.pcount += 1;
         self.active = true;
@@ -325,7 +360,7 @@ impl CycleModel {
 
     fn reset(&mut self) {
         let cycle = self.cycle;
-        *self = Self::fresh(&self.p);
+        *self = Self::fresh(&self.p, self.fault);
         self.cycle = cycle;
     }
 }

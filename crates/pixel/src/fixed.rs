@@ -1,5 +1,5 @@
-//! Fixed-width two's-complement arithmetic shared by both models, so the transaction and
-//! cycle models cannot differ in how they wrap, shift or extend a value.
+//! Fixed-width two's-complement arithmetic of the one datapath ([`crate::datapath`]): how a
+//! value wraps, shifts and extends.
 //!
 //! Registers are kept as `i64` holding the *sign-extended* W-bit value. Wrapping a sum to W
 //! bits is exact modulo 2^W, which is why the models may add in 64 bits and wrap later:
@@ -48,20 +48,4 @@ pub fn zoomed(tdc: u32, tdc_bits: u32, zoom: u32) -> i64 {
 #[inline(always)]
 pub fn prefilter_step(x: i64, held: i64, frac_bits: u32, shift: u32) -> i64 {
     x + (((held << frac_bits) - x) >> shift)
-}
-
-/// Sign of the Haar wavelet at scale `u` for pulse `n` of a frame of 2^`log2_n` pulses and
-/// the register it updates: register 2^u − 1 + v with v = n >> (L − u); `true` (add) in the
-/// first half of the wavelet's support, i.e. when bit L − u − 1 of n is 0.
-#[inline(always)]
-pub fn haar_target(n: u64, u: u32, log2_n: u32) -> (usize, bool) {
-    let v = (n >> (log2_n - u)) as usize;
-    let add = (n >> (log2_n - u - 1)) & 1 == 0;
-    ((1usize << u) - 1 + v, add)
-}
-
-/// Bit r of a packed ROM word (bits beyond the supplied words read as 0).
-#[inline(always)]
-pub fn rom_bit(word: &[u64], r: usize) -> bool {
-    word.get(r / 64).is_some_and(|w| (w >> (r % 64)) & 1 == 1)
 }

@@ -4,7 +4,10 @@
 //!
 //! - [`params`]: the validated parameters ([`PixelParams`]) and their derived sizes;
 //! - [`config`]: the `[pixel]` TOML section ([`PixelConfig`]) and its validation;
-//! - [`fixed`]: the fixed-width arithmetic both models share;
+//! - [`datapath`]: the one datapath (zoom, hold, prefilter, accumulate) both models drive;
+//! - [`schedule`]: the adder schedule, which register each adder touches in which slot;
+//! - [`fault`]: deliberate faults the cycle model carries for the mutation tests;
+//! - [`fixed`]: the fixed-width arithmetic of the datapath;
 //! - [`sequencer`]: the reference pin sequence the testbench and vectors drive;
 //! - [`sizing`]: register widths, readout bytes and compression from a scene;
 //! - [`spectrum`]: the bit-true spectrum of a scene for `tofprobe simulate`.
@@ -13,10 +16,13 @@ pub mod autobins;
 pub mod bench;
 pub mod config;
 pub mod cycle;
+pub mod datapath;
 pub mod error;
+pub mod fault;
 pub mod fixed;
 pub mod params;
 pub mod readout;
+pub mod schedule;
 pub mod sequencer;
 pub mod sizing;
 pub mod spectrum;
@@ -31,9 +37,12 @@ pub mod contract {}
 
 pub use config::{PixelConfig, PixelContext};
 pub use cycle::{CycleModel, PinsIn, PinsOut, RegWrite};
+pub use datapath::Datapath;
 pub use error::PixelError;
+pub use fault::Fault;
 pub use params::{Mode, PixelParams};
 pub use readout::{Readout, ReadoutCollector};
+pub use schedule::{Operation, Schedule};
 pub use sequencer::Sequencer;
 pub use transaction::TransactionModel;
 

@@ -74,6 +74,15 @@ pub struct PixelParams {
     pub rom_depth: usize,
 }
 
+impl Default for PixelParams {
+    /// The committed default design (`rtl/`, scenes/default.toml resolved): the contract's
+    /// default Fourier pixel with W = 39, N = 10^7 (1 s at 10 MHz) and the periodic
+    /// L = 20,000 ΣΔ ROM.
+    fn default() -> Self {
+        PixelParams::fourier_default(39, 10_000_000, 20_000)
+    }
+}
+
 impl PixelParams {
     /// The contract's default Fourier pixel: B = 16, A = 2, C = 16, T = 7, S = 5, F =
     /// [`crate::DEFAULT_FRAC_BITS`], with the given width, frame length and ROM depth.

@@ -3,7 +3,8 @@
 //!
 //! First `rst` high for 2 cycles. Then per frame: for each pulse n, one `pulse` cycle (with
 //! `valid`, `tdc` and ROM word n mod L) and C − 1 idle cycles; after the last pulse, one
-//! `readout` cycle and R + 1 idle cycles while the words come out.
+//! `readout` cycle and R + 1 idle cycles while the words come out. The golden vectors add
+//! one cycle ([`Sequencer::with_status_cycle`]) in which the last status word is seen.
 
 use tofprobe_dsp::RomImage;
 
@@ -51,6 +52,15 @@ pub struct Sequencer<'a> {
     rom_depth: u64,
 }
 
+/// Presents no detection for pulses beyond the stimuli (the status cycle's pulse).
+fn detection(stimuli: &[Option<u32>], index: u64) -> Option<u32> {
+    usize::try_from(index)
+        .ok()
+        .and_then(|i| stimuli.get(i))
+        .copied()
+        .flatten()
+}
+
 impl<'a> Sequencer<'a> {
     /// The sequence for `stimuli.len() / N` frames (the stimuli must be whole frames). A
     /// Fourier pixel needs the ROM; a Haar pixel ignores it.
@@ -80,7 +90,24 @@ impl<'a> Sequencer<'a> {
         })
     }
 
-    /// Total cycles of the sequence: 2 + frames·(N·C + R + 2).
+    /// The sequence with one more cycle at its end, in which the last frame's status word
+    /// (registered at the edge ending its last idle cycle) is seen on the pins. Like the
+    /// chip's sequencer, that cycle presents the next frame's first pulse (no detection,
+    /// ROM address 0).
+    pub fn with_status_cycle(mut self) -> Self {
+        self.total += 1;
+        self
+    }
+
+    /// The global index (frame·N + pulse) of the pulse presented in cycle `cycle`, if any.
+    pub fn pulse_index(&self, cycle: u64) -> Option<u64> {
+        match self.phase(cycle) {
+            Phase::Pulse { frame, pulse } => Some(frame * self.n + pulse),
+            _ => None,
+        }
+    }
+
+    /// Total cycles of the sequence: 2 + frames·(N·C + R + 2) (+ 1 with the status cycle).
     pub fn total_cycles(&self) -> u64 {
         self.total
     }
@@ -123,7 +150,7 @@ impl<'a> Sequencer<'a> {
                 ..PinsIn::default()
             },
             Phase::Pulse { frame, pulse } => {
-                let det = self.stimuli[(frame * self.n + pulse) as usize];
+                let det = detection(self.stimuli, frame * self.n + pulse);
                 let rom_word = self
                     .rom
                     .map(|rom| rom.entry((pulse % self.rom_depth) as usize))

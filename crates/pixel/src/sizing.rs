@@ -129,6 +129,12 @@ pub fn required_width(
         .max(params.operand_bits())
 }
 
+/// Jitter σ on each side of a scene's depth range that the sizing covers, for
+/// `width = "auto"` and `tofprobe size` alike: a detection beyond 6σ has probability
+/// 2·10⁻⁹ (≈ 0.02 of the 10⁷ pulses of a frame), and the width bound already assumes every
+/// sample at the extreme code, which a real frame's sum is far from.
+pub const SIZING_SIGMAS: f64 = 6.0;
+
 /// The TDC codes a scene's detections can take: the depth range [`depth_min_mm`,
 /// `depth_max_mm`] (static depth ± the motion's maximum amplitude) widened by `k_sigma`
 /// jitter σ, in codes of `lsb_mm` from the window start, clamped to the window's `codes`.

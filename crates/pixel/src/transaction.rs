@@ -1,5 +1,7 @@
 //! The transaction-level model: one call per laser pulse, integers only, the same state and
-//! arithmetic as the contract (docs/pixel-contract.md) without the clock. Sweeps use it.
+//! arithmetic as the contract (docs/pixel-contract.md) without the clock: the one
+//! [`Datapath`] driven once per pulse (and once per register operation, in the order of the
+//! one [`Schedule`]). Sweeps use it.
 //!
 //! Two entry points compute the same thing:
 //! - [`TransactionModel::pulse`] updates the register file after every pulse (what the
@@ -13,19 +15,20 @@
 
 use tofprobe_dsp::RomImage;
 
+use crate::datapath::Datapath;
 use crate::error::PixelError;
-use crate::fixed::{haar_target, prefilter_step, wrap, zoomed};
+use crate::fixed::wrap;
 use crate::params::{Mode, PixelParams};
 use crate::readout::Readout;
+use crate::schedule::Schedule;
 
 /// The transaction-level pixel.
 #[derive(Debug, Clone)]
 pub struct TransactionModel {
     params: PixelParams,
     regs: Vec<i64>,
-    primed: bool,
-    held: i64,
-    x: i64,
+    dp: Datapath,
+    schedule: Schedule,
     pcount: u64,
     refused: u64,
     /// Partial sums of [`TransactionModel::run`]: one table of 256 per ROM byte.
@@ -39,9 +42,8 @@ impl TransactionModel {
         Ok(TransactionModel {
             params: params.clone(),
             regs: vec![0; params.registers()],
-            primed: false,
-            held: 0,
-            x: 0,
+            dp: Datapath::new(params),
+            schedule: Schedule::new(params),
             pcount: 0,
             refused: 0,
             tables: Vec::new(),
@@ -60,17 +62,17 @@ impl TransactionModel {
 
     /// The held depth (last valid d = tdc − Z; 0 before the first detection).
     pub fn held(&self) -> i64 {
-        self.held
+        self.dp.held()
     }
 
     /// The prefilter state x in units of 2^−F codes (Fourier; 0 in Haar mode).
     pub fn prefilter_state(&self) -> i64 {
-        self.x
+        self.dp.prefilter_state()
     }
 
     /// Whether a first valid detection has been seen since reset.
     pub fn primed(&self) -> bool {
-        self.primed
+        self.dp.primed()
     }
 
     /// Pulses accepted since the last readout.
@@ -95,14 +97,12 @@ impl TransactionModel {
     pub fn pulse(&mut self, detection: Option<u32>, rom_entry: &[u64]) -> bool {
         match self.params.mode {
             Mode::Fourier => {
-                if let Some(x) = self.advance_fourier(detection) {
-                    let w = self.params.width;
+                if let Some(x) = self.advance(detection) {
+                    let dp = self.dp;
                     for (wi, chunk) in self.regs.chunks_mut(64).enumerate() {
                         let bits = rom_entry.get(wi).copied().unwrap_or(0);
                         for (i, y) in chunk.iter_mut().enumerate() {
-                            // m = 0 (bit 1: add) or −1 (bit 0: subtract); (x ^ m) − m = ±x.
-                            let m = ((bits >> i) & 1) as i64 - 1;
-                            *y = wrap(y.wrapping_add((x ^ m).wrapping_sub(m)), w);
+                            *y = dp.accumulate(*y, x, (bits >> i) & 1 == 1, None);
                         }
                     }
                 }
@@ -113,47 +113,26 @@ impl TransactionModel {
         }
     }
 
-    /// Prefilter and hold for one Fourier pulse; returns the operand if the pulse
-    /// contributes (the pixel was primed before it).
+    /// The datapath's zoom, hold and prefilter for one pulse: the operand, if the pulse
+    /// contributes.
     #[inline(always)]
-    fn advance_fourier(&mut self, detection: Option<u32>) -> Option<i64> {
-        let p = &self.params;
-        let op = if self.primed {
-            self.x = prefilter_step(self.x, self.held, p.frac_bits, p.shift);
-            Some(self.x)
-        } else {
-            None
-        };
-        if let Some(code) = detection {
-            self.held = zoomed(code, p.tdc_bits, p.zoom);
-            if !self.primed {
-                self.primed = true;
-                // The filter starts at the first depth, not at zero: no start transient.
-                self.x = self.held << p.frac_bits;
-            }
-        }
-        op
+    fn advance(&mut self, detection: Option<u32>) -> Option<i64> {
+        self.dp
+            .pulse(detection.is_some(), detection.unwrap_or(0), None)
     }
 
     fn pulse_haar(&mut self, detection: Option<u32>) -> bool {
-        let p = &self.params;
-        if self.pcount >= p.frame_pulses {
+        if self.pcount >= self.params.frame_pulses {
             self.refuse();
             return false;
         }
-        let valid = detection.is_some();
-        if let Some(code) = detection {
-            self.held = zoomed(code, p.tdc_bits, p.zoom);
-        }
-        if self.primed || valid {
-            let l = p.log2_frame();
-            for u in 0..=p.haar_scales {
-                let (r, add) = haar_target(self.pcount, u, l);
-                let v = if add { self.held } else { -self.held };
-                self.regs[r] = wrap(self.regs[r].wrapping_add(v), p.width);
+        if let Some(h) = self.advance(detection) {
+            let l = self.params.log2_frame();
+            for operation in self.schedule.pulse() {
+                let (r, add) = operation.target(self.pcount, l, &[]);
+                self.regs[r] = self.dp.accumulate(self.regs[r], h, add, None);
             }
         }
-        self.primed |= valid;
         self.pcount += 1;
         true
     }
@@ -182,8 +161,8 @@ impl TransactionModel {
         let mut addr = (first_address % depth as u64) as usize;
         // Until the first detection nothing accumulates (the priming rule): step singly.
         let mut rest = detections;
-        while !self.primed && !rest.is_empty() {
-            self.advance_fourier(rest[0]);
+        while !self.dp.primed() && !rest.is_empty() {
+            self.advance(rest[0]);
             rest = &rest[1..];
             addr += 1;
             if addr == depth {
@@ -196,19 +175,12 @@ impl TransactionModel {
         tables.clear();
         tables.resize(2 * nbytes, [0; 256]);
         let (even, odd) = tables.split_at_mut(nbytes);
-        let (f, s, t, z) = (
-            self.params.frac_bits,
-            self.params.shift,
-            self.params.tdc_bits,
-            self.params.zoom,
-        );
-        let (mut x, mut held) = (self.x, self.held);
+        let mut dp = self.dp;
         for (i, &det) in rest.iter().enumerate() {
-            x = prefilter_step(x, held, f, s);
-            held = match det {
-                Some(code) => zoomed(code, t, z),
-                None => held,
-            };
+            // Primed: every pulse contributes its operand.
+            let x = dp
+                .fourier_pulse(det.is_some(), det.unwrap_or(0), None)
+                .unwrap_or(0);
             let set = if i & 1 == 0 { &mut *even } else { &mut *odd };
             if wpe == 1 {
                 // R ≤ 64 (B ≤ 32): one word per entry, the common case.
@@ -231,8 +203,7 @@ impl TransactionModel {
                 addr = 0;
             }
         }
-        self.x = x;
-        self.held = held;
+        self.dp = dp;
         for j in 0..nbytes {
             let (a, b) = tables.split_at_mut(nbytes);
             for (ca, cb) in a[j].iter_mut().zip(b[j].iter_mut()) {

@@ -6,7 +6,8 @@ mod common;
 
 use common::{Rng, random_detection, random_params, random_rom};
 use proptest::prelude::*;
-use tofprobe_pixel::fixed::{haar_target, to_raw};
+use tofprobe_pixel::fixed::to_raw;
+use tofprobe_pixel::schedule::haar_target;
 use tofprobe_pixel::{CycleModel, Mode, PinsIn, PixelParams};
 
 /// Two pixels in lockstep: `a` also gets strobes at cycles where it is not ready (and,

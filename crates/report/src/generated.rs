@@ -6,7 +6,8 @@ use crate::analysis::{RtlProvider, RtlVariant};
 use crate::error::{ReportError, Result};
 use crate::fsutil::write_atomic;
 use std::path::Path;
-use tofprobe_rtlgen::{PixelParams, RenderOptions, render};
+use tofprobe_pixel::PixelParams;
+use tofprobe_rtlgen::{RenderOptions, render};
 
 /// Renders the generated pixel for (B, W), all other parameters from `base`.
 #[derive(Debug, Clone)]
@@ -38,7 +39,7 @@ impl GeneratedPixel {
 
     /// Name of the pixel module.
     pub fn top(&self) -> String {
-        tofprobe_rtlgen::render::module_names(&self.base).0
+        tofprobe_rtlgen::module_names(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX).0
     }
 }
 
@@ -57,7 +58,7 @@ impl RtlProvider for GeneratedPixel {
                 value: format!("B={bins} W={width}"),
                 allowed: e.to_string(),
             })?;
-        let top = tofprobe_rtlgen::render::module_names(&p).0;
+        let top = tofprobe_rtlgen::module_names(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX).0;
         let pixel = files
             .iter()
             .find(|f| f.template == "pixel.v")

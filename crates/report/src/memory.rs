@@ -10,6 +10,7 @@
 
 use crate::error::{ReportError, Result};
 use serde::{Deserialize, Serialize};
+use tofprobe_pixel::sizing::{SIZING_SIGMAS, scene_code_range};
 
 /// How a register's width is counted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -79,14 +80,10 @@ pub fn max_abs_operand(
     Ok((codes as u64) << frac_bits)
 }
 
-/// Jitter margin in σ: a Gaussian sample beyond 5σ has probability 5.7·10⁻⁷, i.e. a few
-/// of the 10⁷ pulses of a frame; the width bound covers them because one outlier adds at
-/// most one operand's worth, far inside the N·max|op| margin of the other pulses.
-pub const JITTER_SIGMAS: f64 = 5.0;
-
-/// The TDC codes a scene produces: its depth range widened by ±[`JITTER_SIGMAS`]·σ, in
-/// codes of the window, clipped to the window's `codes`. With background photons any
-/// code of the window can be detected, so the whole window is returned.
+/// The TDC codes a scene produces: the pixel crate's one sizing rule
+/// ([`tofprobe_pixel::sizing::scene_code_range`]) at ±[`SIZING_SIGMAS`]·σ of jitter, so
+/// `tofprobe size` reports on the codes `width = "auto"` sizes for. With background photons
+/// any code of the window can be detected, so the whole window is returned.
 pub fn scene_codes(
     depth_range_mm: (f64, f64),
     window_start_mm: f64,
@@ -95,21 +92,15 @@ pub fn scene_codes(
     codes: u32,
     background: bool,
 ) -> (u32, u32) {
-    let top = codes.saturating_sub(1);
-    if background {
-        return (0, top);
-    }
-    let code = |d: f64| {
-        let c = ((d - window_start_mm) / lsb_mm).floor();
-        if c.is_nan() {
-            0
-        } else {
-            c.clamp(0.0, f64::from(top)) as u32
-        }
-    };
-    (
-        code(depth_range_mm.0 - JITTER_SIGMAS * jitter_mm),
-        code(depth_range_mm.1 + JITTER_SIGMAS * jitter_mm),
+    scene_code_range(
+        depth_range_mm.0,
+        depth_range_mm.1,
+        jitter_mm,
+        SIZING_SIGMAS,
+        window_start_mm,
+        lsb_mm,
+        codes,
+        background,
     )
 }
 
@@ -287,6 +278,13 @@ mod tests {
             (39, 40)
         );
         assert_eq!(scene_codes((29.9, 30.1), 0.0, 0.75, 0.0, 80, true), (0, 79));
+        // The margin is the pixel crate's 6σ (what `width = "auto"` sizes for), not 5σ:
+        // 50 mm ± 6·1 mm in 1 mm codes → 44..56 (5σ would give 45..55).
+        assert_eq!(SIZING_SIGMAS, 6.0);
+        assert_eq!(
+            scene_codes((50.0, 50.0), 0.0, 1.0, 1.0, 100, false),
+            (44, 56)
+        );
         // Z = 40, F = 6: max(|39 − 40|, |40 − 40|)·64 = 64.
         assert_eq!(operand_from_codes(39, 40, 40, 6), 64);
         assert_eq!(operand_from_codes(0, 79, 0, 6), 79 * 64);

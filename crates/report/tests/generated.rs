@@ -2,10 +2,10 @@
 //! configuration, so the test stays at about a second.
 
 use std::path::Path;
+use tofprobe_pixel::PixelParams;
 use tofprobe_report::analysis::analyse_point;
 use tofprobe_report::generated::GeneratedPixel;
 use tofprobe_report::liberty::Liberty;
-use tofprobe_rtlgen::PixelParams;
 
 #[test]
 fn generated_pixel_synthesises_and_splits() {

@@ -1,10 +1,15 @@
-//! Renders a configuration (TOML file or the default) into a directory: a developer aid.
+//! Renders a configuration (a `[pixel]` TOML table of explicit parameters, or the default)
+//! into a directory: a developer aid.
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let out = std::path::PathBuf::from(args.next().unwrap_or_else(|| "out".into()));
     let p = match args.next() {
-        Some(f) => tofprobe_rtlgen::PixelParams::from_toml_file(std::path::Path::new(&f))?,
-        None => tofprobe_rtlgen::PixelParams::default(),
+        Some(f) => {
+            let text = std::fs::read_to_string(&f)?;
+            let p: tofprobe_pixel::PixelParams = toml::from_str(&text)?;
+            p
+        }
+        None => tofprobe_pixel::PixelParams::default(),
     };
     let rom = tofprobe_rtlgen::stimulus::sign_probe_rom(&p);
     let files = tofprobe_rtlgen::render(&p, &rom, &Default::default())?;

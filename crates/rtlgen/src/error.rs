@@ -6,22 +6,15 @@ use std::path::PathBuf;
 /// Errors of configuration validation, rendering and file writing.
 #[derive(Debug, thiserror::Error)]
 pub enum RtlError {
-    /// A `[pixel]` field is outside its allowed range.
-    #[error("[pixel] {field} = {value} is out of range: allowed {allowed}{hint}")]
-    Range {
-        field: &'static str,
-        value: String,
-        allowed: String,
-        hint: String,
-    },
+    /// Parameters the pixel does not accept (the one validation, tofprobe-pixel's), or
+    /// stimuli and a ROM that do not fit them.
+    #[error(transparent)]
+    Pixel(#[from] tofprobe_pixel::PixelError),
     /// An identifier taken from the configuration is not a safe Verilog identifier.
     #[error(
         "{field} = {value:?} is not a safe Verilog identifier: allowed [a-z][a-z0-9_]{{0,31}}, not a keyword (e.g. \"tofprobe\")"
     )]
     Identifier { field: &'static str, value: String },
-    /// The configuration file could not be parsed.
-    #[error("cannot parse configuration {path}: {message}")]
-    Parse { path: PathBuf, message: String },
     /// A template failed to render.
     #[error("template {template} failed to render: {message}")]
     Render {

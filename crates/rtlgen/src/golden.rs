@@ -1,5 +1,6 @@
-//! Runs the reference sequencer through the cycle model and records what a simulator must
-//! reproduce: the readout of each frame, the register-write trace and output-pin changes
+//! Runs the pixel crate's reference sequencer (with its status cycle) through the pixel
+//! crate's cycle-accurate model, the one model of the pixel, and records what a simulator
+//! must reproduce: the readout of each frame, the register-write trace and output-pin changes
 //! (in full inside a cycle window), and a digest of both per window of pulses everywhere.
 //!
 //! Digest (also implemented by testbench/harness.cpp): events are hashed in cycle order,
@@ -12,20 +13,22 @@
 //! window of its last pulse. Pins are compared from cycle 1 on (before the first reset edge
 //! the RTL's state is undefined); cycle 1's pins are always an event.
 
-use crate::model::{CycleModel, Fault, PinsIn, PinsOut};
-use crate::params::PixelParams;
-use crate::sequencer::Sequencer;
+use std::borrow::Cow;
+
+use tofprobe_dsp::RomImage;
+use tofprobe_pixel::{CycleModel, Fault, Mode, PinsOut, PixelParams, Sequencer};
+
+use crate::error::RtlError;
 
 /// FNV-1a offset basis: the digest of an empty window.
-pub const DIGEST_INIT: u64 = 0xcbf2_9ce4_8422_2325;
-const DIGEST_PRIME: u64 = 0x0000_0100_0000_01b3;
+pub const DIGEST_INIT: u64 = tofprobe_io::FNV_OFFSET;
 
-/// Folds one event into a window digest.
+/// Folds one event into a window digest (FNV-1a's prime, a whole u64 word at a time).
 #[inline]
 pub fn digest_event(h: u64, words: [u64; 4]) -> u64 {
     words
         .iter()
-        .fold(h, |h, w| (h ^ w).wrapping_mul(DIGEST_PRIME))
+        .fold(h, |h, w| (h ^ w).wrapping_mul(tofprobe_io::FNV_PRIME))
 }
 
 /// Packs the pins as in the digest and pins.hex.
@@ -58,39 +61,43 @@ pub struct GoldenOptions {
     pub trace_window: (u64, u64),
 }
 
-/// A cycle-accurate model the golden run can replay: the judge of the vectors. The
-/// co-simulation driver passes the pixel crate's `CycleModel` (crates/cosim
-/// `pixel_bridge::PixelJudge`); this crate's own [`CycleModel`] implements it too, for the
-/// mutation tests' fault model and for callers without the pixel crate.
-pub trait StepModel {
-    /// One clock cycle: the pins seen before the edge, then the edge.
-    fn step(&mut self, pins: &PinsIn) -> PinsOut;
-    /// The register writes (register, raw W-bit value) of the last edge, in adder order.
-    fn writes(&self) -> &[(u32, u64)];
+/// The probe ROM image of `rom` (L × ceil(R/64) packed words) for the pixel crate's
+/// sequencer; `None` in Haar mode (no ROM).
+pub fn rom_image(p: &PixelParams, rom: &[u64]) -> Option<RomImage> {
+    (p.mode == Mode::Fourier)
+        .then(|| RomImage::from_words(p.rom_depth, p.registers(), rom.to_vec()))
 }
 
-impl StepModel for CycleModel {
-    fn step(&mut self, pins: &PinsIn) -> PinsOut {
-        CycleModel::step(self, pins)
-    }
-    fn writes(&self) -> &[(u32, u64)] {
-        CycleModel::writes(self)
-    }
-}
-
-/// Runs this crate's reference model and records the golden data.
-pub fn run(p: &PixelParams, stim: &[Option<u32>], rom: &[u64], o: &GoldenOptions) -> Golden {
-    run_with(CycleModel::new(p, rom, None), p, stim, o)
-}
-
-/// Runs `model` through the contract's sequencer and records the golden data.
-pub fn run_with<M: StepModel>(
-    mut model: M,
+/// The stimuli of `frames` whole frames: `stim` cut to frames·N pulses, padded with pulses
+/// without a detection when shorter.
+pub fn frame_stimuli<'a>(
     p: &PixelParams,
-    stim: &[Option<u32>],
-    o: &GoldenOptions,
-) -> Golden {
-    let seq = Sequencer::new(p, stim, o.frames);
+    stim: &'a [Option<u32>],
+    frames: u64,
+) -> Cow<'a, [Option<u32>]> {
+    let n = usize::try_from(frames.saturating_mul(p.frame_pulses)).unwrap_or(usize::MAX);
+    if stim.len() >= n {
+        Cow::Borrowed(&stim[..n])
+    } else {
+        let mut v = stim.to_vec();
+        v.resize(n, None);
+        Cow::Owned(v)
+    }
+}
+
+/// The contract's reference sequence for the golden vectors: `frames` frames and the
+/// status cycle.
+pub fn sequence<'a>(
+    p: &PixelParams,
+    stim: &'a [Option<u32>],
+    rom: Option<&'a RomImage>,
+) -> Result<Sequencer<'a>, RtlError> {
+    Ok(Sequencer::new(p, stim, rom)?.with_status_cycle())
+}
+
+/// Runs the pixel crate's cycle model through `seq` and records the golden data.
+pub fn run(p: &PixelParams, seq: &Sequencer<'_>, o: &GoldenOptions) -> Result<Golden, RtlError> {
+    let mut model = CycleModel::new(p)?;
     let mut g = Golden {
         cycles: seq.total_cycles(),
         ..Golden::default()
@@ -100,9 +107,8 @@ pub fn run_with<M: StepModel>(
     let mut prev = PinsOut::default();
     let (mut count, mut h) = (0u64, DIGEST_INIT);
     let mut window = 0u64;
-    for sc in seq {
-        let c = sc.cycle;
-        if let Some(pi) = sc.pulse_index {
+    for c in 0..seq.total_cycles() {
+        if let Some(pi) = seq.pulse_index(c) {
             g.pulses = pi + 1;
             let w = pi / o.digest_pulses.max(1);
             if w != window {
@@ -111,7 +117,7 @@ pub fn run_with<M: StepModel>(
                 window = w;
             }
         }
-        let out = model.step(&sc.pins);
+        let out = model.step(&seq.pins(c));
         let full = c >= o.trace_window.0 && c < o.trace_window.1;
         if c >= 1 && (c == 1 || out != prev) {
             h = digest_event(h, [2, c, pack_pins(&out), out.rd_data]);
@@ -127,40 +133,44 @@ pub fn run_with<M: StepModel>(
                 g.readouts.push(std::mem::take(&mut frame_words));
             }
         }
-        for &(reg, val) in model.writes() {
-            h = digest_event(h, [1, c, u64::from(reg), val]);
+        for w in model.writes() {
+            h = digest_event(h, [1, c, u64::from(w.register), w.value]);
             count += 1;
             if full {
-                g.trace.push((c, reg, val));
+                g.trace.push((c, w.register, w.value));
             }
         }
     }
     g.digests.push((count, h));
-    g
+    Ok(g)
 }
 
-/// The first cycle at which a model carrying `fault` differs from the correct model in
-/// any observable (register writes of the edge, or output pins from cycle 1 on), with the
-/// pulse index presented last by then. `None` if the fault never shows.
+/// The first cycle at which the cycle model carrying `fault` differs from the correct one
+/// in any observable (register writes of the edge, or output pins from cycle 1 on), with
+/// the pulse index presented last by then. `None` if the fault never shows.
 pub fn first_divergence(
     p: &PixelParams,
     stim: &[Option<u32>],
     rom: &[u64],
     frames: u64,
     fault: Fault,
-) -> Option<(u64, u64)> {
-    let mut good = CycleModel::new(p, rom, None);
-    let mut bad = CycleModel::new(p, rom, Some(fault));
+) -> Result<Option<(u64, u64)>, RtlError> {
+    let stim = frame_stimuli(p, stim, frames);
+    let image = rom_image(p, rom);
+    let seq = sequence(p, &stim, image.as_ref())?;
+    let mut good = CycleModel::new(p)?;
+    let mut bad = CycleModel::with_fault(p, Some(fault))?;
     let mut pulse = 0;
-    for sc in Sequencer::new(p, stim, frames) {
-        if let Some(pi) = sc.pulse_index {
+    for c in 0..seq.total_cycles() {
+        if let Some(pi) = seq.pulse_index(c) {
             pulse = pi;
         }
-        let a = good.step(&sc.pins);
-        let b = bad.step(&sc.pins);
-        if (sc.cycle >= 1 && a != b) || good.writes() != bad.writes() {
-            return Some((sc.cycle, pulse));
+        let pins = seq.pins(c);
+        let a = good.step(&pins);
+        let b = bad.step(&pins);
+        if (c >= 1 && a != b) || good.writes() != bad.writes() {
+            return Ok(Some((c, pulse)));
         }
     }
-    None
+    Ok(None)
 }

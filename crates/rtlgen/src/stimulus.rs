@@ -1,24 +1,8 @@
 //! Deterministic test stimulus: per-pulse detections and a probe ROM image from a seed
-//! (SplitMix64, so the C++ harness or anyone else can re-derive them from the manifest).
+//! (tofprobe-scene's SplitMix64, so the C++ harness or anyone else can re-derive them from the manifest).
 
-use crate::params::{Mode, PixelParams};
-
-/// SplitMix64: tiny, seedable, and identical on every platform.
-#[derive(Debug, Clone)]
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    pub fn new(seed: u64) -> Self {
-        SplitMix64(seed)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-}
+use tofprobe_pixel::{Mode, PixelParams};
+use tofprobe_scene::SplitMix64;
 
 /// `pulses` detections: a detection with probability 3/4, its code a random walk over the
 /// whole TDC range (so the prefilter sees both small and large steps and negative d).

@@ -4,14 +4,15 @@
 
 use crate::error::RtlError;
 use crate::golden::{self, Golden, GoldenOptions};
-use crate::params::{Mode, PixelParams, fnv1a64};
+use crate::naming::config_hash;
 use crate::render::{HEADER_MARK, rom_entry_hex};
-use crate::sequencer::Sequencer;
 use crate::write::write_generated;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
+use tofprobe_io::fnv1a64;
+use tofprobe_pixel::{Mode, PixelParams};
 
 /// Above this many cycles the full trace is replaced by digests only (a full trace of a
 /// 1.6·10^8-cycle frame would run to gigabytes).
@@ -65,48 +66,40 @@ pub struct Manifest {
     pub files: BTreeMap<String, String>,
 }
 
-/// Runs this crate's reference model for `stim`/`rom` and returns the data plus the
-/// effective trace window.
+/// Runs the pixel crate's cycle model (the one model, the judge of the RTL) through the
+/// contract's sequence for `stim`/`rom` and returns the golden data plus the effective
+/// trace window. Fails when the pixel does not accept the parameters or the ROM.
 pub fn golden_run(
     p: &PixelParams,
     stim: &[Option<u32>],
     rom: &[u64],
     o: &VectorOptions,
-) -> (Golden, (u64, u64)) {
-    golden_run_with(crate::model::CycleModel::new(p, rom, None), p, stim, o)
-}
-
-/// Runs `model` (the judge: the pixel crate's cycle model in `tofprobe vectors`/`cosim`)
-/// for `stim` and returns the data plus the effective trace window.
-pub fn golden_run_with<M: golden::StepModel>(
-    model: M,
-    p: &PixelParams,
-    stim: &[Option<u32>],
-    o: &VectorOptions,
-) -> (Golden, (u64, u64)) {
-    let total = Sequencer::new(p, stim, o.frames).total_cycles();
+) -> Result<(Golden, (u64, u64)), RtlError> {
+    let stim = golden::frame_stimuli(p, stim, o.frames);
+    let image = golden::rom_image(p, rom);
+    let seq = golden::sequence(p, &stim, image.as_ref())?;
+    let total = seq.total_cycles();
     let window = o.trace_window.unwrap_or(if total <= FULL_TRACE_MAX_CYCLES {
         (0, total)
     } else {
         (0, 0)
     });
-    let g = golden::run_with(
-        model,
+    let g = golden::run(
         p,
-        stim,
+        &seq,
         &GoldenOptions {
             frames: o.frames,
             digest_pulses: o.digest_pulses.max(1),
             trace_window: window,
         },
-    );
-    (g, window)
+    )?;
+    Ok((g, window))
 }
 
 fn head(what: &str, p: &PixelParams) -> String {
     format!(
         "{HEADER_MARK} (vectors): {what}. Configuration hash {}. DO NOT EDIT.\n",
-        p.config_hash()
+        config_hash(p)
     )
 }
 
@@ -203,7 +196,7 @@ pub fn write_vectors(
 
     let manifest = Manifest {
         generator: format!("tofprobe-rtlgen {}", env!("CARGO_PKG_VERSION")),
-        config_hash: p.config_hash(),
+        config_hash: config_hash(p),
         mode: format!("{:?}", p.mode).to_lowercase(),
         seed: o.seed,
         frames: o.frames,

@@ -1,4 +1,4 @@
-//! Writing generated files: atomically (temp file + rename), and never over a file that
+//! Writing generated files: whole or not at all (tofprobe-io), and never over a file that
 //! this generator did not write (recognised by its header's first line).
 
 use crate::error::RtlError;
@@ -22,17 +22,9 @@ pub fn is_ours_or_absent(path: &Path) -> Result<bool, RtlError> {
     }
 }
 
-/// Writes `contents` to `path` via a temporary file in the same directory and a rename.
+/// Writes `contents` to `path` whole or not at all ([`tofprobe_io::write_atomic`]).
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), RtlError> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|e| RtlError::io(dir, e))?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    std::fs::write(&tmp, contents).map_err(|e| RtlError::io(&tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| RtlError::io(path, e))
+    tofprobe_io::write_atomic(path, contents).map_err(|e| RtlError::io(path, e))
 }
 
 /// Writes generated files into `dir`. Checks every target first, so either all files are

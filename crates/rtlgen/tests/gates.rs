@@ -6,10 +6,11 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use tofprobe_rtlgen::params::{Mode, PixelParams};
-use tofprobe_rtlgen::render::{RenderOptions, module_names};
+use tofprobe_pixel::{Mode, PixelParams};
+use tofprobe_rtlgen::render::RenderOptions;
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 use tofprobe_rtlgen::write::write_generated;
+use tofprobe_rtlgen::{DEFAULT_MODULE_PREFIX, module_names};
 
 fn have(tool: &str) -> bool {
     let ok = Command::new(tool).arg("-V").output().is_ok();
@@ -119,7 +120,12 @@ fn verilator_lint_is_clean() {
         let dir = render_to(&format!("lint-{name}"), &p);
         let out = Command::new("verilator")
             .current_dir(&dir)
-            .args(["--lint-only", "-Wall", "--top-module", &module_names(&p).2])
+            .args([
+                "--lint-only",
+                "-Wall",
+                "--top-module",
+                &module_names(DEFAULT_MODULE_PREFIX).2,
+            ])
             .args(sources(&dir))
             .output()
             .expect("verilator runs");
@@ -141,7 +147,7 @@ fn yosys_synthesises_without_latches() {
         let script = format!(
             "read_verilog {}; synth -top {}; select -assert-none t:$dlatch t:$_DLATCH_*; tee -o stat.txt stat",
             sources(&dir).join(" "),
-            module_names(&p).2
+            module_names(DEFAULT_MODULE_PREFIX).2
         );
         let out = Command::new("yosys")
             .current_dir(&dir)
@@ -190,7 +196,7 @@ fn iverilog_compiles() {
                 "-o",
                 "/dev/null",
                 "-s",
-                &module_names(&p).2,
+                &module_names(DEFAULT_MODULE_PREFIX).2,
             ])
             .args(sources(&dir))
             .output()

@@ -3,8 +3,9 @@
 //! and `write_generated` refuses foreign files without writing anything.
 
 use proptest::prelude::*;
+use tofprobe_pixel::{Mode, PixelParams};
 use tofprobe_rtlgen::RtlError;
-use tofprobe_rtlgen::params::{Mode, PixelParams, validate_identifier};
+use tofprobe_rtlgen::naming::{config_hash_with_prefix, validate_identifier};
 use tofprobe_rtlgen::render::{HEADER_MARK, RenderOptions, render};
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 use tofprobe_rtlgen::write::write_generated;
@@ -30,10 +31,17 @@ fn identifiers_are_validated() {
         assert!(validate_identifier("module_prefix", good).is_ok());
     }
     let p = PixelParams {
-        module_prefix: "x;endmodule".into(),
+        frame_pulses: 64,
+        rom_depth: 8,
         ..PixelParams::default()
     };
-    let e = p.validate().expect_err("injection rejected").to_string();
+    let o = RenderOptions {
+        module_prefix: "x;endmodule".into(),
+        ..RenderOptions::default()
+    };
+    let e = render(&p, &sign_probe_rom(&p), &o)
+        .expect_err("injection rejected")
+        .to_string();
     assert!(
         e.contains("module_prefix") && e.contains("x;endmodule"),
         "{e}"
@@ -46,28 +54,37 @@ fn range_errors_name_field_value_and_fix() {
         cycles_per_pulse: 7,
         ..PixelParams::default()
     };
-    let e = p.validate().expect_err("K = 16 > C = 7").to_string();
+    let e = render(&p, &[], &RenderOptions::default())
+        .expect_err("K = 16 > C = 7")
+        .to_string();
     assert!(
-        e.contains("cycles_per_pulse") && e.contains('7') && e.contains("minimum 16"),
+        e.contains("cycles_per_pulse = 7") && e.contains("C ≥ 16") && e.ends_with(": 16"),
         "{e}"
     );
     let p = PixelParams {
         width: 10,
         ..PixelParams::default()
     };
-    let e = p.validate().expect_err("W below the operand").to_string();
-    // Operand T+1+F = 8+1+6 = 15 bits with this crate's default.
-    assert!(e.contains("width = 10") && e.contains("15..=63"), "{e}");
+    let e = render(&p, &[], &RenderOptions::default())
+        .expect_err("W below the operand")
+        .to_string();
+    // Operand T+1+F = 7+1+8 = 16 bits with the default.
+    assert!(
+        e.contains("width = 10") && e.contains("16 bits") && e.ends_with(": 16"),
+        "{e}"
+    );
     let p = PixelParams {
         mode: Mode::Haar,
         frame_pulses: 1000,
         ..PixelParams::default()
     };
-    let e = p
-        .validate()
+    let e = render(&p, &[], &RenderOptions::default())
         .expect_err("Haar N not a power of two")
         .to_string();
-    assert!(e.contains("frame_pulses") && e.contains("1024"), "{e}");
+    assert!(
+        e.contains("frame_pulses = 1000") && e.ends_with(": 1024"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -79,8 +96,8 @@ fn headers_name_generator_template_command_hash() {
     };
     let o = RenderOptions {
         command: "tofprobe rtl --out here".into(),
-        mutation: None,
-        rom_note: String::new(),
+        module_prefix: "px".into(),
+        ..RenderOptions::default()
     };
     let files = render(&p, &sign_probe_rom(&p), &o).expect("renders");
     assert_eq!(files.len(), 3, "case-table ROM: pixel, rom, top");
@@ -95,7 +112,8 @@ fn headers_name_generator_template_command_hash() {
             head.contains("DO NOT EDIT") && head.contains("`tofprobe rtl --out here`"),
             "{head}"
         );
-        assert!(head.contains(&p.config_hash()), "{head}");
+        assert!(head.contains(&config_hash_with_prefix(&p, "px")), "{head}");
+        assert!(f.name.starts_with("px_"), "{}", f.name);
     }
 }
 
@@ -136,7 +154,7 @@ proptest! {
         let mut p = PixelParams {
             mode: if haar { Mode::Haar } else { Mode::Fourier }, bins: b, haar_scales: u,
             adders: 1, cycles_per_pulse: 1, tdc_bits: t, zoom: 0, shift: s, frac_bits: f,
-            width: 8, frame_pulses: 1 << ln, rom_depth: l, ..PixelParams::default()
+            width: 8, frame_pulses: 1 << ln, rom_depth: l
         };
         p.adders = a.min(p.ops_per_pulse());
         p.cycles_per_pulse = p.slots() + ec;

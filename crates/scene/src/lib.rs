@@ -12,6 +12,7 @@ mod scene;
 mod sensor;
 mod source;
 pub mod tttr;
+pub mod splitmix;
 
 pub use acquisition::AcquisitionConfig;
 pub use error::SceneError;
@@ -19,6 +20,7 @@ pub use motion::MotionConfig;
 pub use scene::{Scene, SceneConfig};
 pub use sensor::SensorConfig;
 pub use source::{BLOCK_PULSES, FillCounts, PhotonSource};
+pub use splitmix::SplitMix64;
 
 /// Depth per picosecond of time of flight, round trip: 1 ps ↔ 0.15 mm (c/2 = 0.15 mm/ps),
 /// the paper's convention. Depth → time is `t_ps = depth_mm / MM_PER_PS`.

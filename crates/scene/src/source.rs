@@ -30,6 +30,7 @@ use crate::MM_PER_PS;
 use crate::error::SceneError;
 use crate::scene::Scene;
 use crate::sensor::SensorConfig;
+use crate::splitmix::mix;
 
 /// Picoseconds of round-trip time of flight per mm of depth.
 const PS_PER_MM: f64 = 1.0 / MM_PER_PS;
@@ -309,15 +310,7 @@ pub(crate) fn check_window(sensor: &SensorConfig, scene: &Scene) -> Result<(), S
     })
 }
 
-/// SplitMix64 finaliser: a bijective 64-bit mix.
-fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 /// The counter-based seed of a block: distinct (seed, block) pairs give unrelated streams.
 fn block_seed(seed: u64, block: u64) -> u64 {
-    splitmix64(splitmix64(seed) ^ block.wrapping_mul(0xD1B5_4A32_D192_ED03))
+    mix(mix(seed) ^ block.wrapping_mul(0xD1B5_4A32_D192_ED03))
 }

@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::Args;
 use serde::Serialize;
 use tofprobe_cosim::{BuildProfile, CosimOptions, CosimReport, cosim};
-use tofprobe_rtlgen::params::PixelParams;
+use tofprobe_pixel::PixelParams;
 
 use crate::commands::probe_rom::rtl_rom;
 use crate::commands::rtl::rtl_params;
@@ -80,8 +80,7 @@ struct Json {
 
 /// Times the pixel crate's transaction model on the same stimulus (seconds).
 pub fn time_transaction(p: &PixelParams, r: &CosimReport) -> f64 {
-    let pp = tofprobe_cosim::pixel_bridge::to_pixel(p);
-    let Ok(mut m) = tofprobe_pixel::TransactionModel::new(&pp) else {
+    let Ok(mut m) = tofprobe_pixel::TransactionModel::new(p) else {
         return f64::NAN;
     };
     let words = p.registers().div_ceil(64);

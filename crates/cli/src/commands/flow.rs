@@ -17,8 +17,8 @@ use std::path::PathBuf;
 use clap::Args;
 use tofprobe_cosim::{CosimOptions, cosim};
 use tofprobe_dsp::sd::{amplitudes_um, normalise, prefilter_response};
-use tofprobe_rtlgen::model::sext;
-use tofprobe_rtlgen::params::Mode;
+use tofprobe_pixel::Mode;
+use tofprobe_pixel::fixed::sign_extend as sext;
 use tofprobe_rtlgen::write::write_atomic;
 
 use crate::commands::probe_rom::rtl_rom;
@@ -139,7 +139,7 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
         md,
         "Configuration: {} (hash {}), {:?} mode, N = {} pulses/frame, {} frame(s), L = {}.\n\nROM: {}.\n",
         loaded.origin,
-        p.config_hash(),
+        tofprobe_rtlgen::config_hash(&p),
         p.mode,
         p.frame_pulses,
         a.frames,
@@ -259,7 +259,7 @@ pub struct BinReading {
 /// Normalises a Fourier readout `f` (raw W-bit words, register 2k = I, 2k+1 = Q) read with
 /// the ΣΔ ROM `rom`: (I − jQ) · 2/N / (G · A_p · H_pre(f_k)) in codes, times the LSB.
 pub fn normalised_bins(
-    p: &tofprobe_rtlgen::params::PixelParams,
+    p: &tofprobe_pixel::PixelParams,
     f: &[u64],
     rom: &tofprobe_dsp::sd::ProbeRom,
     lsb_mm: f64,
@@ -300,7 +300,7 @@ pub fn normalised_bins(
 /// one-line headline (the strongest bin).
 fn spectrum(
     md: &mut String,
-    p: &tofprobe_rtlgen::params::PixelParams,
+    p: &tofprobe_pixel::PixelParams,
     f: &[u64],
     sd: Option<&tofprobe_dsp::sd::ProbeRom>,
     lsb_mm: f64,
@@ -375,7 +375,7 @@ fn spectrum(
 mod tests {
     use super::*;
     use tofprobe_dsp::sd::{ProbeConfig, ProbeDesign, ProbeRom};
-    use tofprobe_rtlgen::params::PixelParams;
+    use tofprobe_pixel::PixelParams;
 
     #[test]
     fn periodic_short_frame_is_whole_periods() {

@@ -12,7 +12,7 @@
 
 use tofprobe_dsp::sd::{ProbeDesign, ProbeRom};
 use tofprobe_pixel::autobins::band_limit;
-use tofprobe_rtlgen::params::{Mode, PixelParams};
+use tofprobe_pixel::{Mode, PixelParams};
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 
 use crate::config::Config;
@@ -93,7 +93,7 @@ pub fn rtl_rom(config: &Config, origin: &str, p: &mut PixelParams) -> Result<Rtl
         ProbeDesign::new(&config.probe, lowest as f64 / depth as f64).map_err(probe_err)?;
     let rom = ProbeRom::generate(&design, fs, p.frame_pulses, &bins).map_err(probe_err)?;
     p.rom_depth = rom.depth();
-    p.validate()?;
+    p.validate().map_err(tofprobe_rtlgen::RtlError::from)?;
     let wrap = rom
         .wrap_summary()
         .map(|w| format!(", {w}"))

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use tofprobe_pixel::PixelContext;
-use tofprobe_rtlgen::params::PixelParams;
+use tofprobe_pixel::PixelParams;
 use tofprobe_rtlgen::render::RenderOptions;
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 use tofprobe_rtlgen::write::write_generated;
@@ -60,7 +60,7 @@ pub fn rtl_params(
         origin: loaded.origin.clone(),
         message: format!("[pixel]: {e}"),
     })?;
-    let mut p = tofprobe_cosim::pixel_bridge::from_pixel(&resolved);
+    let mut p = resolved;
     if let Some(n) = frame_pulses {
         p.frame_pulses = n;
     }
@@ -75,7 +75,7 @@ pub fn rtl_params(
     if frame_pulses.is_some() && rom_depth.is_none() && windowed {
         p.rom_depth = p.rom_depth.min(p.frame_pulses.max(1) as usize);
     }
-    p.validate()?;
+    p.validate().map_err(tofprobe_rtlgen::RtlError::from)?;
     Ok(p)
 }
 
@@ -129,7 +129,7 @@ pub fn chip_rom(
 fn rom_manifest(rom: &ProbeRom, hex_name: &str, contents: &str, header: &str) -> String {
     let mut m = rom.manifest();
     m.hex_file = hex_name.to_string();
-    m.content_hash = format!("{:016x}", tofprobe_dsp::rom::fnv1a64(contents.as_bytes()));
+    m.content_hash = format!("{:016x}", tofprobe_io::fnv1a64(contents.as_bytes()));
     m.depth = rom.depth();
     m.registers = rom.image.registers();
     // Serialising a plain struct of numbers, strings and vectors cannot fail.
@@ -155,8 +155,8 @@ pub fn render_to(
         rom,
         &RenderOptions {
             command,
-            mutation: None,
             rom_note,
+            ..RenderOptions::default()
         },
     )?;
     let mut pairs: Vec<(String, String)> =
@@ -193,7 +193,7 @@ pub fn run(a: &RtlArgs) -> Result<(), CliError> {
         p.cycles_per_pulse,
         p.frame_pulses,
         p.rom_depth,
-        p.config_hash(),
+        tofprobe_rtlgen::config_hash(&p),
         a.out.display(),
         names.join(", ")
     );

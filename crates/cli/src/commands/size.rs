@@ -110,7 +110,7 @@ pub fn report(a: &SizeArgs) -> Result<SizeReport, CliError> {
         origin: origin.clone(),
         message: format!("[pixel]: {e}"),
     })?;
-    let pixel = tofprobe_cosim::pixel_bridge::from_pixel(&resolved);
+    let pixel = resolved;
     if !(a.node_nm.is_finite() && a.node_nm > 0.0 && a.node_nm <= 1000.0) {
         return Err(option_err("node-nm", a.node_nm, "0 < node ≤ 1000 (nm)"));
     }

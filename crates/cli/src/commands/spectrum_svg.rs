@@ -151,20 +151,10 @@ pub fn write_svg(path: &Path, title: &str, spectrum: &BitTrueSpectrum) -> Result
     write_atomic(path, svg.as_bytes())
 }
 
-/// Writes `bytes` to `path` atomically (temporary file in the same directory, rename).
+/// Writes `bytes` to `path` atomically ([`tofprobe_io::write_atomic`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
-    let io = |e: std::io::Error| CliError::Output {
+    tofprobe_io::write_atomic(path, bytes).map_err(|e| CliError::Output {
         path: path.to_path_buf(),
         message: e.to_string(),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
-    std::fs::write(&tmp, bytes).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io(e)
     })
 }

@@ -6,8 +6,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tofprobe_cosim::pixel_bridge::golden_run;
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
+use tofprobe_rtlgen::vectors::golden_run;
 use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
 
 use crate::commands::probe_rom::rtl_rom;
@@ -67,7 +67,7 @@ pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
         digest_pulses: a.digest_pulses.max(1),
         trace_window: None,
     };
-    let (g, w) = golden_run(&p, &stim, &rom, &o).map_err(tofprobe_cosim::CosimError::Judge)?;
+    let (g, w) = golden_run(&p, &stim, &rom, &o)?;
     let m = write_vectors(&a.out, &p, &stim, &rom, &g, w, &o)?;
     println!(
         "vectors: {} frames, {} pulses, {} cycles, {} trace events, {} digest windows, hash {} -> {}; {note}",

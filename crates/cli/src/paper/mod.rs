@@ -152,19 +152,12 @@ pub fn markdown(rows: &[Row]) -> String {
     s
 }
 
-/// Writes `bytes` to `path` atomically (temp file in the same directory, then rename).
+/// Writes `bytes` to `path` atomically ([`tofprobe_io::write_atomic`]).
 pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<(), PaperError> {
-    let io = |source| PaperError::Io {
+    tofprobe_io::write_atomic(path, bytes).map_err(|source| PaperError::Io {
         path: path.display().to_string(),
         source,
-    };
-    let tmp = path.with_extension(format!(
-        "{}.tmp{}",
-        path.extension().and_then(|e| e.to_str()).unwrap_or(""),
-        std::process::id()
-    ));
-    std::fs::write(&tmp, bytes).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    })
 }
 
 #[cfg(test)]

@@ -267,7 +267,7 @@ pub fn measure_setup(
     // frame of the scene's own detections; the bare harness time (no checking) scaled to
     // N. A passing co-simulation is bit-exact, so its accuracy is the model's.
     if verilator {
-        let mut rtl = tofprobe_cosim::pixel_bridge::from_pixel(&short);
+        let mut rtl = short.clone();
         rtl.rom_depth = rtl.rom_depth.min(rtl.frame_pulses as usize);
         let mut stim = vec![None; short.frame_pulses as usize];
         source.fill_counted(0, &mut stim);

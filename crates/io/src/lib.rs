@@ -1,0 +1,131 @@
+//! The workspace's foundation utilities, written once and used by every crate: whole-or-absent
+//! file output ([`write_atomic`]) and the FNV-1a content hash ([`fnv1a64`], [`Fnv1a64`]) that
+//! names configurations, ROMs, vector files and cache entries.
+//!
+//! Errors are plain [`std::io::Error`]s: each crate maps them into its own error enum with
+//! the path it was writing.
+
+use std::io::Write;
+use std::path::Path;
+
+/// FNV-1a 64-bit offset basis: the hash of no bytes.
+pub const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+/// FNV-1a 64-bit prime.
+pub const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
+
+/// FNV-1a, 64 bits, of `bytes`: small, dependency-free and stable across runs and
+/// platforms. It identifies content (headers, manifests, caches); it is not a
+/// cryptographic digest.
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    let mut h = Fnv1a64::default();
+    h.write(bytes);
+    h.finish()
+}
+
+/// Streaming FNV-1a, 64 bits: [`Fnv1a64::write`] any number of byte slices, then
+/// [`Fnv1a64::finish`]; the result equals [`fnv1a64`] of their concatenation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Fnv1a64(u64);
+
+impl Default for Fnv1a64 {
+    fn default() -> Self {
+        Fnv1a64(FNV_OFFSET)
+    }
+}
+
+impl Fnv1a64 {
+    /// Feeds bytes.
+    pub fn write(&mut self, bytes: &[u8]) -> &mut Self {
+        for &b in bytes {
+            self.0 ^= u64::from(b);
+            self.0 = self.0.wrapping_mul(FNV_PRIME);
+        }
+        self
+    }
+
+    /// The hash of everything fed so far.
+    pub fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// Writes `contents` to `path` whole or not at all: a temporary file in the target's
+/// directory (created if missing), flushed to disk, then renamed over the target, so a
+/// reader never sees a half-written file, and the temporary vanishes on any error
+/// (`tempfile` deletes it when dropped).
+pub fn write_atomic(path: &Path, contents: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    std::fs::create_dir_all(dir)?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let prefix = format!(".{name}.");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    // A generated file is readable like any other file, not private (tempfile's default
+    // 0600 would surprise whoever reads rtl/ or a report).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    let mut tmp = builder.tempfile_in(dir)?;
+    tmp.write_all(contents)?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fnv1a_matches_the_published_test_vectors() {
+        // From the FNV reference (isthe.com/chongo/tech/comp/fnv): "", "a", "foobar".
+        assert_eq!(fnv1a64(b""), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(fnv1a64(b"a"), 0xaf63_dc4c_8601_ec8c);
+        assert_eq!(fnv1a64(b"foobar"), 0x8594_4171_f739_67e8);
+        let mut h = Fnv1a64::default();
+        h.write(b"foo").write(b"bar");
+        assert_eq!(h.finish(), fnv1a64(b"foobar"));
+        // A deliberately wrong prime fails the vector: the check can fail.
+        let wrong = b"a".iter().fold(FNV_OFFSET, |h, &b| {
+            (h ^ u64::from(b)).wrapping_mul(FNV_PRIME + 2)
+        });
+        assert_ne!(wrong, 0xaf63_dc4c_8601_ec8c);
+    }
+
+    #[test]
+    fn atomic_write_replaces_whole_and_leaves_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("sub").join("x.txt");
+        write_atomic(&p, b"one").unwrap();
+        write_atomic(&p, b"two").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"two");
+        let names: Vec<_> = std::fs::read_dir(p.parent().unwrap())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("x.txt")]);
+    }
+
+    #[test]
+    fn failed_write_leaves_neither_target_nor_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        // The target is a directory: the rename fails, and the temporary must go.
+        let target = dir.path().join("taken");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("keep"), b"k").unwrap();
+        assert!(write_atomic(&target, b"data").is_err());
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("taken")]);
+    }
+}
