@@ -5,12 +5,10 @@ pub mod bench;
 pub mod config;
 pub mod cosim;
 pub mod flow;
-pub mod probe_rom;
 pub mod reproduce;
 pub mod rtl;
 pub mod simulate;
 pub mod size;
-pub mod spectrum_svg;
 pub mod tradeoff;
 pub mod vectors;
 

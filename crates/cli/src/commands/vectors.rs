@@ -7,12 +7,11 @@ use std::path::PathBuf;
 
 use clap::Args;
 use tofprobe_cosim::pixel_bridge::golden_run;
-use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
+use tofprobe_design::rom_policy::simulation_rom;
+use tofprobe_design::{RtlOverrides, rtl_params};
+use tofprobe_rtlgen::stimulus::random_stimulus;
 use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
 
-use crate::commands::probe_rom::rtl_rom;
-use crate::commands::rtl::rtl_params;
-use crate::config::Config;
 use crate::error::CliError;
 
 /// Arguments of `tofprobe vectors`.
@@ -49,17 +48,14 @@ pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
             allowed: "1..=1000".into(),
         });
     }
-    let mut p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
-    let (rom, note) = if a.rom_depth.is_some() {
-        (
-            sign_probe_rom(&p),
-            "sign-of-cosine probe ROM (--rom-depth given)".to_string(),
-        )
-    } else {
-        let loaded = Config::load(a.config.as_deref())?;
-        let r = rtl_rom(&loaded.config, &loaded.origin, &mut p)?;
-        (r.words, r.note)
+    let design = tofprobe_design::load(a.config.as_deref())?;
+    let overrides = RtlOverrides {
+        frame_pulses: a.frame_pulses,
+        rom_depth: a.rom_depth,
     };
+    let mut p = rtl_params(&design, &overrides)?;
+    let chip = simulation_rom(&design, &overrides, &mut p)?;
+    let (rom, note) = (chip.words, chip.note);
     let stim = random_stimulus(&p, a.frames * p.frame_pulses, a.seed);
     let o = VectorOptions {
         frames: a.frames,

@@ -16,7 +16,8 @@ use tofprobe_dsp::preprocess::{FrontEnd, FrontEndOutput};
 use tofprobe_dsp::stats::bartlett;
 
 use super::setup::{FS_HZ, LSB_MM, Setup};
-use super::{PaperError, Row, Tolerance};
+use super::{Row, Tolerance};
+use crate::StudyError;
 
 /// (ρ_s, paper kHz, corrected kHz).
 pub const POINTS: &[(f64, f64, f64)] =
@@ -25,7 +26,7 @@ pub const POINTS: &[(f64, f64, f64)] =
 pub const N: u64 = 10_000_000;
 
 /// Measured corner (Hz) of the held-noise spectrum.
-pub fn measure(rho: f64, n: u64, seed: u64) -> Result<f64, PaperError> {
+pub fn measure(rho: f64, n: u64, seed: u64) -> Result<f64, StudyError> {
     let setup = Setup {
         sigma_s_mm: 7.5,
         lsb_mm: LSB_MM,
@@ -87,9 +88,9 @@ pub fn measure(rho: f64, n: u64, seed: u64) -> Result<f64, PaperError> {
 }
 
 /// The bandwidth rows.
-pub fn rows(n: u64) -> Result<Vec<Row>, PaperError> {
+pub fn rows(n: u64) -> Result<Vec<Row>, StudyError> {
     let quick = n != N;
-    let measured: Result<Vec<f64>, PaperError> = POINTS
+    let measured: Result<Vec<f64>, StudyError> = POINTS
         .par_iter()
         .map(|&(r, _, _)| measure(r, n, 0))
         .collect();
