@@ -6,8 +6,8 @@
 
 use std::path::Path;
 
-use tofprobe_dsp::sd::{ProbeDesign, ProbeRom};
-use tofprobe_pixel::{Mode, PixelContext, PixelParams};
+use tofprobe_dsp::sd::{ProbeDesign, ProbeRom, RomMode};
+use tofprobe_pixel::{Mode, PixelContext, PixelError, PixelParams};
 use tofprobe_scene::{PhotonSource, Scene};
 
 use crate::bins::bin_indices;
@@ -67,10 +67,28 @@ pub fn resolve_with(
 
     // The pixel reads the ROM the probe design generates: its depth defaults to the
     // `[probe]` design's (L = N windowed, `probe.rom_depth` periodic).
+    // A Fourier pixel addresses exactly that ROM: another `pixel.rom_depth` would read the
+    // generated ROM on the wrong bin grid (it used to be replaced silently by `rtl`).
     let context = d.pixel_context();
     let mut px = d.pixel.clone();
-    if px.rom_depth.is_none() {
-        px.rom_depth = Some(d.probe.depth(frame));
+    let probe_depth = d.probe.depth(frame);
+    match px.rom_depth {
+        None => px.rom_depth = Some(probe_depth),
+        Some(l) if l != probe_depth && px.mode == Mode::Fourier => {
+            return Err(pixel_err(PixelError::invalid(
+                "rom_depth",
+                l,
+                format!(
+                    "the pixel reads the [probe] ROM, which is L = {probe_depth} deep ({})",
+                    match d.probe.rom_mode {
+                        RomMode::Periodic => "probe.rom_depth, periodic mode",
+                        RomMode::Windowed => "one frame, windowed mode",
+                    }
+                ),
+                format!("{probe_depth} (or leave pixel.rom_depth out)"),
+            )));
+        }
+        Some(_) => {}
     }
     let pixel = px.resolve(&context).map_err(pixel_err)?;
 
