@@ -208,9 +208,9 @@ mod tests {
         );
     }
 
-    /// The one response formula's magnitude is the closed form |H|² = α²/(1 − 2(1−α)cos ω
-    /// + (1−α)²) (1e-12: two exact forms in f64), and its phase at low frequency is the
-    /// one-pulse delay plus the pole's lag.
+    /// The one response formula's magnitude is the closed form
+    /// |H|² = α²/(1 − 2(1−α)cos ω + (1−α)²) (1e-12: two exact forms in f64), and at α = 1
+    /// it is a pure one-pulse delay.
     #[test]
     fn response_magnitude_is_the_closed_form() {
         for &(alpha, f) in &[(1.0 / 32.0, 4.5e-4), (0.5, 0.1), (1.0, 0.25)] {

@@ -241,15 +241,18 @@ fn probe_measurement(rec: &RowRecord<'_>, phasors: Vec<Phasor>) -> Measurement {
     }
 }
 
-/// Float ΣΔ probing of the record's detections (mm from the window start) by the pixel's
-/// rules — the one float front end's hold, priming and prefilter (α = 2^−S), or the hold
-/// alone with `alpha = None` — the pixel's float twin.
+/// Float ΣΔ probing of the record's detections by the pixel's rules — the one float front
+/// end's hold, priming and prefilter (α = 2^−S), or the hold alone with `alpha = None` —
+/// the pixel's float twin, zoomed to the static depth δ0 (the pixel's zoom Z): the
+/// priming pulse adds nothing, so an unzoomed 30 mm offset would leave s_r(0)·δ0 in every
+/// register, ≈ 14 µm at 150 kHz for N = 2^16 (negligible at 10^7, but not the DFT's).
 fn sd_probe(rec: &RowRecord<'_>, alpha: Option<f64>) -> Result<Measurement, StudyError> {
     let probe = rec.probe()?;
+    let zoom = rec.spec.setup().depth_mm();
     let depths = rec
         .detections
         .iter()
-        .map(|d| d.map(|c| rec.source.code_to_depth_mm(c)));
+        .map(|d| d.map(|c| rec.source.code_to_depth_mm(c) - zoom));
     let sums = tofprobe_dsp::sd::probe_detections(&probe.rom, depths, alpha);
     Ok(probe_measurement(rec, probe.phasors(&sums, alpha)))
 }

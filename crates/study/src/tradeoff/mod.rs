@@ -86,7 +86,7 @@ pub fn measure_setup(
     verilator: bool,
 ) -> Result<SceneResult, StudyError> {
     let (config, origin) = (&design.document, design.origin.as_str());
-    let scene_err = |source| StudyError::from(DesignError::scene(&origin, source));
+    let scene_err = |source| StudyError::from(DesignError::scene(origin, source));
     let source = config.photon_source().map_err(scene_err)?;
     let n = su.params.frame_pulses;
     let fs = config.sensor.laser_rate_hz;
@@ -100,7 +100,7 @@ pub fn measure_setup(
         config.probe.osr,
         Some(su.params.bins),
     )
-    .map_err(|source| StudyError::from(DesignError::pixel(&origin, source)))?;
+    .map_err(|source| StudyError::from(DesignError::pixel(origin, source)))?;
     let tone_bin = choice.tones.first().copied();
     let true_amp = tone_bin.and_then(|k| {
         ctx.tones
@@ -164,7 +164,7 @@ pub fn measure_setup(
     // Float full DFT (rustfft over the whole record).
     let t = Instant::now();
     let spec = amplitude_spectrum(&depths, window)
-        .map_err(|source| StudyError::from(DesignError::probe(&origin, source)))?;
+        .map_err(|source| StudyError::from(DesignError::probe(origin, source)))?;
     // ROM bin k is f = k·f_s/L; in the N-point DFT that is k·N/L (equal in windowed mode,
     // the nearest bin in periodic mode when L does not divide N).
     let dft_bins = dft_bins(&su.rom.bin_indices, n, su.params.rom_depth);
@@ -185,7 +185,7 @@ pub fn measure_setup(
     // Float selected-bin DFT (streamed, only the B bins).
     let t = Instant::now();
     let bins = dft_bins;
-    let dsp_err = |source| StudyError::from(DesignError::probe(&origin, source));
+    let dsp_err = |source| StudyError::from(DesignError::probe(origin, source));
     let mut sel = SelectedBins::new(n, &bins, window).map_err(dsp_err)?;
     for chunk in depths.chunks(1 << 16) {
         sel.push(chunk).map_err(dsp_err)?;
@@ -229,7 +229,7 @@ pub fn measure_setup(
     // Bit-true transaction model (streams the photon source itself).
     let t = Instant::now();
     let bt = bit_true_spectrum(&su.params, &su.rom, &source, lsb_mm)
-        .map_err(|source| StudyError::from(DesignError::pixel(&origin, source)))?;
+        .map_err(|source| StudyError::from(DesignError::pixel(origin, source)))?;
     let amps: Vec<f64> = bt.bins.iter().map(|b| b.amplitude_um).collect();
     let (a, nz) = score(&amps);
     readings.push((
@@ -249,7 +249,7 @@ pub fn measure_setup(
     short.rom_depth = short.rom_depth.min(short.frame_pulses as usize);
     let rom = tofprobe_pixel::bench::synthetic_rom(short.rom_depth, short.registers());
     let cb = bench_cycle(&short, &rom, 1)
-        .map_err(|source| StudyError::from(DesignError::pixel(&origin, source)))?;
+        .map_err(|source| StudyError::from(DesignError::pixel(origin, source)))?;
     let per_pulse = cb.seconds / short.frame_pulses as f64;
     readings.push(("cycle-accurate", per_pulse * n as f64, true, a, nz));
 

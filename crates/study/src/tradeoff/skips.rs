@@ -120,7 +120,7 @@ pub fn measure_skips(
         median_seconds(reps, || {
             bit_true_spectrum(&su.params, &su.rom, &src, lsb)
                 .map(|_| ())
-                .map_err(|source| StudyError::from(DesignError::pixel(&origin, source)))
+                .map_err(|source| StudyError::from(DesignError::pixel(origin, source)))
         })
     };
     let bt_clean = bit_true(&clean)?;
@@ -137,7 +137,7 @@ pub fn measure_skips(
     let depths = held_record(&src, &codes)?;
     let bins = dft_bins(&su.rom.bin_indices, n, su.params.rom_depth);
     let window = su.rom.window;
-    let dsp_err = |source| StudyError::from(DesignError::probe(&origin, source));
+    let dsp_err = |source| StudyError::from(DesignError::probe(origin, source));
     let selected = median_seconds(reps, || {
         let mut sel = SelectedBins::new(n, &bins, window).map_err(dsp_err)?;
         for chunk in depths.chunks(1 << 16) {
