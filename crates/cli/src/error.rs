@@ -15,35 +15,40 @@ pub enum CliError {
     /// A study (spectrum, flow, sizing, reproduction, trade-off) failed.
     #[error(transparent)]
     Study(#[from] tofprobe_study::StudyError),
-    /// An output file cannot be written.
-    #[error("cannot write `{path}`: {message}")]
-    Output {
-        /// The output path.
-        path: PathBuf,
-        /// Why.
-        message: String,
-    },
-    /// A command-line option out of range.
-    #[error("--{option} = {value} is out of range: allowed {allowed}")]
-    Option {
-        /// The option's name without dashes.
-        option: String,
-        /// The value given.
-        value: String,
-        /// The allowed range.
-        allowed: String,
-    },
-    /// A sizing report failed (tool or liberty missing, synthesis error, …); the message
-    /// says what to install or pass.
-    #[error("{0}")]
-    Report(#[from] tofprobe_report::ReportError),
     /// JSON serialisation failed (should not happen for plain numbers).
     #[error("cannot serialise JSON output: {0}")]
     Json(#[from] serde_json::Error),
-    /// RTL generation or vector writing failed.
-    #[error("{0}")]
-    Rtl(#[from] tofprobe_rtlgen::RtlError),
-    /// Co-simulation failed to run (a tool missing: the message names the install script).
-    #[error("{0}")]
-    Cosim(#[from] tofprobe_cosim::CosimError),
 }
+
+impl CliError {
+    /// A command-line option out of range.
+    pub fn option(option: impl ToString, value: impl ToString, allowed: impl ToString) -> Self {
+        CliError::Study(tofprobe_study::StudyError::Option {
+            option: option.to_string(),
+            value: value.to_string(),
+            allowed: allowed.to_string(),
+        })
+    }
+
+    /// An output file that cannot be written.
+    pub fn output(path: PathBuf, message: String) -> Self {
+        CliError::Study(tofprobe_study::StudyError::Output { path, message })
+    }
+}
+
+/// Generator, co-simulation and report errors reach the CLI through the study crate's
+/// error, which prints them as they are.
+macro_rules! through_study {
+    ($($t:ty),*) => {$(
+        impl From<$t> for CliError {
+            fn from(e: $t) -> Self {
+                CliError::Study(e.into())
+            }
+        }
+    )*};
+}
+through_study!(
+    tofprobe_rtlgen::RtlError,
+    tofprobe_cosim::CosimError,
+    tofprobe_report::ReportError
+);

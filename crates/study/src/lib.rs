@@ -7,6 +7,7 @@
 pub mod error;
 pub mod flow;
 pub mod paper;
+pub mod records;
 pub mod rtl;
 pub mod sizing;
 pub mod spectrum;

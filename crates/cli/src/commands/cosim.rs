@@ -8,8 +8,8 @@ use std::time::Instant;
 use clap::Args;
 use serde::Serialize;
 use tofprobe_cosim::{BuildProfile, CosimOptions, CosimReport, cosim};
+use tofprobe_design::RtlOverrides;
 use tofprobe_design::rom_policy::simulation_rom;
-use tofprobe_design::{RtlOverrides, rtl_params};
 use tofprobe_rtlgen::params::PixelParams;
 
 use crate::error::CliError;
@@ -116,19 +116,11 @@ pub fn options(p: &PixelParams, a: &CosimArgs) -> CosimOptions {
 
 /// Runs `tofprobe cosim`.
 pub fn run(a: &CosimArgs) -> Result<(), CliError> {
-    if a.frames == 0 || a.frames > 1000 {
-        return Err(CliError::Option {
-            option: "frames".into(),
-            value: a.frames.to_string(),
-            allowed: "1..=1000".into(),
-        });
-    }
-    let design = tofprobe_design::load(a.config.as_deref())?;
     let overrides = RtlOverrides {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
     };
-    let mut p = rtl_params(&design, &overrides)?;
+    let (design, mut p) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
     let mut rom_note = "sign-of-cosine probe ROM (--rom-depth given)".to_string();
     let mut sd_rom = None;
     if a.rtl.is_some() {

@@ -40,11 +40,7 @@ pub struct FlowArgs {
 /// Runs `tofprobe flow`.
 pub fn run(a: &FlowArgs) -> Result<(), CliError> {
     if a.frames == 0 || a.frames > 100 {
-        return Err(CliError::Option {
-            option: "frames".into(),
-            value: a.frames.to_string(),
-            allowed: "1..=100".into(),
-        });
+        return Err(CliError::option("frames", a.frames.to_string(), "1..=100"));
     }
     let design = tofprobe_design::load(a.config.as_deref())?;
     let o = run_flow(

@@ -43,6 +43,27 @@ pub enum Command {
     Tradeoff(tradeoff::TradeoffArgs),
 }
 
+/// The simulating RTL commands' start (`vectors`, `cosim`): `frames` checked (1..=1000),
+/// the configuration resolved, the generator's parameters for the overrides.
+pub fn simulated_design(
+    frames: u64,
+    config: Option<&std::path::Path>,
+    overrides: &tofprobe_design::RtlOverrides,
+) -> Result<
+    (
+        tofprobe_design::ResolvedDesign,
+        tofprobe_rtlgen::params::PixelParams,
+    ),
+    CliError,
+> {
+    if frames == 0 || frames > 1000 {
+        return Err(CliError::option("frames", frames, "1..=1000"));
+    }
+    let design = tofprobe_design::load(config)?;
+    let p = tofprobe_design::rtl_params(&design, overrides)?;
+    Ok((design, p))
+}
+
 /// Runs one subcommand.
 pub fn run(command: Command) -> Result<(), CliError> {
     match command {

@@ -177,10 +177,10 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             spectrum,
         )?;
     } else if let Some(path) = &args.svg {
-        return Err(CliError::Output {
-            path: path.clone(),
-            message: "the spectrum plot needs pixel.mode = \"fourier\"".into(),
-        });
+        return Err(CliError::output(
+            path.clone(),
+            "the spectrum plot needs pixel.mode = \"fourier\"".into(),
+        ));
     }
     if args.json {
         let out = Output {

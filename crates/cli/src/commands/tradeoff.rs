@@ -77,11 +77,7 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     {
         let mut names: Vec<&str> = DEFAULT_SWEEP.iter().map(|s| s.knob).collect();
         names.dedup();
-        return Err(CliError::Option {
-            option: "knob".into(),
-            value: bad.clone(),
-            allowed: names.join(", "),
-        });
+        return Err(CliError::option("knob", bad.clone(), names.join(", ")));
     }
     let mut scenes = Vec::new();
     let mut sweeps = Vec::new();
@@ -106,10 +102,7 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     }
     let table = tables.join("\n");
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).map_err(|e| CliError::Output {
-            path: dir.clone(),
-            message: e.to_string(),
-        })?;
+        std::fs::create_dir_all(dir).map_err(|e| CliError::output(dir.clone(), e.to_string()))?;
         write_atomic(&dir.join("tradeoff.md"), table.as_bytes())?;
         pareto_svg(&dir.join("pareto.svg"), &scenes)?;
     }

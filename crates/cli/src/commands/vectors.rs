@@ -7,8 +7,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 use tofprobe_cosim::pixel_bridge::golden_run;
+use tofprobe_design::RtlOverrides;
 use tofprobe_design::rom_policy::simulation_rom;
-use tofprobe_design::{RtlOverrides, rtl_params};
 use tofprobe_rtlgen::stimulus::random_stimulus;
 use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
 
@@ -41,19 +41,11 @@ pub struct VectorsArgs {
 
 /// Runs `tofprobe vectors`.
 pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
-    if a.frames == 0 || a.frames > 1000 {
-        return Err(CliError::Option {
-            option: "frames".into(),
-            value: a.frames.to_string(),
-            allowed: "1..=1000".into(),
-        });
-    }
-    let design = tofprobe_design::load(a.config.as_deref())?;
     let overrides = RtlOverrides {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
     };
-    let mut p = rtl_params(&design, &overrides)?;
+    let (design, mut p) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
     let chip = simulation_rom(&design, &overrides, &mut p)?;
     let (rom, note) = (chip.words, chip.note);
     let stim = random_stimulus(&p, a.frames * p.frame_pulses, a.seed);

@@ -12,12 +12,12 @@
 use rayon::prelude::*;
 use tofprobe_dsp::Window;
 use tofprobe_dsp::closed_form::{hold_bandwidth_hz, zoh_hold_f3db};
-use tofprobe_dsp::preprocess::{FrontEnd, FrontEndOutput};
 use tofprobe_dsp::stats::bartlett;
 
 use super::setup::{FS_HZ, LSB_MM, Setup};
 use super::{Row, Tolerance};
 use crate::StudyError;
+use crate::records::held_record;
 
 /// (ρ_s, paper kHz, corrected kHz).
 pub const POINTS: &[(f64, f64, f64)] =
@@ -38,11 +38,7 @@ pub fn measure(rho: f64, n: u64, seed: u64) -> Result<f64, StudyError> {
     let source = setup.source(seed)?;
     let det = source.record(n);
     // Zoom to δ0 so the unprimed start (held = 0) is not a step.
-    let mut fe = FrontEnd::new(setup.depth_mm(), FrontEndOutput::Held)?;
-    let held: Vec<f64> = det
-        .iter()
-        .map(|d| fe.step(d.map(|c| source.code_to_depth_mm(c))))
-        .collect();
+    let held = held_record(&source, &det, setup.depth_mm())?;
     drop(det);
     let expected = hold_bandwidth_hz(rho, FS_HZ).unwrap_or(FS_HZ / 4.0);
     let frame = ((20.0 * FS_HZ / expected).log2().ceil() as u32).clamp(4, 24);

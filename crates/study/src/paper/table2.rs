@@ -197,12 +197,7 @@ fn tone_bin(n: usize) -> usize {
 
 /// The held depth of a whole record (mm, from the window start), unprimed pulses 0.
 pub fn held_record(rec: &RowRecord<'_>) -> Result<Vec<f64>, StudyError> {
-    let mut fe = FrontEnd::new(0.0, FrontEndOutput::Held)?;
-    Ok(rec
-        .detections
-        .iter()
-        .map(|d| fe.step(d.map(|c| rec.source.code_to_depth_mm(c))))
-        .collect())
+    crate::records::held_record(rec.source, rec.detections, 0.0)
 }
 
 /// The full-FFT column: noise floor over the band, peak by quadratic interpolation, and

@@ -19,16 +19,15 @@ use tofprobe_dsp::closed_form::{
     hold_response_sq, noise_floor_hold_mm, noise_floor_mm, sigma_total_mm,
 };
 use tofprobe_dsp::dft::amplitude_spectrum;
-use tofprobe_dsp::preprocess::{FrontEnd, FrontEndOutput};
 use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_detections};
 use tofprobe_pixel::autobins::choose_bins;
 use tofprobe_pixel::bench::bench_cycle;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
-use tofprobe_scene::PhotonSource;
 
 use tofprobe_design::{DesignError, ResolvedDesign};
 
 use crate::error::StudyError;
+use crate::records::{detection_record, held_record};
 use crate::spectrum::{BitTrueSetup, setup};
 
 /// Pulses of the shortened frame the cycle-accurate model is timed on.
@@ -127,7 +126,7 @@ pub fn measure_setup(
     // float front end's hold, nothing before the first detection.
     let t0 = Instant::now();
     let detections = detection_record(&source, n);
-    let depths = held_record(&source, &detections)?;
+    let depths = held_record(&source, &detections, 0.0)?;
     let record_s = t0.elapsed().as_secs_f64();
 
     // Closed form: eq. 12 with the window's N_eff and the 1NN hold at ρ = ρ_s (noise factor
@@ -305,23 +304,6 @@ pub fn measure_setup(
         true_amplitude_um: true_amp,
         levels,
     })
-}
-
-/// The TDC codes of `n` pulses, `None` for a missed pulse.
-pub fn detection_record(source: &PhotonSource, n: u64) -> Vec<Option<u32>> {
-    let mut codes = vec![None; usize::try_from(n).unwrap_or(usize::MAX)];
-    source.fill_counted(0, &mut codes);
-    codes
-}
-
-/// The held depth record (mm) of `codes` through the one float front end: the last
-/// detection, 0 before the first one (the pixel accumulates nothing before it primes).
-pub fn held_record(source: &PhotonSource, codes: &[Option<u32>]) -> Result<Vec<f64>, StudyError> {
-    let mut fe = FrontEnd::new(0.0, FrontEndOutput::Held)?;
-    Ok(codes
-        .iter()
-        .map(|c| fe.step(c.map(|c| source.code_to_depth_mm(c))))
-        .collect())
 }
 
 /// The ROM's bins k·f_s/L as indices of the N-point DFT (equal in windowed mode, the

@@ -15,13 +15,13 @@ use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
 
+use super::dft_bins;
 use super::overrides::{shortened, with_overrides};
 use super::timing::median_seconds;
-use super::{dft_bins, held_record};
 use tofprobe_design::{DesignError, ProbeCache, ResolvedDesign};
 
-use super::detection_record;
 use crate::error::StudyError;
+use crate::records::{detection_record, held_record};
 use crate::spectrum::{BitTrueSetup, setup};
 
 /// ρ_b that forces the background path while adding ~10^−5 photons to a 10^7-pulse frame.
@@ -134,7 +134,7 @@ pub fn measure_skips(
     // Only the configured bins: B-bin streamed DFT vs the full FFT on one record.
     let src = clean.photon_source()?;
     let codes = detection_record(&src, n);
-    let depths = held_record(&src, &codes)?;
+    let depths = held_record(&src, &codes, 0.0)?;
     let bins = dft_bins(&su.rom.bin_indices, n, su.params.rom_depth);
     let window = su.rom.window;
     let dsp_err = |source| StudyError::from(DesignError::probe(origin, source));
@@ -162,7 +162,7 @@ pub fn measure_skips(
 
     // No full DFT unless asked: the record and the FFT on top of the bit-true model.
     let record = median_seconds(reps, || {
-        let d = held_record(&src, &detection_record(&src, n))?;
+        let d = held_record(&src, &detection_record(&src, n), 0.0)?;
         amplitude_spectrum(&d, window).map(|_| ()).map_err(dsp_err)
     })?;
     stages.push(row(

@@ -52,11 +52,11 @@ struct Report {
 }
 
 fn err(e: impl std::fmt::Display) -> CliError {
-    CliError::Option {
-        option: "bench dsp".into(),
-        value: e.to_string(),
-        allowed: "an internal computation that succeeds".into(),
-    }
+    CliError::option(
+        "bench dsp",
+        e.to_string(),
+        "an internal computation that succeeds",
+    )
 }
 
 /// Runs the benchmark.

@@ -64,11 +64,11 @@ struct Report {
 pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
     for (option, value) in [("pulses", args.pulses), ("cycle-pulses", args.cycle_pulses)] {
         if !(1000..=1_000_000_000).contains(&value) {
-            return Err(CliError::Option {
-                option: option.into(),
-                value: value.to_string(),
-                allowed: "1000..=1000000000".into(),
-            });
+            return Err(CliError::option(
+                option,
+                value.to_string(),
+                "1000..=1000000000",
+            ));
         }
     }
     // The configuration's pixel (W sized for its own frame), timed on `--pulses` pulses.
@@ -77,11 +77,11 @@ pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
     let mut params = design.pixel.clone();
     params.frame_pulses = args.pulses;
     if params.mode != tofprobe_pixel::Mode::Fourier {
-        return Err(CliError::Option {
-            option: "config".into(),
-            value: format!("pixel.mode = {}", params.mode),
-            allowed: "a Fourier pixel (the benchmark times the I/Q data path)".into(),
-        });
+        return Err(CliError::option(
+            "config",
+            format!("pixel.mode = {}", params.mode),
+            "a Fourier pixel (the benchmark times the I/Q data path)",
+        ));
     }
     params.rom_depth = ROM_DEPTH;
     let rom = synthetic_rom(ROM_DEPTH, params.registers());

@@ -98,11 +98,11 @@ fn time_case(config: &Document, rho_s: f64, rho_b: f64, pulses: u64) -> Result<R
 /// Runs the benchmark.
 pub fn run(args: &SceneBenchArgs) -> Result<(), CliError> {
     if args.pulses < CHUNK as u64 {
-        return Err(CliError::Option {
-            option: "pulses".into(),
-            value: args.pulses.to_string(),
-            allowed: format!("pulses >= {CHUNK}"),
-        });
+        return Err(CliError::option(
+            "pulses",
+            args.pulses,
+            format!("pulses >= {CHUNK}"),
+        ));
     }
     let design = tofprobe_design::load(args.config.as_deref())?;
     let a = time_case(&design.document, 1.0, 0.0, args.pulses)?;

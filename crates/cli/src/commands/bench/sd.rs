@@ -96,11 +96,11 @@ struct Report {
 }
 
 fn err(e: impl std::fmt::Display) -> CliError {
-    CliError::Option {
-        option: "bench sd".into(),
-        value: e.to_string(),
-        allowed: "an internal computation that succeeds".into(),
-    }
+    CliError::option(
+        "bench sd",
+        e.to_string(),
+        "an internal computation that succeeds",
+    )
 }
 
 /// Runs the benchmark.
@@ -159,10 +159,8 @@ pub fn run(args: &SdBenchArgs) -> Result<(), CliError> {
     }
     drop(one_rom);
     if let Some(dir) = &args.rom_dir {
-        rom.write(dir, "probe_rom").map_err(|e| CliError::Output {
-            path: dir.clone(),
-            message: e.to_string(),
-        })?;
+        rom.write(dir, "probe_rom")
+            .map_err(|e| CliError::output(dir.clone(), e.to_string()))?;
     }
     let samples = (2 * bins.len()) as f64 * N_ROM as f64;
 
@@ -352,10 +350,8 @@ fn write_svg(m: &Modulator, path: &std::path::Path) -> Result<(), CliError> {
             .label("f_s / (2 OSR) = 156 kHz");
         root.present().map_err(err)?;
     }
-    tofprobe_dsp::rom::write_atomic(path, text.as_bytes()).map_err(|e| CliError::Output {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })
+    tofprobe_dsp::rom::write_atomic(path, text.as_bytes())
+        .map_err(|e| CliError::output(path.to_path_buf(), e.to_string()))
 }
 
 #[cfg(test)]
