@@ -2,10 +2,7 @@
 //! printed as `error: …` on stderr with exit status 2; no input makes it panic.
 
 mod commands;
-mod config;
 mod error;
-mod paper;
-mod tradeoff;
 
 use std::process::ExitCode;
 

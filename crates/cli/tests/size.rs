@@ -13,13 +13,18 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// The default scene with a one-bin pixel and a 4096-pulse acquisition (a fast synthesis).
+/// The default scene with a one-bin pixel and a 4096-pulse acquisition (a fast synthesis),
+/// its periodic ROM one frame deep (every command refuses a frame that is not whole ROM
+/// periods; `size` used to skip `[probe]` and accept it).
 fn tiny_config(dir: &Path) -> PathBuf {
     let text = DEFAULT
         .replacen("duration_s = 1.0", "pulses = 4096", 1)
-        .replacen("bins = 16", "bins = 1", 1);
+        .replacen("bins = 16", "bins = 1", 1)
+        .replacen("rom_depth = 20000", "rom_depth = 4096", 1);
     assert!(
-        text.contains("pulses = 4096") && text.contains("bins = 1 "),
+        text.contains("pulses = 4096")
+            && text.contains("bins = 1 ")
+            && text.contains("rom_depth = 4096"),
         "default changed"
     );
     let p = dir.join("tiny.toml");

@@ -12,6 +12,15 @@
 //!   x at its own depth (no start transient), from the next pulse on y[n] = x[n].
 //!
 //! State survives between chunks, so records of 10^7 pulses stream in any chunking.
+//!
+//! This is THE float front end: every float level (the DFT references, float ΣΔ probing
+//! in [`crate::sd::probing`], the trade-off's levels, the paper reproduction) runs its
+//! detections through [`FrontEnd`], and [`prefilter_response`] is the one formula for the
+//! prefilter's response.
+
+use std::f64::consts::PI;
+
+use rustfft::num_complex::Complex64;
 
 use crate::error::DspError;
 
@@ -48,14 +57,19 @@ impl FrontEnd {
             return Err(DspError::out_of_range("alpha", alpha, "0 < alpha ≤ 1")
                 .with_hint("the pixel uses 2^-S, e.g. 1/32"));
         }
-        Ok(FrontEnd {
+        Ok(Self::unchecked(zoom, output))
+    }
+
+    /// The front end without the argument checks (callers whose α is the pixel's 2^−S).
+    pub(crate) fn unchecked(zoom: f64, output: FrontEndOutput) -> Self {
+        FrontEnd {
             zoom,
             output,
             primed: false,
             held: 0.0,
             x: 0.0,
             pulses: 0,
-        })
+        }
     }
 
     /// One pulse: returns the value the accumulators see (0 before priming).
@@ -123,11 +137,18 @@ impl FrontEnd {
     }
 }
 
-/// Prefilter gain |H_pre(ω)| of x[n] = (1−α)x[n−1] + α·h[n−1]:
-/// H(z) = α z⁻¹ / (1 − (1−α) z⁻¹), |H|² = α² / (1 − 2(1−α)cos ω + (1−α)²).
-/// (The same form as the mean 1NN hold response with ρ in place of α.)
+/// The prefilter's response H_pre(e^{jω}) = α e^{−jω} / (1 − (1−α) e^{−jω}) at
+/// f/f_s = `f_norm`, of x[n] = (1−α)x[n−1] + α·h[n−1]. Its magnitude squared is
+/// α² / (1 − 2(1−α)cos ω + (1−α)²), the form of the mean 1NN hold response with ρ in
+/// place of α (`closed_form::hold_response_sq`).
+pub fn prefilter_response(alpha: f64, f_norm: f64) -> Complex64 {
+    let zi = Complex64::from_polar(1.0, -2.0 * PI * f_norm);
+    alpha * zi / (1.0 - (1.0 - alpha) * zi)
+}
+
+/// Prefilter gain |H_pre(ω)| at ω = 2π·f/f_s: the magnitude of [`prefilter_response`].
 pub fn prefilter_gain(alpha: f64, omega: f64) -> f64 {
-    crate::closed_form::hold_response_sq(alpha, omega).sqrt()
+    prefilter_response(alpha, omega / (2.0 * PI)).norm()
 }
 
 #[cfg(test)]
@@ -185,6 +206,21 @@ mod tests {
             "{}",
             s[k]
         );
+    }
+
+    /// The one response formula's magnitude is the closed form
+    /// |H|² = α²/(1 − 2(1−α)cos ω + (1−α)²) (1e-12: two exact forms in f64), and at α = 1
+    /// it is a pure one-pulse delay.
+    #[test]
+    fn response_magnitude_is_the_closed_form() {
+        for &(alpha, f) in &[(1.0 / 32.0, 4.5e-4), (0.5, 0.1), (1.0, 0.25)] {
+            let omega = 2.0 * PI * f;
+            let want = crate::closed_form::hold_response_sq(alpha, omega).sqrt();
+            assert!((prefilter_gain(alpha, omega) - want).abs() < 1e-12);
+        }
+        // α = 1: a pure one-pulse delay, e^{−jω}.
+        let h = prefilter_response(1.0, 0.25);
+        assert!((h.re).abs() < 1e-12 && (h.im + 1.0).abs() < 1e-12, "{h}");
     }
 
     #[test]

@@ -11,8 +11,8 @@ mod motion;
 mod scene;
 mod sensor;
 mod source;
-pub mod tttr;
 pub mod splitmix;
+pub mod tttr;
 
 pub use acquisition::AcquisitionConfig;
 pub use error::SceneError;

@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use crate::config::{Config, DEFAULT_TOML};
+use tofprobe_design::DEFAULT_TOML;
+
 use crate::error::CliError;
 
 /// Arguments of `tofprobe config`.
@@ -17,17 +18,18 @@ pub struct ConfigArgs {
     config: Option<PathBuf>,
 }
 
-/// Prints the default, or validates the configuration and reports its key numbers.
+/// Prints the default, or resolves the configuration (the one resolution every command
+/// uses) and reports its key numbers.
 pub fn run(args: &ConfigArgs) -> Result<(), CliError> {
     if args.print_default {
         print!("{DEFAULT_TOML}");
         return Ok(());
     }
-    let loaded = Config::load(args.config.as_deref())?;
-    let c = &loaded.config;
+    let design = tofprobe_design::load(args.config.as_deref())?;
+    let c = &design.document;
     println!(
         "{}: ok ({} pulses at {} Hz, {} TDC codes of {} ps = {} bits, jitter {} mm)",
-        loaded.origin,
+        design.origin,
         c.pulses(),
         c.sensor.laser_rate_hz,
         c.sensor.tdc_codes(),

@@ -8,11 +8,10 @@ use std::time::Instant;
 use clap::Args;
 use serde::Serialize;
 use tofprobe_cosim::{BuildProfile, CosimOptions, CosimReport, cosim};
+use tofprobe_design::RtlOverrides;
+use tofprobe_design::rom_policy::simulation_rom;
 use tofprobe_pixel::PixelParams;
 
-use crate::commands::probe_rom::rtl_rom;
-use crate::commands::rtl::rtl_params;
-use crate::config::Config;
 use crate::error::CliError;
 
 /// Runs longer than this many cycles compare digests of this many pulses instead of every
@@ -78,9 +77,10 @@ struct Json {
     rom: String,
 }
 
-/// Times the pixel crate's transaction model on the same stimulus (seconds).
-pub fn time_transaction(p: &PixelParams, r: &CosimReport) -> f64 {
-    let Ok(mut m) = tofprobe_pixel::TransactionModel::new(p) else {
+/// Times the pixel crate's transaction model (`pp`: the pixel of `p`) on the same stimulus
+/// (seconds).
+pub fn time_transaction(pp: &tofprobe_pixel::PixelParams, p: &PixelParams, r: &CosimReport) -> f64 {
+    let Ok(mut m) = tofprobe_pixel::TransactionModel::new(pp) else {
         return f64::NAN;
     };
     let words = p.registers().div_ceil(64);
@@ -116,28 +116,28 @@ pub fn options(p: &PixelParams, a: &CosimArgs) -> CosimOptions {
 
 /// Runs `tofprobe cosim`.
 pub fn run(a: &CosimArgs) -> Result<(), CliError> {
-    if a.frames == 0 || a.frames > 1000 {
-        return Err(CliError::Option {
-            option: "frames".into(),
-            value: a.frames.to_string(),
-            allowed: "1..=1000".into(),
-        });
-    }
-    let mut p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
+    let overrides = RtlOverrides {
+        frame_pulses: a.frame_pulses,
+        rom_depth: a.rom_depth,
+    };
+    let (design, mut p) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
     let mut rom_note = "sign-of-cosine probe ROM (--rom-depth given)".to_string();
     let mut sd_rom = None;
     if a.rtl.is_some() {
         rom_note = "ROM read back from --rtl".into();
     } else if a.rom_depth.is_none() {
-        let loaded = Config::load(a.config.as_deref())?;
-        let r = rtl_rom(&loaded.config, &loaded.origin, &mut p)?;
+        let r = simulation_rom(&design, &overrides, &mut p)?;
         rom_note = r.note;
         sd_rom = Some(r.words);
     }
     let mut o = options(&p, a);
     o.rom = sd_rom;
     let r = cosim(&p, &o)?;
-    let tx = time_transaction(&p, &r);
+    // The pixel crate's parameters of the simulated frame (N and L as simulated).
+    let mut pp = design.pixel.clone();
+    pp.frame_pulses = p.frame_pulses;
+    pp.rom_depth = p.rom_depth;
+    let tx = time_transaction(&pp, &p, &r);
     let rate = |n: u64, s: f64| if s > 0.0 { n as f64 / s } else { 0.0 };
     let j = Json {
         pass: r.pass,

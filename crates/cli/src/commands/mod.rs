@@ -5,12 +5,10 @@ pub mod bench;
 pub mod config;
 pub mod cosim;
 pub mod flow;
-pub mod probe_rom;
 pub mod reproduce;
 pub mod rtl;
 pub mod simulate;
 pub mod size;
-pub mod spectrum_svg;
 pub mod tradeoff;
 pub mod vectors;
 
@@ -43,6 +41,21 @@ pub enum Command {
     Flow(flow::FlowArgs),
     /// The speed/accuracy trade: every fidelity level timed and scored per scene.
     Tradeoff(tradeoff::TradeoffArgs),
+}
+
+/// The simulating RTL commands' start (`vectors`, `cosim`): `frames` checked (1..=1000),
+/// the configuration resolved, the generator's parameters for the overrides.
+pub fn simulated_design(
+    frames: u64,
+    config: Option<&std::path::Path>,
+    overrides: &tofprobe_design::RtlOverrides,
+) -> Result<(tofprobe_design::ResolvedDesign, tofprobe_pixel::PixelParams), CliError> {
+    if frames == 0 || frames > 1000 {
+        return Err(CliError::option("frames", frames, "1..=1000"));
+    }
+    let design = tofprobe_design::load(config)?;
+    let p = tofprobe_design::rtl_params(&design, overrides)?;
+    Ok((design, p))
 }
 
 /// Runs one subcommand.

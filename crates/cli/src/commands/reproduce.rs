@@ -12,9 +12,10 @@ use std::time::Instant;
 
 use clap::Args;
 use serde::Serialize;
+use tofprobe_study::paper::reproduce::reproduce;
+use tofprobe_study::paper::{self, Row, table2};
 
 use crate::error::CliError;
-use crate::paper::{self, PaperError, Row, bandwidth, fig4, table2};
 
 /// Arguments of `tofprobe reproduce`.
 #[derive(Debug, Args)]
@@ -45,56 +46,18 @@ struct Report<'a> {
     pass: bool,
 }
 
-/// Wall-clock split of a run (s).
-struct Timings {
-    rom: f64,
-    table2: f64,
-}
-
-fn compute(args: &ReproduceArgs) -> Result<(Vec<Row>, Vec<String>, u64, Timings), PaperError> {
-    let (n_t2, n_f4, n_bw) = if args.quick {
-        (1 << 20, 1 << 17, 1 << 21)
-    } else {
-        (10_000_000, fig4::N, bandwidth::N)
-    };
-    let t_rom = Instant::now();
-    // Generated once here; every row's ΣΔ columns share it (`ProbeSetup::shared`).
-    paper::sigma_delta::ProbeSetup::shared(n_t2)?;
-    let rom_seconds = t_rom.elapsed().as_secs_f64();
-    let t_rows = Instant::now();
-    let results = table2::run_all(n_t2)?;
-    let rows_seconds = t_rows.elapsed().as_secs_f64();
-    paper::sigma_delta::ProbeSetup::release(n_t2);
-    let mut rows: Vec<Row> = results
-        .iter()
-        .flat_map(|r| table2::rows_of(r, args.quick))
-        .collect();
-    rows.extend(table2::eq12_row(&results, n_t2, args.quick));
-    rows.extend(fig4::rows(n_f4)?);
-    rows.extend(bandwidth::rows(n_bw)?);
-    let plots = paper::plots::write_all(&args.out, &results)?;
-    Ok((
-        rows,
-        plots,
-        n_t2,
-        Timings {
-            rom: rom_seconds,
-            table2: rows_seconds,
-        },
-    ))
-}
-
-/// Runs the command. Internal failures print `error: …` and exit 2 (CliError has no
-/// variant for dsp/plot errors yet); missed rows exit 1 after the table.
+/// Runs the command. Internal failures print `error: reproduce: …` and exit 2; missed
+/// rows exit 1 after the table.
 pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
     let start = Instant::now();
-    let (rows, plots, n, timings) = match compute(args) {
+    let r = match reproduce(args.quick, &args.out) {
         Ok(v) => v,
         Err(e) => {
             eprintln!("error: reproduce: {e}");
             std::process::exit(2);
         }
     };
+    let (rows, plots, n) = (r.rows, r.plots, r.table2_pulses);
     let seconds = start.elapsed().as_secs_f64();
     let failed = rows.iter().filter(|r| !r.pass).count();
     if args.json {
@@ -102,8 +65,8 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
             quick: args.quick,
             table2_pulses: n,
             seconds,
-            rom_seconds: timings.rom,
-            table2_seconds: timings.table2,
+            rom_seconds: r.rom_seconds,
+            table2_seconds: r.table2_seconds,
             rows: &rows,
             plots,
             rows_failed: failed,
@@ -134,8 +97,8 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
         println!(
             "{} rows, {failed} failed, {seconds:.1} s (ΣΔ ROM {:.1} s, Table 2 rows {:.1} s)",
             rows.len(),
-            timings.rom,
-            timings.table2
+            r.rom_seconds,
+            r.table2_seconds
         );
     }
     if failed > 0 {

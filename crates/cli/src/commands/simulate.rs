@@ -14,7 +14,9 @@ use serde::Serialize;
 use tofprobe_pixel::spectrum::BitTrueSpectrum;
 use tofprobe_scene::{FillCounts, PhotonSource};
 
-use crate::config::Config;
+use tofprobe_design::ResolvedDesign;
+use tofprobe_study::spectrum::{run_spectrum, setup, write_svg};
+
 use crate::error::CliError;
 
 /// Pulses per streamed chunk (a multiple of the source's block, so nothing is regenerated).
@@ -162,23 +164,23 @@ pub fn summarise(source: &PhotonSource, pulses: u64, progress: bool) -> Summary 
 
 /// Runs the command.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
-    let loaded = Config::load(args.config.as_deref())?;
-    let source = loaded.config.photon_source().map_err(|e| loaded.error(e))?;
-    let pulses = loaded.config.pulses();
+    let design = tofprobe_design::load(args.config.as_deref())?;
+    let source = design.photon_source()?;
+    let pulses = design.pulses();
     let progress = !args.json && std::io::stderr().is_terminal();
     let s = summarise(&source, pulses, progress);
-    let bit_true = bit_true(&loaded.config, &loaded.origin, &source)?;
+    let bit_true = bit_true(&design, &source)?;
     if let (Some(path), Some((_, spectrum))) = (&args.svg, &bit_true) {
-        super::spectrum_svg::write_svg(
+        write_svg(
             path,
-            &format!("bit-true spectrum: {}", loaded.origin),
+            &format!("bit-true spectrum: {}", design.origin),
             spectrum,
         )?;
     } else if let Some(path) = &args.svg {
-        return Err(CliError::Output {
-            path: path.clone(),
-            message: "the spectrum plot needs pixel.mode = \"fourier\"".into(),
-        });
+        return Err(CliError::output(
+            path.clone(),
+            "the spectrum plot needs pixel.mode = \"fourier\"".into(),
+        ));
     }
     if args.json {
         let out = Output {
@@ -187,7 +189,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         };
         println!("{}", serde_json::to_string(&out)?);
     } else {
-        println!("configuration      {}", loaded.origin);
+        println!("configuration      {}", design.origin);
         println!("pulses             {}", s.pulses);
         println!(
             "detections         {} ({:.4} per pulse)",
@@ -236,19 +238,18 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
 
 /// Runs the bit-true pixel over one frame (Fourier mode; `None` in Haar mode).
 fn bit_true(
-    config: &Config,
-    origin: &str,
+    design: &ResolvedDesign,
     source: &PhotonSource,
 ) -> Result<Option<(BitTrueOut, BitTrueSpectrum)>, CliError> {
-    if config.pixel.mode != tofprobe_pixel::Mode::Fourier {
+    if design.pixel.mode != tofprobe_pixel::Mode::Fourier {
         return Ok(None);
     }
     let t0 = Instant::now();
-    let setup = super::spectrum_svg::setup(config, origin)?;
+    let setup = setup(design)?;
     let rom_seconds = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let spectrum =
-        super::spectrum_svg::run_spectrum(&setup, source, config.sensor.tdc_lsb_mm(), origin)?;
+    let lsb_mm = design.sensor().tdc_lsb_mm();
+    let spectrum = run_spectrum(&setup, source, lsb_mm, &design.origin)?;
     let model_seconds = t1.elapsed().as_secs_f64();
     let out = BitTrueOut {
         width_bits: setup.params.width,

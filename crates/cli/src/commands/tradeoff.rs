@@ -1,7 +1,7 @@
 //! `tofprobe tradeoff [CONFIG...] [--json] [--out DIR] [--verilator] [--knobs] [--skips]`:
 //! every fidelity level on each configuration (the embedded default without one), timed
 //! per simulated second and scored against the float DFT and the scene's truth; with
-//! `--knobs` the bit-true knob sweep ([`crate::tradeoff::knobs::DEFAULT_SWEEP`]) and with
+//! `--knobs` the bit-true knob sweep ([`tofprobe_study::tradeoff::knobs::DEFAULT_SWEEP`]) and with
 //! `--skips` the skipped-stage speedups, both on a frame of at most `--sweep-pulses` and
 //! timed as the median of `--reps` runs. Markdown tables on stdout (or one JSON object),
 //! and with `--out` the tables (`tradeoff.md`) and the Pareto plot (`pareto.svg`),
@@ -12,12 +12,12 @@ use std::path::PathBuf;
 use clap::Args;
 use serde::Serialize;
 
-use crate::commands::spectrum_svg::write_atomic;
-use crate::config::Config;
+use tofprobe_study::spectrum::write_atomic;
+use tofprobe_study::tradeoff::knobs::{self, DEFAULT_SWEEP, KnobSweep};
+use tofprobe_study::tradeoff::skips::{self, SkipReport, measure_skips};
+use tofprobe_study::tradeoff::{SceneResult, markdown, measure, plot::pareto_svg};
+
 use crate::error::CliError;
-use crate::tradeoff::knobs::{self, DEFAULT_SWEEP, KnobSweep};
-use crate::tradeoff::skips::{self, SkipReport, measure_skips};
-use crate::tradeoff::{SceneResult, markdown, measure, plot::pareto_svg};
 
 /// Arguments of `tofprobe tradeoff`.
 #[derive(Debug, Args)]
@@ -77,40 +77,32 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     {
         let mut names: Vec<&str> = DEFAULT_SWEEP.iter().map(|s| s.knob).collect();
         names.dedup();
-        return Err(CliError::Option {
-            option: "knob".into(),
-            value: bad.clone(),
-            allowed: names.join(", "),
-        });
+        return Err(CliError::option("knob", bad.clone(), names.join(", ")));
     }
     let mut scenes = Vec::new();
     let mut sweeps = Vec::new();
     let mut skip_reports = Vec::new();
     let mut tables = Vec::new();
     for p in paths {
-        let loaded = Config::load(p)?;
-        let (cfg, origin) = (&loaded.config, &loaded.origin);
-        let scene = measure(cfg, origin, args.verilator)?;
+        let design = tofprobe_design::load(p)?;
+        let scene = measure(&design, args.verilator)?;
         tables.push(markdown(&scene));
         scenes.push(scene);
         if args.knobs {
             let settings = knobs::select(DEFAULT_SWEEP, &args.only_knobs);
-            let sw = knobs::sweep(cfg, origin, &settings, args.sweep_pulses, reps);
+            let sw = knobs::sweep(&design, &settings, args.sweep_pulses, reps);
             tables.push(knobs::markdown(&sw));
             sweeps.push(sw);
         }
         if args.skips {
-            let sk = measure_skips(cfg, origin, args.sweep_pulses, reps)?;
+            let sk = measure_skips(&design, args.sweep_pulses, reps)?;
             tables.push(skips::markdown(&sk));
             skip_reports.push(sk);
         }
     }
     let table = tables.join("\n");
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).map_err(|e| CliError::Output {
-            path: dir.clone(),
-            message: e.to_string(),
-        })?;
+        std::fs::create_dir_all(dir).map_err(|e| CliError::output(dir.clone(), e.to_string()))?;
         write_atomic(&dir.join("tradeoff.md"), table.as_bytes())?;
         pareto_svg(&dir.join("pareto.svg"), &scenes)?;
     }

@@ -6,13 +6,12 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
+use tofprobe_design::RtlOverrides;
+use tofprobe_design::rom_policy::simulation_rom;
+use tofprobe_rtlgen::stimulus::random_stimulus;
 use tofprobe_rtlgen::vectors::golden_run;
 use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
 
-use crate::commands::probe_rom::rtl_rom;
-use crate::commands::rtl::rtl_params;
-use crate::config::Config;
 use crate::error::CliError;
 
 /// Arguments of `tofprobe vectors`.
@@ -42,24 +41,13 @@ pub struct VectorsArgs {
 
 /// Runs `tofprobe vectors`.
 pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
-    if a.frames == 0 || a.frames > 1000 {
-        return Err(CliError::Option {
-            option: "frames".into(),
-            value: a.frames.to_string(),
-            allowed: "1..=1000".into(),
-        });
-    }
-    let mut p = rtl_params(a.config.as_deref(), a.frame_pulses, a.rom_depth)?;
-    let (rom, note) = if a.rom_depth.is_some() {
-        (
-            sign_probe_rom(&p),
-            "sign-of-cosine probe ROM (--rom-depth given)".to_string(),
-        )
-    } else {
-        let loaded = Config::load(a.config.as_deref())?;
-        let r = rtl_rom(&loaded.config, &loaded.origin, &mut p)?;
-        (r.words, r.note)
+    let overrides = RtlOverrides {
+        frame_pulses: a.frame_pulses,
+        rom_depth: a.rom_depth,
     };
+    let (design, mut p) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
+    let chip = simulation_rom(&design, &overrides, &mut p)?;
+    let (rom, note) = (chip.words, chip.note);
     let stim = random_stimulus(&p, a.frames * p.frame_pulses, a.seed);
     let o = VectorOptions {
         frames: a.frames,
@@ -67,7 +55,7 @@ pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
         digest_pulses: a.digest_pulses.max(1),
         trace_window: None,
     };
-    let (g, w) = golden_run(&p, &stim, &rom, &o)?;
+    let (g, w) = golden_run(&p, &stim, &rom, &o).map_err(tofprobe_study::StudyError::from)?;
     let m = write_vectors(&a.out, &p, &stim, &rom, &g, w, &o)?;
     println!(
         "vectors: {} frames, {} pulses, {} cycles, {} trace events, {} digest windows, hash {} -> {}; {note}",

@@ -14,6 +14,8 @@ pub use config::{ProbeConfig, RomMode};
 pub use modulator::Modulator;
 pub use ntf::{Ntf, synthesize_ntf};
 pub use probe::{ProbeDesign, ProbeRom, nearest_bin};
-pub use probing::{ProbeAccumulator, amplitudes_um, normalise, prefilter_response, probe_record};
+pub use probing::{
+    ProbeAccumulator, amplitudes_um, normalise, prefilter_response, probe_detections,
+};
 pub use realize::{Cifb, StateSpace, realize_cifb};
 pub use wrap::WrapMetric;

@@ -7,81 +7,69 @@
 //! there because the ±1 probe carries large shaped quantisation noise out of band; it
 //! mixes with broadband depth noise into the bin unless the depth is lowpassed first.
 //!
-//! Two ways in. [`ProbeAccumulator::push`] takes a depth per sample and is the textbook
-//! float ΣΔ: the first sample primes the filter *and* is added. [`ProbeAccumulator::
-//! push_detections`] takes the pixel's input — a detection or none per pulse — and follows
-//! the pixel contract's rules in f64: nothing happens before the first detection, the first
-//! detection primes the hold and the filter and adds nothing, a missed pulse repeats the
-//! held depth (1NN hold). It is the float twin of the bit-true pixel, so the two differ
-//! only by the integer filter's floor residues (crates/pixel/tests/float_sd.rs).
+//! The depth goes through the one float front end ([`crate::preprocess::FrontEnd`]), so
+//! the float ΣΔ is the pixel's float twin: nothing happens before the first detection,
+//! the first detection primes the hold and the filter and adds nothing, a missed pulse
+//! repeats the held depth (1NN hold). It differs from the bit-true pixel only by the
+//! integer filter's floor residues (crates/pixel/tests/float_sd.rs). Without a prefilter
+//! (`alpha = None`) the held depth itself is probed, the priming pulse included.
 
 use super::probe::ProbeRom;
+use crate::preprocess::{FrontEnd, FrontEndOutput};
 use rustfft::num_complex::Complex64;
-use std::f64::consts::PI;
 
-/// Streaming accumulator: feed depths in any chunking, read out at the end.
+pub use crate::preprocess::prefilter_response;
+
+/// Streaming accumulator: feed detections in any chunking, read out at the end.
 #[derive(Debug, Clone)]
 pub struct ProbeAccumulator<'a> {
     rom: &'a ProbeRom,
     alpha: Option<f64>,
-    /// Samples consumed.
+    /// The hold, priming and prefilter.
+    front: FrontEnd,
+    /// Pulses consumed.
     n: u64,
-    x: f64,
-    prev: f64,
     /// acc[r]: register r (2k = I, 2k+1 = Q).
     acc: Vec<f64>,
-    /// Pixel rules: a detection has been seen (hold and filter primed).
-    primed: bool,
-    /// Pixel rules: the held depth.
-    held: f64,
 }
 
 impl<'a> ProbeAccumulator<'a> {
-    /// `alpha`: prefilter coefficient (the pixel's 2^−S), or `None` to probe δ directly.
+    /// `alpha`: prefilter coefficient (the pixel's 2^−S), or `None` to probe the held
+    /// depth directly.
     pub fn new(rom: &'a ProbeRom, alpha: Option<f64>) -> Self {
+        let output = match alpha {
+            Some(alpha) => FrontEndOutput::Prefiltered { alpha },
+            None => FrontEndOutput::Held,
+        };
         ProbeAccumulator {
             rom,
             alpha,
+            front: FrontEnd::unchecked(0.0, output),
             n: 0,
-            x: 0.0,
-            prev: 0.0,
             acc: vec![0.0; rom.image.registers()],
-            primed: false,
-            held: 0.0,
         }
     }
 
     /// Consumes one pulse each under the pixel's rules (see the module docs): `None` = no
-    /// detection. Do not mix with [`Self::push`] on one accumulator.
+    /// detection.
     pub fn push_detections(&mut self, detections: &[Option<f64>]) {
         for &d in detections {
-            if let Some(v) = d {
-                self.held = v;
-                if !self.primed {
-                    // The priming pulse: hold and filter start here, no register moves.
-                    self.primed = true;
-                    self.x = v;
-                    self.prev = v;
-                    self.n += 1;
-                    continue;
-                }
-            } else if !self.primed {
-                self.n += 1;
-                continue;
-            }
-            let x = match self.alpha {
-                Some(a) => {
-                    self.x += a * (self.prev - self.x);
-                    self.prev = self.held;
-                    self.x
-                }
-                None => self.held,
-            };
+            let x = self.front.step(d);
             self.accumulate(x);
         }
     }
 
-    /// Adds ±x to every register by the ROM bits at the current sample and advances it.
+    /// Consumes a depth sample per pulse, every pulse detected (any unit; the readout is
+    /// in the same unit): the first sample primes.
+    pub fn push(&mut self, depths: &[f64]) {
+        for &d in depths {
+            let x = self.front.step(Some(d));
+            self.accumulate(x);
+        }
+    }
+
+    /// Adds ±x to every register by the ROM bits at the current pulse and advances it
+    /// (x = 0 before priming adds nothing).
     fn accumulate(&mut self, x: f64) {
         let l = self.rom.image.depth() as u64;
         let entry = self.rom.image.entry((self.n % l) as usize);
@@ -93,27 +81,7 @@ impl<'a> ProbeAccumulator<'a> {
         self.n += 1;
     }
 
-    /// Consumes depth samples (any unit; the readout is in the same unit).
-    pub fn push(&mut self, depths: &[f64]) {
-        for &d in depths {
-            let x = match self.alpha {
-                Some(a) => {
-                    // Primed by the first sample (x[0] = δ[0]), as the pixel's hold is.
-                    if self.n == 0 {
-                        self.x = d;
-                    } else {
-                        self.x += a * (self.prev - self.x);
-                    }
-                    self.prev = d;
-                    self.x
-                }
-                None => d,
-            };
-            self.accumulate(x);
-        }
-    }
-
-    /// Samples consumed so far.
+    /// Pulses consumed so far.
     pub fn samples(&self) -> u64 {
         self.n
     }
@@ -129,29 +97,23 @@ impl<'a> ProbeAccumulator<'a> {
     }
 }
 
-/// Probes a whole record: raw (I, Q) sums per bin.
-pub fn probe_record(
+/// Probes a whole record of detections (`None` = no detection): raw (I, Q) sums per bin.
+pub fn probe_detections(
     rom: &ProbeRom,
-    depths: impl IntoIterator<Item = f64>,
+    detections: impl IntoIterator<Item = Option<f64>>,
     alpha: Option<f64>,
 ) -> Vec<(f64, f64)> {
     let mut acc = ProbeAccumulator::new(rom, alpha);
     let mut buf = Vec::with_capacity(4096);
-    for d in depths {
+    for d in detections {
         buf.push(d);
         if buf.len() == 4096 {
-            acc.push(&buf);
+            acc.push_detections(&buf);
             buf.clear();
         }
     }
-    acc.push(&buf);
+    acc.push_detections(&buf);
     acc.sums()
-}
-
-/// The prefilter's response H_pre(e^{jω}) = α e^{−jω} / (1 − (1−α) e^{−jω}).
-pub fn prefilter_response(alpha: f64, f_norm: f64) -> Complex64 {
-    let zi = Complex64::from_polar(1.0, -2.0 * PI * f_norm);
-    alpha * zi / (1.0 - (1.0 - alpha) * zi)
 }
 
 /// Turns raw sums of `n` samples into phasors: (I − jQ) · 2/N / (G · A_p · H_pre(f_k)).
@@ -184,6 +146,7 @@ mod tests {
     use super::super::probe::{ProbeDesign, ProbeRom};
     use super::*;
     use crate::window::Window;
+    use std::f64::consts::PI;
 
     /// Gaussian noise from a tiny deterministic generator (xorshift + Box–Muller), so the
     /// test needs no RNG crate.
@@ -238,13 +201,13 @@ mod tests {
         let alpha = 1.0 / 32.0;
         let with = normalise(
             &rom,
-            &probe_record(&rom, d.iter().copied(), Some(alpha)),
+            &probe_detections(&rom, d.iter().map(|&v| Some(v)), Some(alpha)),
             n as u64,
             Some(alpha),
         );
         let without = normalise(
             &rom,
-            &probe_record(&rom, d.iter().copied(), None),
+            &probe_detections(&rom, d.iter().map(|&v| Some(v)), None),
             n as u64,
             None,
         );
@@ -291,7 +254,7 @@ mod tests {
     fn chunking_does_not_change_the_sums() {
         let rom = rom(4096, &[3, 17]);
         let d = gaussian(10_000, 1.0, 7);
-        let whole = probe_record(&rom, d.iter().copied(), Some(0.1));
+        let whole = probe_detections(&rom, d.iter().map(|&v| Some(v)), Some(0.1));
         let mut acc = ProbeAccumulator::new(&rom, Some(0.1));
         for c in d.chunks(777) {
             acc.push(c);
@@ -346,15 +309,28 @@ mod tests {
                 "r {r}"
             );
         }
-        // Every pulse detected: the textbook sums minus the priming sample.
+        // Every pulse detected: the textbook float ΣΔ written out (x_0 = δ_0 added too,
+        // x_n = x_{n−1} + α(δ_{n−1} − x_{n−1})) minus the priming sample's s_r(0)·δ_0.
         let all: Vec<Option<f64>> = d.iter().map(|&v| Some(v)).collect();
         let mut px = ProbeAccumulator::new(&rom, Some(alpha));
         px.push_detections(&all);
-        let text = probe_record(&rom, d.iter().copied(), Some(alpha));
-        for (k, ((pi, pq), (ti, tq))) in px.sums().into_iter().zip(text).enumerate() {
+        let mut text = vec![0.0; regs];
+        let mut x = d[0];
+        for n in 0..d.len() {
+            if n > 0 {
+                x += alpha * (d[n - 1] - x);
+            }
+            for (r, t) in text.iter_mut().enumerate() {
+                *t += if rom.image.bit(n % 4096, r) { x } else { -x };
+            }
+        }
+        for (k, (pi, pq)) in px.sums().into_iter().enumerate() {
             let s0 = |r: usize| if rom.image.bit(0, r) { d[0] } else { -d[0] };
-            assert!((pi - (ti - s0(2 * k))).abs() < 1e-9, "I {k}");
-            assert!((pq - (tq - s0(2 * k + 1))).abs() < 1e-9, "Q {k}");
+            assert!((pi - (text[2 * k] - s0(2 * k))).abs() < 1e-9, "I {k}");
+            assert!(
+                (pq - (text[2 * k + 1] - s0(2 * k + 1))).abs() < 1e-9,
+                "Q {k}"
+            );
         }
     }
 }

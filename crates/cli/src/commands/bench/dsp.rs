@@ -12,7 +12,7 @@ use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::dft::amplitude_spectrum;
 
 use crate::error::CliError;
-use crate::paper::table2;
+use tofprobe_study::paper::table2;
 
 /// Arguments of `tofprobe bench dsp`.
 #[derive(Debug, Args)]
@@ -52,11 +52,11 @@ struct Report {
 }
 
 fn err(e: impl std::fmt::Display) -> CliError {
-    CliError::Option {
-        option: "bench dsp".into(),
-        value: e.to_string(),
-        allowed: "an internal computation that succeeds".into(),
-    }
+    CliError::option(
+        "bench dsp",
+        e.to_string(),
+        "an internal computation that succeeds",
+    )
 }
 
 /// Runs the benchmark.
@@ -99,6 +99,7 @@ pub fn run(args: &DspBenchArgs) -> Result<(), CliError> {
         spec: &spec,
         source: &source,
         detections: &det,
+        probe: None,
     };
     let m = table2::dft_column(&rec).map_err(err)?;
     let table2_row_seconds = t.elapsed().as_secs_f64();
@@ -107,7 +108,7 @@ pub fn run(args: &DspBenchArgs) -> Result<(), CliError> {
     // Every Table 2 row, DFT column only (rayon across rows, seed-to-seed spread included):
     // the reproduction's DFT part as `tofprobe reproduce` runs it.
     let t = Instant::now();
-    let rows = table2::run_all_with(N as u64, &table2::COLUMNS[..1]).map_err(err)?;
+    let rows = table2::run_all_with(N as u64, None, &table2::COLUMNS[..1]).map_err(err)?;
     let table2_all_rows_seconds = t.elapsed().as_secs_f64();
     let table2_rows = rows.len();
     drop(rows);

@@ -14,10 +14,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 use serde::Serialize;
-use tofprobe_pixel::PixelContext;
 use tofprobe_pixel::bench::{bench_cycle, bench_transaction, synthetic_rom};
 
-use crate::config::Config;
 use crate::error::CliError;
 
 /// The target for one 10^7-pulse frame, seconds.
@@ -62,46 +60,38 @@ struct Report {
     pass: bool,
 }
 
-fn pixel_error(origin: &str, e: tofprobe_pixel::PixelError) -> CliError {
-    CliError::Toml {
-        origin: origin.to_string(),
-        message: e.to_string(),
-    }
-}
-
 /// Runs the benchmark.
 pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
     for (option, value) in [("pulses", args.pulses), ("cycle-pulses", args.cycle_pulses)] {
         if !(1000..=1_000_000_000).contains(&value) {
-            return Err(CliError::Option {
-                option: option.into(),
-                value: value.to_string(),
-                allowed: "1000..=1000000000".into(),
-            });
+            return Err(CliError::option(
+                option,
+                value.to_string(),
+                "1000..=1000000000",
+            ));
         }
     }
-    let loaded = Config::load(args.config.as_deref())?;
-    let c = &loaded.config;
-    let ctx = PixelContext::from_sensor(&c.sensor, args.pulses);
-    let mut params = c
-        .pixel
-        .resolve(&ctx)
-        .map_err(|e| pixel_error(&loaded.origin, e))?;
+    // The configuration's pixel (W sized for its own frame), timed on `--pulses` pulses.
+    let design = tofprobe_design::load(args.config.as_deref())?;
+    let c = &design.document;
+    let mut params = design.pixel.clone();
+    params.frame_pulses = args.pulses;
     if params.mode != tofprobe_pixel::Mode::Fourier {
-        return Err(CliError::Option {
-            option: "config".into(),
-            value: format!("pixel.mode = {}", params.mode),
-            allowed: "a Fourier pixel (the benchmark times the I/Q data path)".into(),
-        });
+        return Err(CliError::option(
+            "config",
+            format!("pixel.mode = {}", params.mode),
+            "a Fourier pixel (the benchmark times the I/Q data path)",
+        ));
     }
     params.rom_depth = ROM_DEPTH;
     let rom = synthetic_rom(ROM_DEPTH, params.registers());
     let rate = c.sensor.laser_rate_hz;
     let t = bench_transaction(&params, args.pulses as usize, &rom, rate)
-        .map_err(|e| pixel_error("bench pixel", e))?;
+        .map_err(|e| tofprobe_design::DesignError::pixel("bench pixel", e))?;
     let mut pc = params.clone();
     pc.frame_pulses = args.cycle_pulses;
-    let cy = bench_cycle(&pc, &rom, 1).map_err(|e| pixel_error("bench pixel", e))?;
+    let cy = bench_cycle(&pc, &rom, 1)
+        .map_err(|e| tofprobe_design::DesignError::pixel("bench pixel", e))?;
     let cycle_rate = rate * params.cycles_per_pulse as f64;
     let report = Report {
         bins: params.bins,

@@ -14,8 +14,8 @@ use clap::Args;
 use serde::Serialize;
 use tofprobe_scene::PhotonSource;
 
-use crate::config::Config;
 use crate::error::CliError;
+use tofprobe_design::Document;
 
 /// Target throughput with every pulse a signal photon and no background (pulses/s).
 const TARGET_SIGNAL_ONLY: f64 = 50e6;
@@ -64,14 +64,13 @@ struct Rates {
 }
 
 /// Times `pulses` pulses through one thread.
-fn time_case(config: &Config, rho_s: f64, rho_b: f64, pulses: u64) -> Result<Rates, CliError> {
+fn time_case(config: &Document, rho_s: f64, rho_b: f64, pulses: u64) -> Result<Rates, CliError> {
     let mut c = config.clone();
     c.sensor.signal_rate = rho_s;
     c.sensor.background_rate = rho_b;
-    let source: PhotonSource = c.photon_source().map_err(|source| CliError::Scene {
-        origin: "bench scene".into(),
-        source,
-    })?;
+    let source: PhotonSource = c
+        .photon_source()
+        .map_err(|source| tofprobe_design::DesignError::scene("bench scene", source))?;
     let mut buf = vec![None; CHUNK];
     // Warm-up, then the timed run; the detection count keeps the work observable.
     source.fill(0, &mut buf);
@@ -99,15 +98,15 @@ fn time_case(config: &Config, rho_s: f64, rho_b: f64, pulses: u64) -> Result<Rat
 /// Runs the benchmark.
 pub fn run(args: &SceneBenchArgs) -> Result<(), CliError> {
     if args.pulses < CHUNK as u64 {
-        return Err(CliError::Option {
-            option: "pulses".into(),
-            value: args.pulses.to_string(),
-            allowed: format!("pulses >= {CHUNK}"),
-        });
+        return Err(CliError::option(
+            "pulses",
+            args.pulses,
+            format!("pulses >= {CHUNK}"),
+        ));
     }
-    let loaded = Config::load(args.config.as_deref())?;
-    let a = time_case(&loaded.config, 1.0, 0.0, args.pulses)?;
-    let b = time_case(&loaded.config, 0.3, 0.3, args.pulses)?;
+    let design = tofprobe_design::load(args.config.as_deref())?;
+    let a = time_case(&design.document, 1.0, 0.0, args.pulses)?;
+    let b = time_case(&design.document, 0.3, 0.3, args.pulses)?;
     let judged = (a.cpu.unwrap_or(a.wall), b.cpu.unwrap_or(b.wall));
     let report = Report {
         pulses: args.pulses,

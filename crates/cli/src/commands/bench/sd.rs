@@ -96,19 +96,18 @@ struct Report {
 }
 
 fn err(e: impl std::fmt::Display) -> CliError {
-    CliError::Option {
-        option: "bench sd".into(),
-        value: e.to_string(),
-        allowed: "an internal computation that succeeds".into(),
-    }
+    CliError::option(
+        "bench sd",
+        e.to_string(),
+        "an internal computation that succeeds",
+    )
 }
 
 /// Runs the benchmark.
 pub fn run(args: &SdBenchArgs) -> Result<(), CliError> {
     let cfg = ProbeConfig::default();
-    let design = ProbeDesign::new(&cfg, 1000.0 / FS_HZ).map_err(|source| CliError::Probe {
-        origin: crate::config::DEFAULT_ORIGIN.to_string(),
-        source,
+    let design = ProbeDesign::new(&cfg, 1000.0 / FS_HZ).map_err(|source| {
+        tofprobe_design::DesignError::probe(tofprobe_design::DEFAULT_ORIGIN, source)
     })?;
     let m = &design.modulator;
     let amax = |f: f64| m.max_stable_amplitude(f / FS_HZ);
@@ -160,20 +159,19 @@ pub fn run(args: &SdBenchArgs) -> Result<(), CliError> {
     }
     drop(one_rom);
     if let Some(dir) = &args.rom_dir {
-        rom.write(dir, "probe_rom").map_err(|e| CliError::Output {
-            path: dir.clone(),
-            message: e.to_string(),
-        })?;
+        rom.write(dir, "probe_rom")
+            .map_err(|e| CliError::output(dir.clone(), e.to_string()))?;
     }
     let samples = (2 * bins.len()) as f64 * N_ROM as f64;
 
     // The chip ROM of the embedded default: periodic, its bins from the scene.
-    let loaded = crate::config::Config::load(None)?;
-    let depth = loaded.config.probe.depth(N_ROM);
-    let b = loaded.config.pixel_params().map_err(err)?.bins;
-    let chip_bins = crate::commands::probe_rom::sd_bins(&loaded.config, b, depth).map_err(err)?;
+    let loaded = tofprobe_design::load(None)?;
+    let depth = loaded.document.probe.depth(N_ROM);
+    let b = loaded.pixel.bins;
+    let chip_bins =
+        tofprobe_design::bins::bin_indices(&loaded.document, b, depth as u64).map_err(err)?;
     let chip_design = ProbeDesign::with_known_limit(
-        &loaded.config.probe,
+        &loaded.document.probe,
         design.max_stable_amplitude,
         design.limit_f_norm,
     )
@@ -352,10 +350,8 @@ fn write_svg(m: &Modulator, path: &std::path::Path) -> Result<(), CliError> {
             .label("f_s / (2 OSR) = 156 kHz");
         root.present().map_err(err)?;
     }
-    tofprobe_dsp::rom::write_atomic(path, text.as_bytes()).map_err(|e| CliError::Output {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })
+    tofprobe_dsp::rom::write_atomic(path, text.as_bytes())
+        .map_err(|e| CliError::output(path.to_path_buf(), e.to_string()))
 }
 
 #[cfg(test)]
@@ -367,14 +363,14 @@ mod tests {
     /// amplitude 0.5 is below 0.9 × the measured ≈ 0.77).
     #[test]
     fn default_probe_section_is_the_default_design() {
-        let loaded = crate::config::Config::load(None).expect("default loads");
+        let loaded = tofprobe_design::load(None).expect("default loads");
         let periodic = ProbeConfig {
             rom_mode: tofprobe_dsp::sd::RomMode::Periodic,
             rom_depth: 20_000,
             ..ProbeConfig::default()
         };
-        assert_eq!(loaded.config.probe, periodic);
-        loaded.config.probe.validate().expect("valid");
+        assert_eq!(loaded.document.probe, periodic);
+        loaded.document.probe.validate().expect("valid");
     }
 
     /// Eq. 4 read for 12 bits at full scale: 74 dB ⇒ d = (74 + 13.59)/21.07 ⇒ ≈ 280 kHz

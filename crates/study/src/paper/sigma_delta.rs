@@ -12,8 +12,6 @@
 //! Readouts are phasors in mm, normalised by 2/N, the window gain, A_p and H_pre(f_k)
 //! (`tofprobe_dsp::sd::normalise`), i.e. directly comparable with 2/(N·G)·X[k].
 
-use std::sync::{Arc, Mutex};
-
 use tofprobe_dsp::sd::{ProbeConfig, ProbeDesign, ProbeRom, normalise};
 use tofprobe_pixel::sizing::{
     operand_range, rom_sign_counts, signed_sum_range, twos_complement_bits,
@@ -22,7 +20,8 @@ use tofprobe_pixel::{PixelParams, TransactionModel};
 
 use super::setup::FS_HZ;
 use super::table2::{BIT_TRUE, DFT, F0_HZ, Measurement, RowResult, SD, SD_RAW};
-use super::{PaperError, Row, Tolerance};
+use super::{Row, Tolerance};
+use crate::StudyError;
 
 /// Prefilter coefficient α = 2^−S of the pixel (S = 5).
 pub const SHIFT: u32 = 5;
@@ -72,8 +71,9 @@ pub fn probe_bins(n: u64) -> Vec<u64> {
     bins
 }
 
-/// Everything the ΣΔ columns share across rows: the ROM (generated once per N) and its
-/// per-register sign counts (for the width sizing and the bit-true bound).
+/// Everything the ΣΔ columns share across rows: the ROM (generated once per N, by the
+/// caller, and passed to every row) and its per-register sign counts (for the width
+/// sizing and the bit-true bound).
 #[derive(Debug)]
 pub struct ProbeSetup {
     pub n: u64,
@@ -82,55 +82,18 @@ pub struct ProbeSetup {
     pub sign_counts: Vec<(u64, u64)>,
 }
 
-/// ROMs already generated, by N (a 10^7-pulse ROM of 65 bins is ≈ 240 MB, so a run
-/// releases it when done).
-static SHARED: Mutex<Vec<Arc<ProbeSetup>>> = Mutex::new(Vec::new());
-
 impl ProbeSetup {
-    /// The setup for N = `n`, generated on first use and shared afterwards (the lock is
-    /// held while generating, so rows running in parallel wait instead of generating it
-    /// twice). Unit tests skip the stability sweep ([`ProbeSetup::for_tests`]).
-    pub fn shared(n: u64) -> Result<Arc<ProbeSetup>, PaperError> {
-        let mut cache = SHARED.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(p) = cache.iter().find(|p| p.n == n) {
-            return Ok(Arc::clone(p));
-        }
-        #[cfg(not(test))]
-        let p = Arc::new(Self::new(n)?);
-        #[cfg(test)]
-        let p = Arc::new(Self::for_tests(n));
-        cache.push(Arc::clone(&p));
-        Ok(p)
-    }
-
-    /// Drops the shared setup for N = `n` (its memory is freed once no row holds it).
-    pub fn release(n: u64) {
-        SHARED
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .retain(|p| p.n != n);
-    }
-
     /// Designs the default probe (stability-checked at the lowest probe frequency) and
     /// generates its windowed ROM for N = `n` at [`probe_bins`].
-    #[cfg_attr(test, allow(dead_code))]
-    pub fn new(n: u64) -> Result<Self, PaperError> {
+    pub fn new(n: u64) -> Result<Self, StudyError> {
         let bins = probe_bins(n);
         let k_min = *bins.iter().min().unwrap_or(&1);
         let design = ProbeDesign::new(&ProbeConfig::default(), k_min as f64 / n as f64)?;
         Self::with_design(n, &design)
     }
 
-    /// The same ROM without the stability sweep (seconds in a debug build): the modulator
-    /// is the default one, and A_p = 0.5 is well inside its measured limit ≈ 0.77
-    /// (`ProbeSetup::new` checks it in every `reproduce` run).
-    #[cfg(test)]
-    pub fn for_tests(n: u64) -> Self {
-        let design = ProbeDesign::with_known_limit(&ProbeConfig::default(), 0.77, 1e-4).unwrap();
-        Self::with_design(n, &design).unwrap()
-    }
-
-    fn with_design(n: u64, design: &ProbeDesign) -> Result<Self, PaperError> {
+    /// The setup of a design already made (N = `n`, bins [`probe_bins`]).
+    pub fn with_design(n: u64, design: &ProbeDesign) -> Result<Self, StudyError> {
         let bins = probe_bins(n);
         let rom = ProbeRom::generate(design, FS_HZ, n, &bins)?;
         let sign_counts = rom_sign_counts(&rom.image, rom.image.registers(), n);
@@ -158,7 +121,7 @@ impl ProbeSetup {
     /// default Fourier pixel (S = 5, F = 8, A = 2) with B = the probe bins, C = the slots it
     /// needs, T wide enough for the window, and W from the exact per-register sign counts
     /// so that no final value wraps.
-    pub fn pixel_params(&self, codes: u32) -> Result<PixelParams, PaperError> {
+    pub fn pixel_params(&self, codes: u32) -> Result<PixelParams, StudyError> {
         let mut p = PixelParams::fourier_default(63, self.n, self.rom.depth());
         p.bins = self.bins();
         p.cycles_per_pulse = p.slots();
@@ -213,7 +176,7 @@ pub fn bit_true(
     setup: &ProbeSetup,
     detections: &[Option<u32>],
     codes: u32,
-) -> Result<BitTrue, PaperError> {
+) -> Result<BitTrue, StudyError> {
     let p = setup.pixel_params(codes)?;
     let mut tm = TransactionModel::new(&p)?;
     for (i, chunk) in detections.chunks(1 << 16).enumerate() {
@@ -440,7 +403,15 @@ pub fn error_um(a: &[Phasor], b: &[Phasor]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
+    /// The shared ROM without the stability sweep (seconds in a debug build): the
+    /// modulator is the default one, and A_p = 0.5 is well inside its measured limit
+    /// ≈ 0.77 (`ProbeSetup::new` checks it in every `reproduce` run).
+    pub(crate) fn setup_for_tests(n: u64) -> ProbeSetup {
+        let design = ProbeDesign::with_known_limit(&ProbeConfig::default(), 0.77, 1e-4).unwrap();
+        ProbeSetup::with_design(n, &design).unwrap()
+    }
+
     use super::super::table2::{
         RowRecord, Spec, bit_true_column, dft_column, sd_column, sd_raw_column,
     };
@@ -453,10 +424,12 @@ mod tests {
     fn record_columns(spec: &Spec, n: u64) -> Vec<Option<Measurement>> {
         let source = spec.setup().source(3).unwrap();
         let detections = source.record(n);
+        let probe = setup_for_tests(n);
         let rec = RowRecord {
             spec,
             source: &source,
             detections: &detections,
+            probe: Some(&probe),
         };
         vec![
             dft_column(&rec).unwrap(),

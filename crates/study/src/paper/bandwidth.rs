@@ -12,11 +12,12 @@
 use rayon::prelude::*;
 use tofprobe_dsp::Window;
 use tofprobe_dsp::closed_form::{hold_bandwidth_hz, zoh_hold_f3db};
-use tofprobe_dsp::preprocess::{FrontEnd, FrontEndOutput};
 use tofprobe_dsp::stats::bartlett;
 
 use super::setup::{FS_HZ, LSB_MM, Setup};
-use super::{PaperError, Row, Tolerance};
+use super::{Row, Tolerance};
+use crate::StudyError;
+use crate::records::held_record;
 
 /// (ρ_s, paper kHz, corrected kHz).
 pub const POINTS: &[(f64, f64, f64)] =
@@ -25,7 +26,7 @@ pub const POINTS: &[(f64, f64, f64)] =
 pub const N: u64 = 10_000_000;
 
 /// Measured corner (Hz) of the held-noise spectrum.
-pub fn measure(rho: f64, n: u64, seed: u64) -> Result<f64, PaperError> {
+pub fn measure(rho: f64, n: u64, seed: u64) -> Result<f64, StudyError> {
     let setup = Setup {
         sigma_s_mm: 7.5,
         lsb_mm: LSB_MM,
@@ -37,11 +38,7 @@ pub fn measure(rho: f64, n: u64, seed: u64) -> Result<f64, PaperError> {
     let source = setup.source(seed)?;
     let det = source.record(n);
     // Zoom to δ0 so the unprimed start (held = 0) is not a step.
-    let mut fe = FrontEnd::new(setup.depth_mm(), FrontEndOutput::Held)?;
-    let held: Vec<f64> = det
-        .iter()
-        .map(|d| fe.step(d.map(|c| source.code_to_depth_mm(c))))
-        .collect();
+    let held = held_record(&source, &det, setup.depth_mm())?;
     drop(det);
     let expected = hold_bandwidth_hz(rho, FS_HZ).unwrap_or(FS_HZ / 4.0);
     let frame = ((20.0 * FS_HZ / expected).log2().ceil() as u32).clamp(4, 24);
@@ -87,9 +84,9 @@ pub fn measure(rho: f64, n: u64, seed: u64) -> Result<f64, PaperError> {
 }
 
 /// The bandwidth rows.
-pub fn rows(n: u64) -> Result<Vec<Row>, PaperError> {
+pub fn rows(n: u64) -> Result<Vec<Row>, StudyError> {
     let quick = n != N;
-    let measured: Result<Vec<f64>, PaperError> = POINTS
+    let measured: Result<Vec<f64>, StudyError> = POINTS
         .par_iter()
         .map(|&(r, _, _)| measure(r, n, 0))
         .collect();

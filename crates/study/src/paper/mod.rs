@@ -11,30 +11,12 @@
 pub mod bandwidth;
 pub mod fig4;
 pub mod plots;
+pub mod reproduce;
 pub mod setup;
 pub mod sigma_delta;
 pub mod table2;
 
 use serde::Serialize;
-use thiserror::Error;
-
-/// Errors of the reproduce experiments (all internal: the rows' parameters are fixed).
-#[derive(Debug, Error)]
-pub enum PaperError {
-    #[error(transparent)]
-    Dsp(#[from] tofprobe_dsp::DspError),
-    #[error(transparent)]
-    Scene(#[from] tofprobe_scene::SceneError),
-    #[error(transparent)]
-    Pixel(#[from] tofprobe_pixel::PixelError),
-    #[error("cannot write `{path}`: {source}")]
-    Io {
-        path: String,
-        source: std::io::Error,
-    },
-    #[error("plot `{path}`: {message}")]
-    Plot { path: String, message: String },
-}
 
 /// How a row is judged.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -150,14 +132,6 @@ pub fn markdown(rows: &[Row]) -> String {
         );
     }
     s
-}
-
-/// Writes `bytes` to `path` atomically ([`tofprobe_io::write_atomic`]).
-pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<(), PaperError> {
-    tofprobe_io::write_atomic(path, bytes).map_err(|source| PaperError::Io {
-        path: path.display().to_string(),
-        source,
-    })
 }
 
 #[cfg(test)]

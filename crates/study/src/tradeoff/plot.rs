@@ -7,12 +7,12 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::SceneResult;
-use crate::commands::spectrum_svg::write_atomic;
-use crate::error::CliError;
+use crate::error::StudyError;
+use crate::spectrum::write_atomic;
 
 /// Writes the SVG atomically; levels without a tone amplitude are left out.
-pub fn pareto_svg(path: &Path, scenes: &[SceneResult]) -> Result<(), CliError> {
-    let err = |e: &dyn std::fmt::Display| CliError::Output {
+pub fn pareto_svg(path: &Path, scenes: &[SceneResult]) -> Result<(), StudyError> {
+    let err = |e: &dyn std::fmt::Display| StudyError::Output {
         path: path.to_path_buf(),
         message: e.to_string(),
     };

@@ -1,17 +1,19 @@
-//! The whole TOML configuration document, loaded from a file or from the embedded default
-//! (`scenes/default.toml`, the paper's Fig. 8 case), and validated as a whole.
+//! The whole TOML configuration document, from a file or the embedded default
+//! (`scenes/default.toml`, the paper's Fig. 8 case). This module only parses: what the
+//! document means (validation, defaults, the pixel, the bins) is [`crate::resolve`]'s job,
+//! done once.
 //!
 //! Every table rejects unknown keys (`deny_unknown_fields`), so a typo is an error with a
 //! line and column, not a silently ignored setting. Sections added by later capabilities
-//! (e.g. `[probe]`, `[pixel]`) are `#[serde(default)]` fields of [`Config`].
+//! (e.g. `[probe]`, `[pixel]`) are `#[serde(default)]` fields of [`Document`].
 
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
-use tofprobe_pixel::{PixelContext, PixelParams};
+use tofprobe_pixel::PixelContext;
 use tofprobe_scene::{AcquisitionConfig, PhotonSource, Scene, SceneConfig, SensorConfig};
 
-use crate::error::CliError;
+use crate::error::DesignError;
 
 /// The embedded default configuration text (paper Fig. 8: 0.1 mm at 4.5 kHz on 30 mm,
 /// σ_I = 50 ps, ρ_s = 1, ρ_b = 0, 1 s at 10 MHz).
@@ -27,7 +29,7 @@ pub use tofprobe_pixel::sizing::SIZING_SIGMAS;
 /// The configuration document.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Config {
+pub struct Document {
     /// `[sensor]`: laser, jitter, TDC, window, photon rates.
     pub sensor: SensorConfig,
     /// `[scene]`: static depth and motions.
@@ -42,65 +44,23 @@ pub struct Config {
     pub probe: tofprobe_dsp::sd::ProbeConfig,
 }
 
-/// A loaded, validated configuration together with where it came from.
-#[derive(Debug, Clone)]
-pub struct Loaded {
-    /// The parsed document.
-    pub config: Config,
-    /// The file path, or [`DEFAULT_ORIGIN`].
-    pub origin: String,
-}
-
-impl Config {
+impl Document {
     /// Parses TOML text; `origin` names the source in error messages.
-    pub fn from_toml_str(text: &str, origin: &str) -> Result<Config, CliError> {
-        toml::from_str(text).map_err(|e| CliError::Toml {
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Document, DesignError> {
+        toml::from_str(text).map_err(|e| DesignError::Toml {
             origin: origin.to_string(),
             message: e.to_string().trim_end().to_string(),
         })
     }
 
-    /// Loads `path`, or the embedded default when `path` is `None`, and validates it.
-    pub fn load(path: Option<&Path>) -> Result<Loaded, CliError> {
+    /// Reads and parses `path`, or the embedded default when `path` is `None`; returns the
+    /// document and its origin (the path as given, or [`DEFAULT_ORIGIN`]).
+    pub fn read(path: Option<&Path>) -> Result<(Document, String), DesignError> {
         let (text, origin) = match path {
             None => (DEFAULT_TOML.to_string(), DEFAULT_ORIGIN.to_string()),
             Some(p) => (read_text(p)?, p.display().to_string()),
         };
-        let config = Config::from_toml_str(&text, &origin)?;
-        config.validate(&origin)?;
-        Ok(Loaded { config, origin })
-    }
-
-    /// Validates every section and their consistency (the window must contain the scene,
-    /// `[probe]` must be a valid design, `[pixel]` must resolve against the sensor, the
-    /// acquisition and the scene); `origin` names the file in the error.
-    pub fn validate(&self, origin: &str) -> Result<(), CliError> {
-        let scene_err = |source| CliError::Scene {
-            origin: origin.to_string(),
-            source,
-        };
-        self.sensor.validate().map_err(scene_err)?;
-        let scene = Scene::new(&self.scene).map_err(scene_err)?;
-        self.acquisition
-            .validate(self.sensor.laser_rate_hz)
-            .map_err(scene_err)?;
-        PhotonSource::new(&self.sensor, &scene, self.acquisition.seed).map_err(scene_err)?;
-        self.probe.validate().map_err(|source| CliError::Probe {
-            origin: origin.to_string(),
-            source,
-        })?;
-        let frame = self.pixel.frame_pulses.unwrap_or(self.pulses());
-        self.probe
-            .check_frame(frame)
-            .map_err(|source| CliError::Probe {
-                origin: origin.to_string(),
-                source,
-            })?;
-        self.pixel_params().map_err(|source| CliError::Pixel {
-            origin: origin.to_string(),
-            source,
-        })?;
-        Ok(())
+        Ok((Document::from_toml_str(&text, &origin)?, origin))
     }
 
     /// What the sensor, acquisition, probe design and scene tell the pixel: window codes,
@@ -127,53 +87,30 @@ impl Config {
         ctx.with_scene(scene.tones(), self.probe.osr, codes)
     }
 
-    /// The resolved `[pixel]`: its ROM depth defaults to the `[probe]` design's (L = N in
-    /// windowed mode, `probe.rom_depth` in periodic mode), so the pixel reads the ROM the
-    /// probe design generates.
-    pub fn pixel_params(&self) -> Result<PixelParams, tofprobe_pixel::PixelError> {
-        let ctx = self.pixel_context();
-        let mut px = self.pixel.clone();
-        if px.rom_depth.is_none() {
-            let n = px.frame_pulses.unwrap_or(ctx.pulses);
-            px.rom_depth = Some(self.probe.depth(n));
-        }
-        px.resolve(&ctx)
-    }
-
     /// The number of pulses N of the acquisition.
     pub fn pulses(&self) -> u64 {
         self.acquisition.pulses(self.sensor.laser_rate_hz)
     }
 
-    /// Builds the photon source of this configuration.
+    /// Builds the photon source of this document.
     pub fn photon_source(&self) -> Result<PhotonSource, tofprobe_scene::SceneError> {
         let scene = Scene::new(&self.scene)?;
         PhotonSource::new(&self.sensor, &scene, self.acquisition.seed)
     }
 }
 
-impl Loaded {
-    /// Wraps a scene error with this configuration's origin.
-    pub fn error(&self, source: tofprobe_scene::SceneError) -> CliError {
-        CliError::Scene {
-            origin: self.origin.clone(),
-            source,
-        }
-    }
-}
-
 /// Reads a file as UTF-8 text with a specific error for each way it can fail.
-pub fn read_text(path: &Path) -> Result<String, CliError> {
+pub fn read_text(path: &Path) -> Result<String, DesignError> {
     if path.is_dir() {
-        return Err(CliError::IsDirectory {
+        return Err(DesignError::IsDirectory {
             path: path.to_path_buf(),
         });
     }
-    let bytes = std::fs::read(path).map_err(|source| CliError::Read {
+    let bytes = std::fs::read(path).map_err(|source| DesignError::Read {
         path: path.to_path_buf(),
         source,
     })?;
-    String::from_utf8(bytes).map_err(|e| CliError::NotUtf8 {
+    String::from_utf8(bytes).map_err(|e| DesignError::NotUtf8 {
         path: PathBuf::from(path),
         offset: e.utf8_error().valid_up_to(),
     })
@@ -186,8 +123,8 @@ mod tests {
     /// The embedded default is the paper's Fig. 8 case, and it validates.
     #[test]
     fn embedded_default_is_fig8() {
-        let loaded = Config::load(None).expect("default loads");
-        let c = &loaded.config;
+        let loaded = crate::load(None).expect("default loads");
+        let c = &loaded.document;
         assert_eq!(c.pulses(), 10_000_000); // 1 s at 10 MHz
         assert_eq!(c.sensor.jitter_mm(), 7.5); // 50 ps · 0.15 mm/ps
         assert_eq!(c.sensor.tdc_codes(), 80); // 400 ps / 5 ps
@@ -222,12 +159,12 @@ mod tests {
             } else {
                 key
             };
-            let err = Config::from_toml_str(&text, "t.toml").expect_err("unknown key");
+            let err = Document::from_toml_str(&text, "t.toml").expect_err("unknown key");
             let msg = err.to_string();
             assert!(msg.contains("colour"), "{msg}");
             assert!(msg.contains(&format!("line {line}")), "{msg}");
         }
         let extra_section = format!("{DEFAULT_TOML}\n[extra]\nx = 1\n");
-        assert!(Config::from_toml_str(&extra_section, "t.toml").is_err());
+        assert!(Document::from_toml_str(&extra_section, "t.toml").is_err());
     }
 }

@@ -7,12 +7,13 @@ use rayon::prelude::*;
 use tofprobe_dsp::Window;
 use tofprobe_dsp::closed_form::{noise_floor_mm, sigma_total_mm};
 use tofprobe_dsp::dft::amplitude_spectrum;
-use tofprobe_dsp::preprocess::{FrontEnd, FrontEndOutput};
 use tofprobe_dsp::stats::{NoiseBand, noise_floor};
 use tofprobe_scene::MM_PER_PS;
 
 use super::setup::{FS_HZ, Setup};
-use super::{PaperError, Row, Tolerance};
+use super::{Row, Tolerance};
+use crate::StudyError;
+use crate::records::held_record;
 
 /// (σ_I ps, paper rectangular µm, corrected Blackman µm).
 pub const POINTS: &[(f64, f64, f64)] = &[(2.0, 0.53, 0.70), (20.0, 5.3, 6.98), (200.0, 53.0, 69.8)];
@@ -22,7 +23,7 @@ const LSB_MM: f64 = 0.01;
 /// White noise: any band away from DC; 1 kHz – 1 MHz (99,000 bins at 10 Hz).
 const BAND: (f64, f64) = (1_000.0, 1_000_000.0);
 
-fn one(sigma_i_ps: f64, paper: f64, blackman: f64, n: u64) -> Result<Vec<Row>, PaperError> {
+fn one(sigma_i_ps: f64, paper: f64, blackman: f64, n: u64) -> Result<Vec<Row>, StudyError> {
     let jitter = sigma_i_ps * MM_PER_PS;
     let sigma_s = sigma_total_mm(jitter, LSB_MM);
     let setup = Setup {
@@ -35,11 +36,7 @@ fn one(sigma_i_ps: f64, paper: f64, blackman: f64, n: u64) -> Result<Vec<Row>, P
     };
     let source = setup.source(0)?;
     let det = source.record(n);
-    let mut fe = FrontEnd::new(setup.depth_mm(), FrontEndOutput::Held)?;
-    let held: Vec<f64> = det
-        .iter()
-        .map(|d| fe.step(d.map(|c| source.code_to_depth_mm(c))))
-        .collect();
+    let held = held_record(&source, &det, setup.depth_mm())?;
     let mut rows = Vec::new();
     for (w, paper_v, design_v) in [
         (Window::Rectangular, Some(paper), None),
@@ -66,8 +63,8 @@ fn one(sigma_i_ps: f64, paper: f64, blackman: f64, n: u64) -> Result<Vec<Row>, P
 }
 
 /// The Fig. 4 rows (record length `n`; the figure's is [`N`]).
-pub fn rows(n: u64) -> Result<Vec<Row>, PaperError> {
-    let per: Result<Vec<Vec<Row>>, PaperError> = POINTS
+pub fn rows(n: u64) -> Result<Vec<Row>, StudyError> {
+    let per: Result<Vec<Vec<Row>>, StudyError> = POINTS
         .par_iter()
         .map(|&(s, p, b)| one(s, p, b, n))
         .collect();

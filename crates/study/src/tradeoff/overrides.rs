@@ -1,20 +1,25 @@
 //! Knob settings as data: a configuration with some TOML keys replaced (`pixel.frac_bits =
 //! 0`, `probe.rom_mode = "periodic"`, …), re-validated as a whole, so a sweep is a list of
-//! (key, value) pairs and every setting goes through the same checks as a user's file.
+//! (key, value) pairs and every setting goes through the same resolution as a user's file.
 
-use crate::config::Config;
-use crate::error::CliError;
+use tofprobe_design::{DesignError, Document, ProbeCache, ResolvedDesign, resolve_with};
+
+use crate::error::StudyError;
 
 /// `config` with each `(dotted.key, TOML value)` of `overrides` set (tables created as
-/// needed), then validated; `origin` names the result in errors.
+/// needed), then resolved (probe designs reused from `cache`); `origin` names the result
+/// in errors.
 pub fn with_overrides(
-    config: &Config,
+    config: &Document,
     origin: &str,
     overrides: &[(&str, &str)],
-) -> Result<Config, CliError> {
-    let toml_err = |message: String| CliError::Toml {
-        origin: origin.to_string(),
-        message,
+    cache: &mut ProbeCache,
+) -> Result<ResolvedDesign, StudyError> {
+    let toml_err = |message: String| {
+        StudyError::from(DesignError::Toml {
+            origin: origin.to_string(),
+            message,
+        })
     };
     let mut doc = toml::Table::try_from(config).map_err(|e| toml_err(e.to_string()))?;
     for &(key, value) in overrides {
@@ -42,16 +47,15 @@ pub fn with_overrides(
         }
         table.insert(leaf.to_string(), v);
     }
-    let cfg: Config = doc
+    let cfg: Document = doc
         .try_into()
         .map_err(|e: toml::de::Error| toml_err(e.to_string().trim_end().to_string()))?;
-    cfg.validate(origin)?;
-    Ok(cfg)
+    Ok(resolve_with(cfg, origin, cache)?)
 }
 
 /// `config` shortened to `pulses` (when it has more): the acquisition's N set directly and
 /// any explicit `pixel.frame_pulses` cleared, so the ROM and the frame follow.
-pub fn shortened(config: &Config, pulses: u64) -> Config {
+pub fn shortened(config: &Document, pulses: u64) -> Document {
     let mut c = config.clone();
     if c.pulses() > pulses {
         c.acquisition.pulses = Some(pulses);
@@ -64,10 +68,10 @@ pub fn shortened(config: &Config, pulses: u64) -> Config {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::{DEFAULT_ORIGIN, DEFAULT_TOML};
+    use tofprobe_design::{DEFAULT_ORIGIN, DEFAULT_TOML};
 
-    fn default() -> Config {
-        Config::from_toml_str(DEFAULT_TOML, DEFAULT_ORIGIN).expect("default")
+    fn default() -> Document {
+        Document::from_toml_str(DEFAULT_TOML, DEFAULT_ORIGIN).expect("default")
     }
 
     #[test]
@@ -81,8 +85,10 @@ mod tests {
                 ("probe.rom_mode", "\"periodic\""),
                 ("sensor.background_rate", "0.5"),
             ],
+            &mut ProbeCache::default(),
         )
-        .expect("valid");
+        .expect("valid")
+        .document;
         assert_eq!(c.pixel.frac_bits, 4);
         assert_eq!(c.probe.rom_mode, tofprobe_dsp::sd::RomMode::Periodic);
         assert_eq!(c.sensor.background_rate, 0.5);
@@ -93,9 +99,21 @@ mod tests {
     #[test]
     fn override_to_an_invalid_value_is_rejected_by_validation() {
         // C = 16 cycles cannot serve B = 32 bins on A = 2 adders (needs C ≥ 2B/A = 32).
-        let e = with_overrides(&default(), "t", &[("pixel.bins", "32")]).unwrap_err();
+        let e = with_overrides(
+            &default(),
+            "t",
+            &[("pixel.bins", "32")],
+            &mut ProbeCache::default(),
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("t"), "{e}");
-        let e = with_overrides(&default(), "t", &[("pixel.no_such_knob", "1")]).unwrap_err();
+        let e = with_overrides(
+            &default(),
+            "t",
+            &[("pixel.no_such_knob", "1")],
+            &mut ProbeCache::default(),
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("no_such_knob"), "{e}");
     }
 

@@ -25,7 +25,8 @@ use tofprobe_scene::PhotonSource;
 
 use super::setup::{FS_HZ, LSB_MM, Setup};
 use super::sigma_delta::{self, Phasor, ProbeSetup};
-use super::{PaperError, Row, Tolerance};
+use super::{Row, Tolerance};
+use crate::StudyError;
 
 /// The analysis window of Table 2.
 pub const WINDOW: Window = Window::Blackman;
@@ -131,14 +132,28 @@ pub struct Measurement {
     pub bit_true: Option<sigma_delta::BitTrue>,
 }
 
-/// The data a column sees: the row, its source, the detections of the whole record. The
-/// ΣΔ columns take the probe ROM shared by all rows of the same N from
-/// [`ProbeSetup::shared`].
+/// The data a column sees: the row, its source, the detections of the whole record, and
+/// the probe ROM shared by all rows of the same N (built once by the caller; `None` when
+/// only the DFT column runs).
 #[derive(Debug)]
 pub struct RowRecord<'a> {
     pub spec: &'a Spec,
     pub source: &'a PhotonSource,
     pub detections: &'a [Option<u32>],
+    pub probe: Option<&'a ProbeSetup>,
+}
+
+impl RowRecord<'_> {
+    /// The shared probe ROM the ΣΔ columns read.
+    fn probe(&self) -> Result<&ProbeSetup, StudyError> {
+        self.probe.ok_or_else(|| {
+            StudyError::option(
+                "columns",
+                "ΣΔ",
+                "the DFT column alone without a ProbeSetup (run_all_with(n, None, …))",
+            )
+        })
+    }
 }
 
 /// A column of the table: a name and a function from a row's record to a measurement
@@ -146,7 +161,7 @@ pub struct RowRecord<'a> {
 #[derive(Debug, Clone, Copy)]
 pub struct Column {
     pub name: &'static str,
-    pub measure: fn(&RowRecord<'_>) -> Result<Option<Measurement>, PaperError>,
+    pub measure: fn(&RowRecord<'_>) -> Result<Option<Measurement>, StudyError>,
 }
 
 /// Column names.
@@ -181,18 +196,13 @@ fn tone_bin(n: usize) -> usize {
 }
 
 /// The held depth of a whole record (mm, from the window start), unprimed pulses 0.
-pub fn held_record(rec: &RowRecord<'_>) -> Result<Vec<f64>, PaperError> {
-    let mut fe = FrontEnd::new(0.0, FrontEndOutput::Held)?;
-    Ok(rec
-        .detections
-        .iter()
-        .map(|d| fe.step(d.map(|c| rec.source.code_to_depth_mm(c))))
-        .collect())
+pub fn held_record(rec: &RowRecord<'_>) -> Result<Vec<f64>, StudyError> {
+    crate::records::held_record(rec.source, rec.detections, 0.0)
 }
 
 /// The full-FFT column: noise floor over the band, peak by quadratic interpolation, and
 /// the normalised complex bins 2/(N·G)·X[k] at the probe bins.
-pub fn dft_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, PaperError> {
+pub fn dft_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, StudyError> {
     let held = held_record(rec)?;
     let n = held.len();
     let half = windowed_dft_half(&held, WINDOW)?;
@@ -226,23 +236,31 @@ fn probe_measurement(rec: &RowRecord<'_>, phasors: Vec<Phasor>) -> Measurement {
     }
 }
 
-/// Float ΣΔ probing of the held record, prefiltered (α = 2^−S).
-fn sd_probe(rec: &RowRecord<'_>, alpha: Option<f64>) -> Result<Measurement, PaperError> {
-    let probe = ProbeSetup::shared(rec.detections.len() as u64)?;
-    let held = held_record(rec)?;
-    let sums = tofprobe_dsp::sd::probe_record(&probe.rom, held.iter().copied(), alpha);
+/// Float ΣΔ probing of the record's detections by the pixel's rules — the one float front
+/// end's hold, priming and prefilter (α = 2^−S), or the hold alone with `alpha = None` —
+/// the pixel's float twin, zoomed to the static depth δ0 (the pixel's zoom Z): the
+/// priming pulse adds nothing, so an unzoomed 30 mm offset would leave s_r(0)·δ0 in every
+/// register, ≈ 14 µm at 150 kHz for N = 2^16 (negligible at 10^7, but not the DFT's).
+fn sd_probe(rec: &RowRecord<'_>, alpha: Option<f64>) -> Result<Measurement, StudyError> {
+    let probe = rec.probe()?;
+    let zoom = rec.spec.setup().depth_mm();
+    let depths = rec
+        .detections
+        .iter()
+        .map(|d| d.map(|c| rec.source.code_to_depth_mm(c) - zoom));
+    let sums = tofprobe_dsp::sd::probe_detections(&probe.rom, depths, alpha);
     Ok(probe_measurement(rec, probe.phasors(&sums, alpha)))
 }
 
 /// The float ΣΔ column: the held record prefiltered (α = 1/32) and probed by the ROM.
-pub fn sd_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, PaperError> {
+pub fn sd_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, StudyError> {
     sd_probe(rec, Some(sigma_delta::alpha())).map(Some)
 }
 
 /// The float ΣΔ column without the prefilter: the paper's observation that its error is
 /// several times the floor. Run on the ρ_s = 1, ρ_b = 0 rows only (the setting of the
 /// paper's remark; it costs a full probing pass per row).
-pub fn sd_raw_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, PaperError> {
+pub fn sd_raw_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, StudyError> {
     if rec.spec.rho_s < 1.0 || rec.spec.rho_b > 0.0 {
         return Ok(None);
     }
@@ -250,10 +268,10 @@ pub fn sd_raw_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, PaperEr
 }
 
 /// The bit-true column: the record's TDC codes through the transaction model.
-pub fn bit_true_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, PaperError> {
+pub fn bit_true_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, StudyError> {
     let codes = (rec.spec.setup().window_mm / LSB_MM).ceil() as u32;
-    let probe = ProbeSetup::shared(rec.detections.len() as u64)?;
-    let bt = sigma_delta::bit_true(&probe, rec.detections, codes)?;
+    let probe = rec.probe()?;
+    let bt = sigma_delta::bit_true(probe, rec.detections, codes)?;
     // Codes are 1 mm (LSB_MM), so the phasors are already in mm.
     let mut m = probe_measurement(
         rec,
@@ -264,7 +282,7 @@ pub fn bit_true_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, Paper
 }
 
 /// Noise floor and amplitude of a one-sided amplitude spectrum (mm) → µm.
-pub fn measure_spectrum(spectrum: &[f64], n: usize, tone: bool) -> Result<Measurement, PaperError> {
+pub fn measure_spectrum(spectrum: &[f64], n: usize, tone: bool) -> Result<Measurement, StudyError> {
     let k0 = tone_bin(n);
     let tones: Vec<f64> = if tone { vec![k0 as f64] } else { vec![] };
     let noise = noise_floor(spectrum, n, FS_HZ, &NoiseBand::new(BAND.0, BAND.1), &tones)?;
@@ -282,7 +300,7 @@ pub fn measure_spectrum(spectrum: &[f64], n: usize, tone: bool) -> Result<Measur
 }
 
 /// Amplitude of one seed by streaming (selected bins k0−1, k0, k0+1), µm.
-fn streamed_amplitude(setup: &Setup, n: u64, seed: u64) -> Result<f64, PaperError> {
+fn streamed_amplitude(setup: &Setup, n: u64, seed: u64) -> Result<f64, StudyError> {
     let source = setup.source(seed)?;
     let k0 = tone_bin(n as usize);
     let mut sb = SelectedBins::new(n, &[k0 - 1, k0, k0 + 1], WINDOW)?;
@@ -310,7 +328,7 @@ fn streamed_amplitude(setup: &Setup, n: u64, seed: u64) -> Result<f64, PaperErro
 /// The closed-form noise floor of a row over the same band bins (µm): eq. 12 with the
 /// mixture variance (plus a²/12) and the held-noise factor F(ρ_v, ω) averaged as
 /// sqrt(F) over the band's bins, like the measured mean magnitude.
-pub fn closed_form_noise_um(spec: &Spec, n: usize) -> Result<f64, PaperError> {
+pub fn closed_form_noise_um(spec: &Spec, n: usize) -> Result<f64, StudyError> {
     let setup = spec.setup();
     let fa = first_arrival(&MixtureParams {
         signal_rate: spec.rho_s,
@@ -341,7 +359,7 @@ pub fn closed_form_noise_um(spec: &Spec, n: usize) -> Result<f64, PaperError> {
 
 /// The expected tone amplitude (µm): the mixture's mean follows the signal with gain
 /// g = ∂μ/∂t_s, and the hold's mean response at f0 is |H(ρ_v, ω0)|.
-pub fn closed_form_amp_um(spec: &Spec) -> Result<Option<f64>, PaperError> {
+pub fn closed_form_amp_um(spec: &Spec) -> Result<Option<f64>, StudyError> {
     let Some(a) = spec.amp_um else {
         return Ok(None);
     };
@@ -380,8 +398,9 @@ pub struct RowResult {
 pub fn run_row_with(
     spec: &Spec,
     n: u64,
+    probe: Option<&ProbeSetup>,
     columns_to_run: &[Column],
-) -> Result<RowResult, PaperError> {
+) -> Result<RowResult, StudyError> {
     let setup = spec.setup();
     let source = setup.source(0)?;
     let detections = source.record(n);
@@ -389,6 +408,7 @@ pub fn run_row_with(
         spec,
         source: &source,
         detections: &detections,
+        probe,
     };
     let mut columns = Vec::new();
     for c in columns_to_run {
@@ -406,7 +426,7 @@ pub fn run_row_with(
     let mut amps_um = Vec::new();
     if let Some(a0) = columns[0].1.amp_um {
         amps_um.push(a0);
-        let rest: Result<Vec<f64>, PaperError> = (1..SEEDS)
+        let rest: Result<Vec<f64>, StudyError> = (1..SEEDS)
             .into_par_iter()
             .map(|s| streamed_amplitude(&setup, n, s))
             .collect();
@@ -491,15 +511,20 @@ pub fn rows_of(r: &RowResult, quick: bool) -> Vec<Row> {
     out
 }
 
-/// Runs every row (rayon across rows), all sharing one probe ROM built for `n`.
-pub fn run_all(n: u64) -> Result<Vec<RowResult>, PaperError> {
-    run_all_with(n, COLUMNS)
+/// Runs every row (rayon across rows), all sharing the probe ROM `probe` (N = `probe.n`).
+pub fn run_all(probe: &ProbeSetup) -> Result<Vec<RowResult>, StudyError> {
+    run_all_with(probe.n, Some(probe), COLUMNS)
 }
 
-/// [`run_all`] with a chosen set of columns (see [`run_row_with`]).
-pub fn run_all_with(n: u64, columns: &[Column]) -> Result<Vec<RowResult>, PaperError> {
+/// [`run_all`] with a chosen set of columns (see [`run_row_with`]); the ΣΔ columns need
+/// `probe`, built for N = `n`.
+pub fn run_all_with(
+    n: u64,
+    probe: Option<&ProbeSetup>,
+    columns: &[Column],
+) -> Result<Vec<RowResult>, StudyError> {
     ROWS.par_iter()
-        .map(|s| run_row_with(s, n, columns))
+        .map(|s| run_row_with(s, n, probe, columns))
         .collect()
 }
 
@@ -536,7 +561,8 @@ mod tests {
     fn short_row_matches_closed_form() {
         let spec = ROWS[9];
         let n = 1u64 << 18;
-        let r = run_row_with(&spec, n, COLUMNS).unwrap();
+        let probe = crate::paper::sigma_delta::tests::setup_for_tests(n);
+        let r = run_row_with(&spec, n, Some(&probe), COLUMNS).unwrap();
         let m = &r.columns[0].1;
         assert!(
             (m.noise_um / r.closed_form_um - 1.0).abs() < 0.15,

@@ -15,12 +15,14 @@ use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
 
+use super::dft_bins;
 use super::overrides::{shortened, with_overrides};
 use super::timing::median_seconds;
-use super::{dft_bins, held_record};
-use crate::commands::spectrum_svg::{BitTrueSetup, setup};
-use crate::config::Config;
-use crate::error::CliError;
+use tofprobe_design::{DesignError, ProbeCache, ResolvedDesign};
+
+use crate::error::StudyError;
+use crate::records::{detection_record, held_record};
+use crate::spectrum::{BitTrueSetup, setup};
 
 /// ρ_b that forces the background path while adding ~10^−5 photons to a 10^7-pulse frame.
 pub const TINY_BACKGROUND: f64 = 1e-12;
@@ -67,21 +69,18 @@ fn row(stage: &str, comparison: &str, with: f64, without: f64) -> SkipRow {
     }
 }
 
-/// Times each skip on `config` shortened to at most `pulses`, `reps` runs per timing.
+/// Times each skip on `design` shortened to at most `pulses`, `reps` runs per timing.
 /// The scene's own ρ_s and ρ_b are replaced by the pair compared.
 pub fn measure_skips(
-    config: &Config,
-    origin: &str,
+    design: &ResolvedDesign,
     pulses: u64,
     reps: usize,
-) -> Result<SkipReport, CliError> {
+) -> Result<SkipReport, StudyError> {
+    let (config, origin) = (&design.document, design.origin.as_str());
     let base = shortened(config, pulses);
     let n = base.pulses();
-    let scene_err = |o: &str, source| CliError::Scene {
-        origin: o.to_string(),
-        source,
-    };
-    let rate = |rho_s: f64, rho_b: f64| -> Result<Config, CliError> {
+    let mut cache = ProbeCache::default();
+    let mut rate = |rho_s: f64, rho_b: f64| -> Result<ResolvedDesign, StudyError> {
         with_overrides(
             &base,
             &format!("{origin} with rho_s = {rho_s}, rho_b = {rho_b}"),
@@ -89,6 +88,7 @@ pub fn measure_skips(
                 ("sensor.signal_rate", &format!("{rho_s:e}")),
                 ("sensor.background_rate", &format!("{rho_b:e}")),
             ],
+            &mut cache,
         )
     };
     let clean = rate(1.0, 0.0)?;
@@ -97,12 +97,12 @@ pub fn measure_skips(
     let mut stages = Vec::new();
 
     // Background sampling: the photon source alone.
-    let fill = |c: &Config| -> Result<f64, CliError> {
-        let src = c.photon_source().map_err(|e| scene_err(origin, e))?;
+    let fill = |c: &ResolvedDesign| -> Result<f64, StudyError> {
+        let src = c.photon_source()?;
         let mut codes = vec![None; usize::try_from(n).unwrap_or(usize::MAX)];
         median_seconds(reps, || {
             src.fill_counted(0, &mut codes);
-            Ok::<(), CliError>(())
+            Ok::<(), StudyError>(())
         })
     };
     stages.push(row(
@@ -113,17 +113,14 @@ pub fn measure_skips(
     ));
 
     // The hold: the bit-true model on the same ROM.
-    let su: BitTrueSetup = setup(&clean, origin)?;
-    let lsb = clean.sensor.tdc_lsb_mm();
-    let bit_true = |c: &Config| -> Result<f64, CliError> {
-        let src = c.photon_source().map_err(|e| scene_err(origin, e))?;
+    let su: BitTrueSetup = setup(&clean)?;
+    let lsb = clean.sensor().tdc_lsb_mm();
+    let bit_true = |c: &ResolvedDesign| -> Result<f64, StudyError> {
+        let src = c.photon_source()?;
         median_seconds(reps, || {
             bit_true_spectrum(&su.params, &su.rom, &src, lsb)
                 .map(|_| ())
-                .map_err(|source| CliError::Pixel {
-                    origin: origin.to_string(),
-                    source,
-                })
+                .map_err(|source| StudyError::from(DesignError::pixel(origin, source)))
         })
     };
     let bt_clean = bit_true(&clean)?;
@@ -135,14 +132,12 @@ pub fn measure_skips(
     ));
 
     // Only the configured bins: B-bin streamed DFT vs the full FFT on one record.
-    let src = clean.photon_source().map_err(|e| scene_err(origin, e))?;
-    let depths = held_record(&src, n);
+    let src = clean.photon_source()?;
+    let codes = detection_record(&src, n);
+    let depths = held_record(&src, &codes, 0.0)?;
     let bins = dft_bins(&su.rom.bin_indices, n, su.params.rom_depth);
     let window = su.rom.window;
-    let dsp_err = |source| CliError::Probe {
-        origin: origin.to_string(),
-        source,
-    };
+    let dsp_err = |source| StudyError::from(DesignError::probe(origin, source));
     let selected = median_seconds(reps, || {
         let mut sel = SelectedBins::new(n, &bins, window).map_err(dsp_err)?;
         for chunk in depths.chunks(1 << 16) {
@@ -167,7 +162,7 @@ pub fn measure_skips(
 
     // No full DFT unless asked: the record and the FFT on top of the bit-true model.
     let record = median_seconds(reps, || {
-        let d = held_record(&src, n);
+        let d = held_record(&src, &detection_record(&src, n), 0.0)?;
         amplitude_spectrum(&d, window).map(|_| ()).map_err(dsp_err)
     })?;
     stages.push(row(

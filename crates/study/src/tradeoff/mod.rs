@@ -5,7 +5,6 @@
 //! tone amplitude and the noise floor (mean amplitude over the noise bins) against the
 //! float full DFT and against the scene's true amplitude.
 
-pub mod design_cache;
 pub mod knobs;
 pub mod overrides;
 pub mod plot;
@@ -20,15 +19,16 @@ use tofprobe_dsp::closed_form::{
     hold_response_sq, noise_floor_hold_mm, noise_floor_mm, sigma_total_mm,
 };
 use tofprobe_dsp::dft::amplitude_spectrum;
-use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_record};
+use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_detections};
 use tofprobe_pixel::autobins::choose_bins;
 use tofprobe_pixel::bench::bench_cycle;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
-use tofprobe_scene::PhotonSource;
 
-use crate::commands::spectrum_svg::{BitTrueSetup, setup};
-use crate::config::Config;
-use crate::error::CliError;
+use tofprobe_design::{DesignError, ResolvedDesign};
+
+use crate::error::StudyError;
+use crate::records::{detection_record, held_record};
+use crate::spectrum::{BitTrueSetup, setup};
 
 /// Pulses of the shortened frame the cycle-accurate model is timed on.
 pub const CYCLE_FRAME: u64 = 1 << 14;
@@ -70,32 +70,28 @@ pub struct SceneResult {
 /// The levels' raw readings before scoring: (name, wall s, extrapolated, tone µm, noise µm).
 type Reading = (&'static str, f64, bool, Option<f64>, f64);
 
-/// Measures every level on `config` (Fourier pixel; the float levels use its ROM's bins);
+/// Measures every level on `design` (Fourier pixel; the float levels use its ROM's bins);
 /// with `verilator`, also the Verilator RTL on a shortened frame (builds the harness).
-pub fn measure(config: &Config, origin: &str, verilator: bool) -> Result<SceneResult, CliError> {
-    let su: BitTrueSetup = setup(config, origin)?;
-    measure_setup(config, origin, &su, verilator)
+pub fn measure(design: &ResolvedDesign, verilator: bool) -> Result<SceneResult, StudyError> {
+    let su: BitTrueSetup = setup(design)?;
+    measure_setup(design, &su, verilator)
 }
 
-/// [`measure`] with the pixel already resolved and its ROM generated (`su` from
-/// [`setup`] on the same `config`), so a caller that also times the bit-true model on its
-/// own generates the ROM once.
+/// [`measure`] with the ROM already generated (`su` from [`setup`] on the same `design`),
+/// so a caller that also times the bit-true model on its own generates the ROM once.
 pub fn measure_setup(
-    config: &Config,
-    origin: &str,
+    design: &ResolvedDesign,
     su: &BitTrueSetup,
     verilator: bool,
-) -> Result<SceneResult, CliError> {
-    let scene_err = |source| CliError::Scene {
-        origin: origin.to_string(),
-        source,
-    };
+) -> Result<SceneResult, StudyError> {
+    let (config, origin) = (&design.document, design.origin.as_str());
+    let scene_err = |source| StudyError::from(DesignError::scene(origin, source));
     let source = config.photon_source().map_err(scene_err)?;
     let n = su.params.frame_pulses;
     let fs = config.sensor.laser_rate_hz;
     let sim_seconds = n as f64 / fs;
     let lsb_mm = config.sensor.tdc_lsb_mm();
-    let ctx = config.pixel_context();
+    let ctx = &design.context;
     let choice = choose_bins(
         &ctx.tones,
         fs,
@@ -103,10 +99,7 @@ pub fn measure_setup(
         config.probe.osr,
         Some(su.params.bins),
     )
-    .map_err(|source| CliError::Pixel {
-        origin: origin.to_string(),
-        source,
-    })?;
+    .map_err(|source| StudyError::from(DesignError::pixel(origin, source)))?;
     let tone_bin = choice.tones.first().copied();
     let true_amp = tone_bin.and_then(|k| {
         ctx.tones
@@ -129,10 +122,11 @@ pub fn measure_setup(
     };
     let mut readings: Vec<Reading> = Vec::new();
 
-    // The held depth record (mm), as the pixel sees it: last valid detection, the first
-    // detection before the first one (the float references' priming convention).
+    // The detections (mm) and the held depth record, as the pixel sees them: the one
+    // float front end's hold, nothing before the first detection.
     let t0 = Instant::now();
-    let depths = held_record(&source, n);
+    let detections = detection_record(&source, n);
+    let depths = held_record(&source, &detections, 0.0)?;
     let record_s = t0.elapsed().as_secs_f64();
 
     // Closed form: eq. 12 with the window's N_eff and the 1NN hold at ρ = ρ_s (noise factor
@@ -168,10 +162,8 @@ pub fn measure_setup(
 
     // Float full DFT (rustfft over the whole record).
     let t = Instant::now();
-    let spec = amplitude_spectrum(&depths, window).map_err(|source| CliError::Probe {
-        origin: origin.to_string(),
-        source,
-    })?;
+    let spec = amplitude_spectrum(&depths, window)
+        .map_err(|source| StudyError::from(DesignError::probe(origin, source)))?;
     // ROM bin k is f = k·f_s/L; in the N-point DFT that is k·N/L (equal in windowed mode,
     // the nearest bin in periodic mode when L does not divide N).
     let dft_bins = dft_bins(&su.rom.bin_indices, n, su.params.rom_depth);
@@ -192,10 +184,7 @@ pub fn measure_setup(
     // Float selected-bin DFT (streamed, only the B bins).
     let t = Instant::now();
     let bins = dft_bins;
-    let dsp_err = |source| CliError::Probe {
-        origin: origin.to_string(),
-        source,
-    };
+    let dsp_err = |source| StudyError::from(DesignError::probe(origin, source));
     let mut sel = SelectedBins::new(n, &bins, window).map_err(dsp_err)?;
     for chunk in depths.chunks(1 << 16) {
         sel.push(chunk).map_err(dsp_err)?;
@@ -215,10 +204,15 @@ pub fn measure_setup(
         nz,
     ));
 
-    // Float ΣΔ probing (same ROM, float prefilter α = 2^−S).
+    // Float ΣΔ probing: the pixel's float twin (same ROM, the front end's hold, priming
+    // and prefilter α = 2^−S on the same detections).
     let t = Instant::now();
     let alpha = 1.0 / f64::from(1u32 << su.params.shift);
-    let sums = probe_record(&su.rom, depths.iter().copied(), Some(alpha));
+    let zoom = f64::from(su.params.zoom);
+    let twin = detections
+        .iter()
+        .map(|c| c.map(|c| (f64::from(c) - zoom) * lsb_mm));
+    let sums = probe_detections(&su.rom, twin, Some(alpha));
     let amps = amplitudes_um(&normalise(&su.rom, &sums, n, Some(alpha)));
     let (a, nz) = score(&amps);
     readings.push((
@@ -229,15 +223,12 @@ pub fn measure_setup(
         nz,
     ));
     drop(depths);
+    drop(detections);
 
     // Bit-true transaction model (streams the photon source itself).
     let t = Instant::now();
-    let bt = bit_true_spectrum(&su.params, &su.rom, &source, lsb_mm).map_err(|source| {
-        CliError::Pixel {
-            origin: origin.to_string(),
-            source,
-        }
-    })?;
+    let bt = bit_true_spectrum(&su.params, &su.rom, &source, lsb_mm)
+        .map_err(|source| StudyError::from(DesignError::pixel(origin, source)))?;
     let amps: Vec<f64> = bt.bins.iter().map(|b| b.amplitude_um).collect();
     let (a, nz) = score(&amps);
     readings.push((
@@ -256,10 +247,8 @@ pub fn measure_setup(
     short.frame_pulses = CYCLE_FRAME.min(n);
     short.rom_depth = short.rom_depth.min(short.frame_pulses as usize);
     let rom = tofprobe_pixel::bench::synthetic_rom(short.rom_depth, short.registers());
-    let cb = bench_cycle(&short, &rom, 1).map_err(|source| CliError::Pixel {
-        origin: origin.to_string(),
-        source,
-    })?;
+    let cb = bench_cycle(&short, &rom, 1)
+        .map_err(|source| StudyError::from(DesignError::pixel(origin, source)))?;
     let per_pulse = cb.seconds / short.frame_pulses as f64;
     readings.push(("cycle-accurate", per_pulse * n as f64, true, a, nz));
 
@@ -280,7 +269,7 @@ pub fn measure_setup(
         o.stimulus = Some(stim);
         let rep = tofprobe_cosim::cosim(&rtl, &o)?;
         if !rep.pass {
-            return Err(CliError::Output {
+            return Err(StudyError::Output {
                 path: work,
                 message: "Verilator co-simulation mismatched the model; run `tofprobe cosim`"
                     .into(),
@@ -315,25 +304,6 @@ pub fn measure_setup(
         true_amplitude_um: true_amp,
         levels,
     })
-}
-
-/// The held depth record (mm) of `n` pulses as the pixel sees it: the last valid
-/// detection, the first detection before the first one (the float references' priming
-/// convention).
-pub fn held_record(source: &PhotonSource, n: u64) -> Vec<f64> {
-    let mut codes = vec![None; usize::try_from(n).unwrap_or(usize::MAX)];
-    source.fill_counted(0, &mut codes);
-    let first = codes.iter().flatten().next().copied().unwrap_or(0);
-    let mut held = source.code_to_depth_mm(first);
-    codes
-        .iter()
-        .map(|c| {
-            if let Some(c) = c {
-                held = source.code_to_depth_mm(*c);
-            }
-            held
-        })
-        .collect()
 }
 
 /// The ROM's bins k·f_s/L as indices of the N-point DFT (equal in windowed mode, the

@@ -3,7 +3,7 @@
 use tofprobe_dsp::closed_form::jitter_for_total_mm;
 use tofprobe_scene::{MM_PER_PS, MotionConfig, PhotonSource, Scene, SceneConfig, SensorConfig};
 
-use super::PaperError;
+use crate::StudyError;
 
 /// Laser rate of every experiment (the paper's 10 MHz).
 pub const FS_HZ: f64 = 10e6;
@@ -43,11 +43,11 @@ impl Setup {
     }
 
     /// Jitter σ_I giving the total σ_s with this LSB: sqrt(σ_s² − a²/12).
-    pub fn jitter_mm(&self) -> Result<f64, PaperError> {
+    pub fn jitter_mm(&self) -> Result<f64, StudyError> {
         Ok(jitter_for_total_mm(self.sigma_s_mm, self.lsb_mm)?)
     }
 
-    pub fn source(&self, seed: u64) -> Result<PhotonSource, PaperError> {
+    pub fn source(&self, seed: u64) -> Result<PhotonSource, StudyError> {
         let sensor = SensorConfig {
             laser_rate_hz: FS_HZ,
             jitter_ps: self.jitter_mm()? / MM_PER_PS,

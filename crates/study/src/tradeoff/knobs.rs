@@ -9,12 +9,13 @@
 use serde::Serialize;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
 
-use super::design_cache::DesignCache;
+use tofprobe_design::{DesignError, Document, ProbeCache, ResolvedDesign};
+
 use super::overrides::{shortened, with_overrides};
 use super::timing::median_seconds;
 use super::{LevelResult, measure_setup};
-use crate::config::Config;
-use crate::error::CliError;
+use crate::error::StudyError;
+use crate::spectrum::setup;
 
 /// One knob setting: the knob's name, the value shown, and the TOML keys it sets. A value
 /// `{w_min}`, `{w_min+k}` or `{w_min-k}` is the width `width = "auto"` sizes for the
@@ -153,27 +154,21 @@ pub struct KnobSweep {
     pub rows: Vec<KnobRow>,
 }
 
-/// Runs `settings` on `config` shortened to at most `pulses`, timing the bit-true model
+/// Runs `settings` on `design` shortened to at most `pulses`, timing the bit-true model
 /// `reps` times per setting.
 pub fn sweep(
-    config: &Config,
-    origin: &str,
+    design: &ResolvedDesign,
     settings: &[KnobSetting],
     pulses: u64,
     reps: usize,
 ) -> KnobSweep {
+    let (config, origin) = (&design.document, design.origin.as_str());
     let base = shortened(config, pulses);
-    let w_min = with_overrides(&base, origin, &[("pixel.width", "\"auto\"")])
-        .and_then(|c| {
-            c.pixel_params().map_err(|source| CliError::Pixel {
-                origin: origin.to_string(),
-                source,
-            })
-        })
-        .map(|p| p.width)
+    let mut cache = ProbeCache::default();
+    let w_min = with_overrides(&base, origin, &[("pixel.width", "\"auto\"")], &mut cache)
+        .map(|d| d.pixel.width)
         .map_err(|e| e.to_string());
     let mut true_amp = None;
-    let mut cache = DesignCache::default();
     let rows = settings
         .iter()
         .map(|s| {
@@ -223,7 +218,7 @@ pub fn sweep(
 fn resolve(
     overrides: &[(&'static str, &'static str)],
     w_min: &Result<u32, String>,
-) -> Result<Vec<(&'static str, String)>, CliError> {
+) -> Result<Vec<(&'static str, String)>, StudyError> {
     overrides
         .iter()
         .map(|&(key, value)| {
@@ -236,16 +231,17 @@ fn resolve(
             let w = match w_min {
                 Ok(w) => i64::from(*w),
                 Err(e) => {
-                    return Err(CliError::Toml {
+                    return Err(DesignError::Toml {
                         origin: format!("{key} = {value}"),
                         message: format!("cannot size W: {e}"),
-                    });
+                    }
+                    .into());
                 }
             };
             let delta: i64 = if inner.is_empty() {
                 0
             } else {
-                inner.parse().map_err(|_| CliError::Toml {
+                inner.parse().map_err(|_| DesignError::Toml {
                     origin: format!("{key} = {value}"),
                     message: format!(
                         "knob value {value}: expected {{w_min}}, {{w_min+k}} or {{w_min-k}}"
@@ -258,29 +254,29 @@ fn resolve(
 }
 
 fn measure_row(
-    base: &Config,
+    base: &Document,
     origin: &str,
     s: &KnobSetting,
     overrides: &[(&str, &str)],
     reps: usize,
-    cache: &mut DesignCache,
+    cache: &mut ProbeCache,
     row: &mut KnobRow,
-) -> Result<Option<f64>, CliError> {
+) -> Result<Option<f64>, StudyError> {
     let label = format!("{origin} with {} = {}", s.knob, s.value);
-    let cfg = with_overrides(base, &label, overrides)?;
-    let su = cache.setup(&cfg, &label)?;
+    let design = with_overrides(base, &label, overrides, cache)?;
+    let su = setup(&design)?;
     row.width_bits = Some(su.params.width);
     row.bins = Some(su.params.bins);
     row.rom_depth_entries = Some(su.params.rom_depth);
-    let r = measure_setup(&cfg, &label, &su, false)?;
-    let level = |name: &str| -> Result<&LevelResult, CliError> {
-        r.levels
-            .iter()
-            .find(|l| l.level == name)
-            .ok_or_else(|| CliError::Toml {
+    let r = measure_setup(&design, &su, false)?;
+    let level = |name: &str| -> Result<&LevelResult, StudyError> {
+        r.levels.iter().find(|l| l.level == name).ok_or_else(|| {
+            DesignError::Toml {
                 origin: label.clone(),
                 message: format!("level {name} missing from the measurement"),
-            })
+            }
+            .into()
+        })
     };
     let cf = level("closed form")?;
     let dft = level("float full DFT")?;
@@ -293,26 +289,16 @@ fn measure_row(
     row.amplitude_err_vs_true_um = bt.amplitude_err_vs_true_um;
     row.noise_rel_err_vs_dft = Some(bt.noise_rel_err_vs_dft);
     row.noise_rel_err_vs_closed_form = (cf.noise_um > 0.0).then(|| bt.noise_um / cf.noise_um - 1.0);
-    let source = cfg.photon_source().map_err(|e| cfg_scene_err(&label, e))?;
-    let lsb = cfg.sensor.tdc_lsb_mm();
+    let source = design.photon_source()?;
+    let lsb = design.sensor().tdc_lsb_mm();
     let secs = median_seconds(reps, || {
         bit_true_spectrum(&su.params, &su.rom, &source, lsb)
             .map(|_| ())
-            .map_err(|source| CliError::Pixel {
-                origin: label.clone(),
-                source,
-            })
+            .map_err(|source| StudyError::from(DesignError::pixel(&label, source)))
     })?;
-    let sim_seconds = r.pulses as f64 / cfg.sensor.laser_rate_hz;
+    let sim_seconds = r.pulses as f64 / design.sensor().laser_rate_hz;
     row.bit_true_seconds_per_sim_second = Some(secs / sim_seconds);
     Ok(r.true_amplitude_um)
-}
-
-fn cfg_scene_err(origin: &str, source: tofprobe_scene::SceneError) -> CliError {
-    CliError::Scene {
-        origin: origin.to_string(),
-        source,
-    }
 }
 
 /// The Markdown table of a sweep.

@@ -6,10 +6,11 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::table2::RowResult;
-use super::{PaperError, write_atomic};
+use crate::StudyError;
+use crate::spectrum::write_atomic;
 
-fn plot_err(path: &Path, e: impl std::fmt::Display) -> PaperError {
-    PaperError::Plot {
+fn plot_err(path: &Path, e: impl std::fmt::Display) -> StudyError {
+    StudyError::Plot {
         path: path.display().to_string(),
         message: e.to_string(),
     }
@@ -24,7 +25,7 @@ fn loglog(
     y_label: &str,
     lines: &[(String, Vec<(f64, f64)>)],
     points: &[(String, Vec<(f64, f64)>)],
-) -> Result<(), PaperError> {
+) -> Result<(), StudyError> {
     let all = lines.iter().chain(points).flat_map(|(_, v)| v.iter());
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for &(x, y) in all.filter(|p| p.0 > 0.0 && p.1 > 0.0) {
@@ -85,8 +86,8 @@ fn loglog(
 
 /// Writes spectra.svg, noise_vs_sigma.svg and noise_vs_rho.svg into `dir`; returns the
 /// paths written.
-pub fn write_all(dir: &Path, results: &[RowResult]) -> Result<Vec<String>, PaperError> {
-    std::fs::create_dir_all(dir).map_err(|source| PaperError::Io {
+pub fn write_all(dir: &Path, results: &[RowResult]) -> Result<Vec<String>, StudyError> {
+    std::fs::create_dir_all(dir).map_err(|source| StudyError::Io {
         path: dir.display().to_string(),
         source,
     })?;

@@ -1,0 +1,18 @@
+//! The configuration document and its ONE resolution: [`Document`] (the TOML file or the
+//! embedded default) → [`resolve`] → [`ResolvedDesign`] (scene, sensor, pixel parameters
+//! and widths, Fourier bins, the stability-checked ΣΔ probe design). Every `tofprobe`
+//! command starts from a `ResolvedDesign`. Also the bin chooser ([`bins`]) and the chip
+//! ROM policy of the RTL commands ([`rom_policy`]).
+
+pub mod bins;
+pub mod document;
+pub mod error;
+pub mod probe_cache;
+pub mod resolve;
+pub mod rom_policy;
+
+pub use document::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, SIZING_SIGMAS, read_text};
+pub use error::DesignError;
+pub use probe_cache::ProbeCache;
+pub use resolve::{ResolvedDesign, load, resolve, resolve_with};
+pub use rom_policy::{RtlOverrides, RtlRom, rtl_params};
