@@ -3,6 +3,7 @@
 pub mod config;
 pub mod fullband;
 pub mod fullband_check;
+pub mod fullband_spectrum;
 pub mod lanes;
 pub mod modulator;
 pub mod ntf;

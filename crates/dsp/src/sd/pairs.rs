@@ -335,7 +335,12 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
             } else {
                 &mut trace[done..done + span]
             };
-            step_span::<T, L, N, RES>(
+            let step = if tr.is_empty() {
+                step_span::<T, L, N, RES, false>
+            } else {
+                step_span::<T, L, N, RES, true>
+            };
+            step(
                 &mut s,
                 &mut self.rot,
                 &mut self.acc,
@@ -391,7 +396,7 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
 /// straight-line SIMD.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn step_span<T: Lane, const L: usize, const N: usize, const RES: bool>(
+fn step_span<T: Lane, const L: usize, const N: usize, const RES: bool, const TRACE: bool>(
     s: &mut [[T; L]; N],
     rot: &mut [T; L],
     acc: &mut [T; L],
@@ -420,7 +425,7 @@ fn step_span<T: Lane, const L: usize, const N: usize, const RES: bool>(
         for l in 0..L {
             sm[l] = (u[l] + st[N - 1][l]).bits() & T::SIGN;
         }
-        if !trace.is_empty() {
+        if TRACE {
             let mut w = 0u32;
             for (l, m) in sm.iter().enumerate() {
                 w |= u32::from(*m == T::Bits::default()) << l;
