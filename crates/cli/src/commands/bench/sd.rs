@@ -231,7 +231,7 @@ pub fn run(args: &SdBenchArgs) -> Result<(), CliError> {
 
 /// User + system CPU seconds of this process (Linux /proc; 100 ticks/s, the kernel's
 /// USER_HZ on every mainstream architecture). `None` elsewhere.
-fn process_cpu_seconds() -> Option<f64> {
+pub(crate) fn process_cpu_seconds() -> Option<f64> {
     let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
     // Fields after the parenthesised command name: state is field 3, utime 14, stime 15.
     let rest = stat.rsplit_once(')')?.1;
