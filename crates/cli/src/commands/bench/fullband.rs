@@ -205,11 +205,11 @@ fn grid(max_hz: f64, step_hz: f64, fs: f64, pulses: u64, osr: f64) -> Result<Vec
         allowed,
     };
     if !(step_hz.is_finite() && step_hz >= df) {
-        return Err(opt("--step-hz", step_hz, format!(">= f_s/N = {df} Hz")));
+        return Err(opt("step-hz", step_hz, format!(">= f_s/N = {df} Hz")));
     }
     if !(max_hz.is_finite() && (0.0..band).contains(&max_hz)) {
         return Err(opt(
-            "--max-hz",
+            "max-hz",
             max_hz,
             format!("0 <= max-hz < f_s/(2·OSR) = {band} Hz, e.g. 20000"),
         ));
@@ -248,10 +248,17 @@ fn print_band(name: &str, b: &BandOut) {
         "{name}: {} bins of {:.3} Hz up to {:.0} Hz",
         b.bins, b.bin_hz, b.max_hz
     );
-    println!(
-        "  sigma-delta {:.2} s ({:.3e} modulator steps/s), DFT {:.2} s",
-        b.sd_seconds, b.steps_per_s, b.dft_seconds
-    );
+    if b.steps > 0 {
+        println!(
+            "  sigma-delta {:.2} s ({:.3e} modulator steps/s), DFT {:.2} s",
+            b.sd_seconds, b.steps_per_s, b.dft_seconds
+        );
+    } else {
+        println!(
+            "  sigma-delta {:.2} s (ROM generation, fold and correlate), DFT {:.2} s",
+            b.sd_seconds, b.dft_seconds
+        );
+    }
     println!(
         "  peak {:.1} Hz: sigma-delta {:.2} um, DFT {:.2} um",
         b.peak_hz, b.peak_sd_um, b.peak_dft_um
