@@ -1,9 +1,13 @@
 //! ΣΔ probe design: NTF synthesis, the modulator, probe waveforms and the ROM they fill.
 
 pub mod config;
+pub mod fullband;
+pub mod fullband_check;
+pub mod fullband_spectrum;
 pub mod lanes;
 pub mod modulator;
 pub mod ntf;
+pub mod pairs;
 pub mod probe;
 pub mod probing;
 pub mod quality;
@@ -11,8 +15,10 @@ pub mod realize;
 pub mod wrap;
 
 pub use config::{ProbeConfig, RomMode};
+pub use fullband::FullBandProber;
 pub use modulator::Modulator;
 pub use ntf::{Ntf, synthesize_ntf};
+pub use pairs::LanePrecision;
 pub use probe::{ProbeDesign, ProbeRom, nearest_bin};
 pub use probing::{
     ProbeAccumulator, amplitudes_um, normalise, prefilter_response, probe_detections,

@@ -2,6 +2,8 @@
 //! target, add a variant to [`BenchTarget`] and a line to [`run`].
 
 pub mod dsp;
+pub mod fullband;
+mod fullband_svg;
 pub mod pixel;
 pub mod scene;
 pub mod sd;
@@ -31,6 +33,10 @@ pub enum BenchTarget {
     /// ΣΔ probes: stability limits, SNR vs eq. 4 (orders 1–4, OSR 8–128), a 16-bin
     /// N = 10^7 ROM's generation time (target ≤ 1 s), `--svg` the 50 kHz probe spectrum.
     Sd(sd::SdBenchArgs),
+    /// The Fig. 8 scene's full-band spectrum: ΣΔ probing of every 1 Hz bin of 0–20 kHz
+    /// (N = 10^7) beside the DFT of the same record (target ≤ 300 s); `--periodic` also
+    /// the periodic ROM's whole band.
+    Fullband(fullband::FullBandArgs),
 }
 
 /// Runs one benchmark.
@@ -40,5 +46,6 @@ pub fn run(args: BenchArgs) -> Result<(), CliError> {
         BenchTarget::Dsp(a) => dsp::run(&a),
         BenchTarget::Pixel(a) => pixel::run(&a),
         BenchTarget::Sd(a) => sd::run(&a),
+        BenchTarget::Fullband(a) => fullband::run(&a),
     }
 }
