@@ -73,6 +73,50 @@ pub enum ReportError {
         what: String,
         source: serde_json::Error,
     },
+    /// A corner misses the clock the configuration needs: by how much, on which path.
+    #[error(
+        "timing fails on {library} {corner}: the {clock_mhz:.1} MHz clock ({period_ns:.3} ns) is missed by {violation_ns:.3} ns (critical path {critical_path_ns:.3} ns, f_max {f_max_mhz:.1} MHz) on the path {startpoint} -> {endpoint}; pipeline that path, lower C·f_laser or use a faster corner"
+    )]
+    TimingFailed {
+        library: String,
+        corner: String,
+        clock_mhz: f64,
+        period_ns: f64,
+        violation_ns: f64,
+        critical_path_ns: f64,
+        f_max_mhz: f64,
+        startpoint: String,
+        endpoint: String,
+    },
+    /// The netlist is not equivalent to its RTL.
+    #[error(
+        "the netlist {netlist} is NOT equivalent to the RTL of `{top}` ({unproven} of {total} equivalence points unproven, e.g. {first}); log tail:\n{log_tail}"
+    )]
+    NotEquivalent {
+        netlist: PathBuf,
+        top: String,
+        unproven: u64,
+        total: u64,
+        first: String,
+        log_tail: String,
+    },
+    /// The gate-level simulation could not run (tools, files, netlist shape).
+    #[error("gate-level simulation: {0}")]
+    Cosim(#[from] tofprobe_cosim::CosimError),
+    /// The gate-level simulation ran and differs from the golden vectors.
+    #[error(
+        "gate-level simulation of {netlist} ({cells}) differs from the golden vectors: {mismatches} mismatch(es), the first at cycle {cycle} (pulse {pulse}): {signal} expected {expected}, got {actual}"
+    )]
+    GateLevelMismatch {
+        netlist: PathBuf,
+        cells: String,
+        mismatches: u64,
+        cycle: u64,
+        pulse: u64,
+        signal: String,
+        expected: String,
+        actual: String,
+    },
     /// Drawing the SVG plot failed.
     #[error("drawing the plot {path}: {reason}")]
     Plot { path: PathBuf, reason: String },
