@@ -5,12 +5,15 @@
 
 use std::path::{Path, PathBuf};
 use tofprobe_report::ReportError;
+use tofprobe_report::analysis::RtlProvider;
 use tofprobe_report::equiv::{EquivSpec, check_equivalence};
+use tofprobe_report::generated::GeneratedPixel;
 use tofprobe_report::pdk::Sky130Pdk;
 use tofprobe_report::signoff::{
     OSU018_LIBERTY, SignoffLibrary, SignoffRequest, gate_level, sign_off, signoff_netlist,
 };
 use tofprobe_report::synth::{SynthSpec, synthesise};
+use tofprobe_rtlgen::PixelParams;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -100,44 +103,52 @@ fn signs_off_and_catches_a_broken_gate(lib: &SignoffLibrary, inv: &str, name: &s
     }
 }
 
-/// The broken netlist failing equivalence, on the small fixture pixel (B = 2, W = 8): on
+/// The broken netlist failing equivalence, on a small generated pixel (B = 2, W = 10): on
 /// the full pixel a failed induction falls back to one proof per point (over a thousand
 /// SAT problems of 700k clauses), too slow for CI; the proof itself is the same.
-fn broken_fixture_is_not_equivalent(liberty: &Path, inv: &str, name: &str) {
-    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mini_pixel.v");
-    let params = vec![("B".to_string(), 2), ("W".to_string(), 8)];
+fn broken_small_pixel_is_not_equivalent(liberty: &Path, inv: &str, name: &str) {
+    let px = GeneratedPixel {
+        base: PixelParams {
+            bins: 2,
+            tdc_bits: 4,
+            frac_bits: 2,
+            width: 10,
+            frame_pulses: 1024,
+            rom_depth: 16,
+            ..PixelParams::default()
+        },
+    };
+    let v = px.rtl(2, 10, &cache(name).join("small-rtl")).unwrap();
     let syn = synthesise(
         &SynthSpec {
-            sources: vec![fixture.clone()],
-            top: "mini_pixel".into(),
-            params: params.clone(),
+            sources: v.sources.clone(),
+            top: v.top.clone(),
+            params: v.params.clone(),
             liberty: liberty.to_path_buf(),
             delay_target_ps: Some(6250.0),
-            keep: vec![],
+            keep: vec!["we".into()],
         },
-        &cache(name).join("fixture"),
+        &cache(name).join("small"),
     )
     .unwrap();
     let spec = |netlist: PathBuf| EquivSpec {
-        rtl: vec![fixture.clone()],
-        top: "mini_pixel".into(),
-        params: params.clone(),
+        rtl: v.sources.clone(),
+        top: v.top.clone(),
+        params: v.params.clone(),
         netlist,
         liberty: liberty.to_path_buf(),
     };
-    let work = cache(name).join("fixture-equiv");
+    let work = cache(name).join("small-equiv");
     let ok = check_equivalence(&spec(syn.netlist_verilog.clone()), &work).unwrap();
-    // 4 registers of 8 bits at least, all proven.
-    assert!(ok.points >= 32 && ok.proven == ok.points, "{ok:?}");
-    let broken = cache(name).join("fixture-broken/netlist.v");
-    break_netlist(&syn.netlist_verilog, "\\Y[1] [5]", inv, &broken);
+    // 4 registers of 10 bits at least, all proven.
+    assert!(ok.points >= 40 && ok.proven == ok.points, "{ok:?}");
+    let broken = cache(name).join("small-broken/netlist.v");
+    break_netlist(&syn.netlist_verilog, "\\y[1] [5]", inv, &broken);
     match check_equivalence(&spec(broken), &work) {
         Err(e @ ReportError::NotEquivalent { .. }) => {
             let msg = e.to_string();
             assert!(
-                msg.contains("fixture-broken/netlist.v")
-                    && msg.contains("NOT equivalent")
-                    && msg.contains("Y[1]"),
+                msg.contains("small-broken/netlist.v") && msg.contains("NOT equivalent"),
                 "{msg}"
             );
         }
@@ -147,12 +158,12 @@ fn broken_fixture_is_not_equivalent(liberty: &Path, inv: &str, name: &str) {
 
 #[test]
 fn broken_netlists_are_not_equivalent() {
-    broken_fixture_is_not_equivalent(Path::new(OSU018_LIBERTY), "INVX1", "osu018");
+    broken_small_pixel_is_not_equivalent(Path::new(OSU018_LIBERTY), "INVX1", "osu018");
     let pdk = Sky130Pdk::discover(None)
         .unwrap()
         .expect("sky130_fd_sc_hd PDK");
     let lib = SignoffLibrary::sky130(&pdk, &cache("sky130")).unwrap();
-    broken_fixture_is_not_equivalent(&lib.liberty, "sky130_fd_sc_hd__inv_1", "sky130");
+    broken_small_pixel_is_not_equivalent(&lib.liberty, "sky130_fd_sc_hd__inv_1", "sky130");
 }
 
 #[test]
