@@ -83,17 +83,19 @@ impl CornerTiming {
         if self.meets_clock {
             return Ok(());
         }
-        Err(ReportError::TimingFailed {
-            library: self.library.clone(),
-            corner: self.corner.clone(),
-            clock_mhz: self.clock_mhz,
-            period_ns: 1e3 / self.clock_mhz,
-            violation_ns: -self.slack_ns,
-            critical_path_ns: self.critical_path_ns,
-            f_max_mhz: self.f_max_mhz,
-            startpoint: self.startpoint.clone(),
-            endpoint: self.endpoint.clone(),
-        })
+        Err(ReportError::TimingFailed(Box::new(
+            crate::error::TimingFailure {
+                library: self.library.clone(),
+                corner: self.corner.clone(),
+                clock_mhz: self.clock_mhz,
+                period_ns: 1e3 / self.clock_mhz,
+                violation_ns: -self.slack_ns,
+                critical_path_ns: self.critical_path_ns,
+                f_max_mhz: self.f_max_mhz,
+                startpoint: self.startpoint.clone(),
+                endpoint: self.endpoint.clone(),
+            },
+        )))
     }
 }
 

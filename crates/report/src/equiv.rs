@@ -153,14 +153,16 @@ pub fn check_equivalence(spec: &EquivSpec, work: &Path) -> Result<Equivalence> {
             seconds,
             log: log_path,
         }),
-        Some((points, unproven, first)) if unproven > 0 => Err(ReportError::NotEquivalent {
-            netlist: spec.netlist.clone(),
-            top: spec.top.clone(),
-            unproven,
-            total: points,
-            first,
-            log_tail: tail(&log, 8),
-        }),
+        Some((points, unproven, first)) if unproven > 0 => Err(ReportError::NotEquivalent(
+            Box::new(crate::error::EquivFailure {
+                netlist: spec.netlist.clone(),
+                top: spec.top.clone(),
+                unproven,
+                total: points,
+                first,
+                log_tail: tail(&log, 8),
+            }),
+        )),
         _ => Err(ReportError::ToolFailed {
             tool: "yosys (equivalence)",
             status: out

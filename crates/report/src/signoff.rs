@@ -172,16 +172,18 @@ pub fn gate_level(req: &SignoffRequest<'_>, netlist: &Path) -> Result<GateLevel>
             expected: String::new(),
             actual: String::new(),
         });
-        return Err(ReportError::GateLevelMismatch {
-            netlist: netlist.to_path_buf(),
-            cells: req.library.name.clone(),
-            mismatches: out.mismatches,
-            cycle: m.cycle,
-            pulse: m.pulse,
-            signal: m.signal,
-            expected: m.expected,
-            actual: m.actual,
-        });
+        return Err(ReportError::GateLevelMismatch(Box::new(
+            crate::error::GateLevelFailure {
+                netlist: netlist.to_path_buf(),
+                cells: req.library.name.clone(),
+                mismatches: out.mismatches,
+                cycle: m.cycle,
+                pulse: m.pulse,
+                signal: m.signal,
+                expected: m.expected,
+                actual: m.actual,
+            },
+        )));
     }
     Ok(GateLevel {
         cycles: out.cycles,
