@@ -11,7 +11,7 @@ pub enum CliError {
     /// The configuration does not load or resolve (the message names the file, the key,
     /// the value and a valid one).
     #[error(transparent)]
-    Design(#[from] tofprobe_design::DesignError),
+    Design(Box<tofprobe_design::DesignError>),
     /// A study (spectrum, flow, sizing, reproduction, trade-off) failed.
     #[error(transparent)]
     Study(#[from] tofprobe_study::StudyError),
@@ -52,3 +52,10 @@ through_study!(
     tofprobe_cosim::CosimError,
     tofprobe_report::ReportError
 );
+
+// Boxed: the design error names the file, key and value inline (clippy::result_large_err).
+impl From<tofprobe_design::DesignError> for CliError {
+    fn from(e: tofprobe_design::DesignError) -> Self {
+        CliError::Design(Box::new(e))
+    }
+}

@@ -4,6 +4,7 @@
 
 pub mod driver;
 pub mod error;
+pub mod gate_level;
 pub mod harness;
 pub mod icarus;
 pub mod tools;

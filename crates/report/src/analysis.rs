@@ -95,6 +95,7 @@ pub fn analyse_point(
         params: variant.params,
         liberty: lib.path.clone(),
         delay_target_ps,
+        keep: vec![],
     };
     let synthesis = synthesise(&spec, &cache.join("synth"))?;
     // The split walks a multi-megabyte JSON netlist: cache it next to the synthesis

@@ -73,9 +73,69 @@ pub enum ReportError {
         what: String,
         source: serde_json::Error,
     },
+    /// A corner misses the clock the configuration needs: by how much, on which path.
+    #[error(
+        "timing fails on {} {}: the {:.1} MHz clock ({:.3} ns) is missed by {:.3} ns (critical path {:.3} ns, f_max {:.1} MHz) on the path {} -> {}; pipeline that path, lower C·f_laser or use a faster corner",
+        .0.library, .0.corner, .0.clock_mhz, .0.period_ns, .0.violation_ns, .0.critical_path_ns, .0.f_max_mhz, .0.startpoint, .0.endpoint
+    )]
+    TimingFailed(Box<TimingFailure>),
+    /// The netlist is not equivalent to its RTL.
+    #[error(
+        "the netlist {} is NOT equivalent to the RTL of `{}` ({} of {} equivalence points unproven, e.g. {}); log tail:\n{}",
+        .0.netlist.display(), .0.top, .0.unproven, .0.total, .0.first, .0.log_tail
+    )]
+    NotEquivalent(Box<EquivFailure>),
+    /// The gate-level simulation could not run (tools, files, netlist shape).
+    #[error("gate-level simulation: {0}")]
+    Cosim(#[from] tofprobe_cosim::CosimError),
+    /// The gate-level simulation ran and differs from the golden vectors.
+    #[error(
+        "gate-level simulation of {} ({}) differs from the golden vectors: {} mismatch(es), the first at cycle {} (pulse {}): {} expected {}, got {}",
+        .0.netlist.display(), .0.cells, .0.mismatches, .0.cycle, .0.pulse, .0.signal, .0.expected, .0.actual
+    )]
+    GateLevelMismatch(Box<GateLevelFailure>),
     /// Drawing the SVG plot failed.
     #[error("drawing the plot {path}: {reason}")]
     Plot { path: PathBuf, reason: String },
+}
+
+/// A corner that misses its clock ([`ReportError::TimingFailed`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimingFailure {
+    pub library: String,
+    pub corner: String,
+    pub clock_mhz: f64,
+    pub period_ns: f64,
+    pub violation_ns: f64,
+    pub critical_path_ns: f64,
+    pub f_max_mhz: f64,
+    pub startpoint: String,
+    pub endpoint: String,
+}
+
+/// An equivalence that does not hold ([`ReportError::NotEquivalent`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EquivFailure {
+    pub netlist: PathBuf,
+    pub top: String,
+    pub unproven: u64,
+    pub total: u64,
+    /// The first unproven pair, e.g. `\y[3]_gold [5] \y[3]_gate [5]`.
+    pub first: String,
+    pub log_tail: String,
+}
+
+/// A gate-level replay that differs ([`ReportError::GateLevelMismatch`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GateLevelFailure {
+    pub netlist: PathBuf,
+    pub cells: String,
+    pub mismatches: u64,
+    pub cycle: u64,
+    pub pulse: u64,
+    pub signal: String,
+    pub expected: String,
+    pub actual: String,
 }
 
 /// The crate's result type.

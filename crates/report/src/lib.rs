@@ -1,18 +1,23 @@
 //! Sizing reports for the tofprobe pixel: register widths and readout volume, synthesised
-//! area on a standard-cell liberty (yosys), timing (OpenSTA), the sky130 area-only
-//! mapping scaled to other nodes, sweeps over B and W, and their Markdown/JSON/SVG output.
+//! area on a standard-cell liberty (yosys), timing (OpenSTA) on every liberty and corner,
+//! sky130 (timed PDK, or the area-only mapping) scaled to other nodes, sweeps over B and
+//! W, their Markdown/JSON/SVG output, and sign-off: formal equivalence of netlist and RTL.
 
 pub mod analysis;
+pub mod corners;
+pub mod equiv;
 pub mod error;
 pub mod fsutil;
 pub mod generated;
 pub mod liberty;
 pub mod markdown;
 pub mod memory;
+pub mod pdk;
 pub mod plot;
 pub mod report;
 pub mod scaling;
 pub mod scalogram;
+pub mod signoff;
 pub mod sky130;
 pub mod split;
 pub mod sta;

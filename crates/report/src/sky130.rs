@@ -50,3 +50,24 @@ pub fn sky130_liberty(script: &Path) -> Result<PathBuf> {
     }
     Ok(path)
 }
+
+/// Where the sky130 figures come from: the timed PDK when one is installed, else the
+/// area-only liberty.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Sky130Source {
+    /// sky130_fd_sc_hd with timing: mapped (delay-driven) on tt, timed on every corner.
+    Timed(crate::pdk::Sky130Pdk),
+    /// The area-only liberty of [`sky130_liberty`] (no timing).
+    AreaOnly(PathBuf),
+}
+
+impl Sky130Source {
+    /// The timed PDK if [`crate::pdk::Sky130Pdk::discover`] finds one (`explicit` first),
+    /// else the area-only liberty built by `script`.
+    pub fn resolve(explicit_pdk: Option<&Path>, script: &Path) -> Result<Self> {
+        match crate::pdk::Sky130Pdk::discover(explicit_pdk)? {
+            Some(pdk) => Ok(Self::Timed(pdk)),
+            None => Ok(Self::AreaOnly(sky130_liberty(script)?)),
+        }
+    }
+}

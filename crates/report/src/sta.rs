@@ -56,7 +56,12 @@ pub fn time_netlist(
     work: &Path,
 ) -> Result<Timing> {
     let sta = Tool::Sta.locate()?;
-    let script = work.join("sta.tcl");
+    // One script per liberty: the corners of one netlist are timed in the same directory.
+    let stem = liberty
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let script = work.join(format!("sta-{stem}.tcl"));
     write_atomic(&script, sta_script(liberty, netlist, top, clock).as_bytes())?;
     let out = Command::new(&sta)
         .arg("-no_init")

@@ -31,6 +31,10 @@ pub struct SynthSpec {
     /// that delay, builds buffer trees (fanout ≤ [`MAX_FANOUT`]) and resizes gates, as a
     /// placement flow would; without it a 1,000-load reset net makes f_max meaningless.
     pub delay_target_ps: Option<f64>,
+    /// Wires marked `keep` before synthesis, so ABC keeps them as nets of the netlist (the
+    /// sign-off netlist keeps the write enables `we` the testbench watches); empty for the
+    /// size report.
+    pub keep: Vec<String>,
 }
 
 /// Largest fanout ABC's `buffer` leaves on a net.
@@ -89,6 +93,9 @@ pub fn yosys_script(spec: &SynthSpec, dir: &Path) -> String {
         }
         s += &format!(" {}\n", spec.top);
     }
+    for w in &spec.keep {
+        s += &format!("setattr -set keep 1 {}/w:{w}\n", spec.top);
+    }
     let abc = match spec.delay_target_ps {
         Some(_) => format!(
             "abc -script {} -liberty {lib}",
@@ -135,6 +142,9 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
     }
     if let Some(d) = spec.delay_target_ps {
         h.feed(abc_timing_script(d).as_bytes());
+    }
+    for w in &spec.keep {
+        h.feed(b"keep").feed(w.as_bytes());
     }
     let lib_text = std::fs::read(&spec.liberty).map_err(|e| ReportError::LibertyUnreadable {
         path: spec.liberty.clone(),
@@ -287,8 +297,10 @@ mod tests {
             params: vec![("B".into(), 4), ("W".into(), 12)],
             liberty: "l.lib".into(),
             delay_target_ps: None,
+            keep: vec![],
         };
         let s = yosys_script(&spec, Path::new("/d"));
+        assert!(!s.contains("setattr"));
         assert!(s.contains("chparam -set B 4 -set W 12 pixel"));
         assert!(s.contains("synth -top pixel -flatten"));
         assert!(s.contains("abc -liberty l.lib"));

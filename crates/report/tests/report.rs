@@ -5,8 +5,9 @@ use std::path::Path;
 use tofprobe_report::analysis::ParamRtl;
 use tofprobe_report::liberty::Liberty;
 use tofprobe_report::memory::{MemoryInput, WidthConvention};
-use tofprobe_report::report::{Design, SCHEMA, SizeReport, SizeRequest, build};
-use tofprobe_report::sky130::{default_script, sky130_liberty};
+use tofprobe_report::pdk::Sky130Pdk;
+use tofprobe_report::report::{Design, SCHEMA, SizeReport, SizeRequest, build_with};
+use tofprobe_report::sky130::{Sky130Source, default_script, sky130_liberty};
 
 #[test]
 fn fixture_report_end_to_end() {
@@ -47,7 +48,7 @@ fn fixture_report_end_to_end() {
             laser_rate_hz: 5e9,
         },
         liberty: "/usr/share/qflow/tech/osu018/osu018_stdcells.lib".into(),
-        sky130_liberty: Some(sky),
+        sky130_liberty: Some(sky.clone()),
         sweep_bins: vec![1, 2],
         sweep_widths: vec![7, 8],
         clock_port: "clk".into(),
@@ -55,7 +56,8 @@ fn fixture_report_end_to_end() {
         target_node_nm: 40.0,
         pixel_sides_um: vec![(30.0, Some(6)), (40.0, Some(13))],
     };
-    let r = build(&req).unwrap();
+    // The area-only fallback, explicitly (build() would take the timed PDK when installed).
+    let r = build_with(&req, Some(&Sky130Source::AreaOnly(sky))).unwrap();
     assert_eq!(r.schema, SCHEMA);
     // Memory: 1000 × 40 = 40,000 < 2^16 → 16 + sign = 17 bits; W = 8 is too narrow.
     assert_eq!(r.memory.required_width_bits, 17);
@@ -102,6 +104,49 @@ fn fixture_report_end_to_end() {
     assert!(md.contains("does not fit") && md.contains("no timing") && md.contains("| 2 | 8 |"));
     let svg = tofprobe_report::plot::sweep_svg(&r).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("f_max vs B"));
+    // Only the timing liberty is timed on the area-only path: one corner row, whose
+    // figures are the timing section's, and which misses the 10 GHz clock.
+    assert_eq!(r.timing_corners.len(), 1);
+    let c = &r.timing_corners[0];
+    assert_eq!(
+        (c.f_max_mhz, c.corner.as_str()),
+        (t.sta.f_max_mhz, "typical")
+    );
+    assert!(!c.meets_clock && c.slack_ns < 0.0);
+    assert_eq!(c.registers_per_adder, t.throughput.registers_per_adder);
+
+    // The timed PDK (CI: ../shared/pdk): sky130 mapped on tt and timed on tt/ss/ff.
+    let pdk = Sky130Pdk::discover(None)
+        .unwrap()
+        .expect("sky130_fd_sc_hd PDK at ../shared/pdk or $TOFPROBE_SKY130_PDK");
+    let r = build_with(&req, Some(&Sky130Source::Timed(pdk))).unwrap();
+    let sky = r.sky130.as_ref().unwrap();
+    assert!(sky.has_timing && sky.area.has_timing);
+    let corners: Vec<&str> = r.timing_corners.iter().map(|c| c.corner.as_str()).collect();
+    assert_eq!(
+        corners,
+        ["typical", "tt_025C_1v80", "ss_n40C_1v40", "ff_100C_1v95"]
+    );
+    let f = |i: usize| r.timing_corners[i].f_max_mhz;
+    // Slow-slow at 1.40 V and −40 °C is slower than typical, fast-fast faster.
+    assert!(f(2) < f(1) && f(1) < f(3), "{:?}", r.timing_corners);
+    for c in &r.timing_corners {
+        // slack = period − critical path (4-digit rounding), registers = ⌊f_max / f_laser⌋.
+        assert!(
+            (c.slack_ns - (1e3 / c.clock_mhz - c.critical_path_ns)).abs() < 1e-4,
+            "{c:?}"
+        );
+        assert_eq!(
+            c.registers_per_adder,
+            (c.f_max_mhz * 1e6 / 5e9).floor() as u64
+        );
+        assert_eq!(c.paper_registers_per_adder_min, 16);
+    }
+    let md = tofprobe_report::markdown::render(&r);
+    assert!(
+        md.contains("ss_n40C_1v40") && md.contains("**fails**"),
+        "{md}"
+    );
 }
 
 /// Size reports are written and read back as JSON (the size cache, dashboards): every f64

@@ -91,6 +91,7 @@ fn liberty_without_logic_gates_is_rejected_clearly() {
         params: vec![("B".into(), 1), ("W".into(), 7)],
         liberty: lib.clone(),
         delay_target_ps: None,
+        keep: vec![],
     };
     let msg = synthesise(&spec, &dir).unwrap_err().to_string();
     assert!(
@@ -107,6 +108,7 @@ fn missing_rtl_and_liberty_name_the_file() {
         params: vec![],
         liberty: OSU018.into(),
         delay_target_ps: None,
+        keep: vec![],
     };
     let msg = synthesise(&spec, &cache("none")).unwrap_err().to_string();
     assert!(

@@ -10,7 +10,7 @@ use thiserror::Error;
 pub enum StudyError {
     /// The configuration does not resolve (the message names the key and a valid value).
     #[error(transparent)]
-    Design(#[from] tofprobe_design::DesignError),
+    Design(Box<tofprobe_design::DesignError>),
     /// A float reference refused its input.
     #[error(transparent)]
     Dsp(#[from] tofprobe_dsp::DspError),
@@ -73,5 +73,13 @@ impl StudyError {
             value: value.to_string(),
             allowed: allowed.to_string(),
         }
+    }
+}
+
+// Boxed: the design error carries the generator's and the pixel's errors inline, and every
+// study function returns this type (clippy::result_large_err).
+impl From<tofprobe_design::DesignError> for StudyError {
+    fn from(e: tofprobe_design::DesignError) -> Self {
+        StudyError::Design(Box::new(e))
     }
 }

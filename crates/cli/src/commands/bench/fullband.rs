@@ -19,7 +19,6 @@ use tofprobe_dsp::sd::fullband_spectrum::{
 use tofprobe_dsp::sd::{LanePrecision, ProbeDesign, RomMode};
 
 use super::sd::process_cpu_seconds;
-use crate::config::Config;
 use crate::error::CliError;
 
 /// Arguments of `tofprobe bench fullband`.
@@ -95,21 +94,19 @@ struct Report {
 const TARGET_S: f64 = 300.0;
 
 fn err(e: impl std::fmt::Display) -> CliError {
-    CliError::Option {
-        option: "bench fullband".into(),
-        value: e.to_string(),
-        allowed: "an internal computation that succeeds".into(),
-    }
+    CliError::option(
+        "bench fullband",
+        e.to_string(),
+        "an internal computation that succeeds",
+    )
 }
 
 /// Runs the benchmark.
 pub fn run(args: &FullBandArgs) -> Result<(), CliError> {
-    let loaded = Config::load(args.config.as_deref())?;
-    let cfg = &loaded.config;
-    let probe_err = |source| CliError::Probe {
-        origin: loaded.origin.clone(),
-        source,
-    };
+    let loaded = tofprobe_design::load(args.config.as_deref())?;
+    let cfg = &loaded.document;
+    let probe_err =
+        |source| CliError::from(tofprobe_design::DesignError::probe(&loaded.origin, source));
     let fs = cfg.sensor.laser_rate_hz;
     let pulses = args.pulses.unwrap_or_else(|| cfg.pulses());
     let alpha = 1.0 / f64::from(1u32 << cfg.pixel.shift);
@@ -125,7 +122,9 @@ pub fn run(args: &FullBandArgs) -> Result<(), CliError> {
     let design = ProbeDesign::new(&windowed_cfg, 1000.0 / fs).map_err(probe_err)?;
 
     let t0 = Instant::now();
-    let source = cfg.photon_source().map_err(|e| loaded.error(e))?;
+    let source = cfg
+        .photon_source()
+        .map_err(|e| CliError::from(tofprobe_design::DesignError::scene(&loaded.origin, e)))?;
     let x = prefiltered_record(&source, pulses, alpha).map_err(err)?;
     let record_seconds = t0.elapsed().as_secs_f64();
 
@@ -199,11 +198,7 @@ pub fn run(args: &FullBandArgs) -> Result<(), CliError> {
 fn grid(max_hz: f64, step_hz: f64, fs: f64, pulses: u64, osr: f64) -> Result<Vec<u64>, CliError> {
     let df = fs / pulses as f64;
     let band = fs / (2.0 * osr);
-    let opt = |option: &str, value: f64, allowed: String| CliError::Option {
-        option: option.into(),
-        value: value.to_string(),
-        allowed,
-    };
+    let opt = |option: &str, value: f64, allowed: String| CliError::option(option, value, allowed);
     if !(step_hz.is_finite() && step_hz >= df) {
         return Err(opt("step-hz", step_hz, format!(">= f_s/N = {df} Hz")));
     }

@@ -9,11 +9,7 @@ use tofprobe_dsp::sd::fullband_spectrum::BandSpectrum;
 use crate::error::CliError;
 
 fn err(e: impl std::fmt::Display) -> CliError {
-    CliError::Option {
-        option: "bench fullband --svg".into(),
-        value: e.to_string(),
-        allowed: "a plot that renders".into(),
-    }
+    CliError::option("bench fullband --svg", e.to_string(), "a plot that renders")
 }
 
 /// Writes the plot atomically.
@@ -72,8 +68,6 @@ pub fn write(path: &Path, s: &BandSpectrum, origin: &str) -> Result<(), CliError
             .map_err(err)?;
         root.present().map_err(err)?;
     }
-    tofprobe_dsp::rom::write_atomic(path, text.as_bytes()).map_err(|e| CliError::Output {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })
+    tofprobe_io::write_atomic(path, text.as_bytes())
+        .map_err(|e| CliError::output(path.to_path_buf(), e.to_string()))
 }

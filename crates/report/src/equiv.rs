@@ -1,0 +1,210 @@
+//! Formal equivalence of a mapped netlist and its RTL, with yosys's equivalence passes
+//! (`equiv_make`, `equiv_simple -seq`, `equiv_induct`, `equiv_status -assert`).
+//!
+//! Gold: the RTL through yosys's coarse synthesis (`synth -flatten -run begin:fine`: proc,
+//! const-flop removal, width reduction), so its registers have the names and widths the
+//! netlist's flops carry (`equiv_make` pairs registers by name; a register the netlist
+//! narrowed — `held`'s constant sign bit — would otherwise stay unpaired and break the
+//! induction). What is proven is therefore the fine half of synthesis: techmap, ABC's
+//! mapping, buffering and sizing, and the flop mapping — everything that turns words
+//! into cells. Gate: the netlist with the cells' functions read from the liberty
+//! (`read_liberty` without `-lib`: `function` and `ff` groups become logic and flops).
+//! Both sides get `async2sync; dffunmap` (plain flops: `equiv_simple -seq` steps
+//! through `$dff` only). `equiv_induct` then proves every register and output pair by
+//! one-step induction: all pairs equal at t ⇒ equal at t + 1.
+
+use crate::error::{ReportError, Result};
+use crate::fsutil::write_atomic;
+use crate::tools::{Tool, tail};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// What to compare.
+#[derive(Debug, Clone)]
+pub struct EquivSpec {
+    /// The RTL sources (the gold side).
+    pub rtl: Vec<PathBuf>,
+    /// The module both sides implement.
+    pub top: String,
+    /// Verilog parameter overrides of the RTL (as the netlist was synthesised with).
+    pub params: Vec<(String, i64)>,
+    /// The mapped netlist (`write_verilog -noattr`).
+    pub netlist: PathBuf,
+    /// The liberty whose cells the netlist instantiates (their functions).
+    pub liberty: PathBuf,
+}
+
+/// A proven equivalence.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Equivalence {
+    /// `$equiv` points (paired signal bits: registers and outputs).
+    pub points: u64,
+    /// All of them, proven.
+    pub proven: u64,
+    /// Wall time of yosys (s).
+    pub seconds: f64,
+    /// The yosys log.
+    pub log: PathBuf,
+}
+
+/// The yosys script comparing `spec`.
+pub fn equiv_script(spec: &EquivSpec) -> String {
+    let top = &spec.top;
+    let mut s = String::new();
+    for src in &spec.rtl {
+        s += &format!("read_verilog -sv {}\n", src.display());
+    }
+    if !spec.params.is_empty() {
+        s += "chparam";
+        for (k, v) in &spec.params {
+            s += &format!(" -set {k} {v}");
+        }
+        s += &format!(" {top}\n");
+    }
+    s += &format!(
+        "synth -top {top} -flatten -run begin:fine\n\
+         async2sync\n\
+         dffunmap\n\
+         memory_map\n\
+         opt_clean\n\
+         rename {top} gold\n\
+         design -stash gold\n\
+         read_liberty -ignore_miss_func {lib}\n\
+         read_verilog {net}\n\
+         prep -top {top} -flatten\n\
+         async2sync\n\
+         dffunmap\n\
+         rename {top} gate\n\
+         design -stash gate\n\
+         design -copy-from gold -as gold gold\n\
+         design -copy-from gate -as gate gate\n\
+         equiv_make gold gate equiv\n\
+         hierarchy -top equiv\n\
+         equiv_simple -seq 2\n\
+         equiv_induct -seq 1\n\
+         equiv_status -assert\n",
+        lib = spec.liberty.display(),
+        net = spec.netlist.display(),
+    );
+    s
+}
+
+/// Parses `equiv_status`: (points, unproven, first unproven pair).
+pub fn parse_status(log: &str) -> Option<(u64, u64, String)> {
+    let pos = log.rfind("Executing EQUIV_STATUS pass")?;
+    let text = &log[pos..];
+    let points = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("Found") && l.contains("$equiv cells"))
+        .and_then(|l| l.split_whitespace().nth(1)?.parse().ok())?;
+    // "Of those cells P are proven and U are unproven."
+    let unproven = text
+        .lines()
+        .find(|l| l.contains("are proven and"))
+        .and_then(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            let i = w.iter().position(|x| *x == "and")?;
+            w.get(i + 1)?.parse().ok()
+        })
+        .unwrap_or(0);
+    let first = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("Unproven $equiv "))
+        .and_then(|l| l.split_once(": "))
+        .map(|(_, pair)| pair.trim().to_string())
+        .unwrap_or_default();
+    Some((points, unproven, first))
+}
+
+/// Proves `spec`'s netlist equivalent to its RTL; `work` holds the script and the log.
+/// An unproven pair is [`ReportError::NotEquivalent`], naming the netlist and the first
+/// pair (`\\y[3]_gold [5] \\y[3]_gate [5]`: register 3, bit 5).
+pub fn check_equivalence(spec: &EquivSpec, work: &Path) -> Result<Equivalence> {
+    let yosys = Tool::Yosys.locate()?;
+    for src in &spec.rtl {
+        if !src.is_file() {
+            return Err(ReportError::RtlMissing { path: src.clone() });
+        }
+    }
+    if !spec.netlist.is_file() {
+        return Err(ReportError::RtlMissing {
+            path: spec.netlist.clone(),
+        });
+    }
+    crate::liberty::Liberty::load(&spec.liberty)?;
+    let script = work.join("equiv.ys");
+    write_atomic(&script, equiv_script(spec).as_bytes())?;
+    let log_path = work.join("equiv.log");
+    let start = std::time::Instant::now();
+    let out = Command::new(&yosys)
+        .arg("-q")
+        .arg("-l")
+        .arg(&log_path)
+        .arg(&script)
+        .output()
+        .map_err(|e| ReportError::io("running", &yosys, e))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let log = std::fs::read_to_string(&log_path).unwrap_or_default();
+    match parse_status(&log) {
+        Some((points, 0, _)) if out.status.success() => Ok(Equivalence {
+            points,
+            proven: points,
+            seconds,
+            log: log_path,
+        }),
+        Some((points, unproven, first)) if unproven > 0 => Err(ReportError::NotEquivalent(
+            Box::new(crate::error::EquivFailure {
+                netlist: spec.netlist.clone(),
+                top: spec.top.clone(),
+                unproven,
+                total: points,
+                first,
+                log_tail: tail(&log, 8),
+            }),
+        )),
+        _ => Err(ReportError::ToolFailed {
+            tool: "yosys (equivalence)",
+            status: out
+                .status
+                .code()
+                .map_or("killed by a signal".into(), |c| c.to_string()),
+            log_tail: tail(
+                &format!("{log}{}", String::from_utf8_lossy(&out.stderr)),
+                15,
+            ),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn status_is_parsed_from_the_last_pass() {
+        let log = "17. Executing EQUIV_STATUS pass.\nFound 35 $equiv cells in equiv:\n  Of those cells 24 are proven and 11 are unproven.\n  Unproven $equiv $auto$equiv_make.cc:274:find_same_wires$441: \\x_gold [6] \\x_gate [6]\n";
+        assert_eq!(
+            parse_status(log),
+            Some((35, 11, "\\x_gold [6] \\x_gate [6]".into()))
+        );
+        let ok = "Executing EQUIV_STATUS pass.\nFound 39 $equiv cells in equiv:\n  Of those cells 39 are proven and 0 are unproven.\n  Equivalence successfully proven!\n";
+        assert_eq!(parse_status(ok), Some((39, 0, String::new())));
+        assert_eq!(parse_status("nothing"), None);
+    }
+
+    #[test]
+    fn script_compares_coarse_gold_with_the_liberty_cells() {
+        let s = equiv_script(&EquivSpec {
+            rtl: vec!["p.v".into()],
+            top: "pix".into(),
+            params: vec![("B".into(), 2)],
+            netlist: "n.v".into(),
+            liberty: "c.lib".into(),
+        });
+        assert!(s.contains("chparam -set B 2 pix"));
+        assert!(s.contains("synth -top pix -flatten -run begin:fine"));
+        assert!(s.contains("read_liberty -ignore_miss_func c.lib\nread_verilog n.v"));
+        assert!(s.ends_with("equiv_status -assert\n"));
+    }
+}
