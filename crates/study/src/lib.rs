@@ -8,6 +8,7 @@ pub mod error;
 pub mod flow;
 pub mod paper;
 pub mod records;
+pub mod replay;
 pub mod rtl;
 pub mod sizing;
 pub mod spectrum;

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod config;
 pub mod cosim;
 pub mod flow;
+pub mod replay;
 pub mod reproduce;
 pub mod rtl;
 pub mod simulate;
@@ -28,6 +29,8 @@ pub enum Command {
     /// Re-measure the paper's numbers (Table 2, Fig. 4, eq. 12, 1NN bandwidths) against
     /// the paper and the closed forms; exits 1 if a row misses.
     Reproduce(reproduce::ReproduceArgs),
+    /// Replay a real time-tagged record (PicoQuant PTU, B&H SPC) through the pixel.
+    Replay(replay::ReplayArgs),
     /// Sizing report: widths, readout, area (yosys), timing (OpenSTA), sky130, sweeps.
     Size(size::SizeArgs),
     /// Render the pixel, probe ROM and top into Verilog-2005 (atomic; never overwrites
@@ -65,6 +68,7 @@ pub fn run(command: Command) -> Result<(), CliError> {
         Command::Config(a) => config::run(&a),
         Command::Bench(a) => bench::run(a),
         Command::Reproduce(a) => reproduce::run(&a),
+        Command::Replay(a) => replay::run(&a),
         Command::Size(a) => size::run(&a),
         Command::Rtl(a) => rtl::run(&a),
         Command::Vectors(a) => vectors::run(&a),
