@@ -29,6 +29,41 @@ pub enum CosimError {
     /// The pixel rejects the parameters (the one validation).
     #[error(transparent)]
     Pixel(#[from] tofprobe_pixel::PixelError),
+    /// `--rtl DIR` was rendered for other parameters than the configuration being run.
+    #[error(
+        "{dir}: the RTL was rendered for {parameter} = {rtl}, the configuration being run has {parameter} = {config}: re-render it (`tofprobe rtl`) or run the configuration it was rendered for"
+    )]
+    RtlMismatch {
+        dir: PathBuf,
+        parameter: String,
+        rtl: String,
+        config: String,
+    },
+    /// The RTL's header cannot be read.
+    #[error("{path}: {message}")]
+    RtlHeader { path: PathBuf, message: String },
+    /// The probe ROM image in the RTL directory is malformed or fails its manifest.
+    #[error("probe ROM {path}: {message}")]
+    RomImage { path: PathBuf, message: String },
+    /// The probe ROM image differs from the configuration's ROM.
+    #[error(
+        "{dir}: the probe ROM image differs from the configuration's ROM at entry {entry}: register bit(s) {bits:?} differ (RTL {rtl}, configuration {config}); {differing} entr(y/ies) differ in all"
+    )]
+    RomMismatch {
+        dir: PathBuf,
+        entry: usize,
+        bits: Vec<usize>,
+        rtl: String,
+        config: String,
+        differing: usize,
+    },
+    /// An option outside its range.
+    #[error("{option} = {value} is out of range: {allowed}")]
+    Option {
+        option: &'static str,
+        value: String,
+        allowed: String,
+    },
     /// File-system error, with the path.
     #[error("{path}: {source}")]
     Io {

@@ -12,8 +12,11 @@ use tofprobe_io::fnv1a64;
 /// The harness source, embedded so the binary works outside the source tree.
 pub const HARNESS_CPP: &str = include_str!("../../../testbench/harness.cpp");
 
-/// Verilator flags of every build (lint stays strict: no -Wno-fatal here either).
-pub const VERILATOR_FLAGS: &[&str] = &["-O3", "--x-assign", "fast", "--x-initial", "fast"];
+/// Verilator flags of every build (lint stays strict: no -Wno-fatal here either). X
+/// assignments and initial values are `unique`, i.e. randomised at run time under
+/// `+verilator+rand+reset+2` with a recorded `+verilator+seed+`, so a state element that
+/// reset forgets does not silently start at zero.
+pub const VERILATOR_FLAGS: &[&str] = &["-O3", "--x-assign", "unique", "--x-initial", "unique"];
 
 /// How hard the C++ compiler works: `Check` builds fast for CI, `Speed` runs fast.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
