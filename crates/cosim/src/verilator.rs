@@ -59,6 +59,14 @@ fn verilog_sources(rtl_dir: &Path) -> Result<Vec<PathBuf>, CosimError> {
     Ok(v)
 }
 
+/// A per-process counter: two threads of one process (parallel tests) building the same
+/// RTL must not share a temporary directory (the first to finish publishes, the other's
+/// copy is dropped).
+fn next_build_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
 /// Builds (or reuses) the harness for the RTL in `rtl_dir` whose top module is `top`.
 pub fn build(
     rtl_dir: &Path,
@@ -95,9 +103,11 @@ pub fn build(
             seconds: t0.elapsed().as_secs_f64(),
         });
     }
-    let tmp = cache_root()
-        .join("verilator")
-        .join(format!(".{hash}.{}", std::process::id()));
+    let tmp = cache_root().join("verilator").join(format!(
+        ".{hash}.{}.{}",
+        std::process::id(),
+        next_build_id()
+    ));
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).map_err(|e| CosimError::io(&tmp, e))?;
     let pre = format!("{top}__DOT__u_pixel__DOT__");
