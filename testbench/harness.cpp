@@ -99,12 +99,15 @@ int main(int argc, char** argv) {
     uint64_t win_lo = 0, win_hi = 0;
     bool win_given = false;
     std::string vcd_file;
+    std::string cov_file;  // --coverage FILE: write the coverage counts (a --coverage build)
     uint64_t vcd_lo = 0, vcd_hi = 0;
     for (int i = 2; i < argc; ++i) {
         std::string a = argv[i];
         if (!a.empty() && a[0] == '+') {
             // +verilator+... run-time options (random reset, seed): VerilatedContext's.
             continue;
+        } else if (a == "--coverage" && i + 1 < argc) {
+            cov_file = argv[++i];
         } else if (a == "--bare") {
             bare = true;
         } else if (a == "--window" && i + 2 < argc) {
@@ -350,6 +353,9 @@ int main(int argc, char** argv) {
     if (vcd) vcd->close();
 #endif
     top->final();
+#if VM_COVERAGE
+    if (!cov_file.empty()) ctx->coveragep()->write(cov_file.c_str());
+#endif
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("TOFPROBE-COSIM-DONE cycles=%llu frames=%llu mismatches=%llu seconds=%.6f\n",
                 static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(frames),

@@ -6,7 +6,7 @@
 //! configuration's ROM. A difference is an error naming the parameter (or the ROM entry
 //! and its bits) and both values: it never reaches the simulator as an ordinary FAIL.
 
-use crate::error::CosimError;
+use crate::error::{CosimError, ParamDiff, RomDiff};
 use std::path::Path;
 use tofprobe_dsp::rom::{RomImage, RomManifest};
 use tofprobe_pixel::{Mode, PixelParams};
@@ -115,22 +115,22 @@ pub fn check_header(p: &PixelParams, dir: &Path) -> Result<RtlHeader, CosimError
             .map(|(_, v)| v.clone())
             .unwrap_or_else(|| "(absent)".to_string());
         if got != want {
-            return Err(CosimError::RtlMismatch {
+            return Err(CosimError::RtlMismatch(Box::new(ParamDiff {
                 dir: dir.to_path_buf(),
                 parameter: format!("{k} ({})", meaning(&k)),
                 rtl: got,
                 config: want,
-            });
+            })));
         }
     }
     let want = config_hash_with_prefix(p, DEFAULT_MODULE_PREFIX);
     if h.hash != want {
-        return Err(CosimError::RtlMismatch {
+        return Err(CosimError::RtlMismatch(Box::new(ParamDiff {
             dir: dir.to_path_buf(),
             parameter: "configuration hash".into(),
             rtl: h.hash.clone(),
             config: want,
-        });
+        })));
     }
     Ok(h)
 }
@@ -266,12 +266,12 @@ pub fn compare_rom(
             .map(|w| format!("{w:016x}"))
             .collect::<String>()
     };
-    Err(CosimError::RomMismatch {
+    Err(CosimError::RomMismatch(Box::new(RomDiff {
         dir: dir.to_path_buf(),
         entry: a,
         bits,
         rtl: hex(&x),
         config: hex(&y),
         differing,
-    })
+    })))
 }

@@ -58,6 +58,8 @@ pub struct CosimOptions {
     pub x_seed: u64,
     /// Leading pulses of the first frame forced to misses (directed stimulus: priming).
     pub lead_misses: u64,
+    /// Also measure line/toggle coverage of the pixel module (Verilator `--coverage`).
+    pub coverage: bool,
 }
 
 /// The simulator of a co-simulation: both replay the same vectors, report the first
@@ -101,6 +103,7 @@ impl CosimOptions {
             simulator: Simulator::Verilator,
             x_seed: 1,
             lead_misses: 0,
+            coverage: false,
         }
     }
 }
@@ -132,6 +135,8 @@ pub struct CosimReport {
     pub simulator: Simulator,
     /// The Verilator random-reset seed used (recorded so a failure can be re-run).
     pub x_seed: u64,
+    /// Coverage of the pixel module, when asked for.
+    pub coverage: Option<crate::coverage::Coverage>,
 }
 
 /// Reads the probe ROM image back from an RTL directory, strictly (`check::read_rom`).
@@ -264,6 +269,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
             rom,
             simulator: o.simulator,
             x_seed: o.x_seed,
+            coverage: None,
         });
     }
     let build = verilator::build(&rtl_dir, &top, false, o.profile)?;
@@ -305,6 +311,19 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         )?;
         vcd = Some(f);
     }
+    let coverage = if o.coverage {
+        let (pixel, _, _) = module_names(DEFAULT_MODULE_PREFIX);
+        Some(crate::coverage::measure(
+            &rtl_dir,
+            &vec_dir,
+            &top,
+            &work_dir.join("coverage"),
+            o.x_seed,
+            &format!("{pixel}.v"),
+        )?)
+    } else {
+        None
+    };
     let bare_seconds = if o.measure_bare {
         Some(harness::run_bare(&build.exe, &rtl_dir, &vec_dir)?)
     } else {
@@ -329,5 +348,6 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         rom,
         simulator: o.simulator,
         x_seed: o.x_seed,
+        coverage,
     })
 }

@@ -31,14 +31,10 @@ pub enum CosimError {
     Pixel(#[from] tofprobe_pixel::PixelError),
     /// `--rtl DIR` was rendered for other parameters than the configuration being run.
     #[error(
-        "{dir}: the RTL was rendered for {parameter} = {rtl}, the configuration being run has {parameter} = {config}: re-render it (`tofprobe rtl`) or run the configuration it was rendered for"
+        "{}: the RTL was rendered for {} = {}, the configuration being run has {} = {}: re-render it (`tofprobe rtl`) or run the configuration it was rendered for",
+        .0.dir.display(), .0.parameter, .0.rtl, .0.parameter, .0.config
     )]
-    RtlMismatch {
-        dir: PathBuf,
-        parameter: String,
-        rtl: String,
-        config: String,
-    },
+    RtlMismatch(Box<ParamDiff>),
     /// The RTL's header cannot be read.
     #[error("{path}: {message}")]
     RtlHeader { path: PathBuf, message: String },
@@ -47,16 +43,10 @@ pub enum CosimError {
     RomImage { path: PathBuf, message: String },
     /// The probe ROM image differs from the configuration's ROM.
     #[error(
-        "{dir}: the probe ROM image differs from the configuration's ROM at entry {entry}: register bit(s) {bits:?} differ (RTL {rtl}, configuration {config}); {differing} entr(y/ies) differ in all"
+        "{}: the probe ROM image differs from the configuration's ROM at entry {}: register bit(s) {:?} differ (RTL {}, configuration {}); {} entr(y/ies) differ in all",
+        .0.dir.display(), .0.entry, .0.bits, .0.rtl, .0.config, .0.differing
     )]
-    RomMismatch {
-        dir: PathBuf,
-        entry: usize,
-        bits: Vec<usize>,
-        rtl: String,
-        config: String,
-        differing: usize,
-    },
+    RomMismatch(Box<RomDiff>),
     /// An option outside its range.
     #[error("{option} = {value} is out of range: {allowed}")]
     Option {
@@ -79,4 +69,26 @@ impl CosimError {
             source,
         }
     }
+}
+
+/// A parameter of `--rtl DIR` that differs from the configuration's.
+#[derive(Debug)]
+pub struct ParamDiff {
+    pub dir: PathBuf,
+    pub parameter: String,
+    pub rtl: String,
+    pub config: String,
+}
+
+/// The first ROM entry of `--rtl DIR` that differs from the configuration's ROM.
+#[derive(Debug)]
+pub struct RomDiff {
+    pub dir: PathBuf,
+    pub entry: usize,
+    /// Register bits of that entry that differ.
+    pub bits: Vec<usize>,
+    pub rtl: String,
+    pub config: String,
+    /// Entries that differ in all.
+    pub differing: usize,
 }

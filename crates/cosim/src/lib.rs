@@ -3,6 +3,7 @@
 //! self-checking testbench, and the first-mismatch report.
 
 pub mod check;
+pub mod coverage;
 pub mod driver;
 pub mod error;
 pub mod harness;

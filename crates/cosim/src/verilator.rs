@@ -74,6 +74,18 @@ pub fn build(
     trace: bool,
     profile: BuildProfile,
 ) -> Result<HarnessBuild, CosimError> {
+    build_with(rtl_dir, top, trace, false, profile)
+}
+
+/// [`build`], optionally instrumented for line coverage (`--coverage-line`; the
+/// harness then writes the counts with `--coverage FILE`).
+pub fn build_with(
+    rtl_dir: &Path,
+    top: &str,
+    trace: bool,
+    coverage: bool,
+    profile: BuildProfile,
+) -> Result<HarnessBuild, CosimError> {
     let verilator = require("verilator")?;
     let t0 = Instant::now();
     let sources = verilog_sources(rtl_dir)?;
@@ -84,7 +96,13 @@ pub fn build(
     let mut key = Vec::new();
     key.extend_from_slice(&version.stdout);
     key.extend_from_slice(HARNESS_CPP.as_bytes());
-    key.extend_from_slice(format!("{top} {trace} {profile:?} {VERILATOR_FLAGS:?}").as_bytes());
+    key.extend_from_slice(
+        format!(
+            "{top} {trace} {} {profile:?} {VERILATOR_FLAGS:?}",
+            if coverage { "--coverage-line" } else { "" }
+        )
+        .as_bytes(),
+    );
     for s in &sources {
         key.extend_from_slice(
             s.file_name()
@@ -148,6 +166,9 @@ pub fn build(
     });
     if trace {
         cmd.arg("--trace");
+    }
+    if coverage {
+        cmd.arg("--coverage-line");
     }
     cmd.args(&sources).arg(&cpp);
     let out = cmd.output().map_err(|e| CosimError::io(&verilator, e))?;

@@ -101,14 +101,9 @@ fn every_rendered_parameter_is_checked_before_simulating() {
     ];
     for (p, param, rtl, config) in cases {
         match run(&p, &dir, None, "params") {
-            Err(CosimError::RtlMismatch {
-                parameter,
-                rtl: r,
-                config: c,
-                ..
-            }) => {
+            Err(CosimError::RtlMismatch(d)) => {
                 assert_eq!(
-                    (parameter.as_str(), r.as_str(), c.as_str()),
+                    (d.parameter.as_str(), d.rtl.as_str(), d.config.as_str()),
                     (param, rtl, config)
                 );
             }
@@ -180,13 +175,8 @@ fn a_one_bit_rom_edit_is_caught_with_its_entry_and_bit() {
     // configuration's ROM names entry 17, register bit 5.
     std::fs::remove_file(dir.join("tofprobe_probe_rom.toml")).expect("rm manifest");
     match run(&p, &dir, Some(good), "rom-compare") {
-        Err(CosimError::RomMismatch {
-            entry,
-            bits,
-            differing,
-            ..
-        }) => {
-            assert_eq!((entry, bits, differing), (17, vec![5], 1));
+        Err(CosimError::RomMismatch(d)) => {
+            assert_eq!((d.entry, d.bits.clone(), d.differing), (17, vec![5], 1));
         }
         other => panic!("expected a ROM mismatch, got {other:?}"),
     }

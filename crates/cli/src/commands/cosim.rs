@@ -60,6 +60,10 @@ pub struct CosimArgs {
     /// Directed stimulus: the first K pulses are misses (the priming rule).
     #[arg(long, default_value_t = 0)]
     pub lead_misses: u64,
+    /// Also measure line coverage of the pixel module (Verilator `--coverage-line`) and
+    /// list the lines never hit.
+    #[arg(long)]
+    pub coverage: bool,
     /// Soak: co-simulate N random valid configurations (both modes, every knob, width drawn
     /// or "auto"), drawn from --seed, instead of CONFIG.
     #[arg(long)]
@@ -96,6 +100,8 @@ struct Json {
     first_mismatch_actual: Option<String>,
     simulator: &'static str,
     x_seed: u64,
+    coverage_percent: Option<f64>,
+    uncovered_lines: Option<Vec<String>>,
     verilator_seconds: f64,
     verilator_cycles_per_s: f64,
     bare_verilator_seconds: Option<f64>,
@@ -142,6 +148,7 @@ pub fn options(p: &PixelParams, a: &CosimArgs) -> CosimOptions {
     o.simulator = a.simulator.into();
     o.x_seed = a.x_seed;
     o.lead_misses = a.lead_misses;
+    o.coverage = a.coverage;
     let cycles = a.frames * p.frame_pulses * p.cycles_per_pulse as u64;
     if cycles > LONG_RUN_CYCLES {
         o.digest_pulses = LONG_RUN_DIGEST_PULSES;
@@ -197,6 +204,13 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
         first_mismatch_actual: r.first.as_ref().map(|m| m.actual.clone()),
         simulator: r.simulator.name(),
         x_seed: r.x_seed,
+        coverage_percent: r.coverage.as_ref().map(|c| c.percent()),
+        uncovered_lines: r.coverage.as_ref().map(|c| {
+            c.uncovered
+                .iter()
+                .map(|(n, t)| format!("{}:{n}: {t}", c.file))
+                .collect()
+        }),
         verilator_seconds: r.verilator_seconds,
         verilator_cycles_per_s: rate(r.cycles, r.verilator_seconds),
         bare_verilator_seconds: r.bare_seconds,
@@ -256,6 +270,18 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
                 .unwrap_or_default(),
             j.rom,
         );
+    }
+    if let (false, Some(c)) = (a.json, &r.coverage) {
+        println!(
+            "coverage of {}: {} of {} lines with coverage points hit ({:.1}%)",
+            c.file,
+            c.covered,
+            c.lines,
+            c.percent()
+        );
+        for (n, t) in &c.uncovered {
+            println!("  not hit: {}:{n}: {t}", c.file);
+        }
     }
     if r.pass {
         Ok(())
