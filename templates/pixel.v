@@ -45,7 +45,11 @@ module {{ name }} (
 {%- if fourier %}
     wire accept_pulse = pulse && free && !readout;
 {%- else %}
+{%- if mutation == "haar_frame_limit" %}
+    wire accept_pulse = pulse && free && !readout;
+{%- else %}
     wire accept_pulse = pulse && free && !readout && (pcount != {{ ln + 1 }}'d{{ n }});
+{%- endif %}
 {%- endif %}
     wire refuse = pulse && !accept_pulse;
     wire status_edge = rd_active && (rd_ptr == {{ ib }}'d{{ r }});
@@ -123,7 +127,13 @@ module {{ name }} (
     // ---- register writes: accumulate (slot's adder) or readout clear ----
     wire [{{ r - 1 }}:0] we_c;
 {%- for g in regs %}
+{%- if mutation == "readout_clear" %}
+    assign we_c[{{ g.r }}] = active && acc_en && {{ g.sel }};
+{%- else if mutation == "enable_decode" %}
+    assign we_c[{{ g.r }}] = (active && {{ g.sel }}) || (rd_active && rd_ptr == {{ ib }}'d{{ g.r }});
+{%- else %}
     assign we_c[{{ g.r }}] = (active && acc_en && {{ g.sel }}) || (rd_active && rd_ptr == {{ ib }}'d{{ g.r }});
+{%- endif %}
     wire [{{ w - 1 }}:0] wval_{{ g.r }} = rd_active ? {{ w }}'d0 : sum_{{ g.adder }};
 {%- endfor %}
 {%- if mutation == "schedule_late" %}
@@ -177,7 +187,9 @@ module {{ name }} (
     // ---- control, hold, prefilter ----
     always @(posedge clk) begin
         if (rst) begin
+{%- if mutation != "reset_primed" %}
             primed <= 1'b0;
+{%- endif %}
             held <= {{ t + 1 }}'d0;
             op <= {{ opw }}'d0;
             acc_en <= 1'b0;
@@ -208,7 +220,11 @@ module {{ name }} (
                     rd_index <= rd_ptr;
                     rd_ptr <= rd_ptr + {{ ib }}'d1;
                 end else begin
+{%- if mutation == "status_word" %}
+                    rd_data <= rd_mux;
+{%- else %}
                     rd_data <= refused;
+{%- endif %}
                     rd_index <= {{ ib }}'d{{ r }};
                     rd_active <= 1'b0;
 {%- if !fourier %}
@@ -224,8 +240,10 @@ module {{ name }} (
             end
             if (status_edge) begin
                 refused <= { {{- w - 1 }}'d0, refuse};
+{%- if mutation != "refused_counter" %}
             end else if (refuse && refused != {{ "{" }}{{ w }}{1'b1}}) begin
                 refused <= refused + {{ w }}'d1;
+{%- endif %}
             end
             if (accept_pulse) begin
 {%- if fourier %}
@@ -241,7 +259,11 @@ module {{ name }} (
 {%- else %}
                 if (valid) held <= d;
 {%- endif %}
+{%- if mutation == "prime_on_miss" %}
+                if (!primed) begin
+{%- else %}
                 if (valid && !primed) begin
+{%- endif %}
                     primed <= 1'b1;
                     x <= d_f;
                 end
@@ -250,7 +272,11 @@ module {{ name }} (
                 held <= h_new;
                 op <= h_new;
                 acc_en <= primed || valid;
+{%- if mutation == "prime_on_miss" %}
+                primed <= 1'b1;
+{%- else %}
                 if (valid) primed <= 1'b1;
+{%- endif %}
                 n_lat <= pcount[{{ ln - 1 }}:{{ nlo }}];
                 pcount <= pcount + {{ ln + 1 }}'d1;
 {%- endif %}

@@ -94,15 +94,21 @@ int main(int argc, char** argv) {
                      "usage: harness VECDIR [--bare] [--window LO HI] [--vcd FILE LO HI]\n");
         return 2;
     }
-    std::string dir = argv[1];
+    std::string dir = argv[1];  // usage: harness VECDIR [options] [+verilator+...]
     bool bare = false;
     uint64_t win_lo = 0, win_hi = 0;
     bool win_given = false;
     std::string vcd_file;
+    std::string cov_file;  // --coverage FILE: write the coverage counts (a --coverage build)
     uint64_t vcd_lo = 0, vcd_hi = 0;
     for (int i = 2; i < argc; ++i) {
         std::string a = argv[i];
-        if (a == "--bare") {
+        if (!a.empty() && a[0] == '+') {
+            // +verilator+... run-time options (random reset, seed): VerilatedContext's.
+            continue;
+        } else if (a == "--coverage" && i + 1 < argc) {
+            cov_file = argv[++i];
+        } else if (a == "--bare") {
             bare = true;
         } else if (a == "--window" && i + 2 < argc) {
             win_lo = std::strtoull(argv[i + 1], nullptr, 10);
@@ -245,7 +251,9 @@ int main(int argc, char** argv) {
         Pins now{c, top->ready != 0, top->rd_valid != 0, static_cast<uint32_t>(top->rd_index),
                  static_cast<uint64_t>(top->rd_data)};
         const bool pulse = top->pulse_o;
-        const uint64_t we = static_cast<uint64_t>(PIX_WE);
+        // rst wins: a write enable during reset writes nothing (the state it comes from is
+        // random until the reset edge, under +verilator+rand+reset+2).
+        const uint64_t we = top->rst ? 0 : static_cast<uint64_t>(PIX_WE);
         top->clk = 1;
         top->eval();
 #ifdef TOFPROBE_TRACE
@@ -345,6 +353,9 @@ int main(int argc, char** argv) {
     if (vcd) vcd->close();
 #endif
     top->final();
+#if VM_COVERAGE
+    if (!cov_file.empty()) ctx->coveragep()->write(cov_file.c_str());
+#endif
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("TOFPROBE-COSIM-DONE cycles=%llu frames=%llu mismatches=%llu seconds=%.6f\n",
                 static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(frames),

@@ -9,6 +9,8 @@
 // and run vvp from the RTL directory (the probe ROM's $readmemh file is found there). It
 // ends with exactly one line:
 //   TOFPROBE-COSIM-DONE cycles=<n> frames=<n> mismatches=<n> seconds=0
+// and, under Icarus, exits with status 1 when there was a mismatch. An X on an output pin,
+// a readout word or a write enable (a state element reset forgot) is a mismatch.
 `timescale 1ns / 1ps
 module tb;
 `include "tb_params.vh"
@@ -84,7 +86,9 @@ module tb;
             rd_valid_s = rd_valid;
             rd_index_s = rd_index;
             rd_data_s = rd_data;
-            we = dut.u_pixel.we;
+            // rst wins; any X on the write enables (a register reset forgot) is a mismatch.
+            we = rst ? 64'd0 : dut.u_pixel.we;
+            if (c >= 1 && ^we === 1'bx) mismatch("we", -1, 64'd0, we);
             clk = 1;
             #1;
             if (p_s) begin
@@ -129,6 +133,10 @@ module tb;
         end
         if (ro_i != TB_READOUT_WORDS) mismatch("readout_words", -1, TB_READOUT_WORDS, ro_i);
         $display("TOFPROBE-COSIM-DONE cycles=%0d frames=%0d mismatches=%0d seconds=0", TB_CYCLES, frames, mism);
+`ifdef __ICARUS__
+        // vvp's exit status says FAIL too (a plain $finish exits 0 whatever happened).
+        if (mism != 0) $finish_and_return(1);
+`endif
         $finish;
     end
 endmodule

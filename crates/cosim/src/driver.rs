@@ -3,8 +3,10 @@
 //! a mismatch pin it down to the first cycle (re-running a digest window with its full
 //! trace) and write a VCD around it.
 
+use crate::check;
 use crate::error::CosimError;
 use crate::harness::{self, Mismatch, RunOutcome};
+use crate::icarus;
 use crate::verilator::{self, BuildProfile, HarnessBuild};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -44,10 +46,42 @@ pub struct CosimOptions {
     /// Per-pulse detections to replay (e.g. from the scene); `None` = random from `seed`.
     pub stimulus: Option<Vec<Option<u32>>>,
     /// Probe ROM image to render (L × ceil(R/64) words, e.g. the configuration's ΣΔ ROM);
-    /// `None` = the sign-of-cosine probe of `stimulus::sign_probe_rom`. Ignored with
-    /// `rtl_dir` (the ROM is read back from the given RTL).
+    /// `None` = the sign-of-cosine probe of `stimulus::sign_probe_rom`. With `rtl_dir` it is
+    /// the configuration's ROM that the image in the directory must equal (checked before
+    /// simulating, `check::compare_rom`).
     pub rom: Option<Vec<u64>>,
+    /// Which simulator replays the vectors.
+    pub simulator: Simulator,
+    /// Seed of Verilator's randomised initial register values (`+verilator+rand+reset+2`,
+    /// `+verilator+seed+`): a forgotten reset shows as a mismatch. Must be ≥ 1 (0 would let
+    /// Verilator pick a seed, and the run would not be reproducible).
+    pub x_seed: u64,
+    /// Leading pulses of the first frame forced to misses (directed stimulus: priming).
+    pub lead_misses: u64,
+    /// Also measure line/toggle coverage of the pixel module (Verilator `--coverage`).
+    pub coverage: bool,
 }
+
+/// The simulator of a co-simulation: both replay the same vectors, report the first
+/// mismatch in the same form and end with the same completion line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Simulator {
+    #[default]
+    Verilator,
+    Icarus,
+}
+
+impl Simulator {
+    pub fn name(self) -> &'static str {
+        match self {
+            Simulator::Verilator => "verilator",
+            Simulator::Icarus => "icarus",
+        }
+    }
+}
+
+/// Icarus replays full traces only: runs longer than this many cycles are refused.
+pub const ICARUS_MAX_CYCLES: u64 = 2_000_000;
 
 impl CosimOptions {
     /// Defaults for a short co-simulation in `work_dir`.
@@ -66,6 +100,10 @@ impl CosimOptions {
             stimulus: None,
             digest_only: false,
             rom: None,
+            simulator: Simulator::Verilator,
+            x_seed: 1,
+            lead_misses: 0,
+            coverage: false,
         }
     }
 }
@@ -94,57 +132,16 @@ pub struct CosimReport {
     pub rom: Vec<u64>,
     /// The golden readouts, per frame (R words then the status word, raw W bits).
     pub readouts: Vec<Vec<u64>>,
+    pub simulator: Simulator,
+    /// The Verilator random-reset seed used (recorded so a failure can be re-run).
+    pub x_seed: u64,
+    /// Coverage of the pixel module, when asked for.
+    pub coverage: Option<crate::coverage::Coverage>,
 }
 
-/// Reads the probe ROM image back from an RTL directory (`$readmemh` file or case table).
+/// Reads the probe ROM image back from an RTL directory, strictly (`check::read_rom`).
 pub fn rom_from_rtl(p: &PixelParams, dir: &Path) -> Result<Vec<u64>, CosimError> {
-    if p.mode == Mode::Haar {
-        return Ok(Vec::new());
-    }
-    let (_, rom_name, _) = module_names(DEFAULT_MODULE_PREFIX);
-    let r = p.registers();
-    let words = r.div_ceil(64);
-    let mut rom = vec![0u64; p.rom_depth * words];
-    let put = |rom: &mut Vec<u64>, a: usize, hex: &str| {
-        for (i, ch) in hex.chars().rev().enumerate() {
-            let nib = u64::from(ch.to_digit(16).unwrap_or(0));
-            let bit = i * 4;
-            if bit < r && a < p.rom_depth {
-                rom[a * words + bit / 64] |= nib << (bit % 64);
-            }
-        }
-    };
-    let hex_path = dir.join(format!("{rom_name}.hex"));
-    if hex_path.is_file() {
-        let text = std::fs::read_to_string(&hex_path).map_err(|e| CosimError::io(&hex_path, e))?;
-        let lines = text
-            .lines()
-            .map(str::trim)
-            .filter(|l| !l.is_empty() && !l.starts_with("//"));
-        for (a, l) in lines.enumerate() {
-            put(&mut rom, a, l);
-        }
-        return Ok(rom);
-    }
-    let v_path = dir.join(format!("{rom_name}.v"));
-    let text = std::fs::read_to_string(&v_path).map_err(|e| CosimError::io(&v_path, e))?;
-    for l in text.lines() {
-        // `  6'd12: word = 32'h0f0f0f0f;`
-        let Some((lhs, rhs)) = l.split_once(": word = ") else {
-            continue;
-        };
-        let Some(addr) = lhs
-            .split("'d")
-            .nth(1)
-            .and_then(|a| a.trim().parse::<usize>().ok())
-        else {
-            continue;
-        };
-        if let Some(h) = rhs.split("'h").nth(1) {
-            put(&mut rom, addr, h.trim_end_matches(';').trim());
-        }
-    }
-    Ok(rom)
+    check::read_rom(p, dir)
 }
 
 /// Renders the configuration's RTL (optionally with a fault) into `dir`, with the
@@ -197,12 +194,39 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         }
     };
     let rtl_dir = std::fs::canonicalize(&rtl_dir).map_err(|e| CosimError::io(&rtl_dir, e))?;
-    let rom = rom_from_rtl(p, &rtl_dir)?;
+    // Exact and checked before any simulation: the header's parameters and hash, then the
+    // ROM image against its manifest and the configuration's ROM.
+    check::check_header(p, &rtl_dir)?;
+    let rom = check::read_rom(p, &rtl_dir)?;
+    if let (Some(want), Mode::Fourier) = (&o.rom, p.mode) {
+        check::compare_rom(p, &rtl_dir, &rom, want)?;
+    }
+    if o.x_seed == 0 {
+        return Err(CosimError::Option {
+            option: "x_seed",
+            value: "0".into(),
+            allowed: "1..=2^64-1 (0 lets Verilator choose, irreproducibly); use 1".into(),
+        });
+    }
     let pulses = o.frames * p.frame_pulses;
-    let stim = match &o.stimulus {
+    let mut stim = match &o.stimulus {
         Some(s) if s.len() as u64 >= pulses => s[..pulses as usize].to_vec(),
         _ => random_stimulus(p, pulses, o.seed),
     };
+    for d in stim.iter_mut().take(o.lead_misses as usize) {
+        *d = None;
+    }
+    let cycles_needed =
+        2 + o.frames * (p.frame_pulses * p.cycles_per_pulse as u64 + p.registers() as u64 + 2) + 1;
+    if o.simulator == Simulator::Icarus && (o.digest_only || cycles_needed > ICARUS_MAX_CYCLES) {
+        return Err(CosimError::Option {
+            option: "simulator",
+            value: format!("icarus for {cycles_needed} cycles"),
+            allowed: format!(
+                "Icarus replays full traces only, at most {ICARUS_MAX_CYCLES} cycles: use fewer frames, --frame-pulses, or --simulator verilator"
+            ),
+        });
+    }
     let vopts = VectorOptions {
         frames: o.frames,
         seed: o.seed,
@@ -216,8 +240,40 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
     write_vectors(&vec_dir, p, &stim, &rom, &golden, window, &vopts)?;
     let vec_dir = std::fs::canonicalize(&vec_dir).map_err(|e| CosimError::io(&vec_dir, e))?;
     let (_, _, top) = module_names(DEFAULT_MODULE_PREFIX);
+    if o.simulator == Simulator::Icarus {
+        let t1 = Instant::now();
+        let outcome = icarus::run(&rtl_dir, &vec_dir, &top, &work_dir.join("icarus"))?;
+        let seconds = t1.elapsed().as_secs_f64();
+        let first = outcome.first.clone();
+        let pass = outcome.mismatches == 0 && outcome.frames == o.frames && first.is_none();
+        return Ok(CosimReport {
+            pass,
+            verilator_seconds: seconds,
+            outcome,
+            first,
+            build: HarnessBuild {
+                exe: work_dir.join("icarus").join("tb.vvp"),
+                reused: false,
+                seconds: 0.0,
+            },
+            pulses,
+            cycles: golden.cycles,
+            frames: o.frames,
+            model_seconds,
+            bare_seconds: None,
+            vcd: None,
+            rtl_dir,
+            vectors_dir: vec_dir,
+            readouts: golden.readouts,
+            stimulus: stim,
+            rom,
+            simulator: o.simulator,
+            x_seed: o.x_seed,
+            coverage: None,
+        });
+    }
     let build = verilator::build(&rtl_dir, &top, false, o.profile)?;
-    let outcome = harness::run(&build.exe, &rtl_dir, &vec_dir, None, None)?;
+    let outcome = harness::run(&build.exe, &rtl_dir, &vec_dir, None, None, o.x_seed)?;
     let mut first = outcome.first.clone();
     if let Some(d) = outcome.digest {
         // A digest differed: regenerate that window's full trace and replay it; the earlier
@@ -230,7 +286,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         let wdir = work_dir.join("vectors-window");
         write_vectors(&wdir, p, &stim, &rom, &gw, ww, &wopts)?;
         let wdir = std::fs::canonicalize(&wdir).map_err(|e| CosimError::io(&wdir, e))?;
-        let refined = harness::run(&build.exe, &rtl_dir, &wdir, Some(ww), None)?.first;
+        let refined = harness::run(&build.exe, &rtl_dir, &wdir, Some(ww), None, o.x_seed)?.first;
         first = match (first, refined) {
             (Some(a), Some(b)) => Some(if b.cycle <= a.cycle { b } else { a }),
             (a, b) => b.or(a),
@@ -245,9 +301,29 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         };
         let tb = verilator::build(&rtl_dir, &top, true, o.profile)?;
         let f = work_dir.join("cosim.vcd");
-        harness::run(&tb.exe, &rtl_dir, &vec_dir, None, Some((&f, lo, hi)))?;
+        harness::run(
+            &tb.exe,
+            &rtl_dir,
+            &vec_dir,
+            None,
+            Some((&f, lo, hi)),
+            o.x_seed,
+        )?;
         vcd = Some(f);
     }
+    let coverage = if o.coverage {
+        let (pixel, _, _) = module_names(DEFAULT_MODULE_PREFIX);
+        Some(crate::coverage::measure(
+            &rtl_dir,
+            &vec_dir,
+            &top,
+            &work_dir.join("coverage"),
+            o.x_seed,
+            &format!("{pixel}.v"),
+        )?)
+    } else {
+        None
+    };
     let bare_seconds = if o.measure_bare {
         Some(harness::run_bare(&build.exe, &rtl_dir, &vec_dir)?)
     } else {
@@ -270,5 +346,8 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         readouts: golden.readouts,
         stimulus: stim,
         rom,
+        simulator: o.simulator,
+        x_seed: o.x_seed,
+        coverage,
     })
 }

@@ -29,6 +29,31 @@ pub enum CosimError {
     /// The pixel rejects the parameters (the one validation).
     #[error(transparent)]
     Pixel(#[from] tofprobe_pixel::PixelError),
+    /// `--rtl DIR` was rendered for other parameters than the configuration being run.
+    #[error(
+        "{}: the RTL was rendered for {} = {}, the configuration being run has {} = {}: re-render it (`tofprobe rtl`) or run the configuration it was rendered for",
+        .0.dir.display(), .0.parameter, .0.rtl, .0.parameter, .0.config
+    )]
+    RtlMismatch(Box<ParamDiff>),
+    /// The RTL's header cannot be read.
+    #[error("{path}: {message}")]
+    RtlHeader { path: PathBuf, message: String },
+    /// The probe ROM image in the RTL directory is malformed or fails its manifest.
+    #[error("probe ROM {path}: {message}")]
+    RomImage { path: PathBuf, message: String },
+    /// The probe ROM image differs from the configuration's ROM.
+    #[error(
+        "{}: the probe ROM image differs from the configuration's ROM at entry {}: register bit(s) {:?} differ (RTL {}, configuration {}); {} entr(y/ies) differ in all",
+        .0.dir.display(), .0.entry, .0.bits, .0.rtl, .0.config, .0.differing
+    )]
+    RomMismatch(Box<RomDiff>),
+    /// An option outside its range.
+    #[error("{option} = {value} is out of range: {allowed}")]
+    Option {
+        option: &'static str,
+        value: String,
+        allowed: String,
+    },
     /// File-system error, with the path.
     #[error("{path}: {source}")]
     Io {
@@ -44,4 +69,26 @@ impl CosimError {
             source,
         }
     }
+}
+
+/// A parameter of `--rtl DIR` that differs from the configuration's.
+#[derive(Debug)]
+pub struct ParamDiff {
+    pub dir: PathBuf,
+    pub parameter: String,
+    pub rtl: String,
+    pub config: String,
+}
+
+/// The first ROM entry of `--rtl DIR` that differs from the configuration's ROM.
+#[derive(Debug)]
+pub struct RomDiff {
+    pub dir: PathBuf,
+    pub entry: usize,
+    /// Register bits of that entry that differ.
+    pub bits: Vec<usize>,
+    pub rtl: String,
+    pub config: String,
+    /// Entries that differ in all.
+    pub differing: usize,
 }

@@ -91,9 +91,14 @@ pub fn run(
     vec_dir: &Path,
     window: Option<(u64, u64)>,
     vcd: Option<(&Path, u64, u64)>,
+    x_seed: u64,
 ) -> Result<RunOutcome, CosimError> {
     let mut cmd = Command::new(exe);
     cmd.current_dir(rtl_dir).arg(vec_dir);
+    // Randomised initial register values (built with --x-initial unique): a register that
+    // reset forgets starts from a seed-determined random value, not Verilator's zero.
+    cmd.arg("+verilator+rand+reset+2")
+        .arg(format!("+verilator+seed+{x_seed}"));
     if let Some((lo, hi)) = window {
         cmd.args(["--window", &lo.to_string(), &hi.to_string()]);
     }
@@ -119,6 +124,8 @@ pub fn run_bare(exe: &Path, rtl_dir: &Path, vec_dir: &Path) -> Result<f64, Cosim
         .current_dir(rtl_dir)
         .arg(vec_dir)
         .arg("--bare")
+        .arg("+verilator+rand+reset+2")
+        .arg("+verilator+seed+1")
         .output()
         .map_err(|e| CosimError::io(exe, e))?;
     let text = String::from_utf8_lossy(&out.stdout);

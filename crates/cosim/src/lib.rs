@@ -2,15 +2,20 @@
 //! driver (cached builds, the C++ harness of `testbench/`), an Icarus driver for the plain
 //! self-checking testbench, and the first-mismatch report.
 
+pub mod check;
+pub mod coverage;
 pub mod driver;
 pub mod error;
 pub mod gate_level;
 pub mod harness;
 pub mod icarus;
+pub mod random;
 pub mod tools;
 pub mod verilator;
 
-pub use driver::{CosimOptions, CosimReport, cosim, render_into, render_with_rom, rom_from_rtl};
+pub use driver::{
+    CosimOptions, CosimReport, Simulator, cosim, render_into, render_with_rom, rom_from_rtl,
+};
 pub use error::CosimError;
 pub use harness::{Mismatch, RunOutcome};
 pub use verilator::BuildProfile;

@@ -12,8 +12,11 @@ use tofprobe_io::fnv1a64;
 /// The harness source, embedded so the binary works outside the source tree.
 pub const HARNESS_CPP: &str = include_str!("../../../testbench/harness.cpp");
 
-/// Verilator flags of every build (lint stays strict: no -Wno-fatal here either).
-pub const VERILATOR_FLAGS: &[&str] = &["-O3", "--x-assign", "fast", "--x-initial", "fast"];
+/// Verilator flags of every build (lint stays strict: no -Wno-fatal here either). X
+/// assignments and initial values are `unique`, i.e. randomised at run time under
+/// `+verilator+rand+reset+2` with a recorded `+verilator+seed+`, so a state element that
+/// reset forgets does not silently start at zero.
+pub const VERILATOR_FLAGS: &[&str] = &["-O3", "--x-assign", "unique", "--x-initial", "unique"];
 
 /// How hard the C++ compiler works: `Check` builds fast for CI, `Speed` runs fast.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -56,11 +59,31 @@ fn verilog_sources(rtl_dir: &Path) -> Result<Vec<PathBuf>, CosimError> {
     Ok(v)
 }
 
+/// A per-process counter: two threads of one process (parallel tests) building the same
+/// RTL must not share a temporary directory (the first to finish publishes, the other's
+/// copy is dropped).
+fn next_build_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
 /// Builds (or reuses) the harness for the RTL in `rtl_dir` whose top module is `top`.
 pub fn build(
     rtl_dir: &Path,
     top: &str,
     trace: bool,
+    profile: BuildProfile,
+) -> Result<HarnessBuild, CosimError> {
+    build_with(rtl_dir, top, trace, false, profile)
+}
+
+/// [`build`], optionally instrumented for line coverage (`--coverage-line`; the
+/// harness then writes the counts with `--coverage FILE`).
+pub fn build_with(
+    rtl_dir: &Path,
+    top: &str,
+    trace: bool,
+    coverage: bool,
     profile: BuildProfile,
 ) -> Result<HarnessBuild, CosimError> {
     let verilator = require("verilator")?;
@@ -73,7 +96,13 @@ pub fn build(
     let mut key = Vec::new();
     key.extend_from_slice(&version.stdout);
     key.extend_from_slice(HARNESS_CPP.as_bytes());
-    key.extend_from_slice(format!("{top} {trace} {profile:?} {VERILATOR_FLAGS:?}").as_bytes());
+    key.extend_from_slice(
+        format!(
+            "{top} {trace} {} {profile:?} {VERILATOR_FLAGS:?}",
+            if coverage { "--coverage-line" } else { "" }
+        )
+        .as_bytes(),
+    );
     for s in &sources {
         key.extend_from_slice(
             s.file_name()
@@ -92,9 +121,11 @@ pub fn build(
             seconds: t0.elapsed().as_secs_f64(),
         });
     }
-    let tmp = cache_root()
-        .join("verilator")
-        .join(format!(".{hash}.{}", std::process::id()));
+    let tmp = cache_root().join("verilator").join(format!(
+        ".{hash}.{}.{}",
+        std::process::id(),
+        next_build_id()
+    ));
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).map_err(|e| CosimError::io(&tmp, e))?;
     let pre = format!("{top}__DOT__u_pixel__DOT__");
@@ -135,6 +166,9 @@ pub fn build(
     });
     if trace {
         cmd.arg("--trace");
+    }
+    if coverage {
+        cmd.arg("--coverage-line");
     }
     cmd.args(&sources).arg(&cpp);
     let out = cmd.output().map_err(|e| CosimError::io(&verilator, e))?;

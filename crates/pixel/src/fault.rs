@@ -16,6 +16,21 @@ pub enum Fault {
     HoldInvalid,
     /// The prefilter shifts logically instead of arithmetically.
     LogicalShift,
+    /// Reset forgets `primed` (Verilator's zero start hides it; random reset and Icarus's
+    /// X show it).
+    ResetPrimed,
+    /// The pixel primes on a pulse without a detection.
+    PrimeOnMiss,
+    /// The readout does not clear the registers.
+    ReadoutClear,
+    /// The write enables ignore `acc_en` (a non-contributing pulse still writes).
+    EnableDecode,
+    /// The status word carries the register multiplexer instead of the refused counter.
+    StatusWord,
+    /// The refused counter does not count.
+    RefusedCounter,
+    /// Haar: a full frame accepts further pulses instead of refusing them.
+    HaarFrameLimit,
 }
 
 impl Fault {
@@ -28,6 +43,19 @@ impl Fault {
         Fault::LogicalShift,
     ];
 
+    /// Faults the cycle model has no hook for: the co-simulation must catch them, but the
+    /// cycle where they first show is not predicted (the mutation tests check that they are
+    /// caught, with the first mismatch reported).
+    pub const UNMODELLED: [Fault; 7] = [
+        Fault::ResetPrimed,
+        Fault::PrimeOnMiss,
+        Fault::ReadoutClear,
+        Fault::EnableDecode,
+        Fault::StatusWord,
+        Fault::RefusedCounter,
+        Fault::HaarFrameLimit,
+    ];
+
     /// The name used by templates and reports.
     pub fn name(self) -> &'static str {
         match self {
@@ -36,6 +64,13 @@ impl Fault {
             Fault::NarrowRegister => "narrow_register",
             Fault::HoldInvalid => "hold_invalid",
             Fault::LogicalShift => "logical_shift",
+            Fault::ResetPrimed => "reset_primed",
+            Fault::PrimeOnMiss => "prime_on_miss",
+            Fault::ReadoutClear => "readout_clear",
+            Fault::EnableDecode => "enable_decode",
+            Fault::StatusWord => "status_word",
+            Fault::RefusedCounter => "refused_counter",
+            Fault::HaarFrameLimit => "haar_frame_limit",
         }
     }
 }

@@ -5,11 +5,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 use serde::Serialize;
-use tofprobe_cosim::{BuildProfile, CosimOptions, CosimReport, cosim};
+use tofprobe_cosim::{BuildProfile, CosimOptions, CosimReport, Simulator, cosim};
 use tofprobe_design::RtlOverrides;
-use tofprobe_design::rom_policy::simulation_rom;
+use tofprobe_design::rom_policy::{chip_rom, simulation_rom};
 use tofprobe_pixel::PixelParams;
 
 use crate::error::CliError;
@@ -51,6 +51,39 @@ pub struct CosimArgs {
     /// Also time the bare Verilator model (no checking) to measure the harness overhead.
     #[arg(long)]
     pub bare: bool,
+    /// Simulator replaying the vectors (same stimuli, same report, same JSON).
+    #[arg(long, value_enum, default_value_t = SimulatorArg::Verilator)]
+    pub simulator: SimulatorArg,
+    /// Seed of Verilator's randomised initial register values (≥ 1; recorded in the report).
+    #[arg(long, default_value_t = 1)]
+    pub x_seed: u64,
+    /// Directed stimulus: the first K pulses are misses (the priming rule).
+    #[arg(long, default_value_t = 0)]
+    pub lead_misses: u64,
+    /// Also measure line coverage of the pixel module (Verilator `--coverage-line`) and
+    /// list the lines never hit.
+    #[arg(long)]
+    pub coverage: bool,
+    /// Soak: co-simulate N random valid configurations (both modes, every knob, width drawn
+    /// or "auto"), drawn from --seed, instead of CONFIG.
+    #[arg(long)]
+    pub random: Option<u64>,
+}
+
+/// `--simulator`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SimulatorArg {
+    Verilator,
+    Icarus,
+}
+
+impl From<SimulatorArg> for Simulator {
+    fn from(s: SimulatorArg) -> Self {
+        match s {
+            SimulatorArg::Verilator => Simulator::Verilator,
+            SimulatorArg::Icarus => Simulator::Icarus,
+        }
+    }
 }
 
 #[derive(Debug, Serialize)]
@@ -63,6 +96,12 @@ struct Json {
     first_mismatch_cycle: Option<u64>,
     first_mismatch_pulse: Option<u64>,
     first_mismatch_signal: Option<String>,
+    first_mismatch_expected: Option<String>,
+    first_mismatch_actual: Option<String>,
+    simulator: &'static str,
+    x_seed: u64,
+    coverage_percent: Option<f64>,
+    uncovered_lines: Option<Vec<String>>,
     verilator_seconds: f64,
     verilator_cycles_per_s: f64,
     bare_verilator_seconds: Option<f64>,
@@ -106,6 +145,10 @@ pub fn options(p: &PixelParams, a: &CosimArgs) -> CosimOptions {
     o.rtl_dir = a.rtl.clone();
     o.trace = a.trace;
     o.measure_bare = a.bare;
+    o.simulator = a.simulator.into();
+    o.x_seed = a.x_seed;
+    o.lead_misses = a.lead_misses;
+    o.coverage = a.coverage;
     let cycles = a.frames * p.frame_pulses * p.cycles_per_pulse as u64;
     if cycles > LONG_RUN_CYCLES {
         o.digest_pulses = LONG_RUN_DIGEST_PULSES;
@@ -120,11 +163,20 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
     };
+    if let Some(n) = a.random {
+        return run_random(a, n);
+    }
     let (design, mut p) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
     let mut rom_note = "sign-of-cosine probe ROM (--rom-depth given)".to_string();
     let mut sd_rom = None;
     if a.rtl.is_some() {
-        rom_note = "ROM read back from --rtl".into();
+        // The ROM `tofprobe rtl` renders for this configuration: the image in DIR must be it.
+        let r = chip_rom(&design, &overrides, &mut p)?;
+        rom_note = format!(
+            "ROM of --rtl checked against the configuration's: {}",
+            r.note
+        );
+        sd_rom = Some(r.words);
     } else if a.rom_depth.is_none() {
         let r = simulation_rom(&design, &overrides, &mut p)?;
         rom_note = r.note;
@@ -148,6 +200,17 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
         first_mismatch_cycle: r.first.as_ref().map(|m| m.cycle),
         first_mismatch_pulse: r.first.as_ref().map(|m| m.pulse),
         first_mismatch_signal: r.first.as_ref().map(|m| m.signal.clone()),
+        first_mismatch_expected: r.first.as_ref().map(|m| m.expected.clone()),
+        first_mismatch_actual: r.first.as_ref().map(|m| m.actual.clone()),
+        simulator: r.simulator.name(),
+        x_seed: r.x_seed,
+        coverage_percent: r.coverage.as_ref().map(|c| c.percent()),
+        uncovered_lines: r.coverage.as_ref().map(|c| {
+            c.uncovered
+                .iter()
+                .map(|(n, t)| format!("{}:{n}: {t}", c.file))
+                .collect()
+        }),
         verilator_seconds: r.verilator_seconds,
         verilator_cycles_per_s: rate(r.cycles, r.verilator_seconds),
         bare_verilator_seconds: r.bare_seconds,
@@ -180,16 +243,18 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
             ),
         };
         println!(
-            "cosim {verdict}: {} frame(s), {} pulses, {} cycles, {} mismatches | verilator {:.2} Mcycles/s ({:.2} s{}), cycle model {:.2} Mcycles/s ({:.2} s), transaction model {:.2} Mpulses/s ({:.3} s){}{}; {}",
+            "cosim {verdict}: {} frame(s), {} pulses, {} cycles, {} mismatches | {} {:.2} Mcycles/s ({:.2} s{}, x-seed {}), cycle model {:.2} Mcycles/s ({:.2} s), transaction model {:.2} Mpulses/s ({:.3} s){}{}; {}",
             j.frames,
             j.pulses,
             j.cycles,
             j.mismatches,
+            j.simulator,
             j.verilator_cycles_per_s / 1e6,
             j.verilator_seconds,
             j.bare_verilator_seconds
                 .map(|b| format!(", bare model {b:.2} s"))
                 .unwrap_or_default(),
+            j.x_seed,
             j.cycle_model_cycles_per_s / 1e6,
             j.cycle_model_seconds,
             j.transaction_model_pulses_per_s / 1e6,
@@ -206,7 +271,104 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
             j.rom,
         );
     }
+    if let (false, Some(c)) = (a.json, &r.coverage) {
+        println!(
+            "coverage of {}: {} of {} lines with coverage points hit ({:.1}%)",
+            c.file,
+            c.covered,
+            c.lines,
+            c.percent()
+        );
+        for (n, t) in &c.uncovered {
+            println!("  not hit: {}:{n}: {t}", c.file);
+        }
+    }
     if r.pass {
+        Ok(())
+    } else {
+        std::process::exit(1)
+    }
+}
+
+/// One line (or JSON object) of a soak.
+#[derive(Debug, Serialize)]
+struct SoakCase {
+    case: u64,
+    pass: bool,
+    mode: String,
+    registers: usize,
+    width: u32,
+    width_choice: String,
+    frame_pulses: u64,
+    seed: u64,
+    first_mismatch: Option<String>,
+}
+
+/// `tofprobe cosim --random N --seed S`: N random valid configurations, each co-simulated
+/// over --frames frames; exits 1 if any fails.
+fn run_random(a: &CosimArgs, n: u64) -> Result<(), CliError> {
+    if n == 0 || n > 100_000 {
+        return Err(CliError::option("random", n, "1..=100000"));
+    }
+    let t0 = Instant::now();
+    let mut failed = 0u64;
+    for i in 0..n {
+        let c = tofprobe_cosim::random::random_case(a.seed, i);
+        let mut o = CosimOptions::new(a.out.join(format!("random-{i}")));
+        o.frames = a.frames;
+        o.seed = c.seed;
+        o.simulator = a.simulator.into();
+        o.x_seed = a.x_seed;
+        o.vcd_on_mismatch = false;
+        let r = cosim(&c.params, &o)?;
+        if !r.pass {
+            failed += 1;
+        }
+        let line = SoakCase {
+            case: i,
+            pass: r.pass,
+            mode: format!("{:?}", c.params.mode),
+            registers: c.params.registers(),
+            width: c.params.width,
+            width_choice: format!("{:?}", c.width),
+            frame_pulses: c.params.frame_pulses,
+            seed: c.seed,
+            first_mismatch: r.first.as_ref().map(|m| {
+                format!(
+                    "cycle {} pulse {} {} expected {} actual {}",
+                    m.cycle, m.pulse, m.signal, m.expected, m.actual
+                )
+            }),
+        };
+        if a.json {
+            println!("{}", serde_json::to_string(&line)?);
+        } else {
+            println!(
+                "case {i}: {} {:?} ({:?}, width {:?}) seed {}{}",
+                if r.pass { "PASS" } else { "FAIL" },
+                c.params,
+                c.params.mode,
+                c.width,
+                c.seed,
+                line.first_mismatch
+                    .as_ref()
+                    .map(|m| format!(": {m}"))
+                    .unwrap_or_default()
+            );
+        }
+    }
+    println!(
+        "cosim soak: {} of {n} configuration(s) passed ({}, --seed {}, {} frame(s) each) in {:.1} s",
+        n - failed,
+        a.simulator
+            .to_possible_value()
+            .map(|v| v.get_name().to_string())
+            .unwrap_or_default(),
+        a.seed,
+        a.frames,
+        t0.elapsed().as_secs_f64()
+    );
+    if failed == 0 {
         Ok(())
     } else {
         std::process::exit(1)
