@@ -15,6 +15,7 @@ pub mod reproduce;
 pub mod setup;
 pub mod sigma_delta;
 pub mod table2;
+pub mod transients;
 
 use serde::Serialize;
 
