@@ -88,10 +88,19 @@ pub fn analyse_registers(
         sensor.tdc_lsb_mm(),
         sensor.laser_rate_hz,
     )?;
+    analyse_scalogram(design, s)
+}
+
+/// Thresholds and events of a scalogram of the design's scene (any level's: the float
+/// Haar's too), under the closed-form noise of its static depth.
+pub fn analyse_scalogram(
+    design: &ResolvedDesign,
+    s: Scalogram,
+) -> Result<HaarAnalysis, StudyError> {
     let depth = design.document.scene.depth_mm;
-    let noise = HaarNoise::for_static_scene(sensor, depth)?;
-    let n = usize::try_from(pulses).unwrap_or(usize::MAX);
-    let t = Thresholds::new(&noise, n, p.haar_scales, FAMILY_RATE)?;
+    let noise = HaarNoise::for_static_scene(design.sensor(), depth)?;
+    let n = usize::try_from(s.pulses).unwrap_or(usize::MAX);
+    let t = Thresholds::new(&noise, n, s.scales, FAMILY_RATE)?;
     let events = detect_events(&s, &t)?;
     let thresholds = per_scale(&s, &t);
     Ok(HaarAnalysis {

@@ -40,12 +40,16 @@ fn unit(u: &str) -> &'static str {
 /// One `TransientRow` as a reproduction [`Row`] (its verdict kept).
 pub fn row(t: &TransientRow) -> Row {
     let tol = if t.tolerance.is_infinite() {
-        "structural claim".to_string()
+        "a structural claim".to_string()
+    } else if t.tolerance == 0.0 {
+        "exact".to_string()
+    } else if t.tolerance >= 1e-3 {
+        format!("±{:.3} {}", t.tolerance, t.unit)
     } else {
-        format!("±{} {}", t.tolerance, t.unit)
+        format!("±{:.0e} {}", t.tolerance, t.unit)
     };
     let note = if t.note.is_empty() {
-        tol
+        format!("tolerance: {tol}")
     } else {
         format!("{}; tolerance: {tol}", t.note)
     };
@@ -116,7 +120,7 @@ mod tests {
         };
         let r = row(&t);
         assert!(r.pass && r.family == "Fig. 12 (Haar)" && r.unit == "m/s");
-        assert!(r.note.contains("±0.5 m/s"), "{}", r.note);
+        assert!(r.note.contains("±0.500 m/s"), "{}", r.note);
         t.pass = false;
         assert!(!row(&t).pass);
         t.pass = true;
