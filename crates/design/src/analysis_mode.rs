@@ -83,9 +83,8 @@ pub fn check_haar(
         ""
     };
     let err = |context: String, source| DesignError::Haar {
-        origin: origin.to_string(),
-        context,
-        source,
+        place: format!("`{origin}`: [pixel] {context}"),
+        source: Box::new(source),
     };
     check_frame_pulses(frame)
         .map_err(|e| err(format!("Haar mode{how}, N from {}", frame_field(d)), e))?;

@@ -67,16 +67,14 @@ pub enum DesignError {
         /// What is wrong.
         source: tofprobe_dsp::DspError,
     },
-    /// A Haar frame the pixel cannot run (N not a power of two, U too fine); `context`
-    /// names where N or U came from.
-    #[error("in configuration `{origin}`: [pixel] {context}: {source}")]
+    /// A Haar frame the pixel cannot run (N not a power of two, U too fine); `place` names
+    /// the file, the mode's origin and the field N or U came from.
+    #[error("in configuration {place}: {source}")]
     Haar {
-        /// The file name, or `<embedded default>`.
-        origin: String,
-        /// The mode's origin and the field N or U came from.
-        context: String,
+        /// "`file`: [pixel] Haar mode …, N from acquisition.pulses" and the like.
+        place: String,
         /// What is wrong (names the nearest powers of two or the largest U).
-        source: tofprobe_dsp::DspError,
+        source: Box<tofprobe_dsp::DspError>,
     },
     /// The generator refuses the parameters of the chip ROM policy.
     #[error("{0}")]

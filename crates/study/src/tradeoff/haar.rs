@@ -326,6 +326,19 @@ pub fn markdown(r: &HaarSceneResult) -> String {
 mod tests {
     use super::*;
 
+    /// The coefficient error sees one code: register 0 (scale 0, N = 16 samples) off by one
+    /// code of 0.75 mm reads 0.75/16 mm.
+    #[test]
+    fn coefficient_error_sees_one_code() {
+        let regs = vec![5i64; 7];
+        let a = Scalogram::from_registers(&regs, 16, 2, 0.75, 1e6).unwrap();
+        let mut broken = regs.clone();
+        broken[0] += 1;
+        let b = Scalogram::from_registers(&broken, 16, 2, 0.75, 1e6).unwrap();
+        assert_eq!(max_abs_diff(&a, &a), 0.0);
+        assert_eq!(max_abs_diff(&a, &b), 0.75 / 16.0);
+    }
+
     #[test]
     fn nearest_distances() {
         assert_eq!(worst_nearest_ms(&[1.0, 5.0], &[1.5e0, 4.0]), Some(1000.0));
