@@ -236,6 +236,9 @@ pub fn measure_haar(
     })
 }
 
+/// Builds a level's row: (name, wall s, extrapolated, its analysis, note).
+type Scorer<'a> = dyn Fn(&str, Option<f64>, bool, Option<&HaarAnalysis>, String) -> HaarLevel + 'a;
+
 /// The Verilator RTL on a shortened frame; a harness refusal (e.g. more than 64
 /// registers) is a row saying why, not a failed ladder.
 fn verilator_level(
@@ -243,7 +246,7 @@ fn verilator_level(
     detections: &[Option<u32>],
     n: u64,
     bt: &HaarAnalysis,
-    score: &dyn Fn(&str, Option<f64>, bool, Option<&HaarAnalysis>, String) -> HaarLevel,
+    score: &Scorer,
 ) -> HaarLevel {
     let mut rtl = p.clone();
     rtl.frame_pulses = CYCLE_FRAME.min(n);
