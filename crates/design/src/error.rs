@@ -67,6 +67,15 @@ pub enum DesignError {
         /// What is wrong.
         source: tofprobe_dsp::DspError,
     },
+    /// A Haar frame the pixel cannot run (N not a power of two, U too fine); `place` names
+    /// the file, the mode's origin and the field N or U came from.
+    #[error("in configuration {place}: {source}")]
+    Haar {
+        /// "`file`: [pixel] Haar mode …, N from acquisition.pulses" and the like.
+        place: String,
+        /// What is wrong (names the nearest powers of two or the largest U).
+        source: Box<tofprobe_dsp::DspError>,
+    },
     /// The generator refuses the parameters of the chip ROM policy.
     #[error("{0}")]
     Rtl(#[from] tofprobe_rtlgen::RtlError),

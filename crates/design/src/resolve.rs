@@ -10,6 +10,7 @@ use tofprobe_dsp::sd::{ProbeDesign, ProbeRom, RomMode};
 use tofprobe_pixel::{Mode, PixelContext, PixelError, PixelParams};
 use tofprobe_scene::{PhotonSource, Scene};
 
+use crate::analysis_mode::{ModeDecision, check_haar, decide_mode};
 use crate::bins::bin_indices;
 use crate::document::Document;
 use crate::error::DesignError;
@@ -31,6 +32,11 @@ pub struct ResolvedDesign {
     pub bins: Vec<u64>,
     /// Fourier mode: the `[probe]` design, stability-checked at the lowest bin.
     pub probe_design: Option<ProbeDesign>,
+    /// How the mode was decided (`pixel.mode = "auto"`: which and why).
+    pub mode: ModeDecision,
+    /// Notes every command prints: a mixed scene under `mode = "auto"`, a `[probe]` a Haar
+    /// pixel ignores, transients outside the Haar frame.
+    pub notes: Vec<String>,
 }
 
 /// Reads `path` (or the embedded default) and resolves it.
@@ -71,10 +77,15 @@ pub fn resolve_with(
     // generated ROM on the wrong bin grid (it used to be replaced silently by `rtl`).
     let context = d.pixel_context();
     let mut px = d.pixel.clone();
+    let mode = decide_mode(d, &mut px, frame);
+    let mut notes: Vec<String> = mode.auto.iter().filter_map(|c| c.note.clone()).collect();
+    if mode.mode == Mode::Haar {
+        notes.extend(check_haar(d, &px, &mode, frame, origin)?);
+    }
     let probe_depth = d.probe.depth(frame);
     match px.rom_depth {
         None => px.rom_depth = Some(probe_depth),
-        Some(l) if l != probe_depth && px.mode == Mode::Fourier => {
+        Some(l) if l != probe_depth && mode.mode == Mode::Fourier => {
             return Err(pixel_err(PixelError::invalid(
                 "rom_depth",
                 l,
@@ -109,6 +120,8 @@ pub fn resolve_with(
         pixel,
         bins,
         probe_design,
+        mode,
+        notes,
     })
 }
 

@@ -3,7 +3,9 @@
 //! Every key has a default, so an empty `[pixel]` (or none) gives the reference pixel:
 //! Fourier, B = 16 bins, A = 2 adders (one per lane I and Q), C = 16 cycles per pulse,
 //! S = 5 (α = 1/32), F = [`crate::DEFAULT_FRAC_BITS`], T from the sensor, N from the
-//! acquisition, L = N (one windowed ROM period per frame), W from the sizing. Haar: U = 4.
+//! acquisition, L = N (one windowed ROM period per frame), W from the sizing. Haar: U =
+//! [`DEFAULT_HAAR_SCALES`]. `mode = "auto"` is decided from the scene by the design's
+//! resolution (`tofprobe_dsp::analysis_mode::mode_for_scene`) before this section resolves.
 
 use serde::{Deserialize, Serialize};
 
@@ -40,16 +42,18 @@ impl<T> Choice<T> {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PixelConfig {
-    /// `"fourier"` (default) or `"haar"`.
-    pub mode: Mode,
+    /// `"fourier"` (default), `"haar"`, or `"auto"`: Fourier for periodic motions, Haar
+    /// for transients (decided by the design's resolution, which sees the scene).
+    pub mode: Choice<Mode>,
     /// B: Fourier bins (default 16), or `"auto"`: the scene's in-band tones plus
     /// [`crate::autobins::AUTO_NOISE_BINS`] noise bins.
     pub bins: Choice<usize>,
     /// Bin frequencies in Hz, one per bin; empty (default) = chosen from the scene by the
     /// probe design.
     pub frequencies_hz: Vec<f64>,
-    /// U: finest Haar scale, registers 2^(U+1) − 1 (default 4: 31 registers).
-    pub haar_scales: u32,
+    /// U: finest Haar scale, registers 2^(U+1) − 1 (default [`DEFAULT_HAAR_SCALES`]: 31
+    /// registers; with `mode = "auto"` picking Haar, the design's resolution chooses).
+    pub haar_scales: Option<u32>,
     /// A: adders shared over the registers (default 2).
     pub adders: usize,
     /// C: clock cycles per laser pulse (default 16).
@@ -74,10 +78,10 @@ pub struct PixelConfig {
 impl Default for PixelConfig {
     fn default() -> Self {
         PixelConfig {
-            mode: Mode::Fourier,
+            mode: Choice::Value(Mode::Fourier),
             bins: Choice::Value(16),
             frequencies_hz: Vec::new(),
-            haar_scales: 4,
+            haar_scales: None,
             adders: 2,
             cycles_per_pulse: 16,
             tdc_bits: None,
@@ -90,6 +94,9 @@ impl Default for PixelConfig {
         }
     }
 }
+
+/// U when `haar_scales` is not given (31 registers).
+pub const DEFAULT_HAAR_SCALES: u32 = 4;
 
 /// The ΣΔ OSR assumed when the context does not name one (the default `[probe]`).
 pub const DEFAULT_OSR: f64 = 32.0;
@@ -137,6 +144,17 @@ impl PixelConfig {
             }
             Some(t) => t,
         };
+        let mode = match self.mode {
+            Choice::Value(m) => m,
+            Choice::Auto(_) => {
+                return Err(PixelError::invalid(
+                    "mode",
+                    "auto",
+                    "choosing the mode needs the scene (the configuration's resolution decides it)",
+                    "\"fourier\" or \"haar\"",
+                ));
+            }
+        };
         let frame_pulses = self.frame_pulses.unwrap_or(ctx.pulses);
         let rom_depth = match self.rom_depth {
             Some(l) => l,
@@ -144,7 +162,7 @@ impl PixelConfig {
         };
         let bins = match self.bins {
             Choice::Value(b) => b,
-            Choice::Auto(_) if self.mode == Mode::Haar => 1,
+            Choice::Auto(_) if mode == Mode::Haar => 1,
             Choice::Auto(_) => choose_bins(
                 &ctx.tones,
                 ctx.laser_rate_hz,
@@ -155,7 +173,7 @@ impl PixelConfig {
             .all()
             .len(),
         };
-        if self.mode == Mode::Fourier && !self.frequencies_hz.is_empty() {
+        if mode == Mode::Fourier && !self.frequencies_hz.is_empty() {
             if self.frequencies_hz.len() != bins {
                 return Err(PixelError::invalid(
                     "frequencies_hz",
@@ -181,9 +199,9 @@ impl PixelConfig {
             }
         }
         let mut params = PixelParams {
-            mode: self.mode,
+            mode,
             bins,
-            haar_scales: self.haar_scales,
+            haar_scales: self.haar_scales.unwrap_or(DEFAULT_HAAR_SCALES),
             adders: self.adders,
             cycles_per_pulse: self.cycles_per_pulse,
             tdc_bits,

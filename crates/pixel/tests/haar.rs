@@ -77,5 +77,6 @@ fn default_haar_has_31_registers() {
     let p = haar_params(10, 4, 24);
     assert_eq!((p.registers(), p.ops_per_pulse()), (31, 5));
     let cfg = tofprobe_pixel::PixelConfig::default();
-    assert_eq!(cfg.haar_scales, 4);
+    assert_eq!(cfg.haar_scales, None);
+    assert_eq!(tofprobe_pixel::config::DEFAULT_HAAR_SCALES, 4);
 }

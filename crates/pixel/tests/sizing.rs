@@ -2,7 +2,7 @@
 //! the `[pixel]` validation of widths and schedules.
 
 use tofprobe_dsp::RomImage;
-use tofprobe_pixel::config::PixelContext;
+use tofprobe_pixel::config::{Choice, PixelContext};
 use tofprobe_pixel::sizing::{
     any_sign_range, compression, raw_timestamp_bytes, readout_bytes, required_width,
     rom_sign_counts, twos_complement_bits, unsigned_bits,
@@ -185,20 +185,20 @@ fn impossible_configurations_name_the_nearest_valid_value() {
     );
     // Haar needs N a power of two: 10^7 → 2^23 is nearest.
     assert_eq!(
-        with(&|c| c.mode = Mode::Haar),
+        with(&|c| c.mode = Choice::Value(Mode::Haar)),
         Err(("frame_pulses", "8388608".into()))
     );
     assert_eq!(
         with(&|c| {
-            c.mode = Mode::Haar;
+            c.mode = Choice::Value(Mode::Haar);
             c.frame_pulses = Some(16);
-            c.haar_scales = 4;
+            c.haar_scales = Some(4);
         }),
         Err(("haar_scales", "3".into()))
     );
     // Haar, N = 2^20, U = 4: 31 registers, W for codes 0..79 over N/2 adds and subtracts.
     let mut c = PixelConfig {
-        mode: Mode::Haar,
+        mode: Choice::Value(Mode::Haar),
         frame_pulses: Some(1 << 20),
         ..PixelConfig::default()
     };
@@ -208,7 +208,7 @@ fn impossible_configurations_name_the_nearest_valid_value() {
     assert_eq!(p.width, 27);
     // A frame too long for 63-bit registers (periodic ROM: a windowed one, L = N, would be
     // refused first for its depth beyond 2^32).
-    c.mode = Mode::Fourier;
+    c.mode = Choice::Value(Mode::Fourier);
     c.frame_pulses = Some(1 << 50);
     c.rom_depth = Some(1 << 16);
     assert_eq!(

@@ -1,6 +1,7 @@
 //! The main flow (`tofprobe flow`). Scene → bit-true model → RTL → golden vectors →
 //! Verilator co-simulation → a short report (spectrum at the bins, register widths,
-//! verdict, sizing summary) in the output directory. Installs nothing: a missing tool is
+//! verdict, sizing summary; a Haar pixel's transient analysis and `scalogram.svg`) in the
+//! output directory. Installs nothing: a missing tool is
 //! named together with scripts/install-tools.sh.
 //!
 //! The ROM is the configuration's ΣΔ probe ROM (`probe_rom`); its bins come from the scene
@@ -109,7 +110,7 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
     } else {
         let band = fs / (2.0 * config.probe.osr);
         // Haar frames must be a power of two and have no bins to align.
-        let haar = config.pixel.mode == tofprobe_pixel::Mode::Haar;
+        let haar = design.pixel.mode == tofprobe_pixel::Mode::Haar;
         let probe = &config.probe;
         let periodic = probe.rom_mode == tofprobe_dsp::sd::RomMode::Periodic;
         Some(if haar {
@@ -191,13 +192,7 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
         if p.mode == Mode::Fourier {
             headline = spectrum(&mut md, &p, f, rom.sd.as_ref(), lsb_mm);
         } else {
-            let _ = writeln!(md, "## Haar coefficients (frame 0)\n");
-            headline = format!("{} Haar coefficients in the report", p.registers());
-            let words: Vec<String> = f[..p.registers()]
-                .iter()
-                .map(|w| sext(*w, p.width).to_string())
-                .collect();
-            let _ = writeln!(md, "{}\n", words.join(" "));
+            headline = crate::transients::flow_section(&mut md, design, &p, f, &a.out)?;
         }
     }
     let size_line = if a.no_size {

@@ -13,5 +13,6 @@ pub mod rtl;
 pub mod sizing;
 pub mod spectrum;
 pub mod tradeoff;
+pub mod transients;
 
 pub use error::StudyError;

@@ -1,4 +1,5 @@
-//! `tofprobe config`: print the embedded default configuration, or check a file.
+//! `tofprobe config`: print the embedded default configuration, or check a file (the
+//! analysis mode, and why when `pixel.mode = "auto"` picked it, and the resolution's notes).
 
 use std::path::PathBuf;
 
@@ -37,5 +38,18 @@ pub fn run(args: &ConfigArgs) -> Result<(), CliError> {
         c.sensor.tdc_bits(),
         c.sensor.jitter_mm()
     );
+    println!("analysis mode: {}", design.mode.line());
+    if design.pixel.mode == tofprobe_pixel::Mode::Haar {
+        println!(
+            "Haar pixel: N = {} pulses, U = {} ({} registers), W = {} bits",
+            design.pixel.frame_pulses,
+            design.pixel.haar_scales,
+            design.pixel.registers(),
+            design.pixel.width
+        );
+    }
+    for n in &design.notes {
+        println!("note: {n}");
+    }
     Ok(())
 }

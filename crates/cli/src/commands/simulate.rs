@@ -2,7 +2,10 @@
 //! summarise the record (pulses, detections, background wins, mean and σ of the measured
 //! depth, run time), then run one frame through the bit-true pixel (transaction model) and
 //! print its spectrum at the configured bins (amplitude µm, phase, the noise estimate);
-//! `--svg` plots that spectrum.
+//! `--svg` plots that spectrum. On a Haar pixel the frame's registers become the transient
+//! analysis instead (`tofprobe_study::transients`): coefficients, per-scale thresholds at a
+//! stated false-alarm rate, events; `--json` carries the scalogram and the events, `--svg`
+//! draws the scalogram.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -16,6 +19,7 @@ use tofprobe_scene::{FillCounts, PhotonSource};
 
 use tofprobe_design::ResolvedDesign;
 use tofprobe_study::spectrum::{run_spectrum, setup, write_svg};
+use tofprobe_study::transients::{HaarAnalysis, bit_true_haar};
 
 use crate::error::CliError;
 
@@ -30,7 +34,7 @@ pub struct SimulateArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
-    /// Write an SVG plot of the bit-true spectrum here (atomically).
+    /// Write an SVG plot of the bit-true spectrum (Haar: the scalogram) here (atomically).
     #[arg(long, value_name = "PATH")]
     svg: Option<PathBuf>,
 }
@@ -80,7 +84,24 @@ pub struct BitTrueOut {
 struct Output<'a> {
     #[serde(flatten)]
     summary: &'a Summary,
+    /// "fourier" or "haar", and why when `pixel.mode = "auto"` picked it.
+    mode: String,
+    mode_reason: Option<&'a str>,
+    notes: &'a [String],
     bit_true: Option<&'a BitTrueOut>,
+    /// Haar mode: the frame's transient analysis (scalogram, thresholds, events).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    haar: Option<&'a HaarOut>,
+}
+
+/// The Haar part of the output.
+#[derive(Debug, Clone, Serialize)]
+struct HaarOut {
+    width_bits: u32,
+    frame_pulses: u64,
+    model_seconds: f64,
+    #[serde(flatten)]
+    analysis: HaarAnalysis,
 }
 
 /// The summary of one simulated record.
@@ -170,7 +191,25 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let progress = !args.json && std::io::stderr().is_terminal();
     let s = summarise(&source, pulses, progress);
     let bit_true = bit_true(&design, &source)?;
-    if let (Some(path), Some((_, spectrum))) = (&args.svg, &bit_true) {
+    let haar = if design.pixel.mode == tofprobe_pixel::Mode::Haar {
+        let (analysis, model_seconds) = bit_true_haar(&design)?;
+        Some(HaarOut {
+            width_bits: design.pixel.width,
+            frame_pulses: design.pixel.frame_pulses,
+            model_seconds,
+            analysis,
+        })
+    } else {
+        None
+    };
+    if let (Some(path), Some(h)) = (&args.svg, &haar) {
+        tofprobe_report::scalogram::write_scalogram_svg(
+            &h.analysis.scalogram,
+            &format!("bit-true Haar scalogram: {}", design.origin),
+            Some(&h.analysis.events),
+            path,
+        )?;
+    } else if let (Some(path), Some((_, spectrum))) = (&args.svg, &bit_true) {
         write_svg(
             path,
             &format!("bit-true spectrum: {}", design.origin),
@@ -185,11 +224,19 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     if args.json {
         let out = Output {
             summary: &s,
+            mode: design.pixel.mode.to_string(),
+            mode_reason: design.mode.auto.as_ref().map(|c| c.reason.as_str()),
+            notes: &design.notes,
             bit_true: bit_true.as_ref().map(|b| &b.0),
+            haar: haar.as_ref(),
         };
         println!("{}", serde_json::to_string(&out)?);
     } else {
         println!("configuration      {}", design.origin);
+        println!("analysis mode      {}", design.mode.line());
+        for n in &design.notes {
+            println!("note               {n}");
+        }
         println!("pulses             {}", s.pulses);
         println!(
             "detections         {} ({:.4} per pulse)",
@@ -203,9 +250,16 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             s.seconds,
             s.pulses as f64 / s.seconds.max(1e-9) / 1e6
         );
-        match &bit_true {
-            None => println!("bit-true spectrum  (Haar mode: no spectrum)"),
-            Some((b, _)) => {
+        match (&bit_true, &haar) {
+            (_, Some(h)) => {
+                println!(
+                    "bit-true Haar      W = {} bits, N = {} pulses, U = {} (model {:.2} s)",
+                    h.width_bits, h.frame_pulses, h.analysis.scalogram.scales, h.model_seconds
+                );
+                print!("{}", h.analysis.text());
+            }
+            (None, None) => {}
+            (Some((b, _)), None) => {
                 println!(
                     "bit-true spectrum  W = {} bits, N = {} pulses (ROM {:.2} s, model {:.2} s)",
                     b.width_bits, b.frame_pulses, b.rom_seconds, b.model_seconds
@@ -230,7 +284,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             }
         }
         if let Some(p) = &args.svg {
-            println!("spectrum plot      {}", p.display());
+            if haar.is_some() {
+                println!("scalogram plot     {}", p.display());
+            } else {
+                println!("spectrum plot      {}", p.display());
+            }
         }
     }
     Ok(())

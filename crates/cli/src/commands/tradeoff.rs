@@ -1,6 +1,8 @@
 //! `tofprobe tradeoff [CONFIG...] [--json] [--out DIR] [--verilator] [--knobs] [--skips]`:
 //! every fidelity level on each configuration (the embedded default without one), timed
-//! per simulated second and scored against the float DFT and the scene's truth; with
+//! per simulated second and scored against the float DFT and the scene's truth (a Haar
+//! pixel: float Haar, bit-true, cycle-accurate, Verilator, scored by the coefficient error
+//! against the float Haar and the event time error, `tradeoff::haar`); with
 //! `--knobs` the bit-true knob sweep ([`tofprobe_study::tradeoff::knobs::DEFAULT_SWEEP`]) and with
 //! `--skips` the skipped-stage speedups, both on a frame of at most `--sweep-pulses` and
 //! timed as the median of `--reps` runs. Markdown tables on stdout (or one JSON object),
@@ -13,6 +15,7 @@ use clap::Args;
 use serde::Serialize;
 
 use tofprobe_study::spectrum::write_atomic;
+use tofprobe_study::tradeoff::haar::{self, HaarSceneResult, measure_haar};
 use tofprobe_study::tradeoff::knobs::{self, DEFAULT_SWEEP, KnobSweep};
 use tofprobe_study::tradeoff::skips::{self, SkipReport, measure_skips};
 use tofprobe_study::tradeoff::{SceneResult, markdown, measure, plot::pareto_svg};
@@ -57,6 +60,8 @@ pub struct TradeoffArgs {
 struct JsonOut<'a> {
     scenes: &'a [SceneResult],
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    haar_scenes: &'a [HaarSceneResult],
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
     knobs: &'a [KnobSweep],
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     skips: &'a [SkipReport],
@@ -80,11 +85,24 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
         return Err(CliError::option("knob", bad.clone(), names.join(", ")));
     }
     let mut scenes = Vec::new();
+    let mut haar_scenes = Vec::new();
     let mut sweeps = Vec::new();
     let mut skip_reports = Vec::new();
     let mut tables = Vec::new();
     for p in paths {
         let design = tofprobe_design::load(p)?;
+        if design.pixel.mode == tofprobe_pixel::Mode::Haar {
+            let h = measure_haar(&design, args.verilator)?;
+            tables.push(haar::markdown(&h));
+            if args.knobs || args.skips {
+                tables.push(format!(
+                    "(--knobs / --skips measure the Fourier pixel's knobs and stages: skipped for the Haar pixel of {})\n",
+                    design.origin
+                ));
+            }
+            haar_scenes.push(h);
+            continue;
+        }
         let scene = measure(&design, args.verilator)?;
         tables.push(markdown(&scene));
         scenes.push(scene);
@@ -104,13 +122,16 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir).map_err(|e| CliError::output(dir.clone(), e.to_string()))?;
         write_atomic(&dir.join("tradeoff.md"), table.as_bytes())?;
-        pareto_svg(&dir.join("pareto.svg"), &scenes)?;
+        if !scenes.is_empty() {
+            pareto_svg(&dir.join("pareto.svg"), &scenes)?;
+        }
     }
     if args.json {
         println!(
             "{}",
             serde_json::to_string(&JsonOut {
                 scenes: &scenes,
+                haar_scenes: &haar_scenes,
                 knobs: &sweeps,
                 skips: &skip_reports,
             })?

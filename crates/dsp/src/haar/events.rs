@@ -74,7 +74,7 @@ impl Event {
     /// One line of text (times in ms).
     pub fn text_line(&self) -> String {
         format!(
-            "{:.3} ms ({:.3}–{:.3} ms): depth {} , peak w({},{}) = {:+.4} mm ({:.1} sd) at scale {} ({:.3} ms wavelets, scales {}..{}), rate dδ/dt = {:+.3} m/s",
+            "{:.3} ms ({:.3}–{:.3} ms): depth {}, peak w({},{}) = {:+.4} mm ({:.1} sd) at scale {} ({:.3} ms wavelets, scales {}..{}), rate dδ/dt = {:+.3} m/s",
             self.centre_s * 1e3,
             self.start_s * 1e3,
             self.end_s * 1e3,

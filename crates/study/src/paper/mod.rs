@@ -15,6 +15,7 @@ pub mod reproduce;
 pub mod setup;
 pub mod sigma_delta;
 pub mod table2;
+pub mod transients;
 
 use serde::Serialize;
 
@@ -120,7 +121,8 @@ pub fn markdown(rows: &[Row]) -> String {
         s += &format!(
             "| {} | {} | {} | {} | {} | {:.4} | {} | {} | {} | {} |\n",
             r.family,
-            r.label,
+            // A literal | (as in |w|) would split the Markdown cell.
+            r.label.replace('|', "\\|"),
             r.unit,
             fmt_opt(r.paper),
             fmt_opt(r.design),
@@ -128,7 +130,7 @@ pub fn markdown(rows: &[Row]) -> String {
             fmt_opt(r.closed_form),
             tol,
             if r.pass { "pass" } else { "FAIL" },
-            r.note
+            r.note.replace('|', "\\|")
         );
     }
     s

@@ -5,7 +5,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::sigma_delta::ProbeSetup;
-use super::{Row, bandwidth, fig4, plots, table2};
+use super::{Row, bandwidth, fig4, plots, table2, transients};
 use crate::StudyError;
 
 /// The rows, plots and timings of one run.
@@ -45,7 +45,10 @@ pub fn reproduce(quick: bool, out: &Path) -> Result<Reproduction, StudyError> {
     rows.extend(table2::eq12_row(&results, n_t2, quick));
     rows.extend(fig4::rows(n_f4)?);
     rows.extend(bandwidth::rows(n_bw)?);
-    let plots = plots::write_all(out, &results)?;
+    let figs = transients::figures()?;
+    rows.extend(transients::rows(&figs));
+    let mut plots = plots::write_all(out, &results)?;
+    plots.extend(transients::write_svgs(out, &figs)?);
     Ok(Reproduction {
         rows,
         plots,
