@@ -16,16 +16,20 @@ pub enum Fault {
     HoldInvalid,
     /// The prefilter shifts logically instead of arithmetically.
     LogicalShift,
+    /// The read-ahead stage reads the register file before this edge's writes (no forward
+    /// of the sum being written): a read-after-write hazard, visible only when K = 1.
+    MissingForward,
 }
 
 impl Fault {
     /// All faults, in a fixed order.
-    pub const ALL: [Fault; 5] = [
+    pub const ALL: [Fault; 6] = [
         Fault::SignFlip,
         Fault::ScheduleLate,
         Fault::NarrowRegister,
         Fault::HoldInvalid,
         Fault::LogicalShift,
+        Fault::MissingForward,
     ];
 
     /// The name used by templates and reports.
@@ -36,6 +40,7 @@ impl Fault {
             Fault::NarrowRegister => "narrow_register",
             Fault::HoldInvalid => "hold_invalid",
             Fault::LogicalShift => "logical_shift",
+            Fault::MissingForward => "missing_forward",
         }
     }
 }
