@@ -341,7 +341,12 @@ fn k1_back_to_back_pulses_need_the_forward() {
     for p in [fourier, haar] {
         p.validate().unwrap();
         assert_eq!((p.slots(), p.cycles_per_pulse), (1, 1), "{:?}", p.mode);
-        assert_eq!(back_to_back_first_difference(&p, None), None, "{:?}", p.mode);
+        assert_eq!(
+            back_to_back_first_difference(&p, None),
+            None,
+            "{:?}",
+            p.mode
+        );
         assert!(
             back_to_back_first_difference(&p, Some(Fault::MissingForward)).is_some(),
             "{:?}: the missing forward must show",
