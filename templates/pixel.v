@@ -88,33 +88,46 @@ module {{ name }} (
 {%- endif %}
 {%- endif %}
 
-    // ---- shared adders: adder a serves operation slot*A + a ----
+    // ---- shared adders, pipelined (contract "Pipeline"): adder a serves operation
+    // slot*A + a. Read stage: at every edge adder a reads the register and sign of its
+    // operation at the next edge (slot+1 of this pulse, or slot 0 of a pulse accepted now,
+    // decoded from the values being latched), so the write edge adds yin_a +/- op with no
+    // register-file multiplexer before the adder. ----
+    wire nx_same = active && slot != {{ sw }}'d{{ k - 1 }};
+    wire [{{ sw - 1 }}:0] nslot = nx_same ? slot + {{ sw }}'d1 : {{ sw }}'d0;
+{%- if fourier %}
+    wire [{{ r - 1 }}:0] bits_nx = nx_same ? bits : rom_word;
+{%- else %}
+    wire [{{ nlw - 1 }}:0] n_nx = nx_same ? n_lat : pcount[{{ ln - 1 }}:{{ nlo }}];
+{%- endif %}
     wire [{{ w - 1 }}:0] opx = {{ opx }};
 {%- for ad in adders %}
-    reg [{{ w - 1 }}:0] yin_{{ ad.a }};
-    reg add_{{ ad.a }};
+    reg [{{ w - 1 }}:0] yin_{{ ad.a }};  // read stage: Y of the next operation
+    reg add_{{ ad.a }};                  // read stage: its sign (1 = add)
+    reg [{{ w - 1 }}:0] rd_{{ ad.a }};
+    reg sg_{{ ad.a }};
     always @* begin
-        yin_{{ ad.a }} = {{ w }}'d0;
-        add_{{ ad.a }} = 1'b0;
-        case (slot)
+        rd_{{ ad.a }} = {{ w }}'d0;
+        sg_{{ ad.a }} = 1'b0;
+        case (nslot)
 {%- for c in ad.cases %}
 {%- if c.sel.is_empty() %}
-            {{ sw }}'d{{ c.slot }}: begin yin_{{ ad.a }} = y[{{ c.entries[0].1 }}]; add_{{ ad.a }} = {{ c.add }}; end
+            {{ sw }}'d{{ c.slot }}: begin rd_{{ ad.a }} = y[{{ c.entries[0].1 }}]; sg_{{ ad.a }} = {{ c.add }}; end
 {%- else %}
             {{ sw }}'d{{ c.slot }}: begin
-                add_{{ ad.a }} = {{ c.add }};
+                sg_{{ ad.a }} = {{ c.add }};
                 case ({{ c.sel }})
 {%- for e in c.entries %}
-                    {{ c.sel_bits }}'d{{ e.0 }}: yin_{{ ad.a }} = y[{{ e.1 }}];
+                    {{ c.sel_bits }}'d{{ e.0 }}: rd_{{ ad.a }} = y[{{ e.1 }}];
 {%- endfor %}
 {%- if c.partial %}
-                    default: yin_{{ ad.a }} = {{ w }}'d0;
+                    default: rd_{{ ad.a }} = {{ w }}'d0;
 {%- endif %}
                 endcase
             end
 {%- endif %}
 {%- endfor %}
-            default: begin yin_{{ ad.a }} = {{ w }}'d0; add_{{ ad.a }} = 1'b0; end
+            default: begin rd_{{ ad.a }} = {{ w }}'d0; sg_{{ ad.a }} = 1'b0; end
         endcase
     end
 {%- if mutation == "sign_flip" %}
@@ -122,6 +135,20 @@ module {{ name }} (
 {%- else %}
     wire [{{ w - 1 }}:0] sum_{{ ad.a }} = add_{{ ad.a }} ? (yin_{{ ad.a }} + opx) : (yin_{{ ad.a }} - opx);
 {%- endif %}
+    always @(posedge clk) begin
+        if (rst) begin
+            yin_{{ ad.a }} <= {{ w }}'d0;
+            add_{{ ad.a }} <= 1'b0;
+        end else begin
+{%- if !ad.fwd.is_empty() && mutation != "missing_forward" %}
+            // Forward (K = 1): the previous pulse writes the register read now.
+            yin_{{ ad.a }} <= ({{ ad.fwd }}) ? sum_{{ ad.a }} : rd_{{ ad.a }};
+{%- else %}
+            yin_{{ ad.a }} <= rd_{{ ad.a }};
+{%- endif %}
+            add_{{ ad.a }} <= sg_{{ ad.a }};
+        end
+    end
 {%- endfor %}
 
     // ---- register writes: accumulate (slot's adder) or readout clear ----

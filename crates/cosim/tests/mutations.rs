@@ -2,7 +2,8 @@
 //! the cycle where the same fault, injected through the hooks of the pixel crate's one
 //! cycle model, first changes an observable (a register write or an output pin). That
 //! cycle is computed by the model alone (`first_divergence`), independently of the
-//! simulator.
+//! simulator. The pipeline's missing forward is a K = 1 hazard and runs on a K = 1 pixel
+//! with a pulse at every edge.
 
 mod common;
 use common::*;
@@ -31,24 +32,47 @@ fn config() -> PixelParams {
     }
 }
 
+/// K = 1 with a pulse at every edge (C = 1): each pulse's read ahead meets the previous
+/// pulse's write of the same register, the pipeline hazard the forward resolves.
+fn config_k1() -> PixelParams {
+    PixelParams {
+        bins: 1,
+        adders: 2,
+        cycles_per_pulse: 1,
+        ..config()
+    }
+}
+
+/// The configuration each fault is tested on: the pipeline's missing forward shows only
+/// when K = 1 with back-to-back pulses; every other fault on the K = 2 pixel.
+fn config_for(fault: Fault) -> PixelParams {
+    match fault {
+        Fault::MissingForward => config_k1(),
+        _ => config(),
+    }
+}
+
 #[test]
 fn every_fault_is_caught_at_its_first_cycle() {
     if !tools_or_skip(&["verilator"], "every_fault_is_caught_at_its_first_cycle") {
         return;
     }
-    let p = config();
-    p.validate().expect("valid configuration");
     let seed = 7;
     let frames = 2;
-    let stim = random_stimulus(&p, frames * p.frame_pulses, seed);
-    let rom = sign_probe_rom(&p);
     // The clean RTL passes on the same stimulus (so a failure below is the fault's).
-    let mut o = CosimOptions::new(work_dir("mutation-clean"));
-    o.frames = frames;
-    o.seed = seed;
-    let clean = cosim(&p, &o).expect("clean co-simulation runs");
-    assert!(clean.pass, "clean RTL must pass: {:?}", clean.first);
+    for (name, p) in [("clean", config()), ("clean-k1", config_k1())] {
+        p.validate().expect("valid configuration");
+        let mut o = CosimOptions::new(work_dir(&format!("mutation-{name}")));
+        o.frames = frames;
+        o.seed = seed;
+        let clean = cosim(&p, &o).expect("clean co-simulation runs");
+        assert!(clean.pass, "{name}: clean RTL must pass: {:?}", clean.first);
+    }
+    assert_eq!(config_k1().slots(), 1);
     for fault in Fault::ALL {
+        let p = config_for(fault);
+        let stim = random_stimulus(&p, frames * p.frame_pulses, seed);
+        let rom = sign_probe_rom(&p);
         let (cycle, pulse) = first_divergence(&p, &stim, &rom, frames, fault)
             .expect("the model accepts the configuration")
             .unwrap_or_else(|| panic!("{fault:?} never shows on this stimulus"));

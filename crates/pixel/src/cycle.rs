@@ -6,6 +6,10 @@
 //! clk 1→0" sees exactly what `step` returns, and the register writes of that edge are in
 //! [`CycleModel::writes`].
 //!
+//! The accumulate is pipelined (the contract's "Pipeline"): each adder's register operand,
+//! register and sign are read one edge ahead ([`CycleModel::read_ahead`], after the edge's
+//! writes, which is the forward), and the write edge adds to that operand.
+//!
 //! The arithmetic is the one [`Datapath`]'s, the slot order the one [`Schedule`]'s. The
 //! golden vectors are recorded from this model (tofprobe-rtlgen), and the mutation tests
 //! run it with a [`Fault`] ([`CycleModel::with_fault`]) to predict where a broken RTL
@@ -80,6 +84,8 @@ pub struct CycleModel {
     rd_active: bool,
     rd_ptr: usize,
     y: Vec<i64>,
+    /// Read-ahead stage: per adder of the next slot, (register, add, `yin`).
+    pre: Vec<(usize, bool, i64)>,
     // Registered outputs.
     rd_valid: bool,
     rd_index: u32,
@@ -90,6 +96,8 @@ pub struct CycleModel {
     accepted_last: bool,
     /// ScheduleLate fault: the writes computed at the last edge, applied at this one.
     late: Vec<RegWrite>,
+    /// MissingForward fault: the register file before this edge's writes.
+    stale: Vec<i64>,
 }
 
 impl CycleModel {
@@ -127,6 +135,7 @@ impl CycleModel {
             rd_active: false,
             rd_ptr: 0,
             y: vec![0; r],
+            pre: Vec::with_capacity(params.adders),
             rd_valid: false,
             rd_index: 0,
             rd_data: 0,
@@ -134,6 +143,7 @@ impl CycleModel {
             cycle: 0,
             accepted_last: false,
             late: Vec::new(),
+            stale: Vec::new(),
         }
     }
 
@@ -230,16 +240,16 @@ impl CycleModel {
         let take_pulse = pins.pulse && free && !pins.readout && haar_room;
         let refuse_pulse = pins.pulse && !take_pulse;
 
-        // Accumulate one slot with the old op/bits/n_lat/acc_en: the schedule selects the
-        // register and sign, the datapath adds.
+        if self.fault == Some(Fault::MissingForward) {
+            self.stale.clone_from(&self.y);
+        }
+        // Accumulate one slot with the old op/acc_en: register, sign and register operand
+        // were read ahead at the last edge; the datapath adds.
         if self.active {
             if self.acc_en {
-                for i in 0..self.p.adders {
-                    let Some(operation) = self.schedule.at(self.slot, i) else {
-                        break;
-                    };
-                    let (reg, add) = operation.target(self.n_lat, self.log2_n, &self.bits);
-                    let v = self.dp.accumulate(self.y[reg], self.op, add, self.fault);
+                for i in 0..self.pre.len() {
+                    let (reg, add, yin) = self.pre[i];
+                    let v = self.dp.accumulate(yin, self.op, add, self.fault);
                     self.write(reg, v);
                 }
             }
@@ -281,10 +291,34 @@ impl CycleModel {
             self.rd_active = true;
             self.rd_ptr = 0;
         }
+        if self.active {
+            self.read_ahead();
+        }
         if self.fault == Some(Fault::ScheduleLate) {
             self.apply_late();
         }
         out
+    }
+
+    /// The read stage of the pipeline, for the slot the next edge performs: the schedule
+    /// selects register and sign (from the `bits`/`n_lat` latched now at an accepting
+    /// edge), and the register is read after this edge's writes: the forward of a K = 1
+    /// pulse's write to the next pulse's read of the same register.
+    #[inline(always)]
+    fn read_ahead(&mut self) {
+        self.pre.clear();
+        for i in 0..self.p.adders {
+            let Some(operation) = self.schedule.at(self.slot, i) else {
+                break;
+            };
+            let (reg, add) = operation.target(self.n_lat, self.log2_n, &self.bits);
+            let yin = if self.fault == Some(Fault::MissingForward) {
+                self.stale[reg]
+            } else {
+                self.y[reg]
+            };
+            self.pre.push((reg, add, yin));
+        }
     }
 
     /// A register write of this edge (a trace event).

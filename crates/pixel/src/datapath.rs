@@ -2,8 +2,9 @@
 //! pulse ([`Datapath::pulse`], the operand select) and the register operation
 //! ([`Datapath::accumulate`], the add). The transaction model calls it once per pulse and
 //! once per register; the cycle model once per accepted pulse and once per scheduled
-//! operation of each slot. A pipeline stage between operand select and add goes between
-//! these two calls in the cycle model, nowhere else.
+//! operation of each slot. The read-ahead stage (the contract's "Pipeline": register
+//! operand, register and sign read one edge before the add) sits between these two calls in
+//! the cycle model, nowhere else.
 //!
 //! Fault hooks (`Option<Fault>`, for the mutation tests) sit on the same lines as the
 //! behaviour they break; the transaction model passes `None`, which compiles them away.

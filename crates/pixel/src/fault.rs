@@ -31,16 +31,20 @@ pub enum Fault {
     RefusedCounter,
     /// Haar: a full frame accepts further pulses instead of refusing them.
     HaarFrameLimit,
+    /// The read-ahead stage reads the register file before this edge's writes (no forward
+    /// of the sum being written): a read-after-write hazard, visible only when K = 1.
+    MissingForward,
 }
 
 impl Fault {
     /// All faults, in a fixed order.
-    pub const ALL: [Fault; 5] = [
+    pub const ALL: [Fault; 6] = [
         Fault::SignFlip,
         Fault::ScheduleLate,
         Fault::NarrowRegister,
         Fault::HoldInvalid,
         Fault::LogicalShift,
+        Fault::MissingForward,
     ];
 
     /// Faults the cycle model has no hook for: the co-simulation must catch them, but the
@@ -71,6 +75,7 @@ impl Fault {
             Fault::StatusWord => "status_word",
             Fault::RefusedCounter => "refused_counter",
             Fault::HaarFrameLimit => "haar_frame_limit",
+            Fault::MissingForward => "missing_forward",
         }
     }
 }

@@ -8,7 +8,8 @@ mod common;
 use common::{Rng, random_detection, random_params, random_rom};
 use proptest::prelude::*;
 use tofprobe_pixel::{
-    CycleModel, Mode, PinsIn, PixelParams, Readout, ReadoutCollector, Sequencer, TransactionModel,
+    CycleModel, Fault, Mode, PinsIn, PixelParams, Readout, ReadoutCollector, Sequencer,
+    TransactionModel,
 };
 
 /// Steps idle cycles until the pixel is ready (a pulse would be accepted).
@@ -273,4 +274,83 @@ fn default_schedule_accepts_every_pulse() {
     // 32 registers; two readouts clear 32 registers each.
     assert_eq!(writes, 39 * 32 + 2 * 32);
     assert_eq!(cm.refused(), 0);
+}
+
+/// One frame of back-to-back pulses (a pulse at every edge, C = K = 1) on the cycle model
+/// carrying `fault`; returns the first pulse whose registers differ from the transaction
+/// model's, `None` if the frame and its readout agree.
+fn back_to_back_first_difference(p: &PixelParams, fault: Option<Fault>) -> Option<u64> {
+    let mut rng = Rng(11);
+    let rom = random_rom(&mut rng, p);
+    let mut cm = CycleModel::with_fault(p, fault).unwrap();
+    let mut tm = TransactionModel::new(p).unwrap();
+    for n in 0..p.frame_pulses {
+        assert!(cm.outputs().ready, "K = 1 takes a pulse at every edge");
+        let det = random_detection(&mut rng, p);
+        let word = rom.entry(n as usize % p.rom_depth);
+        cm.step(&PinsIn {
+            pulse: true,
+            valid: det.is_some(),
+            tdc: det.unwrap_or(0),
+            rom_word: word,
+            ..PinsIn::default()
+        });
+        assert!(cm.accepted_pulse());
+        if cm.registers() != tm.registers() {
+            return Some(n);
+        }
+        tm.pulse(det, word);
+    }
+    cm.step(&PinsIn {
+        readout: true,
+        ..PinsIn::default()
+    });
+    (cm.registers() != tm.registers()).then_some(p.frame_pulses)
+}
+
+/// The pipeline's hazard (contract "Pipeline"): with K = 1 the read ahead of each pulse's
+/// slot 0 meets the previous pulse's write of the same register at the same edge (Fourier
+/// P ≤ A: every register; Haar: scale 0 always, scale u while v stays). With the forward
+/// the cycle model equals the transaction model on back-to-back pulses; the model without
+/// it (`MissingForward`) differs, so the check can fail.
+#[test]
+fn k1_back_to_back_pulses_need_the_forward() {
+    let fourier = PixelParams {
+        mode: Mode::Fourier,
+        bins: 2,
+        adders: 4,
+        cycles_per_pulse: 1,
+        tdc_bits: 4,
+        zoom: 3,
+        shift: 1,
+        frac_bits: 2,
+        width: 9,
+        frame_pulses: 40,
+        rom_depth: 8,
+        ..PixelParams::default()
+    };
+    let haar = PixelParams {
+        mode: Mode::Haar,
+        bins: 1,
+        haar_scales: 2,
+        adders: 3,
+        frame_pulses: 16,
+        rom_depth: 1,
+        ..fourier.clone()
+    };
+    for p in [fourier, haar] {
+        p.validate().unwrap();
+        assert_eq!((p.slots(), p.cycles_per_pulse), (1, 1), "{:?}", p.mode);
+        assert_eq!(
+            back_to_back_first_difference(&p, None),
+            None,
+            "{:?}",
+            p.mode
+        );
+        assert!(
+            back_to_back_first_difference(&p, Some(Fault::MissingForward)).is_some(),
+            "{:?}: the missing forward must show",
+            p.mode
+        );
+    }
 }

@@ -107,7 +107,12 @@ struct SlotCase {
 #[derive(Debug)]
 struct Adder {
     a: usize,
+    /// Cases of the read stage, decoded from the next slot's sources (`bits_nx`, `n_nx`).
     cases: Vec<SlotCase>,
+    /// K = 1: when this adder writes, at this edge, the register it reads for the next
+    /// pulse (the forward's condition); empty when K > 1 (consecutive slots touch disjoint
+    /// registers).
+    fwd: String,
 }
 
 #[derive(Debug)]
@@ -215,14 +220,25 @@ fn schedule(p: &PixelParams, sw: u32) -> (Vec<Adder>, Vec<Reg>) {
     let mut regs = Vec::new();
     for a in 0..sched.adders() {
         let mut cases = Vec::new();
+        let mut fwd = String::new();
         for (slot, op) in sched.adder(a) {
             let add = match (op, op.sign_bit(ln)) {
-                (Operation::Fourier { register }, _) => format!("bits[{register}]"),
-                // n_lat keeps pulse-index bits ln−1 .. nlo.
-                (_, Some(bit)) => format!("~n_lat[{}]", bit - nlo),
+                (Operation::Fourier { register }, _) => format!("bits_nx[{register}]"),
+                // n_lat (and n_nx) keep pulse-index bits ln−1 .. nlo.
+                (_, Some(bit)) => format!("~n_nx[{}]", bit - nlo),
                 (_, None) => unreachable!("a Haar operation has a sign bit"),
             };
             let slot_sel = format!("slot == {sw}'d{slot}");
+            if sched.slots() == 1 {
+                fwd = match op.select_bits(ln) {
+                    None => "active && acc_en".to_string(),
+                    Some((hi, lo)) => format!(
+                        "active && acc_en && n_lat[{h}:{l}] == n_nx[{h}:{l}]",
+                        h = hi - nlo,
+                        l = lo - nlo
+                    ),
+                };
+            }
             match op.select_bits(ln) {
                 None => {
                     let r = op.registers().start;
@@ -241,16 +257,17 @@ fn schedule(p: &PixelParams, sw: u32) -> (Vec<Adder>, Vec<Reg>) {
                     });
                 }
                 Some((hi, lo)) => {
-                    let sel = format!("n_lat[{}:{}]", hi - nlo, lo - nlo);
+                    let (h, l) = (hi - nlo, lo - nlo);
                     let bits = hi - lo + 1;
                     let entries: Vec<(usize, usize)> = op.registers().enumerate().collect();
                     for &(v, r) in &entries {
                         regs.push(Reg {
                             r,
                             adder: a,
-                            sel: format!("{slot_sel} && {sel} == {bits}'d{v}"),
+                            sel: format!("{slot_sel} && n_lat[{h}:{l}] == {bits}'d{v}"),
                         });
                     }
+                    let sel = format!("n_nx[{h}:{l}]");
                     cases.push(SlotCase {
                         slot,
                         sel,
@@ -262,7 +279,7 @@ fn schedule(p: &PixelParams, sw: u32) -> (Vec<Adder>, Vec<Reg>) {
                 }
             }
         }
-        adders.push(Adder { a, cases });
+        adders.push(Adder { a, cases, fwd });
     }
     regs.sort_by_key(|g| g.r);
     (adders, regs)

@@ -57,60 +57,89 @@ module tofprobe_pixel (
     /* verilator lint_on UNUSEDSIGNAL */
     wire [15:0] x_new = x_sum[15:0];
 
-    // ---- shared adders: adder a serves operation slot*A + a ----
+    // ---- shared adders, pipelined (contract "Pipeline"): adder a serves operation
+    // slot*A + a. Read stage: at every edge adder a reads the register and sign of its
+    // operation at the next edge (slot+1 of this pulse, or slot 0 of a pulse accepted now,
+    // decoded from the values being latched), so the write edge adds yin_a +/- op with no
+    // register-file multiplexer before the adder. ----
+    wire nx_same = active && slot != 4'd15;
+    wire [3:0] nslot = nx_same ? slot + 4'd1 : 4'd0;
+    wire [31:0] bits_nx = nx_same ? bits : rom_word;
     wire [38:0] opx = {{23{op[15]}}, op};
-    reg [38:0] yin_0;
-    reg add_0;
+    reg [38:0] yin_0;  // read stage: Y of the next operation
+    reg add_0;                  // read stage: its sign (1 = add)
+    reg [38:0] rd_0;
+    reg sg_0;
     always @* begin
-        yin_0 = 39'd0;
-        add_0 = 1'b0;
-        case (slot)
-            4'd0: begin yin_0 = y[0]; add_0 = bits[0]; end
-            4'd1: begin yin_0 = y[2]; add_0 = bits[2]; end
-            4'd2: begin yin_0 = y[4]; add_0 = bits[4]; end
-            4'd3: begin yin_0 = y[6]; add_0 = bits[6]; end
-            4'd4: begin yin_0 = y[8]; add_0 = bits[8]; end
-            4'd5: begin yin_0 = y[10]; add_0 = bits[10]; end
-            4'd6: begin yin_0 = y[12]; add_0 = bits[12]; end
-            4'd7: begin yin_0 = y[14]; add_0 = bits[14]; end
-            4'd8: begin yin_0 = y[16]; add_0 = bits[16]; end
-            4'd9: begin yin_0 = y[18]; add_0 = bits[18]; end
-            4'd10: begin yin_0 = y[20]; add_0 = bits[20]; end
-            4'd11: begin yin_0 = y[22]; add_0 = bits[22]; end
-            4'd12: begin yin_0 = y[24]; add_0 = bits[24]; end
-            4'd13: begin yin_0 = y[26]; add_0 = bits[26]; end
-            4'd14: begin yin_0 = y[28]; add_0 = bits[28]; end
-            4'd15: begin yin_0 = y[30]; add_0 = bits[30]; end
-            default: begin yin_0 = 39'd0; add_0 = 1'b0; end
+        rd_0 = 39'd0;
+        sg_0 = 1'b0;
+        case (nslot)
+            4'd0: begin rd_0 = y[0]; sg_0 = bits_nx[0]; end
+            4'd1: begin rd_0 = y[2]; sg_0 = bits_nx[2]; end
+            4'd2: begin rd_0 = y[4]; sg_0 = bits_nx[4]; end
+            4'd3: begin rd_0 = y[6]; sg_0 = bits_nx[6]; end
+            4'd4: begin rd_0 = y[8]; sg_0 = bits_nx[8]; end
+            4'd5: begin rd_0 = y[10]; sg_0 = bits_nx[10]; end
+            4'd6: begin rd_0 = y[12]; sg_0 = bits_nx[12]; end
+            4'd7: begin rd_0 = y[14]; sg_0 = bits_nx[14]; end
+            4'd8: begin rd_0 = y[16]; sg_0 = bits_nx[16]; end
+            4'd9: begin rd_0 = y[18]; sg_0 = bits_nx[18]; end
+            4'd10: begin rd_0 = y[20]; sg_0 = bits_nx[20]; end
+            4'd11: begin rd_0 = y[22]; sg_0 = bits_nx[22]; end
+            4'd12: begin rd_0 = y[24]; sg_0 = bits_nx[24]; end
+            4'd13: begin rd_0 = y[26]; sg_0 = bits_nx[26]; end
+            4'd14: begin rd_0 = y[28]; sg_0 = bits_nx[28]; end
+            4'd15: begin rd_0 = y[30]; sg_0 = bits_nx[30]; end
+            default: begin rd_0 = 39'd0; sg_0 = 1'b0; end
         endcase
     end
     wire [38:0] sum_0 = add_0 ? (yin_0 + opx) : (yin_0 - opx);
-    reg [38:0] yin_1;
-    reg add_1;
+    always @(posedge clk) begin
+        if (rst) begin
+            yin_0 <= 39'd0;
+            add_0 <= 1'b0;
+        end else begin
+            yin_0 <= rd_0;
+            add_0 <= sg_0;
+        end
+    end
+    reg [38:0] yin_1;  // read stage: Y of the next operation
+    reg add_1;                  // read stage: its sign (1 = add)
+    reg [38:0] rd_1;
+    reg sg_1;
     always @* begin
-        yin_1 = 39'd0;
-        add_1 = 1'b0;
-        case (slot)
-            4'd0: begin yin_1 = y[1]; add_1 = bits[1]; end
-            4'd1: begin yin_1 = y[3]; add_1 = bits[3]; end
-            4'd2: begin yin_1 = y[5]; add_1 = bits[5]; end
-            4'd3: begin yin_1 = y[7]; add_1 = bits[7]; end
-            4'd4: begin yin_1 = y[9]; add_1 = bits[9]; end
-            4'd5: begin yin_1 = y[11]; add_1 = bits[11]; end
-            4'd6: begin yin_1 = y[13]; add_1 = bits[13]; end
-            4'd7: begin yin_1 = y[15]; add_1 = bits[15]; end
-            4'd8: begin yin_1 = y[17]; add_1 = bits[17]; end
-            4'd9: begin yin_1 = y[19]; add_1 = bits[19]; end
-            4'd10: begin yin_1 = y[21]; add_1 = bits[21]; end
-            4'd11: begin yin_1 = y[23]; add_1 = bits[23]; end
-            4'd12: begin yin_1 = y[25]; add_1 = bits[25]; end
-            4'd13: begin yin_1 = y[27]; add_1 = bits[27]; end
-            4'd14: begin yin_1 = y[29]; add_1 = bits[29]; end
-            4'd15: begin yin_1 = y[31]; add_1 = bits[31]; end
-            default: begin yin_1 = 39'd0; add_1 = 1'b0; end
+        rd_1 = 39'd0;
+        sg_1 = 1'b0;
+        case (nslot)
+            4'd0: begin rd_1 = y[1]; sg_1 = bits_nx[1]; end
+            4'd1: begin rd_1 = y[3]; sg_1 = bits_nx[3]; end
+            4'd2: begin rd_1 = y[5]; sg_1 = bits_nx[5]; end
+            4'd3: begin rd_1 = y[7]; sg_1 = bits_nx[7]; end
+            4'd4: begin rd_1 = y[9]; sg_1 = bits_nx[9]; end
+            4'd5: begin rd_1 = y[11]; sg_1 = bits_nx[11]; end
+            4'd6: begin rd_1 = y[13]; sg_1 = bits_nx[13]; end
+            4'd7: begin rd_1 = y[15]; sg_1 = bits_nx[15]; end
+            4'd8: begin rd_1 = y[17]; sg_1 = bits_nx[17]; end
+            4'd9: begin rd_1 = y[19]; sg_1 = bits_nx[19]; end
+            4'd10: begin rd_1 = y[21]; sg_1 = bits_nx[21]; end
+            4'd11: begin rd_1 = y[23]; sg_1 = bits_nx[23]; end
+            4'd12: begin rd_1 = y[25]; sg_1 = bits_nx[25]; end
+            4'd13: begin rd_1 = y[27]; sg_1 = bits_nx[27]; end
+            4'd14: begin rd_1 = y[29]; sg_1 = bits_nx[29]; end
+            4'd15: begin rd_1 = y[31]; sg_1 = bits_nx[31]; end
+            default: begin rd_1 = 39'd0; sg_1 = 1'b0; end
         endcase
     end
     wire [38:0] sum_1 = add_1 ? (yin_1 + opx) : (yin_1 - opx);
+    always @(posedge clk) begin
+        if (rst) begin
+            yin_1 <= 39'd0;
+            add_1 <= 1'b0;
+        end else begin
+            yin_1 <= rd_1;
+            add_1 <= sg_1;
+        end
+    end
 
     // ---- register writes: accumulate (slot's adder) or readout clear ----
     wire [31:0] we_c;
