@@ -39,6 +39,9 @@ pub enum Tolerance {
     /// the mean over the row's seeds (derivation in `stats`); without a closed form the
     /// corrected / paper value is tested the same way.
     Seeds { k: f64, se: f64 },
+    /// Shown, not tested (the reason is in the note): passes by construction, so only
+    /// rows that no estimator could test at this record length use it.
+    Untested,
 }
 
 /// One line of the reproduce table.
@@ -101,7 +104,7 @@ impl Row {
                     .or(paper)
                     .is_none_or(|r| (r - measured).abs() <= k * se),
                 // Evaluated by the caller (sets `pass`); judged true here.
-                Tolerance::Bound => true,
+                Tolerance::Bound | Tolerance::Untested => true,
             };
         Row {
             family,
@@ -141,6 +144,7 @@ pub fn markdown(rows: &[Row]) -> String {
             Tolerance::AtLeast { min } => format!("≥ {min}"),
             Tolerance::Bound => "derived bound".to_string(),
             Tolerance::Seeds { k, se } => format!("±{k}·{se:.3} (se)"),
+            Tolerance::Untested => "not tested".to_string(),
         };
         let z = |v: Option<f64>| v.map_or_else(|| "–".to_string(), |z| format!("{z:+.1}"));
         let stats = if r.seeds.is_empty() {
