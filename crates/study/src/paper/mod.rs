@@ -14,6 +14,7 @@ pub mod plots;
 pub mod reproduce;
 pub mod setup;
 pub mod sigma_delta;
+pub mod stats;
 pub mod table2;
 pub mod transients;
 
@@ -35,6 +36,13 @@ pub enum Tolerance {
     AtLeast { min: f64 },
     /// A derived error bound (stated in the note), checked by the caller.
     Bound,
+    /// Seed statistics (`stats`): |closed form − mean| ≤ k·se, se the standard error of
+    /// the mean over the row's seeds (derivation in `stats`); without a closed form the
+    /// corrected / paper value is tested the same way.
+    Seeds { k: f64, se: f64 },
+    /// Shown, not tested (the reason is in the note): passes by construction, so only
+    /// rows that no estimator could test at this record length use it.
+    Untested,
 }
 
 /// One line of the reproduce table.
@@ -54,6 +62,16 @@ pub struct Row {
     pub pass: bool,
     /// Extra context shown in the table (e.g. the Blackman value, the ZOH approximation).
     pub note: String,
+    /// Seeds the measured value is the mean over (empty: one record).
+    pub seeds: Vec<u64>,
+    /// Seed-to-seed standard deviation of one draw.
+    pub seed_sd: Option<f64>,
+    /// The band the value is read on (Hz), where it is a band statistic.
+    pub band_hz: Option<(f64, f64)>,
+    /// (paper − mean) / (sd·sqrt(1 + 1/S)): the paper's value is one draw of its own.
+    pub z_paper: Option<f64>,
+    /// (closed form − mean) / se.
+    pub z_closed_form: Option<f64>,
 }
 
 impl Row {
@@ -82,8 +100,12 @@ impl Row {
                     .is_none_or(|p| (p - measured).abs() <= k * spread),
                 Tolerance::Reference { rel } => closed_form.is_some() && ok_rel(closed_form, rel),
                 Tolerance::AtLeast { min } => measured >= min,
+                Tolerance::Seeds { k, se } => closed_form
+                    .or(design)
+                    .or(paper)
+                    .is_none_or(|r| (r - measured).abs() <= k * se),
                 // Evaluated by the caller (sets `pass`); judged true here.
-                Tolerance::Bound => true,
+                Tolerance::Bound | Tolerance::Untested => true,
             };
         Row {
             family,
@@ -96,6 +118,11 @@ impl Row {
             tolerance,
             pass,
             note,
+            seeds: Vec::new(),
+            seed_sd: None,
+            band_hz: None,
+            z_paper: None,
+            z_closed_form: None,
         }
     }
 }
@@ -117,6 +144,23 @@ pub fn markdown(rows: &[Row]) -> String {
             Tolerance::Reference { rel } => format!("±{:.3}% of ref", rel * 100.0),
             Tolerance::AtLeast { min } => format!("≥ {min}"),
             Tolerance::Bound => "derived bound".to_string(),
+            Tolerance::Seeds { k, se } => format!("±{k}·{se:.3} (se)"),
+            Tolerance::Untested => "not tested".to_string(),
+        };
+        let z = |v: Option<f64>| v.map_or_else(|| "–".to_string(), |z| format!("{z:+.1}"));
+        let stats = if r.seeds.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "{} seeds {:?}, sd {:.3}{}; z paper {}, z closed {}; ",
+                r.seeds.len(),
+                r.seeds,
+                r.seed_sd.unwrap_or(f64::NAN),
+                r.band_hz
+                    .map_or_else(String::new, |(a, b)| format!(", band {a}–{b} Hz")),
+                z(r.z_paper),
+                z(r.z_closed_form)
+            )
         };
         s += &format!(
             "| {} | {} | {} | {} | {} | {:.4} | {} | {} | {} | {} |\n",
@@ -130,7 +174,7 @@ pub fn markdown(rows: &[Row]) -> String {
             fmt_opt(r.closed_form),
             tol,
             if r.pass { "pass" } else { "FAIL" },
-            r.note.replace('|', "\\|")
+            (stats + &r.note).replace('|', "\\|")
         );
     }
     s

@@ -3,8 +3,11 @@
 //! float (`tofprobe_dsp::sd`, with and without the α = 1/32 prefilter) and bit-true
 //! (`tofprobe_pixel::TransactionModel`, F = 8, S = 5, W sized so nothing wraps).
 //!
-//! Bins: the tone bin (4.5 kHz) first, then [`NOISE_BINS`] bins spread linearly over
-//! 1–150 kHz (below f_s/(2·OSR) = 156 kHz) minus any within [`TONE_GUARD_HZ`] of the tone.
+//! Bins: the tone bin (4.5 kHz) first, then [`NOISE_BINS`] bins spread linearly over the
+//! DFT column's band, 1–10 kHz (`table2::BAND`), minus any within [`TONE_GUARD_HZ`] of the
+//! tone: the ΣΔ, bit-true and DFT noise are all read in the same band (an earlier 1–150 kHz
+//! span made the ΣΔ floor look lower than the DFT's, 29.1 vs 44.4 µm at ρ_s = 0.03, only
+//! because the hold's noise falls above 10 kHz).
 //! The noise statistic is their mean magnitude; the DFT is read on exactly the same bins of
 //! the same record, so the ΣΔ/DFT comparison carries no sampling error of its own, only the
 //! ΣΔ error (probe quantisation noise mixed with the prefiltered depth).
@@ -19,7 +22,7 @@ use tofprobe_pixel::sizing::{
 use tofprobe_pixel::{PixelParams, TransactionModel};
 
 use super::setup::FS_HZ;
-use super::table2::{BIT_TRUE, DFT, F0_HZ, Measurement, RowResult, SD, SD_RAW};
+use super::table2::{BAND, BIT_TRUE, DFT, F0_HZ, Measurement, RowResult, SD, SD_RAW};
 use super::{Row, Tolerance};
 use crate::StudyError;
 
@@ -31,8 +34,8 @@ pub const FRAC_BITS: u32 = tofprobe_pixel::DEFAULT_FRAC_BITS;
 /// first-order effect of a per-bin ΣΔ error ε (relative to the floor) on the mean
 /// magnitude at ≈ ε/sqrt(2·64) ≈ ε/11, well inside 3% for the measured ε.
 pub const NOISE_BINS: usize = 64;
-/// Noise bins span (Hz): above the 1 kHz of the DFT band, below f_s/(2·OSR).
-pub const NOISE_SPAN_HZ: (f64, f64) = (1_000.0, 150_000.0);
+/// Noise bins span (Hz): the DFT column's band.
+pub const NOISE_SPAN_HZ: (f64, f64) = BAND;
 /// Noise bins closer than this to the tone are dropped (the Blackman main lobe is ±3 bins
 /// = ±3 Hz at N = 10^7, ±29 Hz at 2^20, ±460 Hz at 2^16).
 pub const TONE_GUARD_HZ: f64 = 1_000.0;
@@ -280,11 +283,17 @@ pub fn rows(r: &RowResult) -> Vec<Row> {
         Some(dft_noise),
         Tolerance::Reference { rel: NOISE_REL },
         format!(
-            "ref: DFT of the same record on the same {bins} bins (1–150 kHz); ΣΔ error \
-             {:.3}× the floor; paper ΣΔ shown, not tested (its bins are 1–10 kHz)",
+            "seed 0; ref: DFT of the same record on the same {bins} bins ({}–{} Hz); ΣΔ error \
+             {:.3}× the floor; paper ΣΔ shown, not tested (the DFT row tests the floor)",
+            NOISE_SPAN_HZ.0,
+            NOISE_SPAN_HZ.1,
             sd_err / dft_noise
         ),
     ));
+    if let Some(last) = out.last_mut() {
+        last.band_hz = Some(NOISE_SPAN_HZ);
+        last.seeds = vec![super::stats::SEEDS[0]];
+    }
     if let (Some(a_sd), Some(_)) = (sd.amp_um, r.spec.amp_um) {
         let a_dft = norm(dft.phasors[0]) * 1e3;
         // The ΣΔ error at the tone bin is the same mixing noise as at the noise bins; its
@@ -468,14 +477,14 @@ pub(crate) mod tests {
             sd.noise_um, bt.noise_um
         );
         assert!((sd.noise_um / dft_noise - 1.0).abs() < NOISE_REL);
-        // The noise itself is the closed form sqrt(π σ²/N_eff) within the 64-bin sampling
-        // error (0.52/sqrt(64) ≈ 6.5%; 20% is 3σ).
+        // The noise itself is the closed form sqrt(π σ²/N_eff) within the sampling error
+        // of ≈ 40 adjacent 1–10 kHz bins (`stats::floor_rel_sd`: ≈ 13%; 40% is 3σ).
         let theory = (std::f64::consts::PI * 9.0
             / (n as f64 * tofprobe_dsp::Window::Blackman.effective_length_factor()))
         .sqrt()
             * 1e3;
         assert!(
-            (dft_noise / theory - 1.0).abs() < 0.2,
+            (dft_noise / theory - 1.0).abs() < 0.4,
             "{dft_noise} vs {theory}"
         );
         // Amplitude: within 1% of the DFT's at the tone bin (0.17% rms expected).
@@ -495,7 +504,7 @@ pub(crate) mod tests {
         assert!(check.worst_ratio < 1e-2, "{check:?}");
         // Normalised, against the float ΣΔ on the same codes: the register errors (≤ 1e-2
         // of the bound, a few codes) become ≤ 2·5·sqrt(2)/(N·G·A_p·|H_pre|) ≈ 3 µm per
-        // bin at 150 kHz (|H_pre| ≈ 0.32), a tenth of the ≈ 28 µm floor.
+        // bin (|H_pre| ≥ 0.98 in 1–10 kHz), a tenth of the ≈ 28 µm floor.
         let max_diff = bt_diff_um(check);
         eprintln!("bit-true vs float on the same codes: max {max_diff} µm");
         assert!(max_diff < 3.0, "{max_diff}");
@@ -517,15 +526,16 @@ pub(crate) mod tests {
             let b = probe_bins(n);
             let df = FS_HZ / n as f64;
             assert_eq!(b[0], (F0_HZ / df).round() as u64);
-            assert!(
-                b.len() >= NOISE_BINS - 2 && b.len() <= NOISE_BINS + 1,
-                "{}",
-                b.len()
-            );
+            // 2^16: 152 Hz bins, ≈ 40 distinct outside the guard; longer records: all 64
+            // candidates minus the few inside the ±1 kHz guard.
+            let min = if n == 1 << 16 { 30 } else { NOISE_BINS * 3 / 4 };
+            assert!(b.len() >= min && b.len() <= NOISE_BINS + 1, "{}", b.len());
             for &k in &b[1..] {
                 let f = k as f64 * df;
                 assert!(
-                    (f - F0_HZ).abs() >= TONE_GUARD_HZ && f < FS_HZ / 64.0,
+                    (f - F0_HZ).abs() >= TONE_GUARD_HZ
+                        && f >= NOISE_SPAN_HZ.0 - df
+                        && f <= NOISE_SPAN_HZ.1 + df,
                     "{f}"
                 );
             }

@@ -45,6 +45,9 @@ const N_SNR: usize = 1 << 17;
 const N_BAND: usize = 1 << 20;
 /// Peak SNR of 12 bits: 6.02·12 + 1.76 dB.
 const SNR_12_BITS_DB: f64 = 6.02 * 12.0 + 1.76;
+/// 12 bits as the paper reads them, ENOB = SNR_dB/6.02 (no 1.76 dB): 72.24 dB. Eq. 4 at
+/// full scale then gives 297 kHz, the paper's figure.
+const SNR_12_BITS_PAPER_DB: f64 = 6.02 * 12.0;
 
 #[derive(Debug, Serialize)]
 struct SnrRow {
@@ -73,6 +76,8 @@ struct Report {
     band_hz_12_bits_eq4: f64,
     /// Eq. 4 at full scale (how the paper reads its "12 bits below 297 kHz"), Hz.
     band_hz_12_bits_eq4_full_scale: f64,
+    /// The same with the paper's ENOB = SNR_dB/6.02 (12 bits = 72.24 dB), Hz: its 297 kHz.
+    band_hz_12_bits_eq4_full_scale_paper_enob: f64,
     rom_bins: usize,
     rom_pulses: u64,
     rom_seconds_one_thread: f64,
@@ -174,10 +179,11 @@ pub fn run(args: &SdBenchArgs) -> Result<(), CliError> {
     // Eq. 4 inverted for the OSR where it gives 12 bits, at full scale (as the paper
     // reads it) and at amplitude 0.7.
     let t = cfg.order as f64;
-    let band_eq4 = |a: f64| {
-        let d12 = (SNR_12_BITS_DB - eq4_snr_db(cfg.order, 1.0, a)) / (3.01 * (2.0 * t + 1.0));
+    let band_eq4_at = |snr_db: f64, a: f64| {
+        let d12 = (snr_db - eq4_snr_db(cfg.order, 1.0, a)) / (3.01 * (2.0 * t + 1.0));
         FS_HZ / (2.0 * 2f64.powf(d12))
     };
+    let band_eq4 = |a: f64| band_eq4_at(SNR_12_BITS_DB, a);
 
     // Speed: 16 bins spread over the band, N = 10^7, windowed mode.
     let bins: Vec<u64> = (1..=16u64).map(|i| i * 9_700).collect();
@@ -243,6 +249,7 @@ pub fn run(args: &SdBenchArgs) -> Result<(), CliError> {
         band_hz_12_bits_measured: s07.band_for_snr(SNR_12_BITS_DB) * FS_HZ,
         band_hz_12_bits_eq4: band_eq4(0.7),
         band_hz_12_bits_eq4_full_scale: band_eq4(1.0),
+        band_hz_12_bits_eq4_full_scale_paper_enob: band_eq4_at(SNR_12_BITS_PAPER_DB, 1.0),
         rom_bins: bins.len(),
         rom_pulses: N_ROM,
         rom_seconds_one_thread: one,
@@ -319,10 +326,12 @@ fn print_text(r: &Report) {
         r.eq4_snr_db_156khz_amplitude_0_7
     );
     println!(
-        "  12 bits (74 dB) up to {:.0} kHz measured (A = 0.7); eq. 4: {:.0} kHz at A = 0.7, {:.0} kHz at full scale (paper: 297 kHz)",
+        "  12 bits (74 dB = 6.02·12 + 1.76, ENOB = (SNR − 1.76)/6.02) up to {:.0} kHz measured (A = 0.7); eq. 4: {:.0} kHz at A = 0.7, {:.0} kHz at full scale; \
+         the paper's 297 kHz reads ENOB = SNR_dB/6.02 (12 bits = 72.24 dB): eq. 4 at full scale gives {:.0} kHz that way",
         r.band_hz_12_bits_measured / 1e3,
         r.band_hz_12_bits_eq4 / 1e3,
-        r.band_hz_12_bits_eq4_full_scale / 1e3
+        r.band_hz_12_bits_eq4_full_scale / 1e3,
+        r.band_hz_12_bits_eq4_full_scale_paper_enob / 1e3
     );
     println!(
         "  ROM {} bins x N = {}: {:.3} s on {} threads, {:.3} s on one ({:.3e} / {:.3e} modulator samples/s); target <= {} s: {}",
@@ -436,5 +445,9 @@ mod tests {
         let d12 = (SNR_12_BITS_DB - eq4_snr_db(3, 1.0, 1.0)) / (3.01 * 7.0);
         let band = FS_HZ / (2.0 * 2f64.powf(d12));
         assert!((band - 280e3).abs() < 2e3, "{band}");
+        // The paper's reading, ENOB = SNR_dB/6.02: its printed 297 kHz.
+        let d = (SNR_12_BITS_PAPER_DB - eq4_snr_db(3, 1.0, 1.0)) / (3.01 * 7.0);
+        let paper = FS_HZ / (2.0 * 2f64.powf(d));
+        assert!((paper - 297e3).abs() < 1e3, "{paper}");
     }
 }
