@@ -16,31 +16,32 @@ pub enum SceneError {
         /// The allowed range, in words or as an inequality.
         allowed: String,
     },
-    /// The scene's depth range does not fit in the sensor's timing window.
+    /// The scene's depth range does not fit in the sensor's timing window. Blames
+    /// `scene.depth_mm` (with the range of depths that fit) when the motion fits the
+    /// window at all, else the motion's size against the window's length.
     #[error(
-        "scene depth {min_mm:.3}..{max_mm:.3} mm lies outside the timing window \
-         {window_start_mm:.3}..{window_end_mm:.3} mm (sensor.window_start_ps = {window_start_ps}, \
-         sensor.window_length_ps = {window_length_ps}); allowed: the window must contain the \
-         whole depth range, e.g. window_start_ps <= {suggest_start_ps:.1} and \
-         window_start_ps + window_length_ps >= {suggest_end_ps:.1}"
+        "scene.depth_mm = {depth_mm} with its motion spans {min_mm}..{max_mm} mm, which leaves \
+         the timing window [{window_start_mm}, {window_end_mm}) mm \
+         (sensor.window_start_ps = {window_start_ps}, sensor.window_length_ps = {window_length_ps}); \
+         allowed: {allowed}"
     )]
     WindowExcludesDepth {
+        /// `scene.depth_mm` as configured.
+        depth_mm: f64,
         /// Smallest depth the scene can reach (mm).
         min_mm: f64,
         /// Largest depth the scene can reach (mm).
         max_mm: f64,
         /// Window start as depth (mm).
         window_start_mm: f64,
-        /// Window end as depth (mm).
+        /// Window end as depth (mm), exclusive: the last TDC code ends there.
         window_end_mm: f64,
         /// `sensor.window_start_ps` as configured.
         window_start_ps: f64,
         /// `sensor.window_length_ps` as configured.
         window_length_ps: f64,
-        /// Latest window start that would contain the scene (ps).
-        suggest_start_ps: f64,
-        /// Earliest window end that would contain the scene (ps).
-        suggest_end_ps: f64,
+        /// The range of `scene.depth_mm` (or the window) that would work, in words.
+        allowed: String,
     },
     /// Neither or both of `acquisition.pulses` and `acquisition.duration_s` were given.
     #[error(
