@@ -15,6 +15,9 @@ use crate::document::Document;
 use crate::error::DesignError;
 use crate::probe_cache::ProbeCache;
 
+/// Longest frame a windowed ROM (L = N) may span: 2^24 pulses (1.68 s at 10 MHz).
+pub const MAX_WINDOWED_FRAME: u64 = 1 << 24;
+
 /// A configuration resolved once: everything a command needs, already validated.
 #[derive(Debug, Clone)]
 pub struct ResolvedDesign {
@@ -64,6 +67,26 @@ pub fn resolve_with(
     d.probe.validate().map_err(probe_err)?;
     let frame = d.pixel.frame_pulses.unwrap_or(d.pulses());
     d.probe.check_frame(frame).map_err(probe_err)?;
+    // A windowed ROM is one frame deep, and `simulate` builds it whole (≈ 24 bytes per
+    // pulse): bounded here, once, as `rtl` and `vectors` bound theirs.
+    if d.pixel.mode == Mode::Fourier
+        && d.probe.rom_mode == RomMode::Windowed
+        && frame > MAX_WINDOWED_FRAME
+    {
+        return Err(probe_err(
+            tofprobe_dsp::DspError::out_of_range(
+                "probe.rom_mode",
+                "\"windowed\"",
+                format!(
+                    "a windowed ROM is one frame deep (L = N = {frame} pulses from acquisition or \
+                     pixel.frame_pulses); at most {MAX_WINDOWED_FRAME} pulses (≈ 400 MB of ROM)"
+                ),
+            )
+            .with_hint(format!(
+                "rom_mode = \"periodic\", or pixel.frame_pulses <= {MAX_WINDOWED_FRAME}"
+            )),
+        ));
+    }
 
     // The pixel reads the ROM the probe design generates: its depth defaults to the
     // `[probe]` design's (L = N windowed, `probe.rom_depth` periodic).
@@ -98,7 +121,7 @@ pub fn resolve_with(
             return Err(probe_err(
                 tofprobe_dsp::DspError::out_of_range(
                     "probe.osr",
-                    d.probe.osr,
+                    tofprobe_io::text::number(d.probe.osr),
                     format!(
                         "osr < L/2 = {}: the ΣΔ band f_s/(2·OSR) must hold at least the ROM's first bin f_s/L (L = {l})",
                         l as f64 / 2.0

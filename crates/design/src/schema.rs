@@ -86,9 +86,10 @@ pub fn wrong_type(text: &str) -> Option<String> {
         for (key, v) in t {
             if section == "scene" && key == "motion" {
                 let Some(list) = v.as_array() else {
-                    return Some(format!(
+                    return Some(
                         "`scene.motion` has the wrong type: expected [[scene.motion]] tables"
-                    ));
+                            .to_string(),
+                    );
                 };
                 for (i, m) in list.iter().enumerate() {
                     for (mk, mv) in m.as_table().into_iter().flatten() {

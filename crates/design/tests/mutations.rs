@@ -156,7 +156,7 @@ fn mutate(rng: &mut Rng, vals: &[String]) -> (String, Vec<(String, String, Strin
                 .as_table_mut()
                 .unwrap()
         };
-        if rng.next() % 8 == 0 {
+        if rng.next().is_multiple_of(8) {
             if target.remove(&key).is_some() {
                 muts.push((table.to_string(), key, "<removed>".to_string()));
             }
@@ -175,6 +175,7 @@ fn value_forms(lit: &str) -> Vec<String> {
         f.push(format!("{x}"));
         f.push(format!("{x:?}"));
         f.push(format!("{x:e}"));
+        f.push(tofprobe_io::text::number(x));
     }
     if lit == "nan" {
         f.push("NaN".into());
@@ -214,10 +215,10 @@ fn mutated_configurations_resolve_or_name_their_field() {
     for case in 0..cases {
         let (text, muts) = mutate(&mut rng, &vals);
         let run = catch_unwind(AssertUnwindSafe(|| {
-            let doc = Document::from_toml_str(&text, "mutated.toml")?;
-            let d = resolve_with(doc, "mutated.toml", &mut cache)?;
-            rtl_params(&d, &RtlOverrides::default())?;
-            Ok::<_, tofprobe_design::DesignError>(())
+            let doc = Document::from_toml_str(&text, "mutated.toml").map_err(Box::new)?;
+            let d = resolve_with(doc, "mutated.toml", &mut cache).map_err(Box::new)?;
+            rtl_params(&d, &RtlOverrides::default()).map_err(Box::new)?;
+            Ok::<_, Box<tofprobe_design::DesignError>>(())
         }));
         let Ok(result) = run else {
             panics += 1;

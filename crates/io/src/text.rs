@@ -63,6 +63,17 @@ pub fn clip(text: &str, max: usize) -> String {
     format!("{kept}...")
 }
 
+/// A number as an error message shows it: plain when readable, scientific when tiny or huge
+/// (`1e-300`, not 300 zeros), and `NaN`/`inf` as Rust writes them.
+pub fn number(x: f64) -> String {
+    let a = x.abs();
+    if x.is_finite() && a != 0.0 && !(1e-4..1e9).contains(&a) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

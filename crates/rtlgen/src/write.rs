@@ -44,7 +44,7 @@ pub fn write_generated(dir: &Path, files: &[(String, String)]) -> Result<(), Rtl
     let mut set = tofprobe_io::OutputSet::begin(dir).map_err(|e| RtlError::io(dir, e))?;
     for (name, contents) in files {
         set.add(name, contents.as_bytes())
-            .map_err(|e| RtlError::io(&dir.join(name), e))?;
+            .map_err(|e| RtlError::io(dir.join(name), e))?;
     }
     let last = files.last().map(|(n, _)| n.as_str());
     set.commit(last).map_err(|e| RtlError::io(dir, e))

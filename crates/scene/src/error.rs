@@ -19,27 +19,13 @@ pub enum SceneError {
     /// The scene's depth range does not fit in the sensor's timing window. Blames
     /// `scene.depth_mm` (with the range of depths that fit) when the motion fits the
     /// window at all, else the motion's size against the window's length.
-    #[error(
-        "scene.depth_mm = {depth_mm} with its motion spans {min_mm}..{max_mm} mm, which leaves \
-         the timing window [{window_start_mm}, {window_end_mm}) mm \
-         (sensor.window_start_ps = {window_start_ps}, sensor.window_length_ps = {window_length_ps}); \
-         allowed: {allowed}"
-    )]
+    #[error("scene.depth_mm = {depth_mm} {span}; allowed: {allowed}")]
     WindowExcludesDepth {
         /// `scene.depth_mm` as configured.
         depth_mm: f64,
-        /// Smallest depth the scene can reach (mm).
-        min_mm: f64,
-        /// Largest depth the scene can reach (mm).
-        max_mm: f64,
-        /// Window start as depth (mm).
-        window_start_mm: f64,
-        /// Window end as depth (mm), exclusive: the last TDC code ends there.
-        window_end_mm: f64,
-        /// `sensor.window_start_ps` as configured.
-        window_start_ps: f64,
-        /// `sensor.window_length_ps` as configured.
-        window_length_ps: f64,
+        /// The depth range its motion spans and the window it leaves (with the
+        /// `sensor.window_start_ps` / `window_length_ps` that set it), in words.
+        span: String,
         /// The range of `scene.depth_mm` (or the window) that would work, in words.
         allowed: String,
     },
@@ -89,7 +75,7 @@ pub(crate) fn check_range(field: &str, v: f64, lo: f64, hi: f64) -> Result<(), S
     } else {
         Err(SceneError::out_of_range(
             field,
-            v,
+            tofprobe_io::text::number(v),
             format!("{lo} <= {} <= {hi}", leaf(field)),
         ))
     }
@@ -102,7 +88,7 @@ pub(crate) fn check_positive(field: &str, v: f64, hi: f64) -> Result<(), SceneEr
     } else {
         Err(SceneError::out_of_range(
             field,
-            v,
+            tofprobe_io::text::number(v),
             format!("0 < {} <= {hi}", leaf(field)),
         ))
     }

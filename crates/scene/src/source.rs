@@ -320,12 +320,11 @@ pub(crate) fn check_window(sensor: &SensorConfig, scene: &Scene) -> Result<(), S
     };
     Err(SceneError::WindowExcludesDepth {
         depth_mm: depth,
-        min_mm: lo,
-        max_mm: hi,
-        window_start_mm: ws,
-        window_end_mm: we,
-        window_start_ps: sensor.window_start_ps,
-        window_length_ps: sensor.window_length_ps,
+        span: format!(
+            "with its motion spans {lo}..{hi} mm, which leaves the timing window [{ws}, {we}) mm \
+             (sensor.window_start_ps = {}, sensor.window_length_ps = {})",
+            sensor.window_start_ps, sensor.window_length_ps
+        ),
         allowed,
     })
 }

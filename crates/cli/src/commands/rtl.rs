@@ -67,7 +67,7 @@ pub fn run(a: &RtlArgs) -> Result<(), CliError> {
         p.cycles_per_pulse,
         p.frame_pulses,
         p.rom_depth,
-        tofprobe_rtlgen::config_hash(&p),
+        tofprobe_rtlgen::config_hash(p),
         a.out.display(),
         r.files.join(", "),
         r.rom_note

@@ -88,7 +88,7 @@ impl ProbeConfig {
         if !(self.amplitude >= MIN_AMPLITUDE && self.amplitude < 1.0) {
             return Err(DspError::out_of_range(
                 "probe.amplitude",
-                self.amplitude,
+                tofprobe_io::text::number(self.amplitude),
                 format!("{MIN_AMPLITUDE} <= amplitude < 1"),
             )
             .with_hint("0.5 suits the default order-3 design"));
@@ -183,9 +183,20 @@ mod tests {
         };
         let e = bad.validate().unwrap_err().to_string();
         assert!(
-            e.contains("probe.amplitude = 1.2") && e.contains("0 < amplitude < 1"),
+            e.contains("probe.amplitude = 1.2") && e.contains("0.01 <= amplitude < 1"),
             "{e}"
         );
+        // The readout is divided by A_p: a vanishing amplitude is refused, not divided by.
+        for tiny in [1e-300, 5e-324, 0.0099] {
+            let e = ProbeConfig {
+                amplitude: tiny,
+                ..ProbeConfig::default()
+            }
+            .validate()
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains("probe.amplitude"), "{e}");
+        }
         let bad = ProbeConfig {
             h_inf: 0.9,
             ..ProbeConfig::default()

@@ -100,7 +100,7 @@ impl ProbeDesign {
         let limit = SAFETY_MARGIN * a_max;
         // A modulator stable at no usable amplitude is the design's fault, not the
         // amplitude's: name the out-of-band gain (the knob that makes it unstable).
-        if !(limit >= super::config::MIN_AMPLITUDE) {
+        if limit.is_nan() || limit < super::config::MIN_AMPLITUDE {
             return Err(DspError::out_of_range(
                 "probe.h_inf",
                 config.h_inf,
