@@ -20,7 +20,12 @@ struct Cli {
 fn main() -> ExitCode {
     quiet_on_closed_pipe();
     let cli = Cli::parse();
-    match commands::run(cli.command) {
+    let result = commands::run(cli.command);
+    // Output still buffered (a `print!` without newline) fails here, not silently at exit.
+    if let Err(e) = std::io::Write::flush(&mut std::io::stdout()) {
+        return stdout_failed(&e.to_string());
+    }
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
@@ -29,10 +34,17 @@ fn main() -> ExitCode {
     }
 }
 
+/// Standard output cannot be written (`> /dev/full`, a full disk): an error, exit status 2.
+fn stdout_failed(message: &str) -> ExitCode {
+    eprintln!("error: cannot write to standard output: {message}");
+    ExitCode::from(2)
+}
+
 /// `tofprobe … | head` closes stdout early; `println!` then panics with "failed printing to
 /// stdout: Broken pipe". That is the reader's choice, not an error: exit quietly with the
-/// shell's status for SIGPIPE (128 + 13) instead of printing a panic. Every other panic
-/// keeps the default report.
+/// shell's status for SIGPIPE (128 + 13) instead of printing a panic. Any other failure to
+/// print (`> /dev/full`) is an error like any other: `error: …`, exit status 2, no panic
+/// report. Every other panic keeps the default report.
 fn quiet_on_closed_pipe() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
@@ -42,8 +54,13 @@ fn quiet_on_closed_pipe() {
             .map(String::as_str)
             .or_else(|| info.payload().downcast_ref::<&str>().copied())
             .unwrap_or("");
-        if msg.contains("failed printing to stdout") && msg.contains("Broken pipe") {
-            std::process::exit(141);
+        if msg.contains("failed printing to stdout") {
+            if msg.contains("Broken pipe") {
+                std::process::exit(141);
+            }
+            let reason = msg.split(": ").skip(1).collect::<Vec<_>>().join(": ");
+            eprintln!("error: cannot write to standard output: {reason}");
+            std::process::exit(2);
         }
         default(info);
     }));

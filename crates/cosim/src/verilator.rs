@@ -127,6 +127,11 @@ pub fn build_with(
         next_build_id()
     ));
     let _ = std::fs::remove_dir_all(&tmp);
+    // Builds of killed runs (`.HASH.PID` of a dead PID) are never finished: remove them.
+    tofprobe_io::stale::remove_stale(&cache_root().join("verilator"), |n| {
+        let (_, pid) = n.strip_prefix('.')?.rsplit_once('.')?;
+        pid.parse().ok()
+    });
     std::fs::create_dir_all(&tmp).map_err(|e| CosimError::io(&tmp, e))?;
     let pre = format!("{top}__DOT__u_pixel__DOT__");
     let config = format!(

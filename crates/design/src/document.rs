@@ -47,9 +47,16 @@ pub struct Document {
 impl Document {
     /// Parses TOML text; `origin` names the source in error messages.
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Document, DesignError> {
-        toml::from_str(text).map_err(|e| DesignError::Toml {
-            origin: origin.to_string(),
-            message: e.to_string().trim_end().to_string(),
+        toml::from_str(text).map_err(|e| {
+            let parser = crate::schema::clip_message(e.to_string().trim_end());
+            let message = match crate::schema::wrong_type(text) {
+                Some(m) => format!("{m} ({})", parser.lines().last().unwrap_or_default()),
+                None => parser,
+            };
+            DesignError::Toml {
+                origin: origin.to_string(),
+                message,
+            }
         })
     }
 

@@ -46,7 +46,7 @@ pub enum DesignError {
     #[error("in configuration `{origin}`: {source}")]
     Scene {
         /// The file name, or `<embedded default>`.
-        origin: String,
+        origin: Box<str>,
         /// What is wrong.
         source: tofprobe_scene::SceneError,
     },
@@ -55,7 +55,7 @@ pub enum DesignError {
     #[error("in configuration `{origin}`: [pixel]: {source}")]
     Pixel {
         /// The file name, or `<embedded default>`.
-        origin: String,
+        origin: Box<str>,
         /// What is wrong.
         source: tofprobe_pixel::PixelError,
     },
@@ -63,7 +63,7 @@ pub enum DesignError {
     #[error("in configuration `{origin}`: [probe]: {source}")]
     Probe {
         /// The file name, or `<embedded default>`.
-        origin: String,
+        origin: Box<str>,
         /// What is wrong.
         source: tofprobe_dsp::DspError,
     },
@@ -85,7 +85,8 @@ impl DesignError {
     /// A `[pixel]` error of the document `origin`.
     pub fn pixel(origin: &str, source: tofprobe_pixel::PixelError) -> Self {
         DesignError::Pixel {
-            origin: origin.to_string(),
+            // Boxed: keeps the error (and every Result carrying it) under 128 bytes.
+            origin: origin.into(),
             source,
         }
     }
@@ -93,7 +94,8 @@ impl DesignError {
     /// A `[probe]` error of the document `origin`.
     pub fn probe(origin: &str, source: tofprobe_dsp::DspError) -> Self {
         DesignError::Probe {
-            origin: origin.to_string(),
+            // Boxed: keeps the error (and every Result carrying it) under 128 bytes.
+            origin: origin.into(),
             source,
         }
     }
@@ -101,7 +103,8 @@ impl DesignError {
     /// A scene/sensor/acquisition error of the document `origin`.
     pub fn scene(origin: &str, source: tofprobe_scene::SceneError) -> Self {
         DesignError::Scene {
-            origin: origin.to_string(),
+            // Boxed: keeps the error (and every Result carrying it) under 128 bytes.
+            origin: origin.into(),
             source,
         }
     }

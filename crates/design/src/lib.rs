@@ -11,6 +11,7 @@ pub mod error;
 pub mod probe_cache;
 pub mod resolve;
 pub mod rom_policy;
+pub mod schema;
 
 pub use analysis_mode::ModeDecision;
 pub use document::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, SIZING_SIGMAS, read_text};

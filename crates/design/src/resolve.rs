@@ -16,6 +16,9 @@ use crate::document::Document;
 use crate::error::DesignError;
 use crate::probe_cache::ProbeCache;
 
+/// Longest frame a windowed ROM (L = N) may span: 2^24 pulses (1.68 s at 10 MHz).
+pub const MAX_WINDOWED_FRAME: u64 = 1 << 24;
+
 /// A configuration resolved once: everything a command needs, already validated.
 #[derive(Debug, Clone)]
 pub struct ResolvedDesign {
@@ -70,6 +73,26 @@ pub fn resolve_with(
     d.probe.validate().map_err(probe_err)?;
     let frame = d.pixel.frame_pulses.unwrap_or(d.pulses());
     d.probe.check_frame(frame).map_err(probe_err)?;
+    // A windowed ROM is one frame deep, and `simulate` builds it whole (≈ 24 bytes per
+    // pulse): bounded here, once, as `rtl` and `vectors` bound theirs.
+    if d.pixel.mode == Mode::Fourier
+        && d.probe.rom_mode == RomMode::Windowed
+        && frame > MAX_WINDOWED_FRAME
+    {
+        return Err(probe_err(
+            tofprobe_dsp::DspError::out_of_range(
+                "probe.rom_mode",
+                "\"windowed\"",
+                format!(
+                    "a windowed ROM is one frame deep (L = N = {frame} pulses from acquisition or \
+                     pixel.frame_pulses); at most {MAX_WINDOWED_FRAME} pulses (≈ 400 MB of ROM)"
+                ),
+            )
+            .with_hint(format!(
+                "rom_mode = \"periodic\", or pixel.frame_pulses <= {MAX_WINDOWED_FRAME}"
+            )),
+        ));
+    }
 
     // The pixel reads the ROM the probe design generates: its depth defaults to the
     // `[probe]` design's (L = N windowed, `probe.rom_depth` periodic).
@@ -101,7 +124,27 @@ pub fn resolve_with(
         }
         Some(_) => {}
     }
-    let pixel = px.resolve(&context).map_err(pixel_err)?;
+    // An OSR whose band f_s/(2·OSR) lies below the ROM's first bin is the OSR's fault
+    // (it used to be reported against `pixel.bins` or `pixel.rom_depth`).
+    if px.mode == Mode::Fourier && d.pixel.frequencies_hz.is_empty() {
+        let l = px.rom_depth.unwrap_or(probe_depth) as u64;
+        if tofprobe_pixel::autobins::band_limit(l, d.probe.osr) < 2 {
+            return Err(probe_err(
+                tofprobe_dsp::DspError::out_of_range(
+                    "probe.osr",
+                    tofprobe_io::text::number(d.probe.osr),
+                    format!(
+                        "osr < L/2 = {}: the ΣΔ band f_s/(2·OSR) must hold at least the ROM's first bin f_s/L (L = {l})",
+                        l as f64 / 2.0
+                    ),
+                )
+                .with_hint(format!("osr = {}", (l as f64 / 4.0).clamp(4.0, 32.0))),
+            ));
+        }
+    }
+    let pixel = px
+        .resolve(&context)
+        .map_err(|e| pixel_err(derived_from(e, d)))?;
 
     let (bins, probe_design) = if pixel.mode == Mode::Fourier {
         let bins = bin_indices(d, pixel.bins, pixel.rom_depth as u64).map_err(pixel_err)?;
@@ -123,6 +166,44 @@ pub fn resolve_with(
         mode,
         notes,
     })
+}
+
+/// A `[pixel]` refusal of a quantity the document did not set in `[pixel]` says which keys it
+/// was derived from, so the message names a field the user wrote.
+fn derived_from(e: PixelError, d: &Document) -> PixelError {
+    let PixelError::Invalid {
+        field,
+        value,
+        reason,
+        nearest,
+    } = e
+    else {
+        return e;
+    };
+    let source = match field {
+        "frame_pulses" if d.pixel.frame_pulses.is_none() => {
+            "N comes from acquisition.pulses, or acquisition.duration_s × sensor.laser_rate_hz; \
+             change those or set pixel.frame_pulses"
+        }
+        "tdc_bits" if d.pixel.tdc_bits.is_none() => {
+            "T comes from sensor.window_length_ps / sensor.tdc_lsb_ps"
+        }
+        "rom_depth" if d.pixel.rom_depth.is_none() => {
+            "L comes from probe.rom_depth (periodic) or the frame (windowed)"
+        }
+        _ => "",
+    };
+    let reason = if source.is_empty() {
+        reason
+    } else {
+        format!("{reason} ({source})")
+    };
+    PixelError::Invalid {
+        field,
+        value,
+        reason,
+        nearest,
+    }
 }
 
 impl ResolvedDesign {

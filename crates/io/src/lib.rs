@@ -1,12 +1,19 @@
 //! The workspace's foundation utilities, written once and used by every crate: whole-or-absent
-//! file output ([`write_atomic`]) and the FNV-1a content hash ([`fnv1a64`], [`Fnv1a64`]) that
-//! names configurations, ROMs, vector files and cache entries.
+//! file output ([`write_atomic`] for one file, [`OutputSet`] for a command's set of files),
+//! the cleaning of temporaries left by killed runs ([`stale`]), the sanitising of user text
+//! before it reaches a generated file ([`text`]) and the FNV-1a content hash ([`fnv1a64`],
+//! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries.
 //!
 //! Errors are plain [`std::io::Error`]s: each crate maps them into its own error enum with
 //! the path it was writing.
 
-use std::io::Write;
-use std::path::Path;
+mod atomic;
+mod set;
+pub mod stale;
+pub mod text;
+
+pub use atomic::write_atomic;
+pub use set::{OutputSet, STAGE_PREFIX, recover};
 
 /// FNV-1a 64-bit offset basis: the hash of no bytes.
 pub const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
@@ -47,37 +54,6 @@ impl Fnv1a64 {
     pub fn finish(&self) -> u64 {
         self.0
     }
-}
-
-/// Writes `contents` to `path` whole or not at all: a temporary file in the target's
-/// directory (created if missing), flushed to disk, then renamed over the target, so a
-/// reader never sees a half-written file, and the temporary vanishes on any error
-/// (`tempfile` deletes it when dropped).
-pub fn write_atomic(path: &Path, contents: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    std::fs::create_dir_all(dir)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let prefix = format!(".{name}.");
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(".tmp");
-    // A generated file is readable like any other file, not private (tempfile's default
-    // 0600 would surprise whoever reads rtl/ or a report).
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    let mut tmp = builder.tempfile_in(dir)?;
-    tmp.write_all(contents)?;
-    tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
 }
 
 #[cfg(test)]

@@ -58,7 +58,8 @@ fn header(p: &PixelParams, template: &str, o: &RenderOptions) -> String {
          // DO NOT EDIT: regenerate with `{}`.\n\
          // Configuration hash: {} ({:?}, B={}, U={}, A={}, C={}, T={}, Z={}, S={}, F={}, W={}, N={}, L={}).\n",
         env!("CARGO_PKG_VERSION"),
-        o.command,
+        // The command comes from the command line: one safe line, whatever it holds.
+        tofprobe_io::text::sanitize(&o.command),
         config_hash_with_prefix(p, &o.module_prefix),
         p.mode,
         p.bins,

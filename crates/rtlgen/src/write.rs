@@ -1,5 +1,7 @@
-//! Writing generated files: whole or not at all (tofprobe-io), and never over a file that
-//! this generator did not write (recognised by its header's first line).
+//! Writing generated files: each one whole or not at all, a set of them together
+//! ([`tofprobe_io::OutputSet`]: staged in a hidden directory, then moved into place with the
+//! completion file last), and never over a file that this generator did not write
+//! (recognised by its header's first line).
 
 use crate::error::RtlError;
 use crate::render::HEADER_MARK;
@@ -27,8 +29,11 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), RtlError> {
     tofprobe_io::write_atomic(path, contents).map_err(|e| RtlError::io(path, e))
 }
 
-/// Writes generated files into `dir`. Checks every target first, so either all files are
-/// written or none (when one of them is foreign).
+/// Writes generated files into `dir` as one set: every target is checked first (a foreign
+/// one refuses the whole set), then all are staged and moved into place together, the last
+/// of `files` (a vector set's `manifest.toml`) last, so a set without its last file is an
+/// interrupted one that the next write into `dir` completes ([`tofprobe_io::recover`]).
+/// On any error nothing of the new set is left behind.
 pub fn write_generated(dir: &Path, files: &[(String, String)]) -> Result<(), RtlError> {
     for (name, _) in files {
         let path = dir.join(name);
@@ -36,8 +41,11 @@ pub fn write_generated(dir: &Path, files: &[(String, String)]) -> Result<(), Rtl
             return Err(RtlError::Foreign { path });
         }
     }
+    let mut set = tofprobe_io::OutputSet::begin(dir).map_err(|e| RtlError::io(dir, e))?;
     for (name, contents) in files {
-        write_atomic(&dir.join(name), contents.as_bytes())?;
+        set.add(name, contents.as_bytes())
+            .map_err(|e| RtlError::io(dir.join(name), e))?;
     }
-    Ok(())
+    let last = files.last().map(|(n, _)| n.as_str());
+    set.commit(last).map_err(|e| RtlError::io(dir, e))
 }

@@ -16,31 +16,18 @@ pub enum SceneError {
         /// The allowed range, in words or as an inequality.
         allowed: String,
     },
-    /// The scene's depth range does not fit in the sensor's timing window.
-    #[error(
-        "scene depth {min_mm:.3}..{max_mm:.3} mm lies outside the timing window \
-         {window_start_mm:.3}..{window_end_mm:.3} mm (sensor.window_start_ps = {window_start_ps}, \
-         sensor.window_length_ps = {window_length_ps}); allowed: the window must contain the \
-         whole depth range, e.g. window_start_ps <= {suggest_start_ps:.1} and \
-         window_start_ps + window_length_ps >= {suggest_end_ps:.1}"
-    )]
+    /// The scene's depth range does not fit in the sensor's timing window. Blames
+    /// `scene.depth_mm` (with the range of depths that fit) when the motion fits the
+    /// window at all, else the motion's size against the window's length.
+    #[error("scene.depth_mm = {depth_mm} {span}; allowed: {allowed}")]
     WindowExcludesDepth {
-        /// Smallest depth the scene can reach (mm).
-        min_mm: f64,
-        /// Largest depth the scene can reach (mm).
-        max_mm: f64,
-        /// Window start as depth (mm).
-        window_start_mm: f64,
-        /// Window end as depth (mm).
-        window_end_mm: f64,
-        /// `sensor.window_start_ps` as configured.
-        window_start_ps: f64,
-        /// `sensor.window_length_ps` as configured.
-        window_length_ps: f64,
-        /// Latest window start that would contain the scene (ps).
-        suggest_start_ps: f64,
-        /// Earliest window end that would contain the scene (ps).
-        suggest_end_ps: f64,
+        /// `scene.depth_mm` as configured.
+        depth_mm: f64,
+        /// The depth range its motion spans and the window it leaves (with the
+        /// `sensor.window_start_ps` / `window_length_ps` that set it), in words.
+        span: String,
+        /// The range of `scene.depth_mm` (or the window) that would work, in words.
+        allowed: String,
     },
     /// Neither or both of `acquisition.pulses` and `acquisition.duration_s` were given.
     #[error(
@@ -88,7 +75,7 @@ pub(crate) fn check_range(field: &str, v: f64, lo: f64, hi: f64) -> Result<(), S
     } else {
         Err(SceneError::out_of_range(
             field,
-            v,
+            tofprobe_io::text::number(v),
             format!("{lo} <= {} <= {hi}", leaf(field)),
         ))
     }
@@ -101,7 +88,7 @@ pub(crate) fn check_positive(field: &str, v: f64, hi: f64) -> Result<(), SceneEr
     } else {
         Err(SceneError::out_of_range(
             field,
-            v,
+            tofprobe_io::text::number(v),
             format!("0 < {} <= {hi}", leaf(field)),
         ))
     }

@@ -298,15 +298,34 @@ pub(crate) fn check_window(sensor: &SensorConfig, scene: &Scene) -> Result<(), S
     if lo >= ws && hi < we {
         return Ok(());
     }
+    let depth = scene.static_depth_mm();
+    let (below, above) = (depth - lo, hi - depth);
+    let allowed = if below + above < we - ws {
+        format!(
+            "{} <= scene.depth_mm < {} (the motion reaches {below} mm below and {above} mm above it), \
+             or a window with window_start_ps <= {:.1} and window_start_ps + window_length_ps > {:.1}",
+            ws + below,
+            we - above,
+            (lo / MM_PER_PS).max(0.0),
+            hi / MM_PER_PS
+        )
+    } else {
+        format!(
+            "a motion narrower than the window: it spans {} mm, the window {} mm \
+             (smaller scene.motion amplitude_mm, or sensor.window_length_ps > {:.1})",
+            hi - lo,
+            we - ws,
+            (hi - lo) / MM_PER_PS
+        )
+    };
     Err(SceneError::WindowExcludesDepth {
-        min_mm: lo,
-        max_mm: hi,
-        window_start_mm: ws,
-        window_end_mm: we,
-        window_start_ps: sensor.window_start_ps,
-        window_length_ps: sensor.window_length_ps,
-        suggest_start_ps: (lo / MM_PER_PS).max(0.0),
-        suggest_end_ps: hi / MM_PER_PS + sensor.tdc_lsb_ps,
+        depth_mm: depth,
+        span: format!(
+            "with its motion spans {lo}..{hi} mm, which leaves the timing window [{ws}, {we}) mm \
+             (sensor.window_start_ps = {}, sensor.window_length_ps = {})",
+            sensor.window_start_ps, sensor.window_length_ps
+        ),
+        allowed,
     })
 }
 

@@ -102,6 +102,8 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
     if a.frames == 0 || a.frames > 100 {
         return Err(StudyError::option("frames", a.frames, "1..=100"));
     }
+    // Before minutes of co-simulation, not after: a hand-written report.md stays.
+    refuse_foreign_report(&a.out.join("report.md"))?;
     let t_start = std::time::Instant::now();
     let config = &design.document;
     let fs = config.sensor.laser_rate_hz;
@@ -146,11 +148,11 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
     let r = cosim(&p, &o)?;
     let lsb_mm = config.sensor.tdc_lsb_mm();
     let mut md = String::new();
-    let _ = writeln!(md, "# tofprobe flow report\n");
+    let _ = writeln!(md, "{REPORT_TITLE}\n");
     let _ = writeln!(
         md,
         "Configuration: {} (hash {}), {:?} mode, N = {} pulses/frame, {} frame(s), L = {}.\n\nROM: {}.\n",
-        design.origin,
+        tofprobe_io::text::sanitize(&design.origin),
         tofprobe_rtlgen::config_hash(&p),
         p.mode,
         p.frame_pulses,
@@ -227,6 +229,7 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
     let seconds = t_start.elapsed().as_secs_f64();
     let _ = writeln!(md, "Flow time: {seconds:.1} s.");
     let path = a.out.join("report.md");
+    refuse_foreign_report(&path)?;
     write_atomic(&path, md.as_bytes())?;
     Ok(FlowOutcome {
         pass: r.pass,
@@ -238,6 +241,23 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
         size_line,
         report: path,
     })
+}
+
+/// First line of every flow report: a `report.md` that does not start with it was written by
+/// someone else and is never replaced.
+const REPORT_TITLE: &str = "# tofprobe flow report";
+
+/// Refuses to replace a `report.md` that the flow did not write.
+fn refuse_foreign_report(path: &std::path::Path) -> Result<(), StudyError> {
+    match std::fs::read(path) {
+        Ok(bytes) if !bytes.starts_with(REPORT_TITLE.as_bytes()) => {
+            Err(tofprobe_rtlgen::RtlError::Foreign {
+                path: path.to_path_buf(),
+            }
+            .into())
+        }
+        _ => Ok(()),
+    }
 }
 
 /// One probed bin of a readout, normalised.

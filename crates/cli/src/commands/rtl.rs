@@ -30,13 +30,16 @@ pub struct RtlArgs {
     pub frame_pulses: Option<u64>,
 }
 
-/// The command line that regenerates `out` (recorded in every header).
+/// The command line that regenerates `out` (recorded in every header): paths in their
+/// canonical, sanitised form (`tofprobe_io::text::canonical_path`), so no text of the
+/// command line reaches a header raw and `X` and `./X/` give the same bytes.
 pub fn regen_command(a: &RtlArgs) -> String {
+    use tofprobe_io::text::canonical_path;
     let mut s = String::from("tofprobe rtl");
     if let Some(c) = &a.config {
-        s.push_str(&format!(" {}", c.display()));
+        s.push_str(&format!(" {}", canonical_path(c)));
     }
-    s.push_str(&format!(" --out {}", a.out.display()));
+    s.push_str(&format!(" --out {}", canonical_path(&a.out)));
     if let Some(n) = a.frame_pulses {
         s.push_str(&format!(" --frame-pulses {n}"));
     }

@@ -115,10 +115,11 @@ pub struct Summary {
     pub background_wins: u64,
     /// Detections / pulses.
     pub detection_rate: f64,
-    /// Mean measured depth over detections (mm; code-bin centres), 0 without detections.
-    pub mean_depth_mm: f64,
-    /// Standard deviation of the measured depth (mm), 0 with fewer than two detections.
-    pub sigma_depth_mm: f64,
+    /// Mean measured depth over detections (mm; code-bin centres); `null` without
+    /// detections (an empty record has no mean, and 0 would read as a depth).
+    pub mean_depth_mm: Option<f64>,
+    /// Standard deviation of the measured depth (mm); `null` with fewer than two detections.
+    pub sigma_depth_mm: Option<f64>,
     /// Wall-clock time of the simulation (s).
     pub seconds: f64,
 }
@@ -173,12 +174,8 @@ pub fn summarise(source: &PhotonSource, pulses: u64, progress: bool) -> Summary 
         detections: d,
         background_wins: counts.background_wins,
         detection_rate: d as f64 / pulses.max(1) as f64,
-        mean_depth_mm: if d == 0 {
-            0.0
-        } else {
-            source.code_to_depth_mm(0) + mean_code * lsb_mm
-        },
-        sigma_depth_mm: var_code.sqrt() * lsb_mm,
+        mean_depth_mm: (d > 0).then(|| source.code_to_depth_mm(0) + mean_code * lsb_mm),
+        sigma_depth_mm: (d > 1).then(|| var_code.sqrt() * lsb_mm),
         seconds: start.elapsed().as_secs_f64(),
     }
 }
@@ -243,8 +240,16 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             s.detections, s.detection_rate
         );
         println!("background wins    {}", s.background_wins);
-        println!("mean depth         {:.4} mm", s.mean_depth_mm);
-        println!("sigma depth        {:.4} mm", s.sigma_depth_mm);
+        let stat =
+            |x: Option<f64>, none: &str| x.map_or(none.to_string(), |v| format!("{v:.4} mm"));
+        println!(
+            "mean depth         {}",
+            stat(s.mean_depth_mm, "none (no detections)")
+        );
+        println!(
+            "sigma depth        {}",
+            stat(s.sigma_depth_mm, "none (fewer than 2 detections)")
+        );
         println!(
             "run time           {:.3} s ({:.1} M pulses/s)",
             s.seconds,

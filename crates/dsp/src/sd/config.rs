@@ -72,16 +72,24 @@ impl Default for ProbeConfig {
     }
 }
 
+/// Smallest probe amplitude A_p accepted: 1 % of full scale, 40 dB down, where an order-1
+/// OSR-4 design (the coarsest allowed) still keeps the probe above its in-band
+/// quantisation noise.
+pub const MIN_AMPLITUDE: f64 = 0.01;
+
 impl ProbeConfig {
     /// Checks every field against its range (the amplitude against the modulator's
     /// measured stability limit is checked when a ROM is generated).
     pub fn validate(&self) -> Result<(), DspError> {
         validate_design(self.order, self.osr, self.h_inf)?;
-        if !(self.amplitude > 0.0 && self.amplitude < 1.0) {
+        // The readout is divided by A_p: below MIN_AMPLITUDE the probe sinks into the
+        // modulator's own in-band quantisation noise and the division blows that noise up
+        // (1e-300 printed 10^300 µm, 5e-324 inf/NaN).
+        if !(self.amplitude >= MIN_AMPLITUDE && self.amplitude < 1.0) {
             return Err(DspError::out_of_range(
                 "probe.amplitude",
-                self.amplitude,
-                "0 < amplitude < 1",
+                tofprobe_io::text::number(self.amplitude),
+                format!("{MIN_AMPLITUDE} <= amplitude < 1"),
             )
             .with_hint("0.5 suits the default order-3 design"));
         }
@@ -175,9 +183,20 @@ mod tests {
         };
         let e = bad.validate().unwrap_err().to_string();
         assert!(
-            e.contains("probe.amplitude = 1.2") && e.contains("0 < amplitude < 1"),
+            e.contains("probe.amplitude = 1.2") && e.contains("0.01 <= amplitude < 1"),
             "{e}"
         );
+        // The readout is divided by A_p: a vanishing amplitude is refused, not divided by.
+        for tiny in [1e-300, 5e-324, 0.0099] {
+            let e = ProbeConfig {
+                amplitude: tiny,
+                ..ProbeConfig::default()
+            }
+            .validate()
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains("probe.amplitude"), "{e}");
+        }
         let bad = ProbeConfig {
             h_inf: 0.9,
             ..ProbeConfig::default()

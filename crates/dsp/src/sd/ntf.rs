@@ -98,7 +98,7 @@ pub fn validate_design(order: usize, osr: f64, h_inf: f64) -> Result<(), DspErro
     if !osr.is_finite() || osr < MIN_OSR {
         return Err(DspError::out_of_range(
             "probe.osr",
-            osr,
+            tofprobe_io::text::number(osr),
             format!(">= {MIN_OSR}"),
         ));
     }
@@ -106,7 +106,7 @@ pub fn validate_design(order: usize, osr: f64, h_inf: f64) -> Result<(), DspErro
     if !h_inf.is_finite() || h_inf <= 1.0 || h_inf >= limit {
         return Err(DspError::out_of_range(
             "probe.h_inf",
-            h_inf,
+            tofprobe_io::text::number(h_inf),
             format!("1 < h_inf < 2^order = {limit}"),
         )
         .with_hint("1.5 is the Lee criterion for a two-level quantiser"));
@@ -176,7 +176,7 @@ pub fn synthesize_ntf(
     if !converged {
         return Err(DspError::out_of_range(
             "probe.h_inf",
-            h_inf,
+            tofprobe_io::text::number(h_inf),
             format!("a value the order-{order}, OSR-{osr} NTF can reach"),
         )
         .with_hint("the pole iteration did not converge; lower h_inf"));

@@ -98,6 +98,22 @@ impl ProbeDesign {
         f_norm: f64,
     ) -> Result<Self, DspError> {
         let limit = SAFETY_MARGIN * a_max;
+        // A modulator stable at no usable amplitude is the design's fault, not the
+        // amplitude's: name the out-of-band gain (the knob that makes it unstable).
+        if limit.is_nan() || limit < super::config::MIN_AMPLITUDE {
+            return Err(DspError::out_of_range(
+                "probe.h_inf",
+                config.h_inf,
+                format!(
+                    "an h_inf whose order-{} OSR-{} modulator is stable at a probe amplitude of at least {} \
+                     (this one is stable only up to {a_max:.2e} at f/f_s = {f_norm:.3e})",
+                    config.order,
+                    config.osr,
+                    super::config::MIN_AMPLITUDE / SAFETY_MARGIN
+                ),
+            )
+            .with_hint("h_inf = 1.5 (the Lee criterion for a two-level quantiser)"));
+        }
         if config.amplitude > limit {
             return Err(DspError::out_of_range(
                 "probe.amplitude",

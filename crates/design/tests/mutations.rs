@@ -1,0 +1,277 @@
+//! Mutated configurations through the one resolution (what `config`, `simulate` and `rtl`
+//! all start from) and the RTL commands' parameters: no panic, every refusal names a field
+//! of the document and echoes (a bounded form of) the value given, and what resolves also
+//! gives RTL parameters. Deterministic: a fixed seed walks the same cases on every run.
+//! `TOFPROBE_MUTATIONS=N` runs N cases instead of the CI's 600 (the audit in
+//! docs/reliability.md used 5000).
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+use tofprobe_design::{DEFAULT_TOML, Document, ProbeCache, RtlOverrides, resolve_with, rtl_params};
+
+/// SplitMix64: a tiny deterministic generator (the case list must not depend on a crate's
+/// version).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn pick<'a, T>(&mut self, v: &'a [T]) -> &'a T {
+        &v[(self.next() % v.len() as u64) as usize]
+    }
+}
+
+/// Every key a document can hold (those the default leaves out included), by table.
+const KEYS: &[(&str, &[&str])] = &[
+    (
+        "sensor",
+        &[
+            "laser_rate_hz",
+            "jitter_ps",
+            "tdc_lsb_ps",
+            "window_start_ps",
+            "window_length_ps",
+            "signal_rate",
+            "background_rate",
+        ],
+    ),
+    ("scene", &["depth_mm"]),
+    ("acquisition", &["duration_s", "pulses", "seed"]),
+    (
+        "pixel",
+        &[
+            "mode",
+            "bins",
+            "adders",
+            "cycles_per_pulse",
+            "shift",
+            "frac_bits",
+            "tdc_bits",
+            "width",
+            "frame_pulses",
+            "rom_depth",
+            "zoom",
+            "haar_scales",
+            "frequencies_hz",
+        ],
+    ),
+    (
+        "probe",
+        &[
+            "order",
+            "osr",
+            "h_inf",
+            "optimised_zeros",
+            "window",
+            "amplitude",
+            "rom_mode",
+            "rom_depth",
+        ],
+    ),
+    (
+        "motion",
+        &["kind", "amplitude_mm", "frequency_hz", "phase_deg"],
+    ),
+];
+
+/// Values a mutation writes (TOML literals): zero, signs, extremes of f64 and u64,
+/// subnormals, non-finite values, wrong types, a long string.
+fn values() -> Vec<String> {
+    let mut v: Vec<String> = [
+        "0",
+        "-1",
+        "1",
+        "2",
+        "3",
+        "7",
+        "16",
+        "64",
+        "1000",
+        "65536",
+        "1e5",
+        "10000000",
+        "4294967296",
+        "9223372036854775807",
+        "0.0",
+        "-0.0",
+        "0.5",
+        "0.999",
+        "1.0",
+        "1.5",
+        "7.99",
+        "1e-300",
+        "5e-324",
+        "1e300",
+        "1.7976931348623157e308",
+        "inf",
+        "-inf",
+        "nan",
+        "1e-9",
+        "60.0",
+        "-60.0",
+        "\"x\"",
+        "\"auto\"",
+        "true",
+        "[]",
+        "[1.0, 2.0]",
+        "{}",
+        "\"haar\"",
+        "\"windowed\"",
+        "\"periodic\"",
+        "\"square\"",
+        "\"step\"",
+        "\"hann\"",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    v.push(format!("\"{}\"", "y".repeat(100_000)));
+    v
+}
+
+/// The default document with one to three keys set to `values()`; returns the text and the
+/// mutations (table, key, literal).
+fn mutate(rng: &mut Rng, vals: &[String]) -> (String, Vec<(String, String, String)>) {
+    let mut doc: toml::Table = toml::from_str(DEFAULT_TOML).unwrap();
+    let mut muts = Vec::new();
+    for _ in 0..1 + rng.next() % 3 {
+        let (table, keys) = rng.pick(KEYS);
+        let key = rng.pick(keys).to_string();
+        let lit = rng.pick(vals).clone();
+        let value: toml::Value = toml::from_str::<toml::Table>(&format!("v = {lit}"))
+            .unwrap()
+            .remove("v")
+            .unwrap();
+        let target = if *table == "motion" {
+            let scene = doc.get_mut("scene").unwrap().as_table_mut().unwrap();
+            let m = scene.get_mut("motion").unwrap().as_array_mut().unwrap();
+            m[0].as_table_mut().unwrap()
+        } else {
+            doc.entry(table.to_string())
+                .or_insert_with(|| toml::Value::Table(Default::default()))
+                .as_table_mut()
+                .unwrap()
+        };
+        if rng.next().is_multiple_of(8) {
+            if target.remove(&key).is_some() {
+                muts.push((table.to_string(), key, "<removed>".to_string()));
+            }
+        } else {
+            target.insert(key.clone(), value);
+            muts.push((table.to_string(), key, lit));
+        }
+    }
+    (toml::to_string(&doc).unwrap(), muts)
+}
+
+/// The forms a value may take in a message (as written, or as Rust prints the number).
+fn value_forms(lit: &str) -> Vec<String> {
+    let mut f = vec![lit.trim_matches('"').to_string()];
+    if let Ok(x) = lit.parse::<f64>() {
+        f.push(format!("{x}"));
+        f.push(format!("{x:?}"));
+        f.push(format!("{x:e}"));
+        f.push(tofprobe_io::text::number(x));
+    }
+    if lit == "nan" {
+        f.push("NaN".into());
+    }
+    f
+}
+
+/// `section.key` of every key of `doc` (`scene.motion[i].key` for the motions).
+fn dotted_paths(doc: &toml::Table) -> Vec<String> {
+    let mut v = Vec::new();
+    for (section, body) in doc {
+        for (key, value) in body.as_table().into_iter().flatten() {
+            if let Some(list) = value.as_array().filter(|_| key == "motion") {
+                for (i, m) in list.iter().enumerate() {
+                    for k in m.as_table().into_iter().flatten().map(|(k, _)| k) {
+                        v.push(format!("scene.motion[{i}].{k}"));
+                    }
+                }
+            }
+            v.push(format!("{section}.{key}"));
+        }
+    }
+    v
+}
+
+#[test]
+fn mutated_configurations_resolve_or_name_their_field() {
+    let cases: usize = std::env::var("TOFPROBE_MUTATIONS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(600);
+    let vals = values();
+    let mut rng = Rng(0x7f4a_7c15_2024);
+    let mut cache = ProbeCache::default();
+    let (mut ok, mut refused, mut panics) = (0, 0, 0);
+    let mut failures: Vec<String> = Vec::new();
+    for case in 0..cases {
+        let (text, muts) = mutate(&mut rng, &vals);
+        let run = catch_unwind(AssertUnwindSafe(|| {
+            let doc = Document::from_toml_str(&text, "mutated.toml").map_err(Box::new)?;
+            let d = resolve_with(doc, "mutated.toml", &mut cache).map_err(Box::new)?;
+            rtl_params(&d, &RtlOverrides::default()).map_err(Box::new)?;
+            Ok::<_, Box<tofprobe_design::DesignError>>(())
+        }));
+        let Ok(result) = run else {
+            panics += 1;
+            failures.push(format!("case {case}: PANIC on {muts:?}"));
+            continue;
+        };
+        let Err(e) = result else {
+            ok += 1;
+            continue;
+        };
+        refused += 1;
+        let msg = e.to_string();
+        if msg.len() > 4000 {
+            failures.push(format!(
+                "case {case}: {} byte message for {muts:?}",
+                msg.len()
+            ));
+        }
+        // The message names one of the mutated keys (the document's own name for it)
+        // together with its value, unless a mutation only removed a key.
+        let named = muts.iter().any(|(_, key, lit)| {
+            msg.contains(key.as_str())
+                && (lit == "<removed>"
+                    // `pulses` and `duration_s` together: both keys are named.
+                    || msg.contains("exactly one of")
+                    || value_forms(lit)
+                        .iter()
+                        .any(|f| msg.contains(&tofprobe_io::text::clip(f, 60)[..f.len().min(57)])))
+        });
+        // Or a cross-field refusal: it names another key of the document by its dotted path
+        // (`probe.rom_depth = 20000 … a divisor of the frame N`).
+        let doc: toml::Table = toml::from_str(&text).unwrap();
+        let named = named || dotted_paths(&doc).iter().any(|p| msg.contains(p.as_str()));
+        if !named {
+            failures.push(format!(
+                "case {case}: {muts:?}\n    -> {}",
+                tofprobe_io::text::clip(&msg, 400)
+            ));
+        }
+    }
+    eprintln!(
+        "mutations: {cases} cases, {ok} resolved, {refused} refused, {panics} panics, {} unattributed",
+        failures.len()
+    );
+    assert!(
+        failures.is_empty(),
+        "{} of {cases} cases fail:\n{}",
+        failures.len(),
+        failures
+            .iter()
+            .take(40)
+            .cloned()
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+}

@@ -1,0 +1,243 @@
+//! A command's set of output files, whole or absent: [`OutputSet`].
+//!
+//! Protocol (readers and the next run can check it):
+//! 1. every file is written into a hidden stage directory inside the target,
+//!    `DIR/.output-set.tofprobe-PID.stage/`, and flushed to disk;
+//! 2. a `COMMIT` list (the names, in order, the completion file last) is written there:
+//!    from now on the new set is whole on disk;
+//! 3. the target's completion file (e.g. `manifest.toml`) is removed, each staged file is
+//!    renamed into place, the completion file last, and the stage directory is removed.
+//!
+//! A run killed before step 2 leaves the old set untouched and a stage directory that the
+//! next run removes; killed during step 3, it leaves a set without its completion file
+//! (readers refuse it) that the next [`recover`] (run by every [`OutputSet::begin`] on the
+//! same directory) completes from the stage: the old set or the new set, whole.
+
+use std::path::{Path, PathBuf};
+
+use crate::stale::{PID_MARK, pid_alive};
+
+/// Start of a stage directory's name; the pid and `.stage` follow.
+pub const STAGE_PREFIX: &str = ".output-set";
+const STAGE_SUFFIX: &str = ".stage";
+const COMMIT: &str = "COMMIT";
+
+fn stage_pid(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix(STAGE_PREFIX)?.strip_prefix(PID_MARK)?;
+    rest.strip_suffix(STAGE_SUFFIX)?.parse().ok()
+}
+
+/// Files staged for one directory, moved into place together by [`OutputSet::commit`];
+/// dropped uncommitted, it removes its stage (and the target directory if it created it
+/// and it is still empty).
+#[derive(Debug)]
+pub struct OutputSet {
+    target: PathBuf,
+    stage: PathBuf,
+    names: Vec<String>,
+    created_target: bool,
+    done: bool,
+}
+
+impl OutputSet {
+    /// Starts a set for directory `target` (created if missing): first [`recover`]s what
+    /// killed runs left there, then creates this run's stage directory.
+    pub fn begin(target: &Path) -> std::io::Result<OutputSet> {
+        let created_target = !target.exists();
+        std::fs::create_dir_all(target)?;
+        recover(target)?;
+        let stage = target.join(format!(
+            "{STAGE_PREFIX}{PID_MARK}{}{STAGE_SUFFIX}",
+            std::process::id()
+        ));
+        // A stage of this very process (an earlier set into the same directory that
+        // failed) is ours to discard.
+        let _ = std::fs::remove_dir_all(&stage);
+        let mut set = OutputSet {
+            target: target.to_path_buf(),
+            stage: stage.clone(),
+            names: Vec::new(),
+            created_target,
+            done: false,
+        };
+        if let Err(e) = std::fs::create_dir(&stage) {
+            set.done = true;
+            set.remove_created_target();
+            return Err(e);
+        }
+        Ok(set)
+    }
+
+    /// The target directory.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// Stages one file (a plain name, no directories).
+    pub fn add(&mut self, name: &str, contents: &[u8]) -> std::io::Result<()> {
+        use std::io::Write;
+        if name.is_empty() || name.contains(['/', '\\']) || name.starts_with('.') {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!("output file name `{name}` is not a plain visible file name"),
+            ));
+        }
+        let mut f = std::fs::File::create(self.stage.join(name))?;
+        f.write_all(contents)?;
+        f.sync_all()?;
+        self.names.retain(|n| n != name);
+        self.names.push(name.to_string());
+        Ok(())
+    }
+
+    /// Moves the staged files into place, `last` (the set's completion file, e.g. its
+    /// manifest; `None` for none) after all the others.
+    pub fn commit(mut self, last: Option<&str>) -> std::io::Result<()> {
+        let mut order: Vec<String> = self
+            .names
+            .iter()
+            .filter(|n| Some(n.as_str()) != last)
+            .cloned()
+            .collect();
+        if let Some(l) = last.filter(|l| self.names.iter().any(|n| n == l)) {
+            order.push(l.to_string());
+        }
+        let list = order.join("\n") + "\n";
+        let commit = self.stage.join(COMMIT);
+        std::fs::write(&commit, list)?;
+        std::fs::File::open(&commit)?.sync_all()?;
+        self.done = true;
+        finish(&self.target, &self.stage, &order)
+    }
+
+    fn remove_created_target(&self) {
+        if self.created_target {
+            // Only if empty: `remove_dir` refuses a directory with anything in it.
+            let _ = std::fs::remove_dir(&self.target);
+        }
+    }
+}
+
+impl Drop for OutputSet {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = std::fs::remove_dir_all(&self.stage);
+            self.remove_created_target();
+        }
+    }
+}
+
+/// Step 3 of the protocol for a stage whose `COMMIT` list is `order`: files already moved
+/// are skipped, so this also completes an interrupted commit.
+fn finish(target: &Path, stage: &Path, order: &[String]) -> std::io::Result<()> {
+    if let Some(last) = order.last() {
+        let staged_last = stage.join(last);
+        if staged_last.exists() && order.len() > 1 {
+            match std::fs::remove_file(target.join(last)) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
+                _ => {}
+            }
+        }
+    }
+    for name in order {
+        let from = stage.join(name);
+        if from.exists() {
+            std::fs::rename(&from, target.join(name))?;
+        }
+    }
+    std::fs::remove_dir_all(stage)
+}
+
+/// Cleans what killed runs left in `target`: a stage directory of a dead process is
+/// completed (it has a `COMMIT` list: its set was whole) or removed (it has none: the old
+/// set was never touched); stray temporaries of [`crate::write_atomic`] are removed.
+/// Returns an error only when completing a committed stage fails.
+pub fn recover(target: &Path) -> std::io::Result<()> {
+    if let Ok(entries) = std::fs::read_dir(target) {
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let Some(pid) = stage_pid(&name) else {
+                continue;
+            };
+            if pid_alive(pid) {
+                continue;
+            }
+            let stage = e.path();
+            match std::fs::read_to_string(stage.join(COMMIT)) {
+                Ok(list) => {
+                    let order: Vec<String> = list.lines().map(str::to_string).collect();
+                    finish(target, &stage, &order)?;
+                }
+                Err(_) => {
+                    let _ = std::fs::remove_dir_all(&stage);
+                }
+            }
+        }
+    }
+    crate::stale::remove_stale(target, crate::stale::temporary_pid);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn listing(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_set_appears_whole_and_its_stage_vanishes() {
+        let dir = tempfile::tempdir().unwrap();
+        let t = dir.path().join("out");
+        let mut s = OutputSet::begin(&t).unwrap();
+        s.add("a.hex", b"a").unwrap();
+        s.add("manifest.toml", b"m").unwrap();
+        s.add("b.hex", b"b").unwrap();
+        assert!(s.add(".hidden", b"x").is_err());
+        assert!(s.add("../escape", b"x").is_err());
+        s.commit(Some("manifest.toml")).unwrap();
+        assert_eq!(listing(&t), ["a.hex", "b.hex", "manifest.toml"]);
+    }
+
+    #[test]
+    fn a_dropped_set_leaves_nothing_not_even_the_directory_it_made() {
+        let dir = tempfile::tempdir().unwrap();
+        let t = dir.path().join("out");
+        let mut s = OutputSet::begin(&t).unwrap();
+        s.add("a.hex", b"a").unwrap();
+        drop(s);
+        assert!(!t.exists());
+    }
+
+    #[test]
+    fn an_interrupted_commit_is_completed_and_an_uncommitted_stage_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let t = dir.path().to_path_buf();
+        std::fs::write(t.join("a.hex"), b"old a").unwrap();
+        std::fs::write(t.join("manifest.toml"), b"old m").unwrap();
+        // A dead writer (pid above Linux's pid_max) that committed and moved a.hex only.
+        let dead = t.join(format!("{STAGE_PREFIX}{PID_MARK}4194304{STAGE_SUFFIX}"));
+        std::fs::create_dir(&dead).unwrap();
+        std::fs::write(dead.join(COMMIT), "a.hex\nmanifest.toml\n").unwrap();
+        std::fs::write(dead.join("manifest.toml"), b"new m").unwrap();
+        std::fs::write(t.join("a.hex"), b"new a").unwrap();
+        std::fs::remove_file(t.join("manifest.toml")).unwrap();
+        // Another dead writer that never committed.
+        let torn = t.join(format!("{STAGE_PREFIX}{PID_MARK}4194303{STAGE_SUFFIX}"));
+        std::fs::create_dir(&torn).unwrap();
+        std::fs::write(torn.join("a.hex"), b"half").unwrap();
+        if !Path::new("/proc/self").exists() {
+            return;
+        }
+        recover(&t).unwrap();
+        assert_eq!(listing(&t), ["a.hex", "manifest.toml"]);
+        assert_eq!(std::fs::read(t.join("a.hex")).unwrap(), b"new a");
+        assert_eq!(std::fs::read(t.join("manifest.toml")).unwrap(), b"new m");
+    }
+}
