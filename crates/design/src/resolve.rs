@@ -73,9 +73,16 @@ pub fn resolve_with(
     d.probe.validate().map_err(probe_err)?;
     let frame = d.pixel.frame_pulses.unwrap_or(d.pulses());
     d.probe.check_frame(frame).map_err(probe_err)?;
+    // The pixel reads the ROM the probe design generates: its depth defaults to the
+    // `[probe]` design's (L = N windowed, `probe.rom_depth` periodic).
+    // A Fourier pixel addresses exactly that ROM: another `pixel.rom_depth` would read the
+    // generated ROM on the wrong bin grid (it used to be replaced silently by `rtl`).
+    let context = d.pixel_context();
+    let mut px = d.pixel.clone();
+    let mode = decide_mode(d, &mut px, frame);
     // A windowed ROM is one frame deep, and `simulate` builds it whole (≈ 24 bytes per
     // pulse): bounded here, once, as `rtl` and `vectors` bound theirs.
-    if d.pixel.mode == Mode::Fourier
+    if mode.mode == Mode::Fourier
         && d.probe.rom_mode == RomMode::Windowed
         && frame > MAX_WINDOWED_FRAME
     {
@@ -94,13 +101,6 @@ pub fn resolve_with(
         ));
     }
 
-    // The pixel reads the ROM the probe design generates: its depth defaults to the
-    // `[probe]` design's (L = N windowed, `probe.rom_depth` periodic).
-    // A Fourier pixel addresses exactly that ROM: another `pixel.rom_depth` would read the
-    // generated ROM on the wrong bin grid (it used to be replaced silently by `rtl`).
-    let context = d.pixel_context();
-    let mut px = d.pixel.clone();
-    let mode = decide_mode(d, &mut px, frame);
     let mut notes: Vec<String> = mode.auto.iter().filter_map(|c| c.note.clone()).collect();
     if mode.mode == Mode::Haar {
         notes.extend(check_haar(d, &px, &mode, frame, origin)?);
@@ -126,7 +126,7 @@ pub fn resolve_with(
     }
     // An OSR whose band f_s/(2·OSR) lies below the ROM's first bin is the OSR's fault
     // (it used to be reported against `pixel.bins` or `pixel.rom_depth`).
-    if px.mode == Mode::Fourier && d.pixel.frequencies_hz.is_empty() {
+    if mode.mode == Mode::Fourier && d.pixel.frequencies_hz.is_empty() {
         let l = px.rom_depth.unwrap_or(probe_depth) as u64;
         if tofprobe_pixel::autobins::band_limit(l, d.probe.osr) < 2 {
             return Err(probe_err(
