@@ -298,32 +298,44 @@ pub(crate) fn check_window(sensor: &SensorConfig, scene: &Scene) -> Result<(), S
     if lo >= ws && hi < we {
         return Ok(());
     }
+    // Depths in µm resolution: float noise (0.09999999999999432) helps nobody.
+    let r = |x: f64| {
+        let t = format!("{x:.4}");
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
     let depth = scene.static_depth_mm();
     let (below, above) = (depth - lo, hi - depth);
     let allowed = if below + above < we - ws {
         format!(
-            "{} <= scene.depth_mm < {} (the motion reaches {below} mm below and {above} mm above it), \
-             or a window with window_start_ps <= {:.1} and window_start_ps + window_length_ps > {:.1}",
-            ws + below,
-            we - above,
+            "{} <= scene.depth_mm < {} (the motion reaches {} mm below and {} mm above it), \
+             or a window with window_start_ps <= {:.1} and window_start_ps + window_length_ps >= {:.1}",
+            r(ws + below),
+            r(we - above),
+            r(below),
+            r(above),
             (lo / MM_PER_PS).max(0.0),
-            hi / MM_PER_PS
+            hi / MM_PER_PS + sensor.tdc_lsb_ps
         )
     } else {
         format!(
             "a motion narrower than the window: it spans {} mm, the window {} mm \
              (smaller scene.motion amplitude_mm, or sensor.window_length_ps > {:.1})",
-            hi - lo,
-            we - ws,
+            r(hi - lo),
+            r(we - ws),
             (hi - lo) / MM_PER_PS
         )
     };
     Err(SceneError::WindowExcludesDepth {
         depth_mm: depth,
         span: format!(
-            "with its motion spans {lo}..{hi} mm, which leaves the timing window [{ws}, {we}) mm \
+            "with its motion spans {}..{} mm, which lies outside the timing window [{}, {}) mm \
              (sensor.window_start_ps = {}, sensor.window_length_ps = {})",
-            sensor.window_start_ps, sensor.window_length_ps
+            r(lo),
+            r(hi),
+            r(ws),
+            r(we),
+            sensor.window_start_ps,
+            sensor.window_length_ps
         ),
         allowed,
     })
