@@ -127,9 +127,11 @@ pub fn build_with(
         next_build_id()
     ));
     let _ = std::fs::remove_dir_all(&tmp);
-    // Builds of killed runs (`.HASH.PID` of a dead PID) are never finished: remove them.
+    // Builds of killed runs (`.HASH.PID.N` of a dead PID) are never finished: remove them.
+    // The PID is the second field: the last one is the build counter of a live process.
     tofprobe_io::stale::remove_stale(&cache_root().join("verilator"), |n| {
-        let (_, pid) = n.strip_prefix('.')?.rsplit_once('.')?;
+        let mut fields = n.strip_prefix('.')?.split('.');
+        let (_hash, pid) = (fields.next()?, fields.next()?);
         pid.parse().ok()
     });
     std::fs::create_dir_all(&tmp).map_err(|e| CosimError::io(&tmp, e))?;

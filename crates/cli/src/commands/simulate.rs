@@ -86,8 +86,10 @@ struct Output<'a> {
     summary: &'a Summary,
     /// "fourier" or "haar", and why when `pixel.mode = "auto"` picked it.
     mode: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
     mode_reason: Option<&'a str>,
     notes: &'a [String],
+    #[serde(skip_serializing_if = "Option::is_none")]
     bit_true: Option<&'a BitTrueOut>,
     /// Haar mode: the frame's transient analysis (scalogram, thresholds, events).
     #[serde(skip_serializing_if = "Option::is_none")]
