@@ -41,17 +41,17 @@ fn request<'a>(
     }
 }
 
-/// The first cycle at which the golden trace writes register `reg` (trace.hex: 48-bit
-/// cycle, 16-bit register, 64-bit value, one write per line).
-fn first_write(trace: &Path, reg: u64) -> u64 {
+/// The cycles at which the golden trace writes register `reg` (trace.hex: 48-bit cycle,
+/// 16-bit register, 64-bit value, one write per line).
+fn writes(trace: &Path, reg: u64) -> Vec<u64> {
     std::fs::read_to_string(trace)
         .unwrap()
         .lines()
         .filter(|l| !l.starts_with("//") && !l.trim().is_empty())
         .map(|l| u128::from_str_radix(l.trim(), 16).unwrap())
-        .find(|w| (w >> 64) as u64 & 0xffff == reg)
+        .filter(|w| (w >> 64) as u64 & 0xffff == reg)
         .map(|w| (w >> 80) as u64)
-        .unwrap()
+        .collect()
 }
 
 /// `netlist` with the D input of the flop driving `q` (e.g. `\y[0] [3]`) inverted by an
@@ -97,7 +97,19 @@ fn signs_off_and_catches_a_broken_gate(lib: &SignoffLibrary, inv: &str, name: &s
     match gate_level(&req, &broken) {
         Err(ReportError::GateLevelMismatch(m)) => {
             assert_eq!(m.signal, "y[0]", "{name}");
-            assert_eq!(m.cycle, first_write(&vec.join("trace.hex"), 0), "{name}");
+            // The testbench compares y[r] after every write of the trace. Which write of y[0]
+            // first shows the broken bit depends on how synthesis folded the write enable into
+            // the flop's D logic (osu018 has no enable flop; the read-ahead pipeline moved it),
+            // so the check is that the mismatch is at a write of y[0] the trace predicts, within
+            // its first two pulses, and differs from it in exactly the broken bit 3.
+            let w = writes(&vec.join("trace.hex"), 0);
+            assert!(
+                w[..2].contains(&m.cycle),
+                "{name}: cycle {} not in {w:?}",
+                m.cycle
+            );
+            let hex = |s: &str| u64::from_str_radix(s, 16).unwrap_or_else(|_| panic!("{s}"));
+            assert_eq!(hex(&m.expected) ^ hex(&m.actual), 1 << 3, "{name}: {m:?}");
         }
         other => panic!("{name}: the broken netlist must fail gate-level simulation: {other:?}"),
     }
