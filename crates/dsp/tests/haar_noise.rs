@@ -5,19 +5,7 @@
 //! (≈ 10 s); the same function (`static_noise_check`) serves `tofprobe reproduce`.
 
 use tofprobe_dsp::haar::montecarlo::static_noise_check;
-use tofprobe_scene::SensorConfig;
-
-fn sensor(signal_rate: f64, background_rate: f64) -> SensorConfig {
-    SensorConfig {
-        laser_rate_hz: 1e7,
-        jitter_ps: 20.0,
-        tdc_lsb_ps: 5.0,
-        window_start_ps: 0.0,
-        window_length_ps: 400.0,
-        signal_rate,
-        background_rate,
-    }
-}
+use tofprobe_dsp::haar::paper::sensor_with_rates as sensor;
 
 /// Tolerances as in the unit tests: 4 standard errors of an sd estimate (1/sqrt(2m)) plus
 /// 1 % for the model's approximations; false-event frames within 5 Poisson sd.

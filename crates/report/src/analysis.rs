@@ -2,7 +2,7 @@
 //! OpenSTA when the liberty carries timing (cached next to the synthesis).
 
 use crate::error::{ReportError, Result};
-use crate::fsutil::write_atomic;
+use crate::fsutil::cached_json;
 use crate::liberty::Liberty;
 use crate::split::{AreaSplit, BlockNames, split_area};
 use crate::sta::{Timing, time_netlist};
@@ -103,26 +103,14 @@ pub fn analyse_point(
     let split_path = synthesis
         .netlist_json
         .with_file_name(format!("split-v1-w{width}.json"));
-    let split = match std::fs::read_to_string(&split_path)
-        .ok()
-        .and_then(|t| serde_json::from_str::<AreaSplit>(&t).ok())
-    {
-        Some(s) => s,
-        None => {
-            let s = split_area(
-                &synthesis.netlist_json,
-                &variant.top,
-                lib,
-                &BlockNames::contract(width),
-            )?;
-            let json = serde_json::to_vec_pretty(&s).map_err(|e| ReportError::Json {
-                what: split_path.display().to_string(),
-                source: e,
-            })?;
-            write_atomic(&split_path, &json)?;
-            s
-        }
-    };
+    let split = cached_json(&split_path, || {
+        split_area(
+            &synthesis.netlist_json,
+            &variant.top,
+            lib,
+            &BlockNames::contract(width),
+        )
+    })?;
     let timing = if timing && lib.has_timing {
         let dir = synthesis
             .netlist_json
@@ -130,27 +118,15 @@ pub fn analyse_point(
             .map(Path::to_path_buf)
             .unwrap_or_else(|| cache.to_path_buf());
         let cached = dir.join("timing-v2.json");
-        match std::fs::read_to_string(&cached)
-            .ok()
-            .and_then(|t| serde_json::from_str::<Timing>(&t).ok())
-        {
-            Some(t) => Some(t),
-            None => {
-                let t = time_netlist(
-                    &lib.path,
-                    &synthesis.netlist_verilog,
-                    &variant.top,
-                    clock,
-                    &dir,
-                )?;
-                let json = serde_json::to_vec_pretty(&t).map_err(|e| ReportError::Json {
-                    what: cached.display().to_string(),
-                    source: e,
-                })?;
-                write_atomic(&cached, &json)?;
-                Some(t)
-            }
-        }
+        Some(cached_json(&cached, || {
+            time_netlist(
+                &lib.path,
+                &synthesis.netlist_verilog,
+                &variant.top,
+                clock,
+                &dir,
+            )
+        })?)
     } else {
         None
     };

@@ -7,7 +7,7 @@
 //! their characterisation changes.
 
 use crate::error::{ReportError, Result};
-use crate::fsutil::write_atomic;
+use crate::fsutil::cached_json;
 use crate::pdk::{Sky130Pdk, plain_copy};
 use crate::sta::{Timing, time_netlist};
 use crate::synth::Synthesis;
@@ -117,25 +117,15 @@ pub fn time_cached(
         .map(Path::to_path_buf)
         .unwrap_or_default();
     let cached = dir.join(format!("timing-v2-{corner}.json"));
-    if let Some(t) = std::fs::read_to_string(&cached)
-        .ok()
-        .and_then(|t| serde_json::from_str::<Timing>(&t).ok())
-    {
-        return Ok(t);
-    }
-    let t = time_netlist(
-        liberty,
-        &synthesis.netlist_verilog,
-        &synthesis.top,
-        clock,
-        &dir,
-    )?;
-    let json = serde_json::to_vec_pretty(&t).map_err(|e| ReportError::Json {
-        what: cached.display().to_string(),
-        source: e,
-    })?;
-    write_atomic(&cached, &json)?;
-    Ok(t)
+    cached_json(&cached, || {
+        time_netlist(
+            liberty,
+            &synthesis.netlist_verilog,
+            &synthesis.top,
+            clock,
+            &dir,
+        )
+    })
 }
 
 /// Every corner of `pdk` on a netlist mapped onto its typical corner. `typical` is the

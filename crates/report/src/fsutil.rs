@@ -1,5 +1,5 @@
-//! Small file helpers: atomic writes (temp file + rename) and a stable content hash used
-//! as the synthesis cache key.
+//! Small file helpers: atomic writes (temp file + rename), JSON results cached beside a
+//! netlist, and a stable content hash used as the synthesis cache key.
 
 use crate::error::{ReportError, Result};
 use std::path::Path;
@@ -27,6 +27,28 @@ impl Fnv64 {
     pub fn hex(&self) -> String {
         format!("{:016x}", self.0.finish())
     }
+}
+
+/// The JSON value cached at `path`, or `compute`'s, then cached there atomically. A cache
+/// file that does not parse (an older crate version's layout) is recomputed, not an error.
+pub fn cached_json<T, F>(path: &Path, compute: F) -> Result<T>
+where
+    T: serde::Serialize + serde::de::DeserializeOwned,
+    F: FnOnce() -> Result<T>,
+{
+    if let Some(v) = std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| serde_json::from_str::<T>(&t).ok())
+    {
+        return Ok(v);
+    }
+    let v = compute()?;
+    let json = serde_json::to_vec_pretty(&v).map_err(|e| ReportError::Json {
+        what: path.display().to_string(),
+        source: e,
+    })?;
+    write_atomic(path, &json)?;
+    Ok(v)
 }
 
 #[cfg(test)]

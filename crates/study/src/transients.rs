@@ -221,15 +221,11 @@ impl HaarAnalysis {
             out,
             "  scale  wavelet ms      max |w| mm   sd(w) mm   threshold mm"
         );
-        for t in &self.thresholds {
+        for c in self.threshold_rows() {
             let _ = writeln!(
                 out,
-                "  {:>5} {:>11.4} {:>14.4} {:>10.5} {:>14.5}",
-                t.u,
-                t.wavelet_s * 1e3,
-                t.max_abs_mm,
-                t.sd_mm,
-                t.threshold_mm
+                "  {:>5} {:>11} {:>14} {:>10} {:>14}",
+                c[0], c[1], c[2], c[3], c[4]
             );
         }
         for line in self.events.text().lines() {
@@ -237,6 +233,20 @@ impl HaarAnalysis {
         }
         let _ = writeln!(out, "  scene transients: {}", self.scene_line());
         out
+    }
+
+    /// The per-scale threshold table's cells (scale, wavelet ms, max |w|, sd(w), threshold
+    /// mm), formatted once for both the terminal and the Markdown table.
+    fn threshold_rows(&self) -> impl Iterator<Item = [String; 5]> + '_ {
+        self.thresholds.iter().map(|t| {
+            [
+                t.u.to_string(),
+                format!("{:.4}", t.wavelet_s * 1e3),
+                format!("{:.4}", t.max_abs_mm),
+                format!("{:.5}", t.sd_mm),
+                format!("{:.5}", t.threshold_mm),
+            ]
+        })
     }
 
     fn scene_line(&self) -> String {
@@ -273,16 +283,8 @@ impl HaarAnalysis {
             md,
             "| scale | wavelet (ms) | max abs(w) (mm) | sd(w) (mm) | threshold (mm) |\n|---|---|---|---|---|"
         );
-        for t in &self.thresholds {
-            let _ = writeln!(
-                md,
-                "| {} | {:.4} | {:.4} | {:.5} | {:.5} |",
-                t.u,
-                t.wavelet_s * 1e3,
-                t.max_abs_mm,
-                t.sd_mm,
-                t.threshold_mm
-            );
+        for c in self.threshold_rows() {
+            let _ = writeln!(md, "| {} |", c.join(" | "));
         }
         let _ = writeln!(md, "\n### Events\n");
         for line in self.events.text().lines() {

@@ -143,17 +143,7 @@ pub fn static_noise_check(
 mod tests {
     use super::*;
 
-    fn sensor(signal_rate: f64, background_rate: f64) -> SensorConfig {
-        SensorConfig {
-            laser_rate_hz: 1e7,
-            jitter_ps: 20.0,
-            tdc_lsb_ps: 5.0,
-            window_start_ps: 0.0,
-            window_length_ps: 400.0,
-            signal_rate,
-            background_rate,
-        }
-    }
+    use crate::haar::paper::sensor_with_rates as sensor;
 
     /// Measured per-scale sd against the closed form, three sensors (ρ_s = 1; ρ_s = 0.3;
     /// ρ_s = 0.3 with ρ_b = 0.1), 300 frames of 2^14 pulses, U = 6. Scale u has 300·2^u

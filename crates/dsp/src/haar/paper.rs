@@ -106,14 +106,20 @@ pub struct TransientFigure {
 /// The sensor of both figures (the paper does not state one): 10 MHz, σ_I = 20 ps (3 mm),
 /// 5 ps TDC LSB (0.75 mm), a 400 ps (60 mm) window, every pulse detects, no background.
 pub fn sensor() -> SensorConfig {
+    sensor_with_rates(1.0, 0.0)
+}
+
+/// The same sensor with other signal and background rates (ρ_s, ρ_b per pulse): the noise
+/// model's checks sweep them.
+pub fn sensor_with_rates(signal_rate: f64, background_rate: f64) -> SensorConfig {
     SensorConfig {
         laser_rate_hz: 10e6,
         jitter_ps: 20.0,
         tdc_lsb_ps: 5.0,
         window_start_ps: 0.0,
         window_length_ps: 400.0,
-        signal_rate: 1.0,
-        background_rate: 0.0,
+        signal_rate,
+        background_rate,
     }
 }
 
