@@ -49,6 +49,32 @@ fn hydraharp_t3_replays_through_the_pixel() {
         );
     }
     assert!(v["closed_form_floor_um"].as_f64().unwrap() > 0.0);
+    // The floor against the closed form, bin by bin. A noise-only amplitude over its
+    // Rayleigh median has median 1; the sample median of 16 such ratios has sd
+    // 1/(2·f(1)·√16) = 0.18 (f(1) = ln 2, the median-normalised Rayleigh density at 1), so
+    // 2.5 sd gives [0.55, 1.45] (the record's lowest two bins carry real low-frequency
+    // content and only push the median up by one rank).
+    let ratio = v["floor_ratio"].as_f64().unwrap();
+    assert!((0.55..=1.45).contains(&ratio), "floor ratio {ratio}");
+    // The comparison this replaced (median of amplitudes over the mean of the bins'
+    // floors) is 0.46 on this record, outside the band: the hold's floor falls as 1/f
+    // across the bins, so that statistic measures the bins' spread, not the noise.
+    let (amps, mut floors): (Vec<f64>, Vec<f64>) = bins
+        .iter()
+        .map(|b| {
+            (
+                b["amplitude_um"].as_f64().unwrap(),
+                b["closed_form_um"].as_f64().unwrap(),
+            )
+        })
+        .unzip();
+    let mut sorted = amps.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median_amp = 0.5 * (sorted[7] + sorted[8]);
+    floors.sort_by(f64::total_cmp);
+    let mean_floor = floors.iter().sum::<f64>() / floors.len() as f64;
+    let old = median_amp / mean_floor;
+    assert!(!(0.55..=1.45).contains(&old), "old statistic {old}");
     // The text form names the record, the photon count and the floor comparison.
     let out = tofprobe(&["replay", f.to_str().unwrap()]);
     let s = String::from_utf8(out.stdout).unwrap();

@@ -92,10 +92,14 @@ pub struct ReplayOutcome {
     pub bins: Vec<ReplayBin>,
     /// Median bit-true amplitude over the bins (µm): the measured noise floor.
     pub measured_floor_um: f64,
-    /// The closed-form median floor the measured rate and σ imply (µm): the 1NN hold's
-    /// noise factor at each bin, Rayleigh median, averaged over the bins.
+    /// Median over the bins of each bin's closed-form Rayleigh median (µm), the floor the
+    /// measured rate and σ imply (see [`ReplayBin::closed_form_um`]).
     pub closed_form_floor_um: Option<f64>,
-    /// measured / closed form.
+    /// Median over the bins of amplitude / the bin's closed-form median: ≈ 1 when the
+    /// record's depth samples are independent with the measured σ. Bin by bin because the
+    /// hold's floor falls as 1/f above its bandwidth (ρ·f_s/2π, a few hundred Hz at
+    /// ρ = 10⁻³): a median of amplitudes against a mean of floors differs by the bins'
+    /// spread alone (0.46 on the HydraHarp T3 record, which is why this is a ratio of medians).
     pub floor_ratio: Option<f64>,
 }
 
@@ -110,6 +114,9 @@ pub struct ReplayBin {
     pub float_amplitude_um: f64,
     /// Bit-true phase, degrees.
     pub phase_deg: f64,
+    /// The closed-form Rayleigh median of a noise-only amplitude at this bin (µm):
+    /// 0.939·sqrt(π σ² F(ρ, ω)/N_eff), F the 1NN hold's noise factor; `None` without σ.
+    pub closed_form_um: Option<f64>,
 }
 
 /// A record's decoding error (it names the file, the record index and what was expected).
@@ -330,18 +337,26 @@ pub fn replay(
     let float_um = amplitudes_um(&float.readout());
     let (mean, sigma) = moments(d, s1, s2, lsb_mm, sensor.window_start_ps * MM_PER_PS);
     let rate = d as f64 / n as f64;
-    let closed = closed_form_floor(&rom, sigma, rate, sensor.laser_rate_hz, n);
-    let bins = spectrum
+    let closed = closed_form_bins(&rom, sigma, rate, sensor.laser_rate_hz, n);
+    let bins: Vec<ReplayBin> = spectrum
         .bins
         .iter()
         .zip(&float_um)
-        .map(|(b, &f)| ReplayBin {
+        .enumerate()
+        .map(|(k, (b, &f))| ReplayBin {
             frequency_hz: b.frequency_hz,
             amplitude_um: b.amplitude_um,
             float_amplitude_um: f,
             phase_deg: b.phase_deg,
+            closed_form_um: closed.as_ref().map(|c| c[k]),
         })
         .collect();
+    let closed_floor = closed.as_deref().and_then(median);
+    let ratios: Vec<f64> = bins
+        .iter()
+        .filter_map(|b| b.closed_form_um.map(|c| b.amplitude_um / c))
+        .collect();
+    let floor_ratio = closed.as_ref().and_then(|_| median(&ratios));
     let mut counts = stream.counts();
     counts.pulses = n;
     counts.detections = d;
@@ -357,10 +372,8 @@ pub fn replay(
         sigma_depth_mm: sigma,
         bins,
         measured_floor_um: spectrum.median_amplitude_um,
-        closed_form_floor_um: closed,
-        floor_ratio: closed
-            .filter(|c| *c > 0.0)
-            .map(|c| spectrum.median_amplitude_um / c),
+        closed_form_floor_um: closed_floor,
+        floor_ratio,
     })
 }
 
@@ -379,27 +392,58 @@ fn moments(d: u64, s1: u128, s2: u128, lsb_mm: f64, start_mm: f64) -> (Option<f6
     (mean, Some(var.sqrt() * lsb_mm))
 }
 
-/// The closed-form median noise floor over the ROM's bins (µm): Rayleigh median of
-/// sqrt(π σ² F(ρ, ω_k) / N_eff) with the hold's noise factor F at each bin, averaged.
-fn closed_form_floor(
+/// Each ROM bin's closed-form Rayleigh median of a noise-only amplitude (µm):
+/// 0.939·sqrt(π σ² F(ρ, ω_k) / N_eff) with the hold's noise factor F at the bin. `None`
+/// without σ, with ρ outside (0, 1] or a floor that is not positive and finite.
+fn closed_form_bins(
     rom: &ProbeRom,
     sigma_mm: Option<f64>,
     rho: f64,
     fs: f64,
     n: u64,
-) -> Option<f64> {
+) -> Option<Vec<f64>> {
     let sigma = sigma_mm?;
     if !(rho > 0.0 && rho <= 1.0) || rom.bins.is_empty() {
         return None;
     }
     let n_eff = n as f64 * rom.window.effective_length_factor();
-    let sum: f64 = rom
+    let floors: Vec<f64> = rom
         .bins
         .iter()
         .map(|f| {
             let omega = 2.0 * std::f64::consts::PI * f / fs;
-            noise_floor_hold_mm(sigma, rho, omega, n_eff)
+            noise_floor_hold_mm(sigma, rho, omega, n_eff) * RAYLEIGH_MEDIAN_OVER_MEAN * 1000.0
         })
-        .sum();
-    Some(sum / rom.bins.len() as f64 * RAYLEIGH_MEDIAN_OVER_MEAN * 1000.0)
+        .collect();
+    floors
+        .iter()
+        .all(|c| c.is_finite() && *c > 0.0)
+        .then_some(floors)
+}
+
+/// The median (mean of the middle two for an even count); `None` when empty.
+fn median(v: &[f64]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let m = s.len() / 2;
+    Some(if s.len() % 2 == 1 {
+        s[m]
+    } else {
+        0.5 * (s[m - 1] + s[m])
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median;
+
+    #[test]
+    fn median_of_odd_even_and_empty() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), Some(2.5));
+        assert_eq!(median(&[]), None);
+    }
 }
