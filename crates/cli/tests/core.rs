@@ -6,8 +6,6 @@
 //! in one comment line; a path that cannot stand unquoted in YAML is refused, writing
 //! nothing). FuseSoC itself runs the committed cores in scripts/fusesoc-check.sh.
 
-mod common;
-use common::tofprobe;
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
