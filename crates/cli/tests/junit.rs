@@ -354,3 +354,44 @@ fn checker_rejects_malformed_xml() {
         2
     );
 }
+
+/// The soak writes one suite per drawn configuration (`random-<i>.<hash>`), one case per
+/// frame of each.
+#[test]
+fn soak_has_one_suite_per_configuration() {
+    if !tools() {
+        eprintln!("*** SKIPPED: EDA tools missing (scripts/install-tools.sh) ***");
+        return;
+    }
+    let d = scratch("soak");
+    let file = d.join("soak.xml");
+    let o = tofprobe(&[
+        "cosim",
+        "--random",
+        "2",
+        "--seed",
+        "1",
+        "--frames",
+        "2",
+        "--simulator",
+        "icarus",
+        "--out",
+        d.join("work").to_str().expect("utf-8"),
+        "--junit",
+        file.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let xml = std::fs::read_to_string(&file).expect("report");
+    let els = parse(&xml);
+    assert_eq!(count(&els, "testsuite"), 2);
+    assert_eq!(count(&els, "testcase"), 4);
+    assert_eq!(count(&els, "failure"), 0);
+    let suites: Vec<&Element> = els.iter().filter(|e| e.name == "testsuite").collect();
+    for (i, s) in suites.iter().enumerate() {
+        let name = &s.attrs["name"];
+        let hash = name
+            .strip_prefix(&format!("random-{i}."))
+            .unwrap_or_else(|| panic!("suite {name}"));
+        assert!(hash.len() == 16 && hash.chars().all(|c| c.is_ascii_hexdigit()));
+    }
+}
