@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the committed generated files (rtl/ for the default configuration, and the
-# short-frame default RTL + golden vectors under testbench/default-short/) into a temporary
-# directory with the release binary and fails on any byte difference.
+# short-frame default RTL + golden vectors under testbench/default-short/, each RTL with its
+# FuseSoC core) into a temporary directory with the release binary and fails on any byte
+# difference.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -12,7 +13,8 @@ trap 'rm -rf "$tmp"' EXIT
 (
   cd "$tmp"
   "$bin" rtl --out rtl >/dev/null
-  "$bin" rtl --out testbench/default-short/rtl --frame-pulses 64 >/dev/null
+  "$bin" rtl --out testbench/default-short/rtl --frame-pulses 64 \
+    --core-vectors testbench/default-short/vectors --core-testbench testbench/tb.v >/dev/null
   "$bin" vectors --out testbench/default-short/vectors --frame-pulses 64 --frames 2 --seed 1 >/dev/null
 )
 status=0

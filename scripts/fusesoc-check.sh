@@ -1,26 +1,30 @@
 #!/usr/bin/env bash
-# Runs the default's FuseSoC core (testbench/fusesoc/tofprobe_pixel.core) with the users'
-# own tool: `lint` (Verilator --lint-only -Wall on rtl/) and `sim` (Icarus, testbench/tb.v
-# replaying the short golden vectors), and checks sim's completion line reports 0
-# mismatches. `synth` (yosys) is defined but not run here: it maps the 20,000-entry ROM.
-# Uses the cached venv of scripts/py-venv.sh; work files in target/fusesoc.
+# Runs the FuseSoC cores that `tofprobe rtl` renders beside the committed RTL with the
+# users' own tool: `lint` (Verilator --lint-only -Wall) of rtl/tofprobe.core (the default),
+# and `sim` (Icarus, testbench/tb.v replaying the short golden vectors) of
+# testbench/default-short/rtl/tofprobe.core (rendered with --core-vectors/--core-testbench),
+# checking sim's completion line reports 0 mismatches. Both cores are byte-checked against a
+# fresh rendering by scripts/check-generated.sh. `synth` (yosys) is defined but not run
+# here: it maps the 20,000-entry ROM. Uses the cached venv of scripts/py-venv.sh; work files
+# in target/fusesoc.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 venv="$("$root/scripts/py-venv.sh")"
 work="$root/target/fusesoc"
 mkdir -p "$work"
 cd "$work"
-fusesoc=("$venv/bin/fusesoc" --cores-root "$root/testbench/fusesoc")
-core=tofprobe:tofprobe:pixel
+core=tofprobe:tofprobe:tofprobe_pixel
+# Each directory holds one core of that name (the default's and the short frame's): one
+# cores root at a time.
+run() { # cores-root target log
+  "$venv/bin/fusesoc" --cores-root "$1" run --build-root "$work/build-$2" --target "$2" "$core" >"$3" 2>&1
+}
 
-# The core lists ../../rtl files: FuseSoC 2.4 warns that this is deprecated; not our error.
-quiet() { grep -v "is not within the directory containing the core file" || true; }
-
-"${fusesoc[@]}" run --target lint "$core" 2>&1 | quiet >lint.log || {
+run "$root/rtl" lint lint.log || {
   cat lint.log; echo "fusesoc-check: lint FAILED" >&2; exit 1; }
 grep -q "^%Warning\|^%Error" lint.log && { cat lint.log; echo "fusesoc-check: lint FAILED" >&2; exit 1; }
 
-"${fusesoc[@]}" run --target sim "$core" 2>&1 | quiet >sim.log || true
+run "$root/testbench/default-short/rtl" sim sim.log || true
 done_line="$(grep '^TOFPROBE-COSIM-DONE' sim.log || true)"
 if [[ "$done_line" != *" mismatches=0 "* ]]; then
   cat sim.log

@@ -72,6 +72,10 @@ fn committed_rtl_and_short_vectors_regenerate_byte_for_byte() {
             "testbench/default-short/rtl",
             "--frame-pulses",
             "64",
+            "--core-vectors",
+            "testbench/default-short/vectors",
+            "--core-testbench",
+            "testbench/tb.v",
         ],
     );
     run(

@@ -132,6 +132,9 @@ pub struct CosimReport {
     pub rom: Vec<u64>,
     /// The golden readouts, per frame (R words then the status word, raw W bits).
     pub readouts: Vec<Vec<u64>>,
+    /// Per frame: the cycle its readout ends (the golden run's status word), which closes
+    /// the frame when a mismatch is attributed to one ([`crate::junit`]).
+    pub readout_end_cycles: Vec<u64>,
     pub simulator: Simulator,
     /// The Verilator random-reset seed used (recorded so a failure can be re-run).
     pub x_seed: u64,
@@ -264,6 +267,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
             vcd: None,
             rtl_dir,
             vectors_dir: vec_dir,
+            readout_end_cycles: golden.readout_end_cycles,
             readouts: golden.readouts,
             stimulus: stim,
             rom,
@@ -343,6 +347,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         vcd,
         rtl_dir,
         vectors_dir: vec_dir,
+        readout_end_cycles: golden.readout_end_cycles,
         readouts: golden.readouts,
         stimulus: stim,
         rom,

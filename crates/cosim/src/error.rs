@@ -54,6 +54,11 @@ pub enum CosimError {
         value: String,
         allowed: String,
     },
+    /// A report file exists and was not written by this generator.
+    #[error(
+        "{path}: exists and was not written by tofprobe-cosim: refusing to overwrite it; remove it or choose another file"
+    )]
+    Foreign { path: PathBuf },
     /// File-system error, with the path.
     #[error("{path}: {source}")]
     Io {

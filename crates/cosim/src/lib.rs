@@ -1,6 +1,6 @@
 //! Co-simulation of the generated RTL against the cycle-accurate reference: a Verilator
 //! driver (cached builds, the C++ harness of `testbench/`), an Icarus driver for the plain
-//! self-checking testbench, and the first-mismatch report.
+//! self-checking testbench, the first-mismatch report and its JUnit XML for CI.
 
 pub mod check;
 pub mod coverage;
@@ -9,6 +9,7 @@ pub mod error;
 pub mod gate_level;
 pub mod harness;
 pub mod icarus;
+pub mod junit;
 pub mod random;
 pub mod tools;
 pub mod verilator;

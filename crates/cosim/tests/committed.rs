@@ -1,6 +1,6 @@
 //! The committed generated files are consistent: the configuration recorded in each header
 //! is re-rendered with the recorded command and the committed probe ROM and compared byte
-//! for byte (rtl/ and testbench/default-short/), and the committed short-frame vectors are
+//! for byte (rtl/ and testbench/default-short/, the FuseSoC core included), and the committed short-frame vectors are
 //! regenerated from their manifest's seed and frame count with the pixel model as judge.
 //! The ROM's own content is regenerated from the configuration by the CLI's test
 //! (crates/cli/tests/committed.rs) and scripts/check-generated.sh.
@@ -8,6 +8,7 @@
 use std::path::{Path, PathBuf};
 use tofprobe_cosim::driver::rom_from_rtl;
 use tofprobe_pixel::{Mode, PixelParams};
+use tofprobe_rtlgen::core::{CoreSim, relative_path, render_core};
 use tofprobe_rtlgen::render::{RenderOptions, render};
 use tofprobe_rtlgen::stimulus::random_stimulus;
 use tofprobe_rtlgen::vectors::golden_run;
@@ -69,16 +70,27 @@ fn check_rtl_dir(dir: &Path) -> PixelParams {
         .unwrap_or("")
         .to_string();
     let rom = rom_from_rtl(&p, dir).expect("committed ROM reads");
-    let files = render(
-        &p,
-        &rom,
-        &RenderOptions {
-            command,
-            rom_note,
-            ..RenderOptions::default()
-        },
-    )
-    .expect("renders");
+    // The FuseSoC core's sim paths, from the recorded command (relative to the repository
+    // root, where it was run), made relative to the core as `tofprobe rtl` does.
+    let arg = |flag: &str| {
+        let mut t = command.split_whitespace();
+        t.find(|w| *w == flag).and(t.next()).map(Path::new)
+    };
+    let sim = match (arg("--out"), arg("--core-vectors"), arg("--core-testbench")) {
+        (Some(out), Some(v), Some(tb)) => Some(CoreSim {
+            vectors_dir: relative_path(&root(), out, v),
+            testbench: relative_path(&root(), out, tb),
+        }),
+        _ => None,
+    };
+    let options = RenderOptions {
+        command: command.clone(),
+        rom_note,
+        ..RenderOptions::default()
+    };
+    let mut files = render(&p, &rom, &options).expect("renders");
+    let core = render_core(&p, &files, &options, sim.as_ref()).expect("core renders");
+    files.extend(core);
     // The ROM's TOML manifest is the CLI's (crates/cli/tests/committed.rs checks it).
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .expect("dir")

@@ -15,6 +15,11 @@ pub enum RtlError {
         "{field} = {value:?} is not a safe Verilog identifier: allowed [a-z][a-z0-9_]{{0,31}}, not a keyword (e.g. \"tofprobe\")"
     )]
     Identifier { field: &'static str, value: String },
+    /// A path given for the FuseSoC core cannot stand in it unquoted.
+    #[error(
+        "{field} = {value:?} cannot go into the FuseSoC core: allowed a relative path of [A-Za-z0-9._+-] and `/`, not starting with `-` or `/`, at most 200 characters (e.g. \"../vectors\")"
+    )]
+    CorePath { field: &'static str, value: String },
     /// A template failed to render.
     #[error("template {template} failed to render: {message}")]
     Render {

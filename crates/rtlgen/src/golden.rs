@@ -41,6 +41,9 @@ pub fn pack_pins(o: &PinsOut) -> u64 {
 pub struct Golden {
     /// Per frame: R register words then the status word, raw W-bit patterns.
     pub readouts: Vec<Vec<u64>>,
+    /// Per frame: the cycle its readout's last word (the status word) is on the pins, which
+    /// closes the frame for reports that attribute a mismatch to a frame (JUnit).
+    pub readout_end_cycles: Vec<u64>,
     /// (cycle, register, value) inside the trace window.
     pub trace: Vec<(u64, u32, u64)>,
     /// (cycle, pins) changes inside the trace window.
@@ -131,6 +134,7 @@ pub fn run(p: &PixelParams, seq: &Sequencer<'_>, o: &GoldenOptions) -> Result<Go
             frame_words.push(out.rd_data);
             if out.rd_index as usize == r {
                 g.readouts.push(std::mem::take(&mut frame_words));
+                g.readout_end_cycles.push(c);
             }
         }
         for w in model.writes() {

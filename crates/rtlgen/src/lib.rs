@@ -3,8 +3,10 @@
 //! `render` turns a validated `tofprobe_pixel::PixelParams` into the pixel, probe ROM and
 //! top modules (askama templates in `templates/`), with the pixel crate's adder schedule
 //! as case tables; `vectors` runs the pixel crate's reference sequencer through its
-//! cycle-accurate model and writes what a simulator must reproduce.
+//! cycle-accurate model and writes what a simulator must reproduce; `core` renders the
+//! FuseSoC core that packages the RTL for users' tools.
 
+pub mod core;
 pub mod error;
 pub mod golden;
 pub mod naming;

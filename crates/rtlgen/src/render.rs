@@ -52,7 +52,8 @@ pub struct RtlFile {
 /// ROM depths up to this are rendered as a case table, deeper ones use `$readmemh`.
 pub const ROM_TABLE_MAX_DEPTH: usize = 64;
 
-fn header(p: &PixelParams, template: &str, o: &RenderOptions) -> String {
+/// The header of every generated file (`//` comment lines, no final newline).
+pub(crate) fn header(p: &PixelParams, template: &str, o: &RenderOptions) -> String {
     let mut h = format!(
         "{HEADER_MARK} {} from template templates/{template}.\n\
          // DO NOT EDIT: regenerate with `{}`.\n\

@@ -92,14 +92,13 @@ pub struct ReplayOutcome {
     pub bins: Vec<ReplayBin>,
     /// Median bit-true amplitude over the bins (µm): the measured noise floor.
     pub measured_floor_um: f64,
-    /// Median over the bins of each bin's closed-form Rayleigh median (µm), the floor the
-    /// measured rate and σ imply (see [`ReplayBin::closed_form_um`]).
+    /// Median over the bins of the closed-form floors the measured rate and σ imply (µm):
+    /// at each bin the Rayleigh median with the 1NN hold's noise factor F(ρ, ω_k)
+    /// ([`ReplayBin::closed_form_floor_um`]).
     pub closed_form_floor_um: Option<f64>,
-    /// Median over the bins of amplitude / the bin's closed-form median: ≈ 1 when the
-    /// record's depth samples are independent with the measured σ. Bin by bin because the
-    /// hold's floor falls as 1/f above its bandwidth (ρ·f_s/2π, a few hundred Hz at
-    /// ρ = 10⁻³): a median of amplitudes against a mean of floors differs by the bins'
-    /// spread alone (0.46 on the HydraHarp T3 record, which is why this is a ratio of medians).
+    /// Median over the bins of amplitude / closed-form floor, bin by bin ([`floor_ratio`]):
+    /// 1 when the record's detections are the closed form's independent per-pulse draws
+    /// and the bins hold no signal.
     pub floor_ratio: Option<f64>,
 }
 
@@ -114,9 +113,8 @@ pub struct ReplayBin {
     pub float_amplitude_um: f64,
     /// Bit-true phase, degrees.
     pub phase_deg: f64,
-    /// The closed-form Rayleigh median of a noise-only amplitude at this bin (µm):
-    /// 0.939·sqrt(π σ² F(ρ, ω)/N_eff), F the 1NN hold's noise factor; `None` without σ.
-    pub closed_form_um: Option<f64>,
+    /// The closed-form floor at this bin (Rayleigh median, µm), `None` without a σ.
+    pub closed_form_floor_um: Option<f64>,
 }
 
 /// A record's decoding error (it names the file, the record index and what was expected).
@@ -337,7 +335,7 @@ pub fn replay(
     let float_um = amplitudes_um(&float.readout());
     let (mean, sigma) = moments(d, s1, s2, lsb_mm, sensor.window_start_ps * MM_PER_PS);
     let rate = d as f64 / n as f64;
-    let closed = closed_form_bins(&rom, sigma, rate, sensor.laser_rate_hz, n);
+    let closed = closed_form_floors(&rom, sigma, rate, sensor.laser_rate_hz, n);
     let bins: Vec<ReplayBin> = spectrum
         .bins
         .iter()
@@ -348,15 +346,11 @@ pub fn replay(
             amplitude_um: b.amplitude_um,
             float_amplitude_um: f,
             phase_deg: b.phase_deg,
-            closed_form_um: closed.as_ref().map(|c| c[k]),
+            closed_form_floor_um: closed.as_ref().and_then(|c| c.get(k).copied()),
         })
         .collect();
-    let closed_floor = closed.as_deref().and_then(median);
-    let ratios: Vec<f64> = bins
-        .iter()
-        .filter_map(|b| b.closed_form_um.map(|c| b.amplitude_um / c))
-        .collect();
-    let floor_ratio = closed.as_ref().and_then(|_| median(&ratios));
+    let amps: Vec<f64> = bins.iter().map(|b| b.amplitude_um).collect();
+    let ratio = closed.as_deref().and_then(|c| floor_ratio(&amps, c));
     let mut counts = stream.counts();
     counts.pulses = n;
     counts.detections = d;
@@ -372,8 +366,8 @@ pub fn replay(
         sigma_depth_mm: sigma,
         bins,
         measured_floor_um: spectrum.median_amplitude_um,
-        closed_form_floor_um: closed_floor,
-        floor_ratio,
+        closed_form_floor_um: closed.map(median),
+        floor_ratio: ratio,
     })
 }
 
@@ -392,10 +386,12 @@ fn moments(d: u64, s1: u128, s2: u128, lsb_mm: f64, start_mm: f64) -> (Option<f6
     (mean, Some(var.sqrt() * lsb_mm))
 }
 
-/// Each ROM bin's closed-form Rayleigh median of a noise-only amplitude (µm):
-/// 0.939·sqrt(π σ² F(ρ, ω_k) / N_eff) with the hold's noise factor F at the bin. `None`
-/// without σ, with ρ outside (0, 1] or a floor that is not positive and finite.
-fn closed_form_bins(
+/// The closed-form noise floor at each of the ROM's bins (µm): the Rayleigh median of
+/// |Y(ω_k)|, sqrt(π σ² F(ρ, ω_k)/N_eff)·(median/mean), with the hold's noise factor F.
+/// F falls as 1/ω² above the hold's bandwidth (ρ·f_s/2π, ≈ 600 Hz for the HydraHarp T3
+/// sample), so the floors of one spectrum differ bin to bin (×17 over the default's
+/// 4.5–76 kHz there) and are compared bin by bin ([`floor_ratio`]).
+fn closed_form_floors(
     rom: &ProbeRom,
     sigma_mm: Option<f64>,
     rho: f64,
@@ -407,43 +403,80 @@ fn closed_form_bins(
         return None;
     }
     let n_eff = n as f64 * rom.window.effective_length_factor();
-    let floors: Vec<f64> = rom
-        .bins
-        .iter()
-        .map(|f| {
-            let omega = 2.0 * std::f64::consts::PI * f / fs;
-            noise_floor_hold_mm(sigma, rho, omega, n_eff) * RAYLEIGH_MEDIAN_OVER_MEAN * 1000.0
-        })
-        .collect();
-    floors
-        .iter()
-        .all(|c| c.is_finite() && *c > 0.0)
-        .then_some(floors)
+    Some(
+        rom.bins
+            .iter()
+            .map(|f| {
+                let omega = 2.0 * std::f64::consts::PI * f / fs;
+                noise_floor_hold_mm(sigma, rho, omega, n_eff) * RAYLEIGH_MEDIAN_OVER_MEAN * 1000.0
+            })
+            .collect(),
+    )
 }
 
-/// The median (mean of the middle two for an even count); `None` when empty.
-fn median(v: &[f64]) -> Option<f64> {
-    if v.is_empty() {
+/// The median of `v` (the mean of the middle two for an even count, as the spectrum's
+/// median amplitude); 0 for none.
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => 0.0,
+        m if m % 2 == 1 => v[m / 2],
+        m => 0.5 * (v[m / 2 - 1] + v[m / 2]),
+    }
+}
+
+/// Measured against closed form, bin by bin: the median over bins of amplitude_k / floor_k.
+/// Each ratio is a Rayleigh draw over its own median, so the median of them is ≈ 1 (sd
+/// ≈ 0.18 for 16 bins) however much the floors differ between bins. The ratio of the median
+/// amplitude to the mean floor is not: with floors ∝ 1/f over the default's bins it is
+/// ≈ 0.49 even for amplitudes exactly at their floors (the tests below), the 0.46 that
+/// replay reported before. `None` if a floor is not positive or the lengths differ.
+pub fn floor_ratio(amplitudes_um: &[f64], floors_um: &[f64]) -> Option<f64> {
+    if amplitudes_um.len() != floors_um.len()
+        || floors_um.is_empty()
+        || floors_um.iter().any(|f| !(*f > 0.0 && f.is_finite()))
+    {
         return None;
     }
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let m = s.len() / 2;
-    Some(if s.len() % 2 == 1 {
-        s[m]
-    } else {
-        0.5 * (s[m - 1] + s[m])
-    })
+    Some(median(
+        amplitudes_um
+            .iter()
+            .zip(floors_um)
+            .map(|(a, f)| a / f)
+            .collect(),
+    ))
 }
 
 #[cfg(test)]
 mod tests {
-    use super::median;
+    use super::*;
+
+    /// The default's 16 bins (Hz, as replay prints them for the HydraHarp T3 sample).
+    const BINS: [f64; 16] = [
+        4500.0, 5750.0, 10750.0, 15750.0, 20750.0, 25750.0, 30750.0, 35750.0, 40750.0, 45750.0,
+        50750.0, 55750.0, 60750.0, 65750.0, 70750.0, 75750.0,
+    ];
+
+    /// Amplitudes exactly at floors ∝ 1/f (the hold's floors far above its bandwidth): the
+    /// bin-by-bin ratio is 1; the old statistic (median amplitude over mean floor) reads
+    /// ≈ 0.49, the bias behind replay's former 0.46.
+    #[test]
+    fn bin_by_bin_ratio_is_one_at_the_floors_where_median_over_mean_is_not() {
+        let floors: Vec<f64> = BINS.iter().map(|f| 1e6 / f).collect();
+        let r = floor_ratio(&floors, &floors).expect("ratio");
+        assert!((r - 1.0).abs() < 1e-12, "{r}");
+        let old = median(floors.clone()) / (floors.iter().sum::<f64>() / floors.len() as f64);
+        assert!((0.45..0.52).contains(&old), "median/mean = {old}");
+        // The check can fail: amplitudes twice their floors read 2.
+        let doubled: Vec<f64> = floors.iter().map(|f| 2.0 * f).collect();
+        assert!((floor_ratio(&doubled, &floors).expect("ratio") - 2.0).abs() < 1e-12);
+    }
 
     #[test]
-    fn median_of_odd_even_and_empty() {
-        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
-        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), Some(2.5));
-        assert_eq!(median(&[]), None);
+    fn ratio_needs_matching_positive_floors() {
+        assert_eq!(floor_ratio(&[1.0], &[1.0, 2.0]), None);
+        assert_eq!(floor_ratio(&[1.0], &[0.0]), None);
+        assert_eq!(floor_ratio(&[], &[]), None);
+        assert_eq!(median(vec![3.0, 1.0, 2.0, 10.0]), 2.5);
     }
 }

@@ -68,6 +68,32 @@ pub struct CosimArgs {
     /// or "auto"), drawn from --seed, instead of CONFIG.
     #[arg(long)]
     pub random: Option<u64>,
+    /// Also write a JUnit XML report: one test case per frame and configuration, the first
+    /// mismatch as the failure message (written whole; an existing file is replaced only if
+    /// tofprobe wrote it).
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
+}
+
+/// The configuration's name in the JUnit report: the configuration file's stem, `default`
+/// for the embedded default.
+fn junit_name(a: &CosimArgs) -> String {
+    a.config
+        .as_deref()
+        .and_then(|c| c.file_stem())
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "default".to_string())
+}
+
+/// Writes `--junit FILE` if asked (the command line, sanitised, goes into its header).
+fn write_junit(a: &CosimArgs, suites: &[tofprobe_cosim::junit::Suite]) -> Result<(), CliError> {
+    if let Some(path) = &a.junit {
+        let command: Vec<String> = std::iter::once("tofprobe".to_string())
+            .chain(std::env::args().skip(1))
+            .collect();
+        tofprobe_cosim::junit::write(path, suites, &command.join(" "))?;
+    }
+    Ok(())
 }
 
 /// `--simulator`.
@@ -163,6 +189,10 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
     };
+    if let Some(path) = &a.junit {
+        // A foreign file there is refused now, not after the simulation.
+        tofprobe_cosim::junit::check_target(path)?;
+    }
     if let Some(n) = a.random {
         return run_random(a, n);
     }
@@ -283,6 +313,8 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
             println!("  not hit: {}:{n}: {t}", c.file);
         }
     }
+    let suite = tofprobe_cosim::junit::suite(&junit_name(a), &tofprobe_rtlgen::config_hash(&p), &r);
+    write_junit(a, &[suite])?;
     if r.pass {
         Ok(())
     } else {
@@ -312,6 +344,7 @@ fn run_random(a: &CosimArgs, n: u64) -> Result<(), CliError> {
     }
     let t0 = Instant::now();
     let mut failed = 0u64;
+    let mut suites = Vec::new();
     for i in 0..n {
         let c = tofprobe_cosim::random::random_case(a.seed, i);
         let mut o = CosimOptions::new(a.out.join(format!("random-{i}")));
@@ -324,6 +357,11 @@ fn run_random(a: &CosimArgs, n: u64) -> Result<(), CliError> {
         if !r.pass {
             failed += 1;
         }
+        suites.push(tofprobe_cosim::junit::suite(
+            &format!("random-{i}"),
+            &tofprobe_rtlgen::config_hash(&c.params),
+            &r,
+        ));
         let line = SoakCase {
             case: i,
             pass: r.pass,
@@ -368,6 +406,7 @@ fn run_random(a: &CosimArgs, n: u64) -> Result<(), CliError> {
         a.frames,
         t0.elapsed().as_secs_f64()
     );
+    write_junit(a, &suites)?;
     if failed == 0 {
         Ok(())
     } else {

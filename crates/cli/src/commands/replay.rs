@@ -104,19 +104,19 @@ fn print_text(file: &std::path::Path, o: &ReplayOutcome) {
         opt(o.mean_depth_mm, "mm", 4),
         opt(o.sigma_depth_mm, "mm", 4)
     );
-    println!("bit-true spectrum (float twin and the bin's closed-form noise median beside):");
+    println!("bit-true spectrum (float twin and the closed-form floor at the bin beside):");
     for b in &o.bins {
         println!(
-            "  {:>10.1} Hz  {:>10.4} µm  {:>8.2}°   float {:>10.4} µm   closed form {}",
+            "  {:>10.1} Hz  {:>10.4} µm  {:>8.2}°   float {:>10.4} µm   floor {}",
             b.frequency_hz,
             b.amplitude_um,
             b.phase_deg,
             b.float_amplitude_um,
-            opt(b.closed_form_um, "µm", 4)
+            opt(b.closed_form_floor_um, "µm", 4)
         );
     }
     println!(
-        "noise floor: measured (median over bins) {:.4} µm, closed form from ρ and σ (median over bins) {} (median of per-bin ratios {})",
+        "noise floor: measured (median over bins) {:.4} µm, closed form from ρ and σ (median over bins) {}; measured/closed form bin by bin, median over bins: {} (≈ 1 when the detections are independent per pulse and the bins hold no signal)",
         o.measured_floor_um,
         opt(o.closed_form_floor_um, "µm", 4),
         o.floor_ratio

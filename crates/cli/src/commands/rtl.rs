@@ -3,13 +3,15 @@
 //! ROM is the design's ΣΔ ROM (for the default, periodic L = 20,000, 32 bitstreams)
 //! whenever it is at most 2^16 entries deep; a windowed ROM of a long frame (L = N) or
 //! `--rom-depth` renders the sign-of-cosine probe instead, and the command says which
-//! (`tofprobe_design::rom_policy`).
+//! (`tofprobe_design::rom_policy`). Beside the RTL it writes the FuseSoC core
+//! (`<prefix>.core`: `lint`, `synth`, and `sim` with `--core-vectors`/`--core-testbench`)
+//! and the core's yosys script, in the same atomic set.
 
 use std::path::PathBuf;
 
 use clap::Args;
 use tofprobe_design::RtlOverrides;
-use tofprobe_study::rtl::render_design;
+use tofprobe_study::rtl::{CoreSimPaths, render_design};
 
 use crate::error::CliError;
 
@@ -28,6 +30,14 @@ pub struct RtlArgs {
     /// Override the pulses per frame N (e.g. short frames for co-simulation).
     #[arg(long)]
     pub frame_pulses: Option<u64>,
+    /// Give the FuseSoC core a `sim` target replaying these golden vectors (from `tofprobe
+    /// vectors` with the same configuration and overrides); recorded relative to DIR.
+    #[arg(long, value_name = "VECDIR", requires = "core_testbench")]
+    pub core_vectors: Option<PathBuf>,
+    /// The testbench the core's `sim` target compiles (the repository's testbench/tb.v);
+    /// recorded relative to DIR.
+    #[arg(long, value_name = "FILE", requires = "core_vectors")]
+    pub core_testbench: Option<PathBuf>,
 }
 
 /// The command line that regenerates `out` (recorded in every header): paths in their
@@ -46,6 +56,13 @@ pub fn regen_command(a: &RtlArgs) -> String {
     if let Some(l) = a.rom_depth {
         s.push_str(&format!(" --rom-depth {l}"));
     }
+    if let (Some(v), Some(t)) = (&a.core_vectors, &a.core_testbench) {
+        s.push_str(&format!(
+            " --core-vectors {} --core-testbench {}",
+            canonical_path(v),
+            canonical_path(t)
+        ));
+    }
     s
 }
 
@@ -56,7 +73,14 @@ pub fn run(a: &RtlArgs) -> Result<(), CliError> {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
     };
-    let r = render_design(&design, &overrides, &a.out, regen_command(a))?;
+    let sim = match (&a.core_vectors, &a.core_testbench) {
+        (Some(v), Some(t)) => Some(CoreSimPaths {
+            vectors_dir: v.clone(),
+            testbench: t.clone(),
+        }),
+        _ => None,
+    };
+    let r = render_design(&design, &overrides, &a.out, regen_command(a), sim.as_ref())?;
     let p = &r.params;
     println!(
         "rtl: {:?} pixel, {} registers x {} bits, {} adder(s), {} cycles/pulse, N = {}, L = {}, hash {} -> {} ({}); {}",

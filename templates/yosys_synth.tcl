@@ -1,6 +1,7 @@
-# tofprobe: FuseSoC/edalize yosys script for a technology-independent `synth` (edalize's own
-# template calls synth_<arch>, which exists only for FPGA families). edalize copies this
-# file to the work directory and sources it with its generated procs.
+{{ header }}
+# FuseSoC/edalize yosys script of the core's `synth` target (technology-independent:
+# edalize's own template calls synth_<arch>, which exists only for FPGA families). edalize
+# copies this file to the work directory and sources it with its generated procs.
 yosys -import
 source edalize_yosys_procs.tcl
 verilog_defaults -push
