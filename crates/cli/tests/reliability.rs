@@ -7,26 +7,13 @@
 mod common;
 
 use std::collections::BTreeMap;
-use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use common::{default_text, edit, tofprobe};
+use common::{default_text, edit, listing, tofprobe, whole_set_seed};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-}
-
-/// Every entry of `dir` (names), sorted.
-fn listing(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .map(|r| {
-            r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-                .collect()
-        })
-        .unwrap_or_default();
-    v.sort();
-    v
 }
 
 const EVIL: &str =
@@ -106,28 +93,6 @@ fn the_spelling_of_out_does_not_change_a_byte() {
             "{n}"
         );
     }
-}
-
-/// The manifest's seed when every file matches the manifest's hashes (a whole set), else
-/// `None`.
-fn whole_set_seed(dir: &Path) -> Option<u64> {
-    let m: toml::Table =
-        toml::from_str(&std::fs::read_to_string(dir.join("manifest.toml")).ok()?).ok()?;
-    let files = m.get("files")?.as_table()?;
-    for (name, hash) in files {
-        let bytes = std::fs::read(dir.join(name)).ok()?;
-        if format!("{:016x}", tofprobe_io::fnv1a64(&bytes)) != hash.as_str()? {
-            return None;
-        }
-    }
-    let visible: Vec<String> = listing(dir)
-        .into_iter()
-        .filter(|n| !n.starts_with('.'))
-        .collect();
-    let mut expected: Vec<String> = files.keys().cloned().collect();
-    expected.push("manifest.toml".into());
-    expected.sort();
-    (visible == expected).then(|| m.get("seed")?.as_integer().map(|s| s as u64))?
 }
 
 #[test]
