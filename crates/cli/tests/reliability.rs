@@ -243,7 +243,7 @@ fn extreme_configurations_print_only_finite_numbers() {
             String::from_utf8_lossy(&o.stderr)
         );
         let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        check_finite(what, "", &v);
+        common::finite::assert_finite(what, &v);
         let t = bin().arg("simulate").arg(&cfg).output().unwrap();
         let text = String::from_utf8_lossy(&t.stdout).to_lowercase();
         assert!(
@@ -253,21 +253,6 @@ fn extreme_configurations_print_only_finite_numbers() {
     }
     let o = tofprobe(&["config", "--print-default"]);
     assert!(o.status.success());
-}
-
-/// Every number finite (serde_json writes NaN/inf as null): a null is allowed only for the
-/// statistics an empty record does not have.
-fn check_finite(what: &str, key: &str, v: &serde_json::Value) {
-    match v {
-        serde_json::Value::Null => assert!(
-            key == "mean_depth_mm" || key == "sigma_depth_mm" || key.starts_with("rom_wrap"),
-            "{what}: `{key}` is null (NaN or inf?)"
-        ),
-        serde_json::Value::Number(n) => assert!(n.as_f64().is_some_and(f64::is_finite)),
-        serde_json::Value::Array(a) => a.iter().for_each(|x| check_finite(what, key, x)),
-        serde_json::Value::Object(o) => o.iter().for_each(|(k, x)| check_finite(what, k, x)),
-        _ => {}
-    }
 }
 
 #[test]

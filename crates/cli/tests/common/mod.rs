@@ -3,6 +3,8 @@
 //! tests run on. Each test binary uses a subset.
 #![allow(dead_code)]
 
+pub mod finite;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
