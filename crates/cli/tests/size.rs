@@ -57,8 +57,17 @@ fn tiny_pixel_json_report() {
     let dir = scratch("json");
     let cfg = tiny_config(&dir);
     let cfg = cfg.to_str().unwrap();
+    let set = dir.join("set");
     let out = size(
-        &[cfg, "--no-sky130", "--json", "--sweep-bins", "1"],
+        &[
+            cfg,
+            "--no-sky130",
+            "--json",
+            "--sweep-bins",
+            "1",
+            "--out",
+            set.to_str().unwrap(),
+        ],
         &[],
         &dir.join("cache"),
     );
@@ -66,6 +75,12 @@ fn tiny_pixel_json_report() {
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
+    );
+    // `--out` writes one set, whole (tofprobe_io::OutputSet): the three files and no
+    // stage or temporary.
+    assert_eq!(
+        common::listing(&set),
+        ["size-report.json", "size-report.md", "size-sweep.svg"]
     );
     let text = String::from_utf8(out.stdout).unwrap();
     assert_eq!(text.trim().lines().count(), 1, "exactly one JSON object");
