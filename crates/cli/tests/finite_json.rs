@@ -3,7 +3,8 @@
 //! the binary on extreme configurations — every bound of the amplitudes and rates, no
 //! detections, one bin — and the shared check (`common::finite`) walks every number.
 //! `size` and `reproduce --quick` are checked by their own tests (size.rs, reproduce.rs),
-//! which already pay for their runs.
+//! which already pay for their runs. Also: an empty record prints "none"/`null` rather than
+//! 0.0000 µm, and the probe amplitude's printed bound is a value that is accepted.
 
 mod common;
 
@@ -158,4 +159,113 @@ fn the_check_catches_a_null_figure() {
     assert!(r.is_err());
     let ok = serde_json::json!({"mean_depth_mm": null, "x": [1.5, 2]});
     assert_eq!(common::finite::assert_finite("ok", &ok).numbers, 2);
+}
+
+/// A record without detections has no spectrum: `simulate` and `replay` say so (text) and
+/// give `null` (JSON) instead of 0.0000 µm; with detections the same figures are numbers.
+#[test]
+fn an_empty_record_says_so_instead_of_printing_zero() {
+    let tmp = tempfile::tempdir().unwrap();
+    let empty = tmp.path().join("empty.toml");
+    std::fs::write(&empty, short(&[("signal_rate = 1.0", "signal_rate = 0.0")])).unwrap();
+    let full = tmp.path().join("full.toml");
+    std::fs::write(&full, short(&[])).unwrap();
+    let sim = |cfg: &Path, json: bool| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_tofprobe"));
+        c.arg("simulate").arg(cfg);
+        if json {
+            c.arg("--json");
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let text = sim(&empty, false);
+    assert!(text.contains("none (no detections in the frame)"), "{text}");
+    assert!(
+        text.contains("mean depth         none (no detections)"),
+        "{text}"
+    );
+    assert!(
+        !text
+            .lines()
+            .any(|l| l.contains("0.0000") && (l.contains("um") || l.contains("mm"))),
+        "a zero figure printed for an empty record:\n{text}"
+    );
+    let v: serde_json::Value = serde_json::from_str(&sim(&empty, true)).unwrap();
+    let bt = &v["bit_true"];
+    assert!(bt["noise_estimate_um"].is_null(), "{bt}");
+    for b in bt["bins"].as_array().unwrap() {
+        assert!(
+            b["amplitude_um"].is_null() && b["phase_deg"].is_null(),
+            "{b}"
+        );
+        assert!(b["frequency_hz"].as_f64().is_some_and(|f| f > 0.0), "{b}");
+    }
+    // With detections the same figures are numbers: the check above can fail.
+    let v: serde_json::Value = serde_json::from_str(&sim(&full, true)).unwrap();
+    assert!(
+        v["bit_true"]["noise_estimate_um"]
+            .as_f64()
+            .is_some_and(|x| x > 0.0)
+    );
+    assert!(sim(&full, false).contains("noise estimate"));
+
+    let rec = record();
+    if !rec.exists() {
+        eprintln!("skipped replay: no record at {}", rec.display());
+        return;
+    }
+    // The short configuration's 0–400 ps window misses every photon of the record.
+    let o = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .arg("replay")
+        .arg(&rec)
+        .arg(&full)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(text.contains("detections: 0 in the window"), "{text}");
+    assert!(
+        text.contains("bit-true spectrum: none (no detections in the window)"),
+        "{text}"
+    );
+    assert!(!text.contains("0.0000 µm"), "{text}");
+}
+
+/// The refusal of a too-large probe amplitude prints a bound that is itself accepted
+/// (0.69975 used to print as 0.6998, which was refused).
+#[test]
+fn the_printed_amplitude_bound_is_a_value_that_works() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = tmp.path().join("a.toml");
+    std::fs::write(&cfg, short(&[("amplitude = 0.5 ", "amplitude = 0.99 ")])).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .arg("config")
+        .arg(&cfg)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let bound = err
+        .split("amplitude <= ")
+        .nth(1)
+        .and_then(|r| r.split(|c: char| c != '.' && !c.is_ascii_digit()).next())
+        .unwrap_or_else(|| panic!("no bound in: {err}"));
+    assert!(err.contains("0.01 <= amplitude"), "{err}");
+    std::fs::write(
+        &cfg,
+        short(&[("amplitude = 0.5 ", &format!("amplitude = {bound} "))]),
+    )
+    .unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .arg("config")
+        .arg(&cfg)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "the printed bound {bound} is refused: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
