@@ -1,5 +1,6 @@
 //! The `tofprobe` command: one subcommand per capability (see `commands/`). Errors are
-//! printed as `error: …` on stderr with exit status 2; no input makes it panic.
+//! printed as `error: …` on stderr with exit status 2; no input makes it panic. An interrupt
+//! (SIGINT, SIGTERM) removes the run's temporaries and exits with 130.
 
 mod commands;
 mod error;
@@ -19,6 +20,7 @@ struct Cli {
 
 fn main() -> ExitCode {
     quiet_on_closed_pipe();
+    remove_temporaries_on_interrupt();
     let cli = Cli::parse();
     let result = commands::run(cli.command);
     // Output still buffered (a `print!` without newline) fails here, not silently at exit.
@@ -31,6 +33,23 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// SIGINT (Ctrl-C), SIGTERM or SIGHUP: remove every temporary the run registered (staged
+/// output sets, atomic-write temporaries, Verilator builds in progress; see
+/// `tofprobe_io::live`) and exit with 130, the shell's status for an interrupt. The old
+/// output set stays whole. The handler runs on ctrlc's own thread, not in signal context.
+fn remove_temporaries_on_interrupt() {
+    if let Err(e) = ctrlc::set_handler(|| {
+        eprintln!("tofprobe: interrupted; removing temporaries");
+        tofprobe_io::live::remove_all_and_exit(130)
+    }) {
+        // Without the handler a signal still ends the run; the next run cleans the
+        // temporaries (tofprobe_io::stale). Say so rather than fail.
+        eprintln!(
+            "warning: no interrupt handler ({e}); temporaries of an interrupted run are removed by the next run"
+        );
     }
 }
 

@@ -7,26 +7,13 @@
 mod common;
 
 use std::collections::BTreeMap;
-use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use common::{default_text, edit, tofprobe};
+use common::{default_text, edit, listing, tofprobe, whole_set_seed};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-}
-
-/// Every entry of `dir` (names), sorted.
-fn listing(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .map(|r| {
-            r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-                .collect()
-        })
-        .unwrap_or_default();
-    v.sort();
-    v
 }
 
 const EVIL: &str =
@@ -106,28 +93,6 @@ fn the_spelling_of_out_does_not_change_a_byte() {
             "{n}"
         );
     }
-}
-
-/// The manifest's seed when every file matches the manifest's hashes (a whole set), else
-/// `None`.
-fn whole_set_seed(dir: &Path) -> Option<u64> {
-    let m: toml::Table =
-        toml::from_str(&std::fs::read_to_string(dir.join("manifest.toml")).ok()?).ok()?;
-    let files = m.get("files")?.as_table()?;
-    for (name, hash) in files {
-        let bytes = std::fs::read(dir.join(name)).ok()?;
-        if format!("{:016x}", tofprobe_io::fnv1a64(&bytes)) != hash.as_str()? {
-            return None;
-        }
-    }
-    let visible: Vec<String> = listing(dir)
-        .into_iter()
-        .filter(|n| !n.starts_with('.'))
-        .collect();
-    let mut expected: Vec<String> = files.keys().cloned().collect();
-    expected.push("manifest.toml".into());
-    expected.sort();
-    (visible == expected).then(|| m.get("seed")?.as_integer().map(|s| s as u64))?
 }
 
 #[test]
@@ -278,7 +243,7 @@ fn extreme_configurations_print_only_finite_numbers() {
             String::from_utf8_lossy(&o.stderr)
         );
         let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        check_finite(what, "", &v);
+        common::finite::assert_finite(what, &v);
         let t = bin().arg("simulate").arg(&cfg).output().unwrap();
         let text = String::from_utf8_lossy(&t.stdout).to_lowercase();
         assert!(
@@ -288,21 +253,6 @@ fn extreme_configurations_print_only_finite_numbers() {
     }
     let o = tofprobe(&["config", "--print-default"]);
     assert!(o.status.success());
-}
-
-/// Every number finite (serde_json writes NaN/inf as null): a null is allowed only for the
-/// statistics an empty record does not have.
-fn check_finite(what: &str, key: &str, v: &serde_json::Value) {
-    match v {
-        serde_json::Value::Null => assert!(
-            key == "mean_depth_mm" || key == "sigma_depth_mm" || key.starts_with("rom_wrap"),
-            "{what}: `{key}` is null (NaN or inf?)"
-        ),
-        serde_json::Value::Number(n) => assert!(n.as_f64().is_some_and(f64::is_finite)),
-        serde_json::Value::Array(a) => a.iter().for_each(|x| check_finite(what, key, x)),
-        serde_json::Value::Object(o) => o.iter().for_each(|(k, x)| check_finite(what, k, x)),
-        _ => {}
-    }
 }
 
 #[test]

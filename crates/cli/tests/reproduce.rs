@@ -19,6 +19,8 @@ fn quick_json_rows_carry_seeds_bands_and_z_scores() {
     ]);
     let _ = std::fs::remove_dir_all(&dir);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    // Every figure finite; nulls only where a row has no reference (docs/reliability.md).
+    common::finite::assert_finite("reproduce --quick --json", &v);
     assert!(
         out.status.success(),
         "{}",

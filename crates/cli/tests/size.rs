@@ -2,6 +2,8 @@
 //! on stdout with the documented schema, and clear errors for a missing liberty, a
 //! liberty without flops, and missing yosys / OpenSTA.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -55,8 +57,17 @@ fn tiny_pixel_json_report() {
     let dir = scratch("json");
     let cfg = tiny_config(&dir);
     let cfg = cfg.to_str().unwrap();
+    let set = dir.join("set");
     let out = size(
-        &[cfg, "--no-sky130", "--json", "--sweep-bins", "1"],
+        &[
+            cfg,
+            "--no-sky130",
+            "--json",
+            "--sweep-bins",
+            "1",
+            "--out",
+            set.to_str().unwrap(),
+        ],
         &[],
         &dir.join("cache"),
     );
@@ -65,9 +76,17 @@ fn tiny_pixel_json_report() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // `--out` writes one set, whole (tofprobe_io::OutputSet): the three files and no
+    // stage or temporary.
+    assert_eq!(
+        common::listing(&set),
+        ["size-report.json", "size-report.md", "size-sweep.svg"]
+    );
     let text = String::from_utf8(out.stdout).unwrap();
     assert_eq!(text.trim().lines().count(), 1, "exactly one JSON object");
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    // One bin, the smallest pixel: every figure finite (docs/reliability.md).
+    common::finite::assert_finite("size --json, one bin", &v);
     assert_eq!(v["schema"], "tofprobe-size-report/1");
     assert_eq!(v["design"]["registers"], 2);
     // 2 registers of W bits, found by the split, each W flops in the register file.

@@ -29,6 +29,14 @@ fn tradeoff_reports_every_level() {
         "{}",
         String::from_utf8_lossy(&res.stderr)
     );
+    // `--out` writes one set, whole (tofprobe_io::OutputSet): no stage or temporary left.
+    let left = common::listing(&dir);
+    assert!(
+        left.contains(&"tradeoff.md".to_string())
+            && left.contains(&"pareto.svg".to_string())
+            && left.iter().all(|n| !n.starts_with('.')),
+        "{left:?}"
+    );
     let v: serde_json::Value = serde_json::from_slice(&res.stdout).expect("one JSON object");
     let levels = v["scenes"][0]["levels"].as_array().expect("levels");
     let get = |name: &str| {

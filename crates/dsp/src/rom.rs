@@ -248,8 +248,9 @@ pub struct RomManifest {
 }
 
 impl RomManifest {
-    /// Writes `<dir>/<stem>.hex` and `<dir>/<stem>.toml` atomically (hex first, so a
-    /// manifest never names a missing file); the manifest's hash is filled in here.
+    /// Writes `<dir>/<stem>.hex` and `<dir>/<stem>.toml` as one set, whole or absent
+    /// (`tofprobe_io::OutputSet`, the manifest last, so a manifest never names a missing
+    /// or older file); the manifest's hash is filled in here.
     pub fn write(&self, image: &RomImage, dir: &Path, stem: &str) -> Result<PathBuf, DspError> {
         let hex = image.to_readmemh();
         let mut m = self.clone();
@@ -257,13 +258,17 @@ impl RomManifest {
         m.content_hash = format!("{:016x}", fnv1a64(hex.as_bytes()));
         m.depth = image.depth();
         m.registers = image.registers();
-        write_atomic(&dir.join(&m.hex_file), hex.as_bytes())?;
-        let text = toml::to_string(&m).map_err(|e| DspError::Io {
-            path: dir.join(format!("{stem}.toml")).display().to_string(),
+        let manifest = format!("{stem}.toml");
+        let path = dir.join(&manifest);
+        let io = |e: &dyn std::fmt::Display| DspError::Io {
+            path: path.display().to_string(),
             message: e.to_string(),
-        })?;
-        let path = dir.join(format!("{stem}.toml"));
-        write_atomic(&path, text.as_bytes())?;
+        };
+        let text = toml::to_string(&m).map_err(|e| io(&e))?;
+        let mut set = tofprobe_io::OutputSet::begin(dir).map_err(|e| io(&e))?;
+        set.add(&m.hex_file, hex.as_bytes()).map_err(|e| io(&e))?;
+        set.add(&manifest, text.as_bytes()).map_err(|e| io(&e))?;
+        set.commit(Some(&manifest)).map_err(|e| io(&e))?;
         Ok(path)
     }
 

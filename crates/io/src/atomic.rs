@@ -50,10 +50,16 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> std::io::Result<()> {
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o644));
     }
-    let mut tmp = builder.tempfile_in(dir)?;
+    // Registered while it lives, so an interrupt removes it (crate::live).
+    let (mut tmp, live) = crate::live::create(
+        crate::live::Kind::Temporary,
+        || builder.tempfile_in(dir),
+        |t| t.path().to_path_buf(),
+    )?;
     tmp.write_all(contents)?;
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
+    drop(live);
     Ok(())
 }
 

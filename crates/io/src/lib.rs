@@ -1,6 +1,7 @@
 //! The workspace's foundation utilities, written once and used by every crate: whole-or-absent
 //! file output ([`write_atomic`] for one file, [`OutputSet`] for a command's set of files),
-//! the cleaning of temporaries left by killed runs ([`stale`]), the sanitising of user text
+//! the registry of live temporaries that an interrupt removes ([`live`]), the cleaning of
+//! temporaries left by killed runs ([`stale`]), the sanitising of user text
 //! before it reaches a generated file ([`text`]) and the FNV-1a content hash ([`fnv1a64`],
 //! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries.
 //!
@@ -8,6 +9,7 @@
 //! the path it was writing.
 
 mod atomic;
+pub mod live;
 mod set;
 pub mod stale;
 pub mod text;

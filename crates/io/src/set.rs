@@ -15,6 +15,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::live::{self, Kind, Live};
 use crate::stale::{PID_MARK, pid_alive};
 
 /// Start of a stage directory's name; the pid and `.stage` follow.
@@ -37,6 +38,9 @@ pub struct OutputSet {
     names: Vec<String>,
     created_target: bool,
     done: bool,
+    /// The stage (and the target if this run made it) in the registry of live
+    /// temporaries, removed by an interrupt ([`crate::live`]).
+    live: Vec<Live>,
 }
 
 impl OutputSet {
@@ -44,7 +48,17 @@ impl OutputSet {
     /// killed runs left there, then creates this run's stage directory.
     pub fn begin(target: &Path) -> std::io::Result<OutputSet> {
         let created_target = !target.exists();
-        std::fs::create_dir_all(target)?;
+        let mut registered = Vec::new();
+        if created_target {
+            let ((), l) = live::create(
+                Kind::CreatedDir,
+                || std::fs::create_dir_all(target),
+                |_| target.to_path_buf(),
+            )?;
+            registered.push(l);
+        } else {
+            std::fs::create_dir_all(target)?;
+        }
         recover(target)?;
         let stage = target.join(format!(
             "{STAGE_PREFIX}{PID_MARK}{}{STAGE_SUFFIX}",
@@ -59,11 +73,19 @@ impl OutputSet {
             names: Vec::new(),
             created_target,
             done: false,
+            live: registered,
         };
-        if let Err(e) = std::fs::create_dir(&stage) {
-            set.done = true;
-            set.remove_created_target();
-            return Err(e);
+        match live::create(
+            Kind::Temporary,
+            || std::fs::create_dir(&stage),
+            |_| stage.clone(),
+        ) {
+            Ok(((), l)) => set.live.push(l),
+            Err(e) => {
+                set.done = true;
+                set.remove_created_target();
+                return Err(e);
+            }
         }
         Ok(set)
     }
@@ -82,7 +104,9 @@ impl OutputSet {
                 format!("output file name `{name}` is not a plain visible file name"),
             ));
         }
-        let mut f = std::fs::File::create(self.stage.join(name))?;
+        // Created with the interrupt handler held off: it never misses a file it must
+        // remove with the stage.
+        let mut f = live::critical(|| std::fs::File::create(self.stage.join(name)))?;
         f.write_all(contents)?;
         f.sync_all()?;
         self.names.retain(|n| n != name);
@@ -104,10 +128,16 @@ impl OutputSet {
         }
         let list = order.join("\n") + "\n";
         let commit = self.stage.join(COMMIT);
-        std::fs::write(&commit, list)?;
-        std::fs::File::open(&commit)?.sync_all()?;
-        self.done = true;
-        finish(&self.target, &self.stage, &order)
+        // An interrupt waits for the commit: it finds the set staged (and removes the
+        // stage: the old set stays) or moved into place, never half moved.
+        // If the COMMIT list cannot be written, `done` stays false and dropping the set
+        // removes the stage.
+        live::critical(|| {
+            std::fs::write(&commit, list)?;
+            std::fs::File::open(&commit)?.sync_all()?;
+            self.done = true;
+            finish(&self.target, &self.stage, &order)
+        })
     }
 
     fn remove_created_target(&self) {

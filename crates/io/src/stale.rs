@@ -1,7 +1,7 @@
-//! Temporaries of killed runs. No signal handler can run on SIGKILL (and the workspace has no
-//! unsafe code to install one for SIGINT/SIGTERM), so every temporary this workspace creates
-//! carries the creating process id in its name, and the next run that writes beside it
-//! removes those whose process is gone.
+//! Temporaries of killed runs. SIGINT/SIGTERM remove them at once (the binary's handler and
+//! [`crate::live`]), but no handler runs on SIGKILL, so every temporary this workspace
+//! creates carries the creating process id in its name, and the next run that writes beside
+//! it removes those whose process is gone.
 
 use std::path::Path;
 

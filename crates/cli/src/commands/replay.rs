@@ -56,11 +56,29 @@ pub fn run(a: &ReplayArgs) -> Result<(), CliError> {
     };
     let out = replay(&a.file, design.as_ref(), &req)?;
     if a.json {
-        println!("{}", serde_json::to_string(&out)?);
+        println!("{}", serde_json::to_string(&json(&out)?)?);
     } else {
         print_text(&a.file, &out);
     }
     Ok(())
+}
+
+/// The JSON object: `ReplayOutcome` as is, except that a frame without detections has
+/// no spectrum: each bin's `amplitude_um`, `float_amplitude_um` and `phase_deg` and the
+/// `measured_floor_um` are `null` (0 would read as a measured amplitude).
+fn json(o: &ReplayOutcome) -> Result<serde_json::Value, CliError> {
+    let mut v = serde_json::to_value(o)?;
+    if o.counts.detections == 0 {
+        if let Some(bins) = v.get_mut("bins").and_then(|b| b.as_array_mut()) {
+            for b in bins {
+                for k in ["amplitude_um", "float_amplitude_um", "phase_deg"] {
+                    b[k] = serde_json::Value::Null;
+                }
+            }
+        }
+        v["measured_floor_um"] = serde_json::Value::Null;
+    }
+    Ok(v)
 }
 
 fn opt(v: Option<f64>, unit: &str, digits: usize) -> String {
@@ -104,6 +122,11 @@ fn print_text(file: &std::path::Path, o: &ReplayOutcome) {
         opt(o.mean_depth_mm, "mm", 4),
         opt(o.sigma_depth_mm, "mm", 4)
     );
+    if o.counts.detections == 0 {
+        println!("bit-true spectrum: none (no detections in the window)");
+        println!("noise floor: none (no detections)");
+        return;
+    }
     println!("bit-true spectrum (float twin and the closed-form floor at the bin beside):");
     for b in &o.bins {
         println!(

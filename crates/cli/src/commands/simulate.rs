@@ -44,10 +44,11 @@ pub struct SimulateArgs {
 pub struct BinOut {
     /// Probe frequency, Hz.
     pub frequency_hz: f64,
-    /// Amplitude, µm.
-    pub amplitude_um: f64,
-    /// Phase, degrees.
-    pub phase_deg: f64,
+    /// Amplitude, µm; `null` when the frame has no detections (an empty record has no
+    /// spectrum, and 0 would read as a measured amplitude).
+    pub amplitude_um: Option<f64>,
+    /// Phase, degrees; `null` when the frame has no detections.
+    pub phase_deg: Option<f64>,
 }
 
 /// The bit-true part of the output.
@@ -59,8 +60,9 @@ pub struct BitTrueOut {
     pub frame_pulses: u64,
     /// One entry per bin, ROM order.
     pub bins: Vec<BinOut>,
-    /// Median amplitude over the bins, µm (noise estimate when most bins hold no tone).
-    pub noise_estimate_um: f64,
+    /// Median amplitude over the bins, µm (noise estimate when most bins hold no tone);
+    /// `null` when the frame has no detections.
+    pub noise_estimate_um: Option<f64>,
     /// Wall time of ROM generation (s).
     pub rom_seconds: f64,
     /// ROM organisation: "windowed" or "periodic".
@@ -189,7 +191,10 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let pulses = design.pulses();
     let progress = !args.json && std::io::stderr().is_terminal();
     let s = summarise(&source, pulses, progress);
-    let bit_true = bit_true(&design, &source)?;
+    // The bit-true frame is the record's first N pulses (the same source and seed): a
+    // record without detections leaves it empty too.
+    let empty_frame = s.detections == 0 && design.pixel.frame_pulses <= s.pulses;
+    let bit_true = bit_true(&design, &source, empty_frame)?;
     let haar = if design.pixel.mode == tofprobe_pixel::Mode::Haar {
         let (analysis, model_seconds) = bit_true_haar(&design)?;
         Some(HaarOut {
@@ -277,17 +282,21 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                     .map(|w| format!(", {w}"))
                     .unwrap_or_default();
                 println!("  probe ROM {} L = {}{wrap}", b.rom_mode, b.rom_depth);
-                println!("  frequency Hz   amplitude um    phase deg");
-                for bin in &b.bins {
-                    println!(
-                        "  {:>12.2} {:>14.4} {:>12.2}",
-                        bin.frequency_hz, bin.amplitude_um, bin.phase_deg
-                    );
+                match b.noise_estimate_um {
+                    None => println!("  spectrum           none (no detections in the frame)"),
+                    Some(noise) => {
+                        println!("  frequency Hz   amplitude um    phase deg");
+                        for bin in &b.bins {
+                            println!(
+                                "  {:>12.2} {:>14.4} {:>12.2}",
+                                bin.frequency_hz,
+                                bin.amplitude_um.unwrap_or(0.0),
+                                bin.phase_deg.unwrap_or(0.0)
+                            );
+                        }
+                        println!("  noise estimate {noise:.4} um (median over bins)");
+                    }
                 }
-                println!(
-                    "  noise estimate {:.4} um (median over bins)",
-                    b.noise_estimate_um
-                );
             }
         }
         if let Some(p) = &args.svg {
@@ -301,10 +310,12 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Runs the bit-true pixel over one frame (Fourier mode; `None` in Haar mode).
+/// Runs the bit-true pixel over one frame (Fourier mode; `None` in Haar mode);
+/// `empty_frame`: the frame has no detections, and its figures are absent, not 0.
 fn bit_true(
     design: &ResolvedDesign,
     source: &PhotonSource,
+    empty_frame: bool,
 ) -> Result<Option<(BitTrueOut, BitTrueSpectrum)>, CliError> {
     if design.pixel.mode != tofprobe_pixel::Mode::Fourier {
         return Ok(None);
@@ -324,11 +335,11 @@ fn bit_true(
             .iter()
             .map(|b| BinOut {
                 frequency_hz: b.frequency_hz,
-                amplitude_um: b.amplitude_um,
-                phase_deg: b.phase_deg,
+                amplitude_um: (!empty_frame).then_some(b.amplitude_um),
+                phase_deg: (!empty_frame).then_some(b.phase_deg),
             })
             .collect(),
-        noise_estimate_um: spectrum.median_amplitude_um,
+        noise_estimate_um: (!empty_frame).then_some(spectrum.median_amplitude_um),
         rom_seconds,
         rom_mode: setup.rom.mode.name().to_string(),
         rom_depth: setup.rom.depth(),

@@ -60,13 +60,17 @@ pub fn report(a: &SizeArgs) -> Result<SizeReport, CliError> {
 pub fn run(a: &SizeArgs) -> Result<(), CliError> {
     let r = report(a)?;
     if let Some(dir) = &a.out {
+        // One set, whole or absent (tofprobe_io::OutputSet), the JSON report last.
         let json = serde_json::to_vec_pretty(&r)?;
-        tofprobe_report::fsutil::write_atomic(&dir.join("size-report.json"), &json)?;
-        tofprobe_report::fsutil::write_atomic(
-            &dir.join("size-report.md"),
-            markdown::render(&r).as_bytes(),
-        )?;
-        plot::write_sweep_svg(&r, &dir.join("size-sweep.svg"))?;
+        let svg = plot::sweep_svg(&r)
+            .map_err(|reason| CliError::output(dir.join("size-sweep.svg"), reason))?;
+        let io = |e: std::io::Error| CliError::output(dir.clone(), e.to_string());
+        let mut set = tofprobe_io::OutputSet::begin(dir).map_err(io)?;
+        set.add("size-sweep.svg", svg.as_bytes()).map_err(io)?;
+        set.add("size-report.md", markdown::render(&r).as_bytes())
+            .map_err(io)?;
+        set.add("size-report.json", &json).map_err(io)?;
+        set.commit(Some("size-report.json")).map_err(io)?;
     }
     if a.json {
         println!("{}", serde_json::to_string(&r)?);

@@ -14,11 +14,10 @@ use std::path::PathBuf;
 use clap::Args;
 use serde::Serialize;
 
-use tofprobe_study::spectrum::write_atomic;
 use tofprobe_study::tradeoff::haar::{self, HaarSceneResult, measure_haar};
 use tofprobe_study::tradeoff::knobs::{self, DEFAULT_SWEEP, KnobSweep};
 use tofprobe_study::tradeoff::skips::{self, SkipReport, measure_skips};
-use tofprobe_study::tradeoff::{SceneResult, markdown, measure, plot::pareto_svg};
+use tofprobe_study::tradeoff::{SceneResult, markdown, measure, plot::pareto_svg_text};
 
 use crate::error::CliError;
 
@@ -120,11 +119,19 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     }
     let table = tables.join("\n");
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).map_err(|e| CliError::output(dir.clone(), e.to_string()))?;
-        write_atomic(&dir.join("tradeoff.md"), table.as_bytes())?;
-        if !scenes.is_empty() {
-            pareto_svg(&dir.join("pareto.svg"), &scenes)?;
+        // One set, whole or absent (tofprobe_io::OutputSet), the table last.
+        let io = |e: std::io::Error| CliError::output(dir.clone(), e.to_string());
+        let svg = if scenes.is_empty() {
+            None
+        } else {
+            Some(pareto_svg_text(&dir.join("pareto.svg"), &scenes)?)
+        };
+        let mut set = tofprobe_io::OutputSet::begin(dir).map_err(io)?;
+        if let Some(svg) = svg {
+            set.add("pareto.svg", svg.as_bytes()).map_err(io)?;
         }
+        set.add("tradeoff.md", table.as_bytes()).map_err(io)?;
+        set.commit(Some("tradeoff.md")).map_err(io)?;
     }
     if args.json {
         println!(

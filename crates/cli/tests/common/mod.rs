@@ -3,6 +3,9 @@
 //! tests run on. Each test binary uses a subset.
 #![allow(dead_code)]
 
+pub mod finite;
+
+use std::path::Path;
 use std::process::{Command, Output};
 
 /// Runs the built `tofprobe` with `args`.
@@ -50,4 +53,38 @@ pub fn short_tone_frame(n: u64) -> String {
             ("cycles_per_pulse = 16", "cycles_per_pulse = 4"),
         ],
     )
+}
+
+/// Every entry of `dir` (names), sorted.
+pub fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .map(|r| {
+            r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// The manifest's seed when every file matches the manifest's hashes (a whole set), else
+/// `None`.
+pub fn whole_set_seed(dir: &Path) -> Option<u64> {
+    let m: toml::Table =
+        toml::from_str(&std::fs::read_to_string(dir.join("manifest.toml")).ok()?).ok()?;
+    let files = m.get("files")?.as_table()?;
+    for (name, hash) in files {
+        let bytes = std::fs::read(dir.join(name)).ok()?;
+        if format!("{:016x}", tofprobe_io::fnv1a64(&bytes)) != hash.as_str()? {
+            return None;
+        }
+    }
+    let visible: Vec<String> = listing(dir)
+        .into_iter()
+        .filter(|n| !n.starts_with('.'))
+        .collect();
+    let mut expected: Vec<String> = files.keys().cloned().collect();
+    expected.push("manifest.toml".into());
+    expected.sort();
+    (visible == expected).then(|| m.get("seed")?.as_integer().map(|s| s as u64))?
 }

@@ -118,7 +118,13 @@ impl ProbeDesign {
             return Err(DspError::out_of_range(
                 "probe.amplitude",
                 config.amplitude,
-                format!("0 < amplitude <= {limit:.4}"),
+                // Rounded down: the printed bound is a value that works (0.69975 printed
+                // as 0.6998 was itself refused).
+                format!(
+                    "{} <= amplitude <= {:.4}",
+                    super::config::MIN_AMPLITUDE,
+                    (limit * 1e4).floor() / 1e4
+                ),
             )
             .with_hint(format!(
                 "the order-{} OSR-{} H_inf-{} modulator is stable up to {a_max:.4} at \

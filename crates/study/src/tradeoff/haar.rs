@@ -256,8 +256,11 @@ fn verilator_level(
     o.measure_bare = true;
     o.profile = tofprobe_cosim::BuildProfile::Speed;
     o.stimulus = Some(detections[..rtl.frame_pulses as usize].to_vec());
+    // Removed after the run, and by an interrupt during it (tofprobe_io::live).
+    let live = tofprobe_io::live::register(tofprobe_io::live::Kind::Temporary, &work);
     let r = tofprobe_cosim::cosim(&rtl, &o);
     let _ = std::fs::remove_dir_all(&work);
+    drop(live);
     match r {
         Ok(rep) if rep.pass => {
             let secs = rep.bare_seconds.unwrap_or(rep.verilator_seconds);

@@ -268,7 +268,13 @@ pub fn measure_setup(
         o.measure_bare = true;
         o.profile = tofprobe_cosim::BuildProfile::Speed;
         o.stimulus = Some(stim);
-        let rep = tofprobe_cosim::cosim(&rtl, &o)?;
+        // A scratch directory: removed after the run, and by an interrupt during it
+        // (tofprobe_io::live).
+        let live = tofprobe_io::live::register(tofprobe_io::live::Kind::Temporary, &work);
+        let rep = tofprobe_cosim::cosim(&rtl, &o);
+        let _ = std::fs::remove_dir_all(&work);
+        drop(live);
+        let rep = rep?;
         if !rep.pass {
             return Err(StudyError::Output {
                 path: work,

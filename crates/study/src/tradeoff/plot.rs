@@ -12,6 +12,12 @@ use crate::spectrum::write_atomic;
 
 /// Writes the SVG atomically; levels without a tone amplitude are left out.
 pub fn pareto_svg(path: &Path, scenes: &[SceneResult]) -> Result<(), StudyError> {
+    write_atomic(path, pareto_svg_text(path, scenes)?.as_bytes())
+}
+
+/// The text of [`pareto_svg`], for a caller that writes it as part of a set of files;
+/// `path` only names the file in errors.
+pub fn pareto_svg_text(path: &Path, scenes: &[SceneResult]) -> Result<String, StudyError> {
     let err = |e: &dyn std::fmt::Display| StudyError::Output {
         path: path.to_path_buf(),
         message: e.to_string(),
@@ -87,5 +93,5 @@ pub fn pareto_svg(path: &Path, scenes: &[SceneResult]) -> Result<(), StudyError>
             .map_err(|e| err(&e))?;
         root.present().map_err(|e| err(&e))?;
     }
-    write_atomic(path, svg.as_bytes())
+    Ok(svg)
 }
