@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 use tofprobe_io::fnv1a64;
+use tofprobe_io::stale::{pid_tagged, temporary_pid};
 
 /// The harness source, embedded so the binary works outside the source tree.
 pub const HARNESS_CPP: &str = include_str!("../../../testbench/harness.cpp");
@@ -134,19 +135,12 @@ pub fn build_with(
             seconds: t0.elapsed().as_secs_f64(),
         });
     }
-    let tmp = cache_root().join("verilator").join(format!(
-        ".{hash}.{}.{}",
-        std::process::id(),
-        next_build_id()
-    ));
+    let tmp = cache_root()
+        .join("verilator")
+        .join(pid_tagged(&hash, &next_build_id().to_string()));
     let _ = std::fs::remove_dir_all(&tmp);
-    // Builds of killed runs (`.HASH.PID.N` of a dead PID) are never finished: remove them.
-    // The PID is the second field: the last one is the build counter of a live process.
-    tofprobe_io::stale::remove_stale(&cache_root().join("verilator"), |n| {
-        let mut fields = n.strip_prefix('.')?.split('.');
-        let (_hash, pid) = (fields.next()?, fields.next()?);
-        pid.parse().ok()
-    });
+    // Builds of killed runs (a dead PID in the name) are never finished: remove them.
+    tofprobe_io::stale::remove_stale(&cache_root().join("verilator"), temporary_pid);
     // Registered while the build runs, so an interrupt removes it (tofprobe_io::live), and
     // removed by the guard on any error: a failed or interrupted build leaves no directory.
     let ((), live) = tofprobe_io::live::create(

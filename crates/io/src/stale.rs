@@ -21,6 +21,13 @@ pub fn pid_alive(pid: u32) -> bool {
     proc.join(pid.to_string()).exists()
 }
 
+/// A hidden temporary name for `base` carrying this process's id, `.BASE.tofprobe-PID.TAG`:
+/// the one spelling every writer uses, which [`temporary_pid`] reads back, so
+/// `remove_stale(dir, temporary_pid)` can never mistake another field for the id.
+pub fn pid_tagged(base: &str, tag: &str) -> String {
+    format!(".{base}{PID_MARK}{}.{tag}", std::process::id())
+}
+
 /// The process id in a temporary's name `….tofprobe-PID.…` (hidden names only), if any.
 pub fn temporary_pid(name: &str) -> Option<u32> {
     if !name.starts_with('.') {
@@ -71,6 +78,17 @@ mod tests {
         assert_eq!(temporary_pid(".tofprobe-stage-7"), None);
         assert_eq!(temporary_pid("x.tofprobe-123.tmp"), None);
         assert_eq!(temporary_pid(".x.tmp"), None);
+    }
+
+    /// The writer's spelling round-trips through the parser, whatever the tag: the
+    /// Verilator cache once wrote `.HASH.PID.N` and parsed N (a build counter) as the PID,
+    /// deleting live builds of the same process.
+    #[test]
+    fn pid_tagged_names_parse_back_to_this_process() {
+        for tag in ["0", "17", "tmp", "3.v"] {
+            let n = pid_tagged("0123456789abcdef", tag);
+            assert_eq!(temporary_pid(&n), Some(std::process::id()), "{n}");
+        }
     }
 
     #[test]
