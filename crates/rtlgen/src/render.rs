@@ -93,7 +93,9 @@ fn header(p: &PixelParams, template: &str, o: &RenderOptions) -> String {
             .collect();
         h.push_str(&format!("// Probe ROM: {note}\n"));
     }
-    if let Some(d) = o.directed {
+    // Only the top changes with the sequencer: the pixel and ROM files stay byte-identical
+    // (so coverage of the pixel adds up over both sequencers' runs, line by line).
+    if let (Some(d), "top.v") = (o.directed, template) {
         h.push_str(&format!(
             "// {DIRECTED_MARK} (long_frame = {}), docs/pixel-contract.md \"The directed sequencer\".\n",
             d.long_frame
