@@ -123,6 +123,8 @@ pub struct CosimReport {
     pub build: HarnessBuild,
     pub pulses: u64,
     pub cycles: u64,
+    /// Frames read out (status words): `frames` of the reference sequencer, three per loop
+    /// of the directed one.
     pub frames: u64,
     /// Seconds of the reference cycle model (golden run, digests included).
     pub model_seconds: f64,
@@ -296,7 +298,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
             },
             pulses,
             cycles: golden.cycles,
-            frames: o.frames,
+            frames,
             model_seconds,
             bare_seconds: None,
             vcd: None,
@@ -376,7 +378,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         build,
         pulses,
         cycles: golden.cycles,
-        frames: o.frames,
+        frames,
         model_seconds,
         bare_seconds,
         vcd,
