@@ -39,7 +39,7 @@ fn loop_cycles(m: u64) -> u64 {
     let (n, c, k, r) = (16, 16, 16, 32);
     n * c + 1 + (r + 2) // frame 0, readout with a pulse, pulses during the readout
         + 2 * k + n * c + 2 * 4096 + k + (k + 1) + (r + 2) // frame 1
-        + m * n * c + 1 + (k + 1) + (r + 2) // frame 2
+        + (m * n - 1) * c + 1 + (k + 1) + (r + 2) // frame 2
 }
 
 #[test]

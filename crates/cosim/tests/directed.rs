@@ -12,12 +12,12 @@ use tofprobe_pixel::{DirectedOptions, Mode, PixelParams, TransactionModel};
 /// frame 0 counts the pulse refused with the readout and the R refused while the words come
 /// out (R + 1; the one at the status edge goes to frame 1); frame 1 saturates (2^W − 1);
 /// frame 2 refuses nothing in Fourier mode, and in Haar mode the long frame's pulses beyond
-/// N plus the pulse before the readout strobes ((long − 1)·N + 1).
+/// N ((long − 1)·N).
 fn status_words(p: &PixelParams, long: u64) -> [u64; 3] {
     let r = p.registers() as u64;
     let frame2 = match p.mode {
         Mode::Fourier => 0,
-        Mode::Haar => (long - 1) * p.frame_pulses + 1,
+        Mode::Haar => (long - 1) * p.frame_pulses,
     };
     [r + 1, p.refused_max(), frame2]
 }

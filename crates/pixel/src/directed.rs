@@ -218,9 +218,10 @@ impl Program {
 ///    enough to saturate the refused counter (2·min(2^W, 4096) cycles: Haar refuses all,
 ///    Fourier with K ≥ 2 at least half); K idle cycles; K + 1 readout strobes (the first
 ///    taken, the rest ignored during the readout) and R + 2 idle cycles.
-/// 2. `long_frame`·N pulses one every C cycles (registers sized for N wrap); a pulse and
-///    K + 1 readout strobes at the next cycles (ignored while the pipeline is busy, K ≥ 3);
-///    R + 2 idle cycles.
+/// 2. `long_frame`·N − 1 pulses (at least 1) one every C cycles, the last one C cycles
+///    later too, and K + 1 readout strobes at the cycles after it (ignored while the
+///    pipeline is busy, K ≥ 3: with `long_frame` = 1 a Haar frame takes that last pulse,
+///    its N-th); registers sized for N wrap; R + 2 idle cycles.
 pub fn directed_program(p: &PixelParams, o: &DirectedOptions) -> Result<Program, PixelError> {
     p.validate()?;
     if o.long_frame == 0 {
@@ -285,13 +286,19 @@ pub fn directed_program(p: &PixelParams, o: &DirectedOptions) -> Result<Program,
             "readout strobes: one taken, the rest ignored",
         ),
         step(false, false, 1, r + 2, "the words come out"),
-        step(true, false, c, o.long_frame * n, "frame 2: the long frame"),
+        step(
+            true,
+            false,
+            c,
+            (o.long_frame * n - 1).max(1),
+            "frame 2: the long frame, but its last pulse",
+        ),
         step(
             true,
             false,
             1,
             1,
-            "a pulse, then readout strobes while busy",
+            "its last pulse, then readout strobes while busy",
         ),
         step(false, true, 1, k + 1, "readout strobes: ignored while busy"),
         step(false, false, 1, r + 2, "the words come out"),
