@@ -9,7 +9,9 @@
 mod common;
 
 use common::{Rng, random_detection, random_params, random_rom};
-use tofprobe_pixel::{CycleModel, DirectedOptions, Mode, PixelParams, Sequencer, directed_program};
+use tofprobe_pixel::{
+    CycleModel, DirectedOptions, Fault, Mode, PixelParams, Sequencer, directed_program,
+};
 
 /// Paths seen, counted per edge from the pins and the model's state before it.
 #[derive(Debug, Default)]
@@ -173,4 +175,43 @@ fn directed_schedule_takes_every_refusal_path_with_closed_form_status_words() {
         "too few saturating configurations: {saturating}"
     );
     assert!(totals.refused_reading > 0 && totals.readout_ignored_busy > 0);
+}
+
+/// The status words of two loops under the cycle model carrying `fault`.
+fn status_under(seed: u64, fault: Option<Fault>) -> (PixelParams, Vec<u64>) {
+    let mut rng = Rng(seed);
+    let p = random_params(&mut rng);
+    let rom = random_rom(&mut rng, &p);
+    let prog = directed_program(&p, &DirectedOptions::default()).expect("program");
+    let stim: Vec<Option<u32>> = (0..2 * prog.loop_pulses())
+        .map(|_| random_detection(&mut rng, &p))
+        .collect();
+    let seq = Sequencer::directed(&p, prog, &stim, Some(&rom), 2)
+        .expect("sequence")
+        .with_status_cycle();
+    let mut m = CycleModel::with_fault(&p, fault).expect("model");
+    let r = p.registers() as u32;
+    let words = seq
+        .map(|pins| m.step(&pins))
+        .filter(|o| o.rd_valid && o.rd_index == r)
+        .map(|o| o.rd_data)
+        .collect();
+    (p, words)
+}
+
+/// The closed forms can fail: a counter that does not count, or a status word that does
+/// not carry it, misses frame 0's R + 1 on every configuration.
+#[test]
+fn broken_refusal_paths_miss_the_closed_forms() {
+    for fault in [Fault::RefusedCounter, Fault::StatusWord] {
+        for seed in 0..50u64 {
+            let (p, good) = status_under(seed, None);
+            let (_, bad) = status_under(seed, Some(fault));
+            assert_eq!(Some(good[0]), closed_form(&p, 1)[0], "seed {seed}");
+            assert_ne!(
+                bad[0], good[0],
+                "{fault:?} seed {seed}: frame 0's status word"
+            );
+        }
+    }
 }
