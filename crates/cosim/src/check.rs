@@ -135,6 +135,44 @@ pub fn check_header(p: &PixelParams, dir: &Path) -> Result<RtlHeader, CosimError
     Ok(h)
 }
 
+/// The sequencer the top in `dir` was rendered with must be the one the run drives: the
+/// reference one (no `// Sequencer: directed` header line) or the directed one with the
+/// same `long_frame`; the golden vectors of one cannot judge the other.
+pub fn check_sequencer(
+    dir: &Path,
+    directed: Option<&tofprobe_pixel::DirectedOptions>,
+) -> Result<(), CosimError> {
+    use tofprobe_rtlgen::render::DIRECTED_MARK;
+    let (_, _, top) = module_names(DEFAULT_MODULE_PREFIX);
+    let path = dir.join(format!("{top}.v"));
+    let text = std::fs::read_to_string(&path).map_err(|e| CosimError::io(&path, e))?;
+    let describe = |d: Option<u64>| match d {
+        Some(l) => format!("directed (long_frame = {l})"),
+        None => "reference".to_string(),
+    };
+    let rtl = text
+        .lines()
+        .take(20)
+        .find_map(|l| l.strip_prefix("// ")?.strip_prefix(DIRECTED_MARK))
+        .map(|rest| {
+            rest.trim_start_matches(" (long_frame = ")
+                .split(')')
+                .next()
+                .and_then(|v| v.parse::<u64>().ok())
+                .unwrap_or(0)
+        });
+    let want = directed.map(|d| d.long_frame);
+    if rtl != want {
+        return Err(CosimError::RtlMismatch(Box::new(ParamDiff {
+            dir: dir.to_path_buf(),
+            parameter: "sequencer (the top's stimulus schedule)".into(),
+            rtl: describe(rtl),
+            config: describe(want),
+        })));
+    }
+    Ok(())
+}
+
 /// Reads the probe ROM image of `dir` strictly: the `$readmemh` file (every line, depth
 /// exactly L, checked against `<rom>.toml`'s content hash when the manifest is there) or
 /// the case table of a shallow ROM. Haar: empty.

@@ -10,7 +10,7 @@ use crate::icarus;
 use crate::verilator::{self, BuildProfile, HarnessBuild};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use tofprobe_pixel::{Fault, Mode, PixelParams};
+use tofprobe_pixel::{DirectedOptions, Fault, Mode, PixelParams, directed_program};
 use tofprobe_rtlgen::render::RenderOptions;
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
 use tofprobe_rtlgen::vectors::{VectorOptions, golden_run, write_vectors};
@@ -60,6 +60,10 @@ pub struct CosimOptions {
     pub lead_misses: u64,
     /// Also measure line/toggle coverage of the pixel module (Verilator `--coverage`).
     pub coverage: bool,
+    /// Drive the contract's directed sequencer instead of the reference one: `frames`
+    /// loops of its program (refusals, the refused counter to saturation, readouts ignored,
+    /// a long frame), rendered into the top and walked by the model alike.
+    pub directed: Option<DirectedOptions>,
 }
 
 /// The simulator of a co-simulation: both replay the same vectors, report the first
@@ -104,6 +108,7 @@ impl CosimOptions {
             x_seed: 1,
             lead_misses: 0,
             coverage: false,
+            directed: None,
         }
     }
 }
@@ -118,6 +123,8 @@ pub struct CosimReport {
     pub build: HarnessBuild,
     pub pulses: u64,
     pub cycles: u64,
+    /// Frames read out (status words): `frames` of the reference sequencer, three per loop
+    /// of the directed one.
     pub frames: u64,
     /// Seconds of the reference cycle model (golden run, digests included).
     pub model_seconds: f64,
@@ -153,6 +160,29 @@ pub fn render_into(p: &PixelParams, dir: &Path, mutation: Option<Fault>) -> Resu
     render_with_rom(p, &sign_probe_rom(p), dir, mutation)
 }
 
+/// Renders like [`render_with_rom`], the top driven by the directed sequencer when
+/// `directed` is given.
+pub fn render_driven(
+    p: &PixelParams,
+    rom: &[u64],
+    dir: &Path,
+    mutation: Option<Fault>,
+    directed: Option<DirectedOptions>,
+) -> Result<(), CosimError> {
+    let files = tofprobe_rtlgen::render(
+        p,
+        rom,
+        &RenderOptions {
+            mutation,
+            directed,
+            ..RenderOptions::default()
+        },
+    )?;
+    let pairs: Vec<(String, String)> = files.into_iter().map(|f| (f.name, f.contents)).collect();
+    write_generated(dir, &pairs)?;
+    Ok(())
+}
+
 /// Renders the configuration's RTL with the given probe ROM image (L × ceil(R/64) words).
 pub fn render_with_rom(
     p: &PixelParams,
@@ -160,17 +190,7 @@ pub fn render_with_rom(
     dir: &Path,
     mutation: Option<Fault>,
 ) -> Result<(), CosimError> {
-    let files = tofprobe_rtlgen::render(
-        p,
-        rom,
-        &RenderOptions {
-            mutation,
-            ..RenderOptions::default()
-        },
-    )?;
-    let pairs: Vec<(String, String)> = files.into_iter().map(|f| (f.name, f.contents)).collect();
-    write_generated(dir, &pairs)?;
-    Ok(())
+    render_driven(p, rom, dir, mutation, None)
 }
 
 /// Runs one co-simulation.
@@ -190,8 +210,8 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         None => {
             let d = work_dir.join("rtl");
             match &o.rom {
-                Some(rom) => render_with_rom(p, rom, &d, o.mutation)?,
-                None => render_into(p, &d, o.mutation)?,
+                Some(rom) => render_driven(p, rom, &d, o.mutation, o.directed)?,
+                None => render_driven(p, &sign_probe_rom(p), &d, o.mutation, o.directed)?,
             }
             d
         }
@@ -211,7 +231,24 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
             allowed: "1..=2^64-1 (0 lets Verilator choose, irreproducibly); use 1".into(),
         });
     }
-    let pulses = o.frames * p.frame_pulses;
+    check::check_sequencer(&rtl_dir, o.directed.as_ref())?;
+    let program = o
+        .directed
+        .as_ref()
+        .map(|d| directed_program(p, d))
+        .transpose()
+        .map_err(tofprobe_rtlgen::RtlError::from)?;
+    let (pulses, cycles_needed) = match &program {
+        Some(prog) => (
+            o.frames * prog.loop_pulses(),
+            2 + o.frames * prog.loop_cycles() + 1,
+        ),
+        None => (
+            o.frames * p.frame_pulses,
+            2 + o.frames * (p.frame_pulses * p.cycles_per_pulse as u64 + p.registers() as u64 + 2)
+                + 1,
+        ),
+    };
     let mut stim = match &o.stimulus {
         Some(s) if s.len() as u64 >= pulses => s[..pulses as usize].to_vec(),
         _ => random_stimulus(p, pulses, o.seed),
@@ -219,8 +256,9 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
     for d in stim.iter_mut().take(o.lead_misses as usize) {
         *d = None;
     }
-    let cycles_needed =
-        2 + o.frames * (p.frame_pulses * p.cycles_per_pulse as u64 + p.registers() as u64 + 2) + 1;
+    if let Some(prog) = &program {
+        prog.miss_frame_leads(&mut stim);
+    }
     if o.simulator == Simulator::Icarus && (o.digest_only || cycles_needed > ICARUS_MAX_CYCLES) {
         return Err(CosimError::Option {
             option: "simulator",
@@ -235,6 +273,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         seed: o.seed,
         digest_pulses: o.digest_pulses,
         trace_window: o.digest_only.then_some((0, 0)),
+        directed: o.directed,
     };
     let t0 = Instant::now();
     let (golden, window) = golden_run(p, &stim, &rom, &vopts)?;
@@ -248,7 +287,8 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         let outcome = icarus::run(&rtl_dir, &vec_dir, &top, &work_dir.join("icarus"))?;
         let seconds = t1.elapsed().as_secs_f64();
         let first = outcome.first.clone();
-        let pass = outcome.mismatches == 0 && outcome.frames == o.frames && first.is_none();
+        let frames = golden.readouts.len() as u64;
+        let pass = outcome.mismatches == 0 && outcome.frames == frames && first.is_none();
         return Ok(CosimReport {
             pass,
             verilator_seconds: seconds,
@@ -261,7 +301,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
             },
             pulses,
             cycles: golden.cycles,
-            frames: o.frames,
+            frames,
             model_seconds,
             bare_seconds: None,
             vcd: None,
@@ -296,7 +336,8 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
             (a, b) => b.or(a),
         };
     }
-    let pass = outcome.mismatches == 0 && outcome.frames == o.frames && first.is_none();
+    let frames = golden.readouts.len() as u64;
+    let pass = outcome.mismatches == 0 && outcome.frames == frames && first.is_none();
     let mut vcd = None;
     if o.trace || (o.vcd_on_mismatch && !pass) {
         let (lo, hi) = match &first {
@@ -341,7 +382,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         build,
         pulses,
         cycles: golden.cycles,
-        frames: o.frames,
+        frames,
         model_seconds,
         bare_seconds,
         vcd,

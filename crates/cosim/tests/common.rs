@@ -35,3 +35,23 @@ pub fn short_default(mode: Mode) -> PixelParams {
         ..PixelParams::default()
     }
 }
+
+/// K = 3 (Fourier: R = 6 over 2 adders; Haar: U = 2, 3 scales over 1 adder), C = 4, and
+/// W = 8: 2^W − 1 = 255 refusals saturate the counter, a frame of 16 pulses of 4-bit codes
+/// fits, and a 4× longer one wraps.
+pub fn directed_config(mode: Mode) -> PixelParams {
+    PixelParams {
+        mode,
+        bins: 3,
+        haar_scales: 2,
+        adders: if mode == Mode::Fourier { 2 } else { 1 },
+        cycles_per_pulse: 4,
+        tdc_bits: 4,
+        zoom: 5,
+        shift: 2,
+        frac_bits: 2,
+        width: 8,
+        frame_pulses: 16,
+        rom_depth: 16,
+    }
+}

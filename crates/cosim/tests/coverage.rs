@@ -1,25 +1,29 @@
 //! Line coverage of the pixel module under the CI stimuli (Verilator `--coverage`,
-//! `verilator_coverage --annotate`): every line with a coverage point is hit, except the
-//! ones listed in `NEEDS_REFUSALS` — lines that only a refused pulse can reach (the
-//! reference sequencer never refuses one; see crates/cosim/tests/mutations.rs) — and
-//! `DEAD`: the `default` arm of an adder's slot case (and of its read-ahead case) when the slot counter's 2^bits values
-//! are all listed slots (K a power of two), kept so the case is full for lint.
+//! `verilator_coverage --annotate`). The CI set per mode: the reference sequencer with
+//! frames starting with misses, and the directed sequencer (docs/pixel-contract.md, "The
+//! directed sequencer") on the same RTL (only the top differs, so the pixel's lines add up
+//! line by line). Together they hit every line with a coverage point except `DEAD`, the
+//! structurally unreachable `default` arms kept so each case is full for lint: an adder's
+//! slot case when the slot counter's 2^bits values are all listed slots (K a power of
+//! two), and its read-ahead case for every K (the selector is slot + 1 ≤ K − 1, or 0).
+//! On a K = 3 pixel the directed run alone hits every other line.
 
 mod common;
 use common::*;
+use std::collections::BTreeSet;
 use tofprobe_cosim::{CosimOptions, cosim};
-use tofprobe_pixel::Mode;
+use tofprobe_pixel::{DirectedOptions, Mode};
 
 /// Source fragments of the lines only a refused pulse reaches (the refused counter's
-/// increment and the saturation compare, the Haar frame-full compare's false arm).
+/// increment and the saturation compare): the reference sequencer alone misses them.
 const NEEDS_REFUSALS: &[&str] = &["refused <= refused +", "refused != "];
 const DEAD: &[&str] = &["default: begin yin_", "default: begin rd_"];
 
 #[test]
-fn pixel_lines_are_covered_except_the_refusal_path() {
+fn pixel_lines_are_covered_by_the_ci_set() {
     if !tools_or_skip(
         &["verilator", "verilator_coverage"],
-        "pixel_lines_are_covered_except_the_refusal_path",
+        "pixel_lines_are_covered_by_the_ci_set",
     ) {
         return;
     }
@@ -32,26 +36,72 @@ fn pixel_lines_are_covered_except_the_refusal_path() {
         p.adders = 2;
         p.cycles_per_pulse = 3;
         p.validate().expect("valid");
-        let mut o = CosimOptions::new(work_dir(&format!("coverage-{mode:?}")));
-        o.frames = 2;
-        o.lead_misses = 3;
-        o.coverage = true;
-        o.vcd_on_mismatch = false;
-        let r = cosim(&p, &o).expect("runs");
-        assert!(r.pass, "{:?}", r.first);
-        let c = r.coverage.expect("coverage measured");
-        eprintln!(
-            "{mode:?}: {} of {} lines with coverage points hit ({:.1}%); not hit: {:?}",
-            c.covered,
-            c.lines,
-            c.percent(),
-            c.uncovered
-        );
-        assert!(c.lines > 20, "too few coverage points: {c:?}");
-        for (line, text) in &c.uncovered {
+        let run = |p: &tofprobe_pixel::PixelParams, name: &str, directed| {
+            let mut o = CosimOptions::new(work_dir(&format!("coverage-{mode:?}-{name}")));
+            o.frames = 2;
+            o.lead_misses = 3;
+            o.coverage = true;
+            o.vcd_on_mismatch = false;
+            o.directed = directed;
+            let r = cosim(p, &o).expect("runs");
+            assert!(r.pass, "{mode:?} {name}: {:?}", r.first);
+            let c = r.coverage.expect("coverage measured");
+            eprintln!(
+                "{mode:?} {name}: {} of {} lines with coverage points hit ({:.1}%); not hit: {:?}",
+                c.covered,
+                c.lines,
+                c.percent(),
+                c.uncovered
+            );
+            assert!(c.lines > 20, "too few coverage points: {c:?}");
+            c
+        };
+        let reference = run(&p, "reference", None);
+        for (line, text) in &reference.uncovered {
             assert!(
                 NEEDS_REFUSALS.iter().chain(DEAD).any(|f| text.contains(f)),
-                "{mode:?}: line {line} `{text}` is not covered"
+                "{mode:?}: line {line} `{text}` is not covered by the reference run"
+            );
+        }
+        let directed = run(&p, "directed", Some(DirectedOptions::default()));
+        assert_eq!(directed.lines, reference.lines, "the same pixel file");
+        let missed = |c: &tofprobe_cosim::coverage::Coverage| -> BTreeSet<usize> {
+            c.uncovered.iter().map(|(l, _)| *l).collect()
+        };
+        let both: Vec<_> = reference
+            .uncovered
+            .iter()
+            .filter(|(l, _)| missed(&directed).contains(l))
+            .collect();
+        let set_covered = reference.lines - both.len();
+        eprintln!(
+            "{mode:?} CI set: {set_covered} of {} lines hit; not hit by either run: {both:?}",
+            reference.lines
+        );
+        for (line, text) in &both {
+            assert!(
+                DEAD.iter().any(|f| text.contains(f)),
+                "{mode:?}: line {line} `{text}` is covered by no CI run"
+            );
+        }
+        // The refusal lines the reference run misses, the directed run hits.
+        assert!(
+            reference
+                .uncovered
+                .iter()
+                .any(|(_, t)| NEEDS_REFUSALS.iter().any(|f| t.contains(f))),
+            "{mode:?}: the reference run reaches the refusal lines: the test shows nothing"
+        );
+        // K = 3: the slot case's default arm is live (the slot counter idles at K); the
+        // directed run alone hits every line but the read-ahead case's default arms, which
+        // no K reaches (its selector is slot + 1 ≤ K − 1, or 0).
+        let k3 = directed_config(mode);
+        let full = run(&k3, "directed-k3", Some(DirectedOptions::default()));
+        assert_eq!(full.uncovered.len(), k3.adders, "{mode:?} K = 3: {full:?}");
+        for (line, text) in &full.uncovered {
+            assert!(
+                text.contains("default: begin rd_"),
+                "{mode:?} K = 3: line {line} `{text}` is not covered"
             );
         }
     }

@@ -10,7 +10,7 @@ use common::*;
 use tofprobe_cosim::{CosimOptions, cosim};
 use tofprobe_pixel::Fault;
 use tofprobe_pixel::{Mode, PixelParams};
-use tofprobe_rtlgen::golden::first_divergence;
+use tofprobe_rtlgen::golden::{first_divergence, first_divergence_with};
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
 
 /// Small enough to verilate quickly; W = operand + 1 so register 0 overflows W−1 bits
@@ -134,20 +134,76 @@ fn digest_mismatch_is_refined_to_the_first_cycle() {
     assert_eq!((m.cycle, m.pulse), (cycle, pulse), "{m:?}");
 }
 
-/// Faults that need refused pulses to show: the reference sequencer never refuses one
-/// (every pulse arrives when the pipeline is free and the Haar frame has room), and the
-/// co-simulation has no directed refusal schedule yet, so these survive. Listed here so
-/// the test fails, and they move to the caught list, once such a stimulus exists.
-const NEEDS_REFUSALS: [Fault; 3] = [
-    Fault::StatusWord,
-    Fault::RefusedCounter,
-    Fault::HaarFrameLimit,
-];
+/// The refusal path's faults (status word, refused counter, Haar frame limit): the
+/// reference sequencer refuses no pulse, so they show only under the directed sequencer
+/// (docs/pixel-contract.md, "The directed sequencer"). Each is caught, in every mode it
+/// applies to, at exactly the cycle (and pulse) the model carrying it predicts, with the
+/// expected and actual values of that mismatch. The score is asserted: 5/5.
+#[test]
+fn refusal_faults_are_caught_at_their_first_cycle_by_the_directed_schedule() {
+    if !tools_or_skip(
+        &["verilator"],
+        "refusal_faults_are_caught_at_their_first_cycle_by_the_directed_schedule",
+    ) {
+        return;
+    }
+    let (seed, frames) = (5, 1);
+    let directed = tofprobe_pixel::DirectedOptions::default();
+    let (mut caught, mut total) = (0, 0);
+    for mode in [Mode::Fourier, Mode::Haar] {
+        let p = directed_config(mode);
+        for fault in Fault::REFUSAL {
+            if mode == Mode::Fourier && fault == Fault::HaarFrameLimit {
+                continue;
+            }
+            total += 1;
+            let prog = tofprobe_pixel::directed_program(&p, &directed).expect("program");
+            let mut stim = random_stimulus(&p, frames * prog.loop_pulses(), seed);
+            prog.miss_frame_leads(&mut stim);
+            let rom = sign_probe_rom(&p);
+            let (cycle, pulse) =
+                first_divergence_with(&p, &stim, &rom, frames, Some(&directed), fault)
+                    .expect("the model accepts the configuration")
+                    .unwrap_or_else(|| panic!("{mode:?} {fault:?} never shows on the schedule"));
+            // Under the reference sequencer the same fault never shows (why it survived).
+            let ref_stim = random_stimulus(&p, 2 * p.frame_pulses, seed);
+            assert_eq!(
+                first_divergence(&p, &ref_stim, &rom, 2, fault).expect("model"),
+                None,
+                "{mode:?} {fault:?} shows under the reference sequencer"
+            );
+            let mut o = CosimOptions::new(work_dir(&format!("refusal-{mode:?}-{}", fault.name())));
+            o.frames = frames;
+            o.seed = seed;
+            o.mutation = Some(fault);
+            o.vcd_on_mismatch = false;
+            o.directed = Some(directed);
+            let r = cosim(&p, &o).expect("mutated co-simulation runs");
+            assert!(!r.pass, "{mode:?} {fault:?} was not caught");
+            let m = r
+                .first
+                .unwrap_or_else(|| panic!("{mode:?} {fault:?}: no first mismatch reported"));
+            assert_eq!(
+                (m.cycle, m.pulse),
+                (cycle, pulse),
+                "{mode:?} {fault:?}: reported {m:?}, the model says cycle {cycle}"
+            );
+            caught += 1;
+            eprintln!(
+                "{mode:?} {fault:?}: caught at cycle {} (pulse {}): {} expected {} actual {}",
+                m.cycle, m.pulse, m.signal, m.expected, m.actual
+            );
+        }
+    }
+    eprintln!("refusal faults caught at their predicted cycle: {caught}/{total}");
+    assert_eq!((caught, total), (5, 5));
+}
 
 /// The faults the cycle model has no hook for, under Icarus (a fast compile per mutant, and
 /// every state element reset forgets is an X there), in both modes, with a directed
 /// stimulus whose frames start with missed pulses (the priming rule): each is caught, with
-/// its first mismatch reported, except the ones that need refusals.
+/// its first mismatch reported (the refusal path's faults are modelled: see
+/// `refusal_faults_are_caught_at_their_first_cycle_by_the_directed_schedule`).
 #[test]
 fn unmodelled_faults_are_caught_under_icarus() {
     if !tools_or_skip(
@@ -180,19 +236,8 @@ fn unmodelled_faults_are_caught_under_icarus() {
         assert!(clean.pass, "{mode:?} clean: {:?}", clean.first);
         assert_eq!(clean.stimulus[..3], [None, None, None]);
         for fault in Fault::UNMODELLED {
-            if mode == Mode::Fourier && fault == Fault::HaarFrameLimit {
-                continue;
-            }
             total += 1;
             let r = run(Some(fault));
-            if NEEDS_REFUSALS.contains(&fault) {
-                assert!(
-                    r.pass,
-                    "{fault:?} is caught now: move it out of NEEDS_REFUSALS"
-                );
-                eprintln!("{mode:?} {fault:?}: survives (needs refused pulses)");
-                continue;
-            }
             assert!(!r.pass, "{mode:?} {fault:?} was not caught");
             let m = r
                 .first
@@ -205,7 +250,7 @@ fn unmodelled_faults_are_caught_under_icarus() {
         }
     }
     eprintln!("unmodelled faults caught: {caught}/{total}");
-    assert_eq!((caught, total), (8, 13));
+    assert_eq!((caught, total), (8, 8));
 }
 
 /// A forgotten reset passes with registers that start at zero; with randomised initial

@@ -235,7 +235,9 @@ impl CycleModel {
         }
         let w = self.p.width;
         let free = self.free();
-        let haar_room = self.p.mode == Mode::Fourier || self.pcount < self.p.frame_pulses;
+        let haar_room = self.p.mode == Mode::Fourier
+            || self.pcount < self.p.frame_pulses
+            || self.fault == Some(Fault::HaarFrameLimit);
         let take_readout = pins.readout && free;
         let take_pulse = pins.pulse && free && !pins.readout && haar_room;
         let refuse_pulse = pins.pulse && !take_pulse;
@@ -261,6 +263,7 @@ impl CycleModel {
 
         // Readout progress; at every edge without it rd_valid falls.
         let mut refused_next = self.refused;
+        let status_edge = self.rd_active && self.rd_ptr == self.r;
         if self.rd_active {
             if self.rd_ptr < self.r {
                 self.rd_data = to_raw(self.y[self.rd_ptr], w);
@@ -269,7 +272,12 @@ impl CycleModel {
                 self.write(self.rd_ptr, 0);
                 self.rd_ptr += 1;
             } else {
-                self.rd_data = self.refused & mask(w);
+                // StatusWord: the RTL's word multiplexer, whose default arm (index R) is 0.
+                self.rd_data = if self.fault == Some(Fault::StatusWord) {
+                    0
+                } else {
+                    self.refused & mask(w)
+                };
                 self.rd_index = self.r as u32;
                 self.rd_valid = true;
                 refused_next = 0;
@@ -279,7 +287,9 @@ impl CycleModel {
         } else {
             self.rd_valid = false;
         }
-        if refuse_pulse {
+        // RefusedCounter: only the status edge's `refused ← 0 or 1` remains.
+        let counts = self.fault != Some(Fault::RefusedCounter) || status_edge;
+        if refuse_pulse && counts {
             refused_next = (refused_next + 1).min(self.p.refused_max());
         }
         self.refused = refused_next;
@@ -384,7 +394,9 @@ impl CycleModel {
                     *last &= mask(used as u32);
                 }
             }
-            Mode::Haar => self.n_lat = self.pcount,
+            // The RTL latches pcount's low log2(N) bits (only beyond a full frame, under
+            // the HaarFrameLimit fault, does that differ from pcount).
+            Mode::Haar => self.n_lat = self.pcount & (self.p.frame_pulses - 1),
         }
         self.pcount += 1;
         self.active = true;

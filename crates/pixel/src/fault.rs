@@ -47,17 +47,24 @@ impl Fault {
         Fault::MissingForward,
     ];
 
+    /// Faults of the refusal path, which the cycle model carries but the reference
+    /// sequencer never shows (it refuses no pulse): the directed sequencer
+    /// ([`crate::directed`]) shows each, at the cycle the model predicts. `HaarFrameLimit`
+    /// is Haar only.
+    pub const REFUSAL: [Fault; 3] = [
+        Fault::StatusWord,
+        Fault::RefusedCounter,
+        Fault::HaarFrameLimit,
+    ];
+
     /// Faults the cycle model has no hook for: the co-simulation must catch them, but the
     /// cycle where they first show is not predicted (the mutation tests check that they are
     /// caught, with the first mismatch reported).
-    pub const UNMODELLED: [Fault; 7] = [
+    pub const UNMODELLED: [Fault; 4] = [
         Fault::ResetPrimed,
         Fault::PrimeOnMiss,
         Fault::ReadoutClear,
         Fault::EnableDecode,
-        Fault::StatusWord,
-        Fault::RefusedCounter,
-        Fault::HaarFrameLimit,
     ];
 
     /// The name used by templates and reports.

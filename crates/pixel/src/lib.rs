@@ -9,6 +9,7 @@
 //! - [`fault`]: deliberate faults the cycle model carries for the mutation tests;
 //! - [`fixed`]: the fixed-width arithmetic of the datapath;
 //! - [`sequencer`]: the reference pin sequence the testbench and vectors drive;
+//! - [`directed`]: the directed schedule beside it (refusals, saturation, wrap-around);
 //! - [`sizing`]: register widths, readout bytes and compression from a scene;
 //! - [`spectrum`]: the bit-true spectrum of a scene for `tofprobe simulate`.
 
@@ -17,6 +18,7 @@ pub mod bench;
 pub mod config;
 pub mod cycle;
 pub mod datapath;
+pub mod directed;
 pub mod error;
 pub mod fault;
 pub mod fixed;
@@ -38,6 +40,7 @@ pub mod contract {}
 pub use config::{PixelConfig, PixelContext};
 pub use cycle::{CycleModel, PinsIn, PinsOut, RegWrite};
 pub use datapath::Datapath;
+pub use directed::{DirectedOptions, Program, directed_program};
 pub use error::PixelError;
 pub use fault::Fault;
 pub use params::{Mode, PixelParams};

@@ -5,10 +5,14 @@
 //! `valid`, `tdc` and ROM word n mod L) and C − 1 idle cycles; after the last pulse, one
 //! `readout` cycle and R + 1 idle cycles while the words come out. The golden vectors add
 //! one cycle ([`Sequencer::with_status_cycle`]) in which the last status word is seen.
+//!
+//! [`Sequencer::directed`] walks the directed schedule instead ([`crate::directed`]): the
+//! same reset, then loop after loop of its [`Program`].
 
 use tofprobe_dsp::RomImage;
 
 use crate::cycle::PinsIn;
+use crate::directed::Program;
 use crate::error::PixelError;
 use crate::params::{Mode, PixelParams};
 use crate::transaction::{check_rom, frame_len};
@@ -50,6 +54,8 @@ pub struct Sequencer<'a> {
     total: u64,
     cycle: u64,
     rom_depth: u64,
+    /// The directed schedule, when this is not the reference sequencer.
+    program: Option<Program>,
 }
 
 /// Presents no detection for pulses beyond the stimuli (the status cycle's pulse).
@@ -87,7 +93,43 @@ impl<'a> Sequencer<'a> {
             total: RESET_CYCLES + frames * frame_cycles,
             cycle: 0,
             rom_depth: params.rom_depth.max(1) as u64,
+            program: None,
         })
+    }
+
+    /// The directed sequence: reset, then `loops` loops of `program` (built for `params`
+    /// by [`crate::directed::directed_program`]). `stimuli` holds one detection per pulse
+    /// strobe (`loops` · [`Program::loop_pulses`]; strobes beyond it present no detection).
+    /// A Fourier pixel needs the ROM; a Haar pixel ignores it.
+    pub fn directed(
+        params: &PixelParams,
+        program: Program,
+        stimuli: &'a [Option<u32>],
+        rom: Option<&'a RomImage>,
+        loops: u64,
+    ) -> Result<Self, PixelError> {
+        params.validate()?;
+        let rom = match params.mode {
+            Mode::Fourier => Some(check_rom(params, rom)?),
+            Mode::Haar => None,
+        };
+        let loop_cycles = program.loop_cycles();
+        Ok(Sequencer {
+            stimuli,
+            rom,
+            n: params.frame_pulses,
+            c: params.cycles_per_pulse as u64,
+            frame_cycles: loop_cycles,
+            total: RESET_CYCLES + loops * loop_cycles,
+            cycle: 0,
+            rom_depth: params.rom_depth.max(1) as u64,
+            program: Some(program),
+        })
+    }
+
+    /// The directed schedule this sequence walks (`None`: the reference sequencer).
+    pub fn program(&self) -> Option<&Program> {
+        self.program.as_ref()
     }
 
     /// The sequence with one more cycle at its end, in which the last frame's status word
@@ -101,6 +143,13 @@ impl<'a> Sequencer<'a> {
 
     /// The global index (frame·N + pulse) of the pulse presented in cycle `cycle`, if any.
     pub fn pulse_index(&self, cycle: u64) -> Option<u64> {
+        if let Some(prog) = &self.program {
+            let t = cycle.checked_sub(RESET_CYCLES)?;
+            let a = prog.at(t % prog.loop_cycles());
+            return a
+                .pulse
+                .then(|| t / prog.loop_cycles() * prog.loop_pulses() + a.pulse_in_loop);
+        }
         match self.phase(cycle) {
             Phase::Pulse { frame, pulse } => Some(frame * self.n + pulse),
             _ => None,
@@ -112,17 +161,30 @@ impl<'a> Sequencer<'a> {
         self.total
     }
 
-    /// Cycles per frame, N·C + R + 2.
+    /// Cycles per frame, N·C + R + 2 (directed: cycles per loop).
     pub fn frame_cycles(&self) -> u64 {
         self.frame_cycles
     }
 
-    /// What cycle `cycle` of the sequence does.
+    /// What cycle `cycle` of the sequence does (directed: `frame` counts loops, `pulse`
+    /// the pulse strobes of the loop; a cycle with both strobes is a `Pulse`).
     pub fn phase(&self, cycle: u64) -> Phase {
         if cycle < RESET_CYCLES {
             return Phase::Reset;
         }
         let t = cycle - RESET_CYCLES;
+        if let Some(prog) = &self.program {
+            let frame = t / prog.loop_cycles();
+            let a = prog.at(t % prog.loop_cycles());
+            return match (a.pulse, a.readout) {
+                (true, _) => Phase::Pulse {
+                    frame,
+                    pulse: a.pulse_in_loop,
+                },
+                (false, true) => Phase::Readout { frame },
+                (false, false) => Phase::Idle,
+            };
+        }
         let frame = t / self.frame_cycles;
         let within = t % self.frame_cycles;
         let pulses = self.n * self.c;
@@ -144,6 +206,25 @@ impl<'a> Sequencer<'a> {
 
     /// The pins of cycle `cycle`.
     pub fn pins(&self, cycle: u64) -> PinsIn<'a> {
+        if let (Some(prog), Some(t)) = (&self.program, cycle.checked_sub(RESET_CYCLES)) {
+            let a = prog.at(t % prog.loop_cycles());
+            if !a.pulse {
+                return PinsIn {
+                    readout: a.readout,
+                    ..PinsIn::default()
+                };
+            }
+            let index = t / prog.loop_cycles() * prog.loop_pulses() + a.pulse_in_loop;
+            let det = detection(self.stimuli, index);
+            return PinsIn {
+                pulse: true,
+                valid: det.is_some(),
+                tdc: det.unwrap_or(0),
+                rom_word: self.rom_word(a.address),
+                readout: a.readout,
+                ..PinsIn::default()
+            };
+        }
         match self.phase(cycle) {
             Phase::Reset => PinsIn {
                 rst: true,
@@ -151,10 +232,7 @@ impl<'a> Sequencer<'a> {
             },
             Phase::Pulse { frame, pulse } => {
                 let det = detection(self.stimuli, frame * self.n + pulse);
-                let rom_word = self
-                    .rom
-                    .map(|rom| rom.entry((pulse % self.rom_depth) as usize))
-                    .unwrap_or(&[]);
+                let rom_word = self.rom_word(pulse);
                 PinsIn {
                     pulse: true,
                     valid: det.is_some(),
@@ -169,6 +247,15 @@ impl<'a> Sequencer<'a> {
             },
             Phase::Idle | Phase::Draining => PinsIn::default(),
         }
+    }
+}
+
+impl<'a> Sequencer<'a> {
+    /// The ROM word of pulse `n` of a frame (address n mod L; empty in Haar mode).
+    fn rom_word(&self, n: u64) -> &'a [u64] {
+        self.rom
+            .map(|rom| rom.entry((n % self.rom_depth) as usize))
+            .unwrap_or(&[])
     }
 }
 

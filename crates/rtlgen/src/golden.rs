@@ -16,7 +16,10 @@
 use std::borrow::Cow;
 
 use tofprobe_dsp::RomImage;
-use tofprobe_pixel::{CycleModel, Fault, Mode, PinsOut, PixelParams, Sequencer};
+use tofprobe_pixel::{
+    CycleModel, DirectedOptions, Fault, Mode, PinsOut, PixelParams, Program, Sequencer,
+    directed_program,
+};
 
 use crate::error::RtlError;
 
@@ -98,6 +101,55 @@ pub fn sequence<'a>(
     Ok(Sequencer::new(p, stim, rom)?.with_status_cycle())
 }
 
+/// The pulse strobes of `frames` runs of the sequencer: frames·N for the reference one,
+/// frames loops of the directed program otherwise.
+pub fn pulses_for(p: &PixelParams, frames: u64, program: Option<&Program>) -> u64 {
+    match program {
+        Some(prog) => frames.saturating_mul(prog.loop_pulses()),
+        None => frames.saturating_mul(p.frame_pulses),
+    }
+}
+
+/// A run's stimuli (cut or padded to its pulse strobes) and the directed program, if any.
+pub type RunStimuli<'a> = (Cow<'a, [Option<u32>]>, Option<Program>);
+
+/// The sequence that drives a run: the reference sequencer for `frames` frames, or with
+/// `directed` `frames` loops of the directed program (docs/pixel-contract.md, "The directed
+/// sequencer"); the status cycle appended either way. Returns the stimuli cut (or padded
+/// with misses) to the run's pulse strobes, for the sequence to borrow.
+pub fn stimuli_and_program<'a>(
+    p: &PixelParams,
+    stim: &'a [Option<u32>],
+    frames: u64,
+    directed: Option<&DirectedOptions>,
+) -> Result<RunStimuli<'a>, RtlError> {
+    let program = directed.map(|o| directed_program(p, o)).transpose()?;
+    let n = usize::try_from(pulses_for(p, frames, program.as_ref())).unwrap_or(usize::MAX);
+    let stim = if stim.len() >= n {
+        Cow::Borrowed(&stim[..n])
+    } else {
+        let mut v = stim.to_vec();
+        v.resize(n, None);
+        Cow::Owned(v)
+    };
+    Ok((stim, program))
+}
+
+/// The sequence for stimuli from [`stimuli_and_program`]: the reference one, or `frames`
+/// loops of `program`; with the status cycle.
+pub fn sequence_for<'a>(
+    p: &PixelParams,
+    stim: &'a [Option<u32>],
+    rom: Option<&'a RomImage>,
+    frames: u64,
+    program: Option<Program>,
+) -> Result<Sequencer<'a>, RtlError> {
+    match program {
+        Some(prog) => Ok(Sequencer::directed(p, prog, stim, rom, frames)?.with_status_cycle()),
+        None => sequence(p, stim, rom),
+    }
+}
+
 /// Runs the pixel crate's cycle model through `seq` and records the golden data.
 pub fn run(p: &PixelParams, seq: &Sequencer<'_>, o: &GoldenOptions) -> Result<Golden, RtlError> {
     let mut model = CycleModel::new(p)?;
@@ -159,9 +211,22 @@ pub fn first_divergence(
     frames: u64,
     fault: Fault,
 ) -> Result<Option<(u64, u64)>, RtlError> {
-    let stim = frame_stimuli(p, stim, frames);
+    first_divergence_with(p, stim, rom, frames, None, fault)
+}
+
+/// [`first_divergence`] under the reference sequencer (`directed` `None`) or `frames`
+/// loops of the directed one.
+pub fn first_divergence_with(
+    p: &PixelParams,
+    stim: &[Option<u32>],
+    rom: &[u64],
+    frames: u64,
+    directed: Option<&DirectedOptions>,
+    fault: Fault,
+) -> Result<Option<(u64, u64)>, RtlError> {
+    let (stim, program) = stimuli_and_program(p, stim, frames, directed)?;
     let image = rom_image(p, rom);
-    let seq = sequence(p, &stim, image.as_ref())?;
+    let seq = sequence_for(p, &stim, image.as_ref(), frames, program)?;
     let mut good = CycleModel::new(p)?;
     let mut bad = CycleModel::with_fault(p, Some(fault))?;
     let mut pulse = 0;

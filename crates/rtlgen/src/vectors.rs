@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 use tofprobe_io::fnv1a64;
-use tofprobe_pixel::{Mode, PixelParams};
+use tofprobe_pixel::{DirectedOptions, Mode, PixelParams};
 
 /// Above this many cycles the full trace is replaced by digests only (a full trace of a
 /// 1.6·10^8-cycle frame would run to gigabytes).
@@ -27,6 +27,9 @@ pub struct VectorOptions {
     pub digest_pulses: u64,
     /// Cycles [lo, hi) recorded in full; `None` = everything if short, nothing if long.
     pub trace_window: Option<(u64, u64)>,
+    /// Drive the directed sequencer (`frames` loops of its program) instead of the
+    /// reference one; the RTL must be rendered with the same options.
+    pub directed: Option<DirectedOptions>,
 }
 
 impl Default for VectorOptions {
@@ -36,6 +39,7 @@ impl Default for VectorOptions {
             seed: 1,
             digest_pulses: 1,
             trace_window: None,
+            directed: None,
         }
     }
 }
@@ -62,6 +66,10 @@ pub struct Manifest {
     pub trace_events: usize,
     pub pin_events: usize,
     pub digest_windows: usize,
+    /// The directed sequencer's options, when it drove the run (absent: the reference
+    /// sequencer).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub directed: Option<String>,
     /// File name → FNV-1a-64 of its bytes (hex).
     pub files: BTreeMap<String, String>,
 }
@@ -75,9 +83,9 @@ pub fn golden_run(
     rom: &[u64],
     o: &VectorOptions,
 ) -> Result<(Golden, (u64, u64)), RtlError> {
-    let stim = golden::frame_stimuli(p, stim, o.frames);
+    let (stim, program) = golden::stimuli_and_program(p, stim, o.frames, o.directed.as_ref())?;
     let image = golden::rom_image(p, rom);
-    let seq = golden::sequence(p, &stim, image.as_ref())?;
+    let seq = golden::sequence_for(p, &stim, image.as_ref(), o.frames, program)?;
     let total = seq.total_cycles();
     let window = o.trace_window.unwrap_or(if total <= FULL_TRACE_MAX_CYCLES {
         (0, total)
@@ -214,6 +222,12 @@ pub fn write_vectors(
         trace_events: g.trace.len(),
         pin_events: g.pins.len(),
         digest_windows: g.digests.len(),
+        directed: o.directed.map(|d| {
+            format!(
+                "long_frame = {}, lead_misses = {}",
+                d.long_frame, d.lead_misses
+            )
+        }),
         files: files
             .iter()
             .map(|(n, c)| (n.clone(), format!("{:016x}", fnv1a64(c.as_bytes()))))

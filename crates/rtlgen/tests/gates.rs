@@ -1,12 +1,12 @@
 //! Quality gates on the rendered RTL of several configurations (both modes, odd widths,
 //! A > 1, case-table and `$readmemh` ROMs): `verilator --lint-only -Wall` with zero
-//! warnings, yosys `synth -top` with no latches and no warnings beyond the register file's
+//! warnings (the top with either sequencer), yosys `synth -top` with no latches and no warnings beyond the register file's
 //! memory-to-registers note, and `iverilog -g2005` compiles. Skipped loudly only when a tool
 //! is missing (CI installs them).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use tofprobe_pixel::{Mode, PixelParams};
+use tofprobe_pixel::{DirectedOptions, Mode, PixelParams};
 use tofprobe_rtlgen::render::RenderOptions;
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 use tofprobe_rtlgen::write::write_generated;
@@ -90,12 +90,15 @@ fn configs() -> Vec<(&'static str, PixelParams)> {
 }
 
 fn render_to(name: &str, p: &PixelParams) -> PathBuf {
+    render_with(name, p, &RenderOptions::default())
+}
+
+fn render_with(name: &str, p: &PixelParams, o: &RenderOptions) -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join("gates")
         .join(name);
     let _ = std::fs::remove_dir_all(&dir);
-    let files =
-        tofprobe_rtlgen::render(p, &sign_probe_rom(p), &RenderOptions::default()).expect("renders");
+    let files = tofprobe_rtlgen::render(p, &sign_probe_rom(p), o).expect("renders");
     let pairs: Vec<(String, String)> = files.into_iter().map(|f| (f.name, f.contents)).collect();
     write_generated(&dir, &pairs).expect("writes");
     dir
@@ -116,8 +119,19 @@ fn verilator_lint_is_clean() {
     if !have("verilator") {
         return;
     }
-    for (name, p) in configs() {
-        let dir = render_to(&format!("lint-{name}"), &p);
+    // Both sequencers of the top: the reference one and the directed one (its step table).
+    let directed = RenderOptions {
+        directed: Some(DirectedOptions::default()),
+        ..RenderOptions::default()
+    };
+    let runs = configs().into_iter().flat_map(|(name, p)| {
+        [
+            (name.to_string(), p.clone(), RenderOptions::default()),
+            (format!("{name}-directed"), p, directed.clone()),
+        ]
+    });
+    for (name, p, o) in runs {
+        let dir = render_with(&format!("lint-{name}"), &p, &o);
         let out = Command::new("verilator")
             .current_dir(&dir)
             .args([

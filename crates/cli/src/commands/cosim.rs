@@ -10,7 +10,7 @@ use serde::Serialize;
 use tofprobe_cosim::{BuildProfile, CosimOptions, CosimReport, Simulator, cosim};
 use tofprobe_design::RtlOverrides;
 use tofprobe_design::rom_policy::{chip_rom, simulation_rom};
-use tofprobe_pixel::PixelParams;
+use tofprobe_pixel::{DirectedOptions, PixelParams};
 
 use crate::error::CliError;
 
@@ -64,6 +64,15 @@ pub struct CosimArgs {
     /// list the lines never hit.
     #[arg(long)]
     pub coverage: bool,
+    /// Drive the contract's directed sequencer instead of the reference one (refused
+    /// pulses, the refused counter to saturation, ignored readouts, a long frame:
+    /// docs/pixel-contract.md "The directed sequencer"); --frames counts its loops, three
+    /// frames each.
+    #[arg(long)]
+    pub directed: bool,
+    /// With --directed: the long frame presents M·N pulses (registers sized for N wrap).
+    #[arg(long, default_value_t = 1, requires = "directed")]
+    pub long_frame: u64,
     /// Soak: co-simulate N random valid configurations (both modes, every knob, width drawn
     /// or "auto"), drawn from --seed, instead of CONFIG.
     #[arg(long)]
@@ -175,6 +184,10 @@ pub fn options(p: &PixelParams, a: &CosimArgs) -> CosimOptions {
     o.x_seed = a.x_seed;
     o.lead_misses = a.lead_misses;
     o.coverage = a.coverage;
+    o.directed = a.directed.then(|| DirectedOptions {
+        long_frame: a.long_frame,
+        ..DirectedOptions::default()
+    });
     let cycles = a.frames * p.frame_pulses * p.cycles_per_pulse as u64;
     if cycles > LONG_RUN_CYCLES {
         o.digest_pulses = LONG_RUN_DIGEST_PULSES;

@@ -54,6 +54,7 @@ pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
         seed: a.seed,
         digest_pulses: a.digest_pulses.max(1),
         trace_window: None,
+        directed: None,
     };
     let (g, w) = golden_run(&p, &stim, &rom, &o).map_err(tofprobe_study::StudyError::from)?;
     let m = write_vectors(&a.out, &p, &stim, &rom, &g, w, &o)?;
