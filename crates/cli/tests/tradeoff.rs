@@ -73,7 +73,11 @@ fn tradeoff_reports_every_level() {
     assert!((amp("float full DFT") - 1000.0).abs() < 272.0);
     // No background, every pulse detects: gain 1 and |H| = 1 up to the in-window
     // probability of a 3 mm Gaussian 30 mm from either edge (1 − 10^−23).
-    assert!((amp("closed form") - 1000.0).abs() < 1e-6, "{}", amp("closed form"));
+    assert!(
+        (amp("closed form") - 1000.0).abs() < 1e-6,
+        "{}",
+        amp("closed form")
+    );
     let md = std::fs::read_to_string(dir.join("tradeoff.md")).expect("table");
     assert!(md.contains("| cycle-accurate (extrapolated) |"), "{md}");
     let svg = std::fs::read_to_string(dir.join("pareto.svg")).expect("plot");
@@ -228,7 +232,10 @@ fn tradeoff_knob_table_and_skips_on_a_tiny_frame() {
 /// sd sqrt(4/π − 1)/sqrt(15) = 13.5%: 3 sd.
 #[test]
 fn closed_form_level_models_background_pile_up() {
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/table2-background.toml");
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/table2-background.toml"
+    );
     let res = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
         .args(["tradeoff", scene, "--json"])
         .output()
@@ -253,7 +260,10 @@ fn closed_form_level_models_background_pile_up() {
     );
     let noise = get("float full DFT", "noise_um");
     let sd = noise / (std::f64::consts::PI / 2.0).sqrt();
-    assert!((cf - dft).abs() < 2.5 * sd, "closed form {cf} µm, DFT {dft} µm, sd {sd}");
+    assert!(
+        (cf - dft).abs() < 2.5 * sd,
+        "closed form {cf} µm, DFT {dft} µm, sd {sd}"
+    );
     let ignoring_background = 100.0;
     assert!(
         (ignoring_background - dft).abs() > 2.5 * sd,
