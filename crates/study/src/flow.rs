@@ -203,6 +203,7 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
         let sa = SizeOptions {
             liberty: None,
             no_sky130: !a.sky130,
+            sky130_pdk: None,
             node_nm: 40.0,
             // The configured point only: the B/W sweeps are `tofprobe size`'s job.
             sweep_bins: Some(vec![p.bins as u64]),
