@@ -86,3 +86,70 @@ fn vectors_on_a_frame_too_short_for_the_band_fall_back_to_the_sign_probe() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `flow --signoff` on a two-bin pixel's short frame (N = 64, 2 frames): the co-simulated
+/// RTL is synthesised on osu018 and on sky130 (its PDK beside the checkout, as CI has it),
+/// the netlists replay the flow's own vectors bit-exactly at gate level and are proven
+/// equivalent; the report gets a sign-off section. A frame too long for gate level is
+/// refused before any simulation, naming the option and the cycle count. (A broken netlist
+/// failing both checks is crates/report/tests/signoff.rs.)
+#[test]
+fn flow_signoff_on_a_short_frame() {
+    if !have("verilator") || !have("iverilog") || !have("yosys") {
+        return;
+    }
+    let dir = scratch("signoff");
+    std::fs::create_dir_all(&dir).unwrap();
+    let cfg = dir.join("two.toml");
+    let text = include_str!("../../../scenes/default.toml").replacen("bins = 16", "bins = 2", 1);
+    assert!(text.contains("bins = 2 "), "default changed");
+    std::fs::write(&cfg, text).unwrap();
+    let out_dir = dir.join("out");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "flow",
+            cfg.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--no-size",
+            "--signoff",
+        ];
+        args.extend_from_slice(extra);
+        tofprobe(&args)
+    };
+    let out = run(&["--frame-pulses", "64", "--frames", "2"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout} {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // 2 + 2·(64·16 + 4 + 2) + 1 = 2063 cycles (4 registers: 2 bins × I, Q).
+    for lib in [
+        "sign-off osu018: PASS",
+        "sign-off sky130_fd_sc_hd tt_025C_1v80: PASS",
+    ] {
+        assert!(stdout.contains(lib), "{lib} missing: {stdout}");
+    }
+    assert_eq!(
+        stdout
+            .matches("gate-level replay 2063 cycles, 2 frame(s) bit-exact")
+            .count(),
+        2,
+        "{stdout}"
+    );
+    let md = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(
+        md.contains("## Sign-off") && md.contains("equivalence proven"),
+        "{md}"
+    );
+
+    let out = run(&["--frame-pulses", "60000"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--signoff") && err.contains("960009-cycle trace"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -154,3 +154,60 @@ fn missing_tools_say_what_to_install() {
     );
     fails_with(&out, &["`sta`", "opensta"]);
 }
+
+/// `--sky130-pdk DIR` times the pixel on every sky130 corner found beside the osu018
+/// figures (the tiny pixel: seconds). Physics orders the corners: ff (1.95 V, fast) above tt
+/// (1.8 V) above ss (1.4 V, −40 °C), so swapped or mislabelled liberties fail; the number of
+/// registers one adder serves at the laser rate grows with f_max. A directory that holds no
+/// tt liberty is an error naming the option and the path, before any synthesis.
+#[test]
+fn sky130_pdk_option_times_every_corner() {
+    let dir = scratch("sky130-pdk");
+    let cfg = tiny_config(&dir);
+    let cfg = cfg.to_str().unwrap();
+    let pdk = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/pdk/sky130_fd_sc_hd"
+    );
+    let out = size(
+        &[cfg, "--sky130-pdk", pdk, "--json"],
+        &[],
+        &dir.join("cache"),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(v["sky130"]["has_timing"], true, "{v}");
+    let corners = v["timing_corners"].as_array().expect("timing_corners");
+    let f = |corner: &str| {
+        let c = corners
+            .iter()
+            .find(|c| c["corner"] == corner)
+            .unwrap_or_else(|| panic!("corner {corner} in {corners:?}"));
+        let fmax = c["f_max_mhz"].as_f64().expect("f_max");
+        assert!(fmax.is_finite() && fmax > 0.0, "{c}");
+        (
+            fmax,
+            c["registers_per_adder"]
+                .as_u64()
+                .expect("registers per adder"),
+        )
+    };
+    let (ss, tt, ff) = (f("ss_n40C_1v40"), f("tt_025C_1v80"), f("ff_100C_1v95"));
+    assert!(ff.0 > tt.0 && tt.0 > ss.0, "ff {ff:?} tt {tt:?} ss {ss:?}");
+    assert!(
+        ff.1 >= tt.1 && tt.1 >= ss.1,
+        "ff {ff:?} tt {tt:?} ss {ss:?}"
+    );
+    assert!(corners.iter().any(|c| c["library"] == "osu018_stdcells"));
+
+    let out = size(
+        &[cfg, "--sky130-pdk", "/nonexistent/pdk"],
+        &[],
+        &dir.join("cache"),
+    );
+    fails_with(&out, &["--sky130-pdk", "/nonexistent/pdk"]);
+}

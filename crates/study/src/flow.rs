@@ -43,12 +43,15 @@ pub struct FlowOptions {
     pub no_size: bool,
     /// Include the sky130 area-only mapping in the sizing summary.
     pub sky130: bool,
+    /// Sign off the co-simulated RTL: synthesis, gate-level replay of the same vectors and
+    /// equivalence on every library found ([`crate::signoff`]); short frames only.
+    pub signoff: bool,
 }
 
 /// What the flow found.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlowOutcome {
-    /// Whether the co-simulation passed.
+    /// Whether the co-simulation (and, when asked, every library's sign-off) passed.
     pub pass: bool,
     /// Pulses per frame simulated.
     pub frame_pulses: u64,
@@ -64,6 +67,8 @@ pub struct FlowOutcome {
     pub size_line: String,
     /// The report written.
     pub report: PathBuf,
+    /// The sign-off per library (empty without `signoff`).
+    pub signoff: Vec<crate::signoff::SignoffLine>,
 }
 
 /// Longest default short frame of the flow.
@@ -132,6 +137,10 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
     };
     let mut p = rtl_params(design, &overrides)?;
     let rom = rtl_rom(design, &mut p)?;
+    if a.signoff {
+        // Before the co-simulation: a trace too long for gate level is refused at once.
+        crate::signoff::check_length(&p, a.frames)?;
+    }
     // Scene → TDC stream.
     let source = design.photon_source()?;
     let mut stim = vec![None; (a.frames * p.frame_pulses) as usize];
@@ -203,6 +212,7 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
         let sa = SizeOptions {
             liberty: None,
             no_sky130: !a.sky130,
+            sky130_pdk: None,
             node_nm: 40.0,
             // The configured point only: the B/W sweeps are `tofprobe size`'s job.
             sweep_bins: Some(vec![p.bins as u64]),
@@ -226,13 +236,32 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
             " (sky130 skipped; --sky130 includes it)"
         }
     );
+    let mut signoff = Vec::new();
+    if a.signoff {
+        let _ = writeln!(md, "## Sign-off\n");
+        if r.pass {
+            signoff = crate::signoff::sign_off_all(
+                &p,
+                fs,
+                &r.rtl_dir,
+                &r.vectors_dir,
+                &a.out.join("signoff"),
+            )?;
+            for l in &signoff {
+                let _ = writeln!(md, "- {}", l.text);
+            }
+            let _ = writeln!(md);
+        } else {
+            let _ = writeln!(md, "Not run: the co-simulation failed.\n");
+        }
+    }
     let seconds = t_start.elapsed().as_secs_f64();
     let _ = writeln!(md, "Flow time: {seconds:.1} s.");
     let path = a.out.join("report.md");
     refuse_foreign_report(&path)?;
     write_atomic(&path, md.as_bytes())?;
     Ok(FlowOutcome {
-        pass: r.pass,
+        pass: r.pass && signoff.iter().all(|l| l.pass()),
         frame_pulses: p.frame_pulses,
         cycles: r.cycles,
         mismatches: r.outcome.mismatches,
@@ -240,6 +269,7 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
         headline,
         size_line,
         report: path,
+        signoff,
     })
 }
 

