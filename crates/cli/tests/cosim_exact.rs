@@ -9,9 +9,7 @@ use common::tofprobe;
 use std::path::{Path, PathBuf};
 
 fn tools() -> bool {
-    ["verilator", "iverilog", "vvp"]
-        .iter()
-        .all(|t| tofprobe_cosim::tools::require(t).is_ok())
+    common::have_tools(&["verilator", "iverilog", "vvp"])
 }
 
 /// A copy of testbench/default-short/rtl (the default with N = 64) under the target dir.
@@ -38,13 +36,7 @@ fn out_dir(name: &str) -> String {
 }
 
 fn json(o: &std::process::Output) -> serde_json::Value {
-    let text = String::from_utf8_lossy(&o.stdout);
-    serde_json::from_str(text.lines().last().unwrap_or("")).unwrap_or_else(|e| {
-        panic!(
-            "not JSON ({e}): {text}\n{}",
-            String::from_utf8_lossy(&o.stderr)
-        )
-    })
+    common::last_json(o)
 }
 
 #[test]

@@ -11,9 +11,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 fn tools() -> bool {
-    ["iverilog", "vvp"]
-        .iter()
-        .all(|t| tofprobe_cosim::tools::require(t).is_ok())
+    common::have_tools(&["iverilog", "vvp"])
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -198,13 +196,7 @@ fn cosim(rtl: &Path, out: &Path, junit: &Path, extra: &[&str]) -> std::process::
 }
 
 fn json(o: &std::process::Output) -> serde_json::Value {
-    let text = String::from_utf8_lossy(&o.stdout);
-    serde_json::from_str(text.lines().last().unwrap_or("")).unwrap_or_else(|e| {
-        panic!(
-            "not JSON ({e}): {text}\n{}",
-            String::from_utf8_lossy(&o.stderr)
-        )
-    })
+    common::last_json(o)
 }
 
 #[test]

@@ -16,6 +16,26 @@ pub fn tofprobe(args: &[&str]) -> Output {
         .expect("run tofprobe")
 }
 
+/// Whether every one of `tools` is installed (the co-simulation tests skip, saying so,
+/// without them).
+pub fn have_tools(tools: &[&'static str]) -> bool {
+    tools
+        .iter()
+        .all(|t| tofprobe_cosim::tools::require(t).is_ok())
+}
+
+/// The JSON object a `--json` command printed on its last stdout line (panics with both
+/// streams when it is not one).
+pub fn last_json(o: &Output) -> serde_json::Value {
+    let text = String::from_utf8_lossy(&o.stdout);
+    serde_json::from_str(text.lines().last().unwrap_or("")).unwrap_or_else(|e| {
+        panic!(
+            "not JSON ({e}): {text}\n{}",
+            String::from_utf8_lossy(&o.stderr)
+        )
+    })
+}
+
 /// The embedded default configuration's text (`config --print-default`).
 pub fn default_text() -> String {
     String::from_utf8(tofprobe(&["config", "--print-default"]).stdout).expect("utf-8")

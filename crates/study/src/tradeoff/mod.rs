@@ -17,8 +17,8 @@ use std::time::Instant;
 use serde::Serialize;
 use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::closed_form::{
-    MixtureParams, first_arrival, hold_response_sq, mixture_gain, noise_floor_hold_mm,
-    noise_floor_mm,
+    FirstArrival, MixtureParams, first_arrival, hold_response_sq, mixture_gain,
+    noise_floor_hold_mm, noise_floor_mm,
 };
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_detections};
@@ -149,7 +149,17 @@ pub fn measure_setup(
         window_mm: config.sensor.window_end_mm() - config.sensor.window_start_mm(),
     };
     let dsp_err = |source| StudyError::from(DesignError::probe(origin, source));
-    let arrival = first_arrival(&mixture).map_err(dsp_err)?;
+    // A scene without photons has no mixture: no detections, so the closed form reads 0.
+    let arrival = if mixture.signal_rate + mixture.background_rate > 0.0 {
+        first_arrival(&mixture).map_err(dsp_err)?
+    } else {
+        FirstArrival {
+            valid_rate: 0.0,
+            mean_mm: mixture.signal_depth_mm,
+            variance_mm2: mixture.jitter_mm * mixture.jitter_mm,
+            signal_fraction: 0.0,
+        }
+    };
     let sigma = (arrival.variance_mm2 + lsb_mm * lsb_mm / 12.0).sqrt();
     let rho = arrival.valid_rate.min(1.0);
     let n_eff = n as f64 * window.effective_length_factor();
