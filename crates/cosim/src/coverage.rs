@@ -69,6 +69,9 @@ pub fn measure(
         .arg("--annotate")
         .arg(&ann)
         .args(["--annotate-min", "1"])
+        // A file whose every point was hit is written too (without it, 100% coverage
+        // leaves no annotated file to read).
+        .arg("--annotate-all")
         .arg(&dat)
         .output()
         .map_err(|e| CosimError::io(&tool, e))?;

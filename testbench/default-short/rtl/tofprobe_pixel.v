@@ -90,7 +90,11 @@ module tofprobe_pixel (
             4'd13: begin rd_0 = y[26]; sg_0 = bits_nx[26]; end
             4'd14: begin rd_0 = y[28]; sg_0 = bits_nx[28]; end
             4'd15: begin rd_0 = y[30]; sg_0 = bits_nx[30]; end
+            // The read-ahead slot is 0..K-1 for every K: this arm is unreachable, kept so the
+            // case is full for lint, and left out of line coverage.
+            // verilator coverage_off
             default: begin rd_0 = 39'd0; sg_0 = 1'b0; end
+            // verilator coverage_on
         endcase
     end
     wire [38:0] sum_0 = add_0 ? (yin_0 + opx) : (yin_0 - opx);
@@ -127,7 +131,11 @@ module tofprobe_pixel (
             4'd13: begin rd_1 = y[27]; sg_1 = bits_nx[27]; end
             4'd14: begin rd_1 = y[29]; sg_1 = bits_nx[29]; end
             4'd15: begin rd_1 = y[31]; sg_1 = bits_nx[31]; end
+            // The read-ahead slot is 0..K-1 for every K: this arm is unreachable, kept so the
+            // case is full for lint, and left out of line coverage.
+            // verilator coverage_off
             default: begin rd_1 = 39'd0; sg_1 = 1'b0; end
+            // verilator coverage_on
         endcase
     end
     wire [38:0] sum_1 = add_1 ? (yin_1 + opx) : (yin_1 - opx);
