@@ -8,7 +8,6 @@ mod common;
 
 use common::{tofprobe, windowed_default};
 use std::path::PathBuf;
-use std::process::Command;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("tofprobe-flow-{}-{name}", std::process::id()));
@@ -16,20 +15,9 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-fn have(tool: &str) -> bool {
-    let ok = Command::new("sh")
-        .args(["-c", &format!("command -v {tool}")])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        eprintln!("\n*** SKIPPED: {tool} not installed (scripts/install-tools.sh) ***\n");
-    }
-    ok
-}
-
 #[test]
 fn flow_on_the_default_uses_the_sigma_delta_rom_and_passes() {
-    if !have("verilator") {
+    if !common::have_tools(&["verilator"]) {
         return;
     }
     let dir = scratch("default");
@@ -95,7 +83,7 @@ fn vectors_on_a_frame_too_short_for_the_band_fall_back_to_the_sign_probe() {
 /// failing both checks is crates/report/tests/signoff.rs.)
 #[test]
 fn flow_signoff_on_a_short_frame() {
-    if !have("verilator") || !have("iverilog") || !have("yosys") {
+    if !common::have_tools(&["verilator", "iverilog", "yosys"]) {
         return;
     }
     let dir = scratch("signoff");

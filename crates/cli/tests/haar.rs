@@ -272,22 +272,11 @@ fn tradeoff_on_a_haar_scene_has_the_haar_rows() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-fn have(tool: &str) -> bool {
-    let ok = std::process::Command::new("sh")
-        .args(["-c", &format!("command -v {tool}")])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        eprintln!("\n*** SKIPPED: {tool} not installed (scripts/install-tools.sh) ***\n");
-    }
-    ok
-}
-
 /// `flow` on a small Haar frame (U = 4: 31 registers, within the harness's 64): the
 /// co-simulated readout becomes the transient analysis and `scalogram.svg`.
 #[test]
 fn flow_on_a_haar_frame_reports_the_events_and_the_scalogram() {
-    if !have("verilator") {
+    if !common::have_tools(&["verilator"]) {
         return;
     }
     let dir = scratch("flow");

@@ -16,12 +16,19 @@ pub fn tofprobe(args: &[&str]) -> Output {
         .expect("run tofprobe")
 }
 
-/// Whether every one of `tools` is installed (the co-simulation tests skip, saying so,
-/// without them).
+/// Whether every one of `tools` is installed; the first missing one is named on stderr
+/// (the EDA tests skip without them).
 pub fn have_tools(tools: &[&'static str]) -> bool {
-    tools
+    match tools
         .iter()
-        .all(|t| tofprobe_cosim::tools::require(t).is_ok())
+        .find(|t| tofprobe_cosim::tools::require(t).is_err())
+    {
+        None => true,
+        Some(t) => {
+            eprintln!("\n*** SKIPPED: {t} not installed (scripts/install-tools.sh) ***\n");
+            false
+        }
+    }
 }
 
 /// The JSON object a `--json` command printed on its last stdout line (panics with both
