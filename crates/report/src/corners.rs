@@ -17,6 +17,9 @@ use std::path::{Path, PathBuf};
 /// The paper's claim: the adder is shared over at least 16 bins' registers at 10 MHz.
 pub const PAPER_REGISTERS_PER_ADDER_MIN: u64 = 16;
 
+/// The slack a corner must keep, as a percentage of the period, to count as closed.
+pub const MARGIN_PERCENT: f64 = 10.0;
+
 /// One liberty/corner's verdict (JSON: `timing_corners[]`).
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct CornerTiming {
@@ -36,6 +39,11 @@ pub struct CornerTiming {
     pub slack_ns: f64,
     /// slack ≥ 0.
     pub meets_clock: bool,
+    /// Slack as a percentage of the clock period (one decimal).
+    pub slack_percent: f64,
+    /// slack ≥ [`MARGIN_PERCENT`] % of the period: closed with the margin a design keeps
+    /// for placement, routing and clock skew, which this synthesis-only timing omits.
+    pub meets_margin: bool,
     /// Start of the critical path.
     pub startpoint: String,
     /// End of the critical path.
@@ -70,6 +78,8 @@ impl CornerTiming {
             clock_mhz,
             slack_ns: slack,
             meets_clock: slack >= 0.0,
+            slack_percent: (slack / period * 1e3).round() / 10.0,
+            meets_margin: slack >= period * MARGIN_PERCENT / 100.0,
             startpoint: sta.startpoint.clone(),
             endpoint: sta.endpoint.clone(),
             path_cells: sta.path_cells,

@@ -17,6 +17,13 @@ pub struct LibCell {
     pub flop: bool,
     /// Has at least one output pin with a `function`.
     pub functional: bool,
+    /// Some output's `function` is a bare name (`"A"`): with one input and `!sequential`,
+    /// a buffer.
+    pub identity: bool,
+    /// Input pins (`direction : input`).
+    pub inputs: u32,
+    /// Marked `dont_use : true`: synthesis must not map onto it.
+    pub dont_use: bool,
 }
 
 /// A parsed liberty file.
@@ -160,6 +167,9 @@ impl Liberty {
                         sequential: false,
                         flop: false,
                         functional: false,
+                        identity: false,
+                        inputs: 0,
+                        dont_use: false,
                     },
                 );
             }
@@ -185,8 +195,29 @@ impl Liberty {
                 }
             }
             "function" if depth == 3 => {
+                // A name (sky130 writes "(A)"), not a constant ("1") or an expression.
+                let value = value.trim_start_matches('(').trim_end_matches(')').trim();
+                let bare = value.starts_with(|ch: char| ch.is_ascii_alphabetic())
+                    && value
+                        .chars()
+                        .all(|ch| ch.is_ascii_alphanumeric() || ch == '_');
                 if let Some(c) = self.current_cell(stack) {
                     c.functional = true;
+                    c.identity |= bare;
+                }
+            }
+            "direction"
+                if depth == 3
+                    && value == "input"
+                    && stack.last().is_some_and(|(k, _)| k == "pin") =>
+            {
+                if let Some(c) = self.current_cell(stack) {
+                    c.inputs += 1;
+                }
+            }
+            "dont_use" if depth == 2 => {
+                if let Some(c) = self.current_cell(stack) {
+                    c.dont_use = value == "true";
                 }
             }
             _ => {}
@@ -213,6 +244,19 @@ impl Liberty {
         Ok(())
     }
 
+    /// The smallest buffer synthesis may use (a combinational cell whose output is one of
+    /// its inputs, not `dont_use`; the first by name among equals): ABC's model of what
+    /// drives a flop's output (see `synth::abc_constraints`).
+    pub fn drive_cell(&self) -> Option<&str> {
+        self.cells
+            .iter()
+            .filter(|(_, c)| {
+                c.identity && c.inputs == 1 && !c.sequential && !c.dont_use && c.area > 0.0
+            })
+            .min_by(|a, b| a.1.area.total_cmp(&b.1.area))
+            .map(|(n, _)| n.as_str())
+    }
+
     /// Area of the smallest flop cell (a yardstick for the report).
     pub fn smallest_flop(&self) -> Option<(&str, f64)> {
         self.cells
@@ -221,6 +265,36 @@ impl Liberty {
             .map(|(n, c)| (n.as_str(), c.area))
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
+}
+
+/// Cells a liberty offers that logic synthesis must not use, by name fragment. sky130's
+/// `lpflow_*` cells are the low-power flow's isolation, keep-alive and KAPWR-rail cells
+/// (extra power pins a plain netlist does not connect) and `probe*_p` the probe pads; the
+/// PDK's own flow (OpenLane) keeps them out of synthesis, but its liberties do not mark
+/// them `dont_use`, and ABC picked isolation buffers for the default pixel's adders.
+pub const NOT_FOR_SYNTHESIS: [&str; 3] = ["__lpflow_", "__probe_p_", "__probec_p_"];
+
+/// `text` with `dont_use : true ;` added to every cell named by [`NOT_FOR_SYNTHESIS`] (as
+/// the first attribute of its group, on the line after `cell ("NAME") {`); `None` when no
+/// cell needed it, so an ordinary liberty is used as it is.
+pub fn mark_not_for_synthesis(text: &str) -> Option<String> {
+    let mut out = String::with_capacity(text.len() + 4096);
+    let mut marked = 0usize;
+    for line in text.split_inclusive('\n') {
+        out.push_str(line);
+        let t = line.trim();
+        if t.starts_with("cell")
+            && t.ends_with('{')
+            && NOT_FOR_SYNTHESIS.iter().any(|p| t.contains(p))
+        {
+            if !line.ends_with('\n') {
+                out.push('\n');
+            }
+            out.push_str("        dont_use : true ;\n");
+            marked += 1;
+        }
+    }
+    (marked > 0).then_some(out)
 }
 
 #[cfg(test)]
@@ -250,6 +324,43 @@ library (tiny) {
         assert!(lib.has_timing);
         assert_eq!(lib.smallest_flop(), Some(("DFF", 96.5)));
         lib.require_pixel_cells().unwrap();
+    }
+
+    #[test]
+    fn drive_cell_is_the_smallest_usable_buffer() {
+        // INV is not a buffer ("!A"), DFF's "IQ" is a state: no drive cell yet.
+        let lib = Liberty::parse(Path::new("tiny.lib"), TINY).unwrap();
+        assert_eq!(lib.drive_cell(), None);
+        let buf = |name: &str, area: f64, extra: &str| {
+            format!(
+                "  cell ({name}) {{ area : {area} ; {extra} pin (A) {{ direction : input ; }}\n    pin (X) {{ direction : output ; function : \"(A)\" ; }} }}\n"
+            )
+        };
+        // A tie cell's output function "1" is a constant, not a buffer.
+        let tie = "  cell (TIEHI) { area : 1.0 ; pin (HI) { direction : output ; function : \"1\" ; } }\n";
+        let text = TINY.replacen(
+            "  cell (INV)",
+            &(tie.to_string()
+                + &buf("BUFX4", 8.0, "")
+                + &buf("BUFX2", 4.0, "")
+                + &buf("ISO", 2.0, "dont_use : true ;")
+                + "  cell (INV)"),
+            1,
+        );
+        let lib = Liberty::parse(Path::new("bufs.lib"), &text).unwrap();
+        // TIEHI and ISO are smaller, but a constant and dont_use; BUFX2 beats BUFX4.
+        assert_eq!(lib.drive_cell(), Some("BUFX2"));
+    }
+
+    #[test]
+    fn sky130_low_power_cells_are_marked_dont_use() {
+        let text = "library (l) {\n    cell (\"sky130_fd_sc_hd__buf_1\") {\n        area : 3.75 ;\n    }\n    cell (\"sky130_fd_sc_hd__lpflow_isobufsrc_1\") {\n        area : 5.0 ;\n    }\n}\n";
+        let marked = mark_not_for_synthesis(text).expect("one cell to mark");
+        let lib = Liberty::parse(Path::new("m.lib"), &marked).unwrap();
+        assert!(lib.cells["sky130_fd_sc_hd__lpflow_isobufsrc_1"].dont_use);
+        assert!(!lib.cells["sky130_fd_sc_hd__buf_1"].dont_use);
+        // A liberty without such cells is left alone (no copy).
+        assert_eq!(mark_not_for_synthesis(TINY), None);
     }
 
     #[test]

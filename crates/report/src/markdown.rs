@@ -59,18 +59,27 @@ fn corner_table(out: &mut String, r: &SizeReport) {
     };
     let _ = writeln!(
         out,
-        "\n### Per liberty and corner, at C·f_laser = {:.1} MHz\n\n| library | corner | f_max MHz | slack ns | critical path | registers per adder (paper: ≥ {}) |\n|---|---|---:|---:|---|---:|",
-        first.clock_mhz, first.paper_registers_per_adder_min
+        "\n### Per liberty and corner, at C·f_laser = {:.1} MHz\n\n| library | corner | f_max MHz | slack ns | verdict (margin ≥ {:.0} %) | critical path | registers per adder (paper: ≥ {}) |\n|---|---|---:|---:|---|---|---:|",
+        first.clock_mhz,
+        crate::corners::MARGIN_PERCENT,
+        first.paper_registers_per_adder_min
     );
     for c in &r.timing_corners {
         let _ = writeln!(
             out,
-            "| {} | {} | {:.1} | {:+.3}{} | `{}` → `{}` ({} cells) | {} |",
+            "| {} | {} | {:.1} | {:+.3}{} | {} | `{}` → `{}` ({} cells) | {} |",
             c.library,
             c.corner,
             c.f_max_mhz,
             c.slack_ns,
             if c.meets_clock { "" } else { " **fails**" },
+            if c.meets_margin {
+                format!("fits, {:.1} % slack", c.slack_percent)
+            } else if c.meets_clock {
+                format!("fits, {:.1} % slack: below the margin", c.slack_percent)
+            } else {
+                format!("**fails** by {:.3} ns", -c.slack_ns)
+            },
             c.startpoint,
             c.endpoint,
             c.path_cells,

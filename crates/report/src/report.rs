@@ -386,7 +386,7 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
     let assumptions = vec![
         "Area is the sum of standard-cell areas after yosys synthesis (synth -flatten, dfflibmap, abc -liberty): no placement utilisation, no routing, no well taps.".into(),
         format!(
-            "On the timing liberty ABC maps for the clock the configuration needs (C·f_laser → {:.0} ps), builds buffer trees (fanout ≤ {}) and resizes gates; the sky130 mapping is area-driven without buffers.",
+            "On a timing liberty ABC maps for the clock the configuration needs (C·f_laser → {:.0} ps): two rounds of delay-oriented restructuring (&synch2, &if -g) before mapping, flop outputs modelled as driven by the library's smallest buffer (abc -constr), buffer trees (fanout ≤ {}) and gate sizing; cells not meant for logic synthesis (sky130's lpflow_* and probe cells) are dont_use. The area-only sky130 fallback is mapped without timing.",
             1e12 / (d.cycles_per_pulse as f64 * d.laser_rate_hz),
             crate::synth::MAX_FANOUT
         ),

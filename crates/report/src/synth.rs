@@ -38,16 +38,32 @@ pub struct SynthSpec {
 }
 
 /// Largest fanout ABC's `buffer` leaves on a net.
-pub const MAX_FANOUT: u32 = 16;
+pub const MAX_FANOUT: u32 = 8;
 
-/// ABC's script for timing-driven mapping with buffering and sizing (yosys's default
-/// liberty script plus `buffer`, `upsize`, `dnsize`).
+/// ABC's script for timing-driven mapping. Yosys's default liberty script maps the AIG as
+/// `dc2`/`&dch` leave it, which keeps the ripple structure of the adders (a chain of
+/// `maj3` cells: 39 bits took 7 ns on sky130 tt) and never buffers a net driven by a flop
+/// (flop outputs are ABC's primary inputs). So: two rounds of delay-oriented restructuring
+/// (`&synch2`, SOP balancing `&if -g`) before `&nf`, and buffering and sizing that respect
+/// the constraints file (`-c`: primary inputs driven by the library's smallest buffer, see
+/// [`abc_constraints`]). Measured on the default pixel at 6250 ps: sky130 tt 8.20 → 4.55 ns
+/// at +1% area, osu018 6.34 → 3.13 ns.
 pub fn abc_timing_script(delay_ps: f64) -> String {
     let d = delay_ps.round().max(1.0);
     format!(
-        "strash; &get -n; &fraig -x; &put; scorr; dc2; dretime; strash; &get -n; &dch -f; \
-         &nf -D {d}; &put; buffer -N {MAX_FANOUT}; upsize -D {d}; dnsize -D {d}; stime -p\n"
+        "strash; &get -n; &fraig -x; &put; scorr; dc2; dretime; strash; &get -n; \
+         &st; &synch2; &if -g -K 6; &st; &synch2; &if -g -K 6; &st; &synch2; &dch -f; \
+         &nf -D {d}; &put; buffer -c -N {MAX_FANOUT}; upsize -c -D {d}; dnsize -c -D {d}; \
+         stime -c -p\n"
     )
+}
+
+/// ABC's constraints file (`abc -constr`): every primary input of the mapped logic (a
+/// flop's Q, a port) is driven like the library's smallest buffer `drive_cell`, so ABC
+/// sizes and buffers high-fanout flop outputs (the sign and operand flops feed every bit
+/// of an adder) instead of assuming an ideal driver.
+pub fn abc_constraints(drive_cell: &str) -> String {
+    format!("set_driving_cell {drive_cell}\n")
 }
 
 /// The result of one synthesis run.
@@ -79,8 +95,9 @@ fn yosys_version(yosys: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// The yosys script for `spec`, writing into `dir`.
-pub fn yosys_script(spec: &SynthSpec, dir: &Path) -> String {
+/// The yosys script for `spec`, writing into `dir`; `constrained`: a timed run passes
+/// `dir/abc.constr` ([`abc_constraints`]) to ABC.
+pub fn yosys_script(spec: &SynthSpec, dir: &Path, constrained: bool) -> String {
     let lib = spec.liberty.display();
     let mut s = format!("read_liberty -lib {lib}\n");
     for src in &spec.sources {
@@ -97,6 +114,11 @@ pub fn yosys_script(spec: &SynthSpec, dir: &Path) -> String {
         s += &format!("setattr -set keep 1 {}/w:{w}\n", spec.top);
     }
     let abc = match spec.delay_target_ps {
+        Some(_) if constrained => format!(
+            "abc -script {} -constr {} -liberty {lib}",
+            dir.join("abc.script").display(),
+            dir.join("abc.constr").display()
+        ),
         Some(_) => format!(
             "abc -script {} -liberty {lib}",
             dir.join("abc.script").display()
@@ -132,7 +154,7 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
         ..spec.clone()
     };
     let mut h = Fnv64::default();
-    h.feed(b"tofprobe-synth-v1").feed(spec.top.as_bytes());
+    h.feed(b"tofprobe-synth-v2").feed(spec.top.as_bytes());
     for src in &spec.sources {
         let text = std::fs::read(src).map_err(|_| ReportError::RtlMissing { path: src.clone() })?;
         h.feed(&text);
@@ -162,11 +184,44 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
         return Ok(cached);
     }
     std::fs::create_dir_all(&dir).map_err(|e| ReportError::io("creating", &dir, e))?;
+    // Map onto a copy with the cells synthesis must not use marked `dont_use` (ABC honours
+    // it), when the liberty has such cells; the area and timing of the others are the same.
+    let text = String::from_utf8_lossy(&lib_text);
+    let marked = crate::liberty::mark_not_for_synthesis(&text);
+    let map_spec = match &marked {
+        Some(m) => {
+            // One copy per liberty text beside the cache entries, not one per entry (12 MB
+            // for a sky130 corner).
+            let mut lh = Fnv64::default();
+            lh.feed(m.as_bytes());
+            let map_lib = cache_root.join(format!("map-{}.lib", lh.hex()));
+            if !map_lib.exists() {
+                write_atomic(&map_lib, m.as_bytes())?;
+            }
+            SynthSpec {
+                liberty: map_lib,
+                ..spec.clone()
+            }
+        }
+        None => spec.clone(),
+    };
+    let mut constrained = false;
     if let Some(d) = spec.delay_target_ps {
         write_atomic(&dir.join("abc.script"), abc_timing_script(d).as_bytes())?;
+        let map_lib = match &marked {
+            Some(m) => Liberty::parse(&map_spec.liberty, m)?,
+            None => lib.clone(),
+        };
+        if let Some(cell) = map_lib.drive_cell() {
+            write_atomic(&dir.join("abc.constr"), abc_constraints(cell).as_bytes())?;
+            constrained = true;
+        }
     }
     let script_path = dir.join("synth.ys");
-    write_atomic(&script_path, yosys_script(spec, &dir).as_bytes())?;
+    write_atomic(
+        &script_path,
+        yosys_script(&map_spec, &dir, constrained).as_bytes(),
+    )?;
     let start = std::time::Instant::now();
     let out = Command::new(&yosys)
         .arg("-q")
@@ -299,7 +354,7 @@ mod tests {
             delay_target_ps: None,
             keep: vec![],
         };
-        let s = yosys_script(&spec, Path::new("/d"));
+        let s = yosys_script(&spec, Path::new("/d"), false);
         assert!(!s.contains("setattr"));
         assert!(s.contains("chparam -set B 4 -set W 12 pixel"));
         assert!(s.contains("synth -top pixel -flatten"));
@@ -308,15 +363,24 @@ mod tests {
             delay_target_ps: Some(6250.0),
             ..spec
         };
-        let s = yosys_script(&timed, Path::new("/d"));
+        let s = yosys_script(&timed, Path::new("/d"), false);
         assert!(
             s.contains("abc -script /d/abc.script -liberty l.lib"),
             "{s}"
         );
+        let s = yosys_script(&timed, Path::new("/d"), true);
+        assert!(
+            s.contains("abc -script /d/abc.script -constr /d/abc.constr -liberty l.lib"),
+            "{s}"
+        );
         let abc = abc_timing_script(6250.0);
         assert!(
-            abc.contains("&nf -D 6250;") && abc.contains("buffer -N 16;"),
+            abc.contains("&if -g -K 6;")
+                && abc.contains("&nf -D 6250;")
+                && abc.contains("buffer -c -N 8;")
+                && abc.contains("upsize -c -D 6250;"),
             "{abc}"
         );
+        assert_eq!(abc_constraints("BUFX2"), "set_driving_cell BUFX2\n");
     }
 }
