@@ -4,6 +4,7 @@
 //! command starts from a `ResolvedDesign`. Also the bin chooser ([`bins`]) and the chip
 //! ROM policy of the RTL commands ([`rom_policy`]).
 
+pub mod adders;
 pub mod analysis_mode;
 pub mod bins;
 pub mod document;
@@ -13,6 +14,7 @@ pub mod resolve;
 pub mod rom_policy;
 pub mod schema;
 
+pub use adders::AdderChoice;
 pub use analysis_mode::ModeDecision;
 pub use document::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, SIZING_SIGMAS, read_text};
 pub use error::DesignError;

@@ -40,6 +40,8 @@ pub struct ResolvedDesign {
     /// Notes every command prints: a mixed scene under `mode = "auto"`, a `[probe]` a Haar
     /// pixel ignores, transients outside the Haar frame.
     pub notes: Vec<String>,
+    /// What `adders = "auto"` chose and the timing behind it (`None`: A was explicit).
+    pub adders: Option<crate::adders::AdderChoice>,
 }
 
 /// Reads `path` (or the embedded default) and resolves it.
@@ -142,6 +144,17 @@ pub fn resolve_with(
             ));
         }
     }
+    // `adders = "auto"`: A and C from measured timing (crate::adders), then the pixel
+    // resolves with them like any explicit value.
+    let adders = if matches!(px.adders, tofprobe_pixel::config::Choice::Auto(_)) {
+        let choice = crate::adders::choose(&px, &context, origin)?;
+        px.adders = tofprobe_pixel::config::Choice::Value(choice.adders);
+        px.cycles_per_pulse = choice.cycles_per_pulse;
+        notes.push(choice.note());
+        Some(choice)
+    } else {
+        None
+    };
     let pixel = px
         .resolve(&context)
         .map_err(|e| pixel_err(derived_from(e, d)))?;
@@ -165,6 +178,7 @@ pub fn resolve_with(
         probe_design,
         mode,
         notes,
+        adders,
     })
 }
 

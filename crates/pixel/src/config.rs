@@ -54,8 +54,15 @@ pub struct PixelConfig {
     /// U: finest Haar scale, registers 2^(U+1) − 1 (default [`DEFAULT_HAAR_SCALES`]: 31
     /// registers; with `mode = "auto"` picking Haar, the design's resolution chooses).
     pub haar_scales: Option<u32>,
-    /// A: adders shared over the registers (default 2).
-    pub adders: usize,
+    /// A: adders shared over the registers (default 2), or `"auto"`: the fewest adders
+    /// whose pixel meets the laser rate on `timing_liberty`, with C = ⌈P/A⌉ cycles per
+    /// pulse, decided by the design's resolution from a measured f_max
+    /// (`tofprobe_design::adders`); this section alone refuses it.
+    pub adders: Choice<usize>,
+    /// The liberty `adders = "auto"` times on: `"osu018"` (default, Debian's
+    /// qflow-tech-osu018), `"sky130"` (the timed sky130_fd_sc_hd PDK's tt corner, found as
+    /// `tofprobe size` finds it) or a path to a liberty with timing.
+    pub timing_liberty: Option<String>,
     /// C: clock cycles per laser pulse (default 16).
     pub cycles_per_pulse: usize,
     /// T: TDC width in bits; default: the smallest that codes the sensor's window.
@@ -82,7 +89,8 @@ impl Default for PixelConfig {
             bins: Choice::Value(16),
             frequencies_hz: Vec::new(),
             haar_scales: None,
-            adders: 2,
+            adders: Choice::Value(2),
+            timing_liberty: None,
             cycles_per_pulse: 16,
             tdc_bits: None,
             zoom: 0,
@@ -198,11 +206,23 @@ impl PixelConfig {
                 }
             }
         }
+        let adders = match self.adders {
+            Choice::Value(a) => a,
+            Choice::Auto(_) => {
+                return Err(PixelError::invalid(
+                    "adders",
+                    "\"auto\"",
+                    "\"auto\" is chosen from a synthesis of the pixel on a liberty: the design's \
+                     resolution (tofprobe_design::resolve) decides it, the [pixel] section alone cannot",
+                    "a number of adders, e.g. 2",
+                ));
+            }
+        };
         let mut params = PixelParams {
             mode,
             bins,
             haar_scales: self.haar_scales.unwrap_or(DEFAULT_HAAR_SCALES),
-            adders: self.adders,
+            adders,
             cycles_per_pulse: self.cycles_per_pulse,
             tdc_bits,
             zoom: self.zoom,
@@ -298,6 +318,29 @@ mod tests {
 
     /// `"auto"` parses for bins and width; explicit values still do; anything else is a
     /// parse error.
+    /// `adders = "auto"` parses, and only the design's resolution (which can synthesise)
+    /// decides it: the section alone refuses it naming the key and what works.
+    #[test]
+    fn auto_adders_parse_and_need_the_design() {
+        let c: PixelConfig =
+            toml::from_str("adders = \"auto\"\ntiming_liberty = \"sky130\"").unwrap();
+        assert_eq!(c.adders, Choice::AUTO);
+        assert_eq!(c.timing_liberty.as_deref(), Some("sky130"));
+        let ctx = PixelContext {
+            tdc_codes: 80,
+            laser_rate_hz: 10e6,
+            pulses: 4096,
+            code_range: None,
+            tones: vec![],
+            osr: DEFAULT_OSR,
+        };
+        let msg = c.resolve(&ctx).unwrap_err().to_string();
+        assert!(msg.contains("adders") && msg.contains("design"), "{msg}");
+        let c: PixelConfig = toml::from_str("adders = 1").unwrap();
+        assert_eq!(c.adders, Choice::Value(1));
+        assert!(toml::from_str::<PixelConfig>("adders = \"many\"").is_err());
+    }
+
     #[test]
     fn auto_and_explicit_values_parse() {
         let c: PixelConfig = toml::from_str("bins = \"auto\"\nwidth = \"auto\"").unwrap();

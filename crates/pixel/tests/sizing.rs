@@ -155,7 +155,7 @@ fn impossible_configurations_name_the_nearest_valid_value() {
     // One adder: C ≥ 32.
     assert_eq!(
         with(&|c| {
-            c.adders = 1;
+            c.adders = Choice::Value(1);
         }),
         Err(("cycles_per_pulse", "32".into()))
     );
@@ -174,7 +174,10 @@ fn impossible_configurations_name_the_nearest_valid_value() {
     assert_eq!(with(&|c| c.zoom = 128), Err(("zoom", "127".into())));
     assert_eq!(with(&|c| c.shift = 16), Err(("shift", "15".into())));
     assert_eq!(with(&|c| c.frac_bits = 17), Err(("frac_bits", "16".into())));
-    assert_eq!(with(&|c| c.adders = 33), Err(("adders", "32".into())));
+    assert_eq!(
+        with(&|c| c.adders = Choice::Value(33)),
+        Err(("adders", "32".into()))
+    );
     assert_eq!(
         with(&|c| c.bins = tofprobe_pixel::config::Choice::Value(0)),
         Err(("bins", "1".into()))

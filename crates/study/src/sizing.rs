@@ -39,15 +39,7 @@ pub struct SizeOptions {
 }
 
 fn cache_dir(arg: Option<&Path>) -> PathBuf {
-    if let Some(p) = arg {
-        return p.to_path_buf();
-    }
-    let base = std::env::var_os("TOFPROBE_CACHE")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("XDG_CACHE_HOME").map(|p| PathBuf::from(p).join("tofprobe")))
-        .or_else(|| std::env::var_os("HOME").map(|p| PathBuf::from(p).join(".cache/tofprobe")))
-        .unwrap_or_else(|| std::env::temp_dir().join("tofprobe-cache"));
-    base.join("synth")
+    tofprobe_report::fsutil::synth_cache_dir(arg)
 }
 
 /// Builds the sizing report of `design`.
