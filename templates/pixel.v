@@ -69,6 +69,15 @@ module {{ name }} (
     wire [{{ xw }}:0] diff = {held_f[{{ xw - 1 }}], held_f} - {x[{{ xw - 1 }}], x};
 {%- if mutation == "logical_shift" %}
     wire [{{ xw }}:0] step = diff >> {{ s }};
+{%- else if round_half > 0 %}
+    // Prefilter rounding "nearest": 2^(S-1) added before the shift (round half up), one
+    // bit wider so the sum cannot wrap; the step lies between 0 and diff, so its top bit
+    // is the sign and is dropped.
+    wire [{{ xw + 1 }}:0] diff_r = {diff[{{ xw }}], diff} + {{ xw + 2 }}'d{{ round_half }};
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [{{ xw + 1 }}:0] step_r = $signed(diff_r) >>> {{ s }};
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [{{ xw }}:0] step = step_r[{{ xw }}:0];
 {%- else %}
     wire [{{ xw }}:0] step = $signed(diff) >>> {{ s }};
 {%- endif %}

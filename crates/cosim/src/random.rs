@@ -1,12 +1,13 @@
 //! Random valid configurations for `tofprobe cosim --random N --seed S` and the CI's eight:
-//! both modes and every knob of the pixel (B or U, A, C, T, Z, S, F, W, N, L), the register
+//! both modes and every knob of the pixel (B or U, A, C, T, Z, S, F, W, N, L, the prefilter's
+//! rounding), the register
 //! width either drawn or `auto` (sized by `tofprobe_pixel::sizing::required_width` for the
 //! whole TDC range and the sign probe ROM actually replayed), and sometimes sized for a
 //! frame 16× shorter than the one simulated, so the wrapping accumulators really wrap.
 //! Kept small (R ≤ 15, N ≤ 64) because every configuration is a Verilator build.
 
 use tofprobe_pixel::sizing::required_width;
-use tofprobe_pixel::{Mode, PixelParams};
+use tofprobe_pixel::{Mode, PixelParams, Rounding};
 use tofprobe_rtlgen::golden::rom_image;
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 use tofprobe_scene::SplitMix64;
@@ -53,6 +54,7 @@ pub fn random_case(seed: u64, i: u64) -> RandomCase {
         width: 8,
         frame_pulses: 1 << ln,
         rom_depth: pick(&mut rng, 1, 48) as usize,
+        prefilter_rounding: Rounding::Floor,
     };
     p.adders = (pick(&mut rng, 1, 4) as usize).min(p.ops_per_pulse());
     p.cycles_per_pulse = p.slots() + pick(&mut rng, 0, 2) as usize;
@@ -72,9 +74,14 @@ pub fn random_case(seed: u64, i: u64) -> RandomCase {
             required_width(&sized, 0, (1u32 << t) - 1, rom.as_ref()).min(63)
         }
     };
+    let seed = rng.next_u64() % 10_000 + 1;
+    // Drawn last, so every other field of a case is what it was before the knob existed.
+    if p.mode == Mode::Fourier && rng.next_u64() & 1 == 1 {
+        p.prefilter_rounding = Rounding::Nearest;
+    }
     RandomCase {
         params: p,
-        seed: rng.next_u64() % 10_000 + 1,
+        seed,
         width,
     }
 }

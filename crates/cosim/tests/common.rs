@@ -53,5 +53,6 @@ pub fn directed_config(mode: Mode) -> PixelParams {
         width: 8,
         frame_pulses: 16,
         rom_depth: 16,
+        prefilter_rounding: Default::default(),
     }
 }

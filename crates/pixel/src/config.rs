@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::autobins::choose_bins;
 use crate::error::PixelError;
-use crate::params::{MAX_WIDTH, Mode, PixelParams, ceil_log2};
+use crate::params::{MAX_WIDTH, Mode, PixelParams, Rounding, ceil_log2};
 use crate::sizing;
 
 /// The keyword `"auto"` of a `[pixel]` key that can be chosen from the scene.
@@ -73,6 +73,9 @@ pub struct PixelConfig {
     pub shift: u32,
     /// F: prefilter fraction bits (default [`crate::DEFAULT_FRAC_BITS`]).
     pub frac_bits: u32,
+    /// How the prefilter's shift rounds: `"floor"` (default) or `"nearest"` (no bias,
+    /// same widths).
+    pub prefilter_rounding: Rounding,
     /// W: register width in bits; default: what the whole timing window needs (safe with
     /// any background); `"auto"`: what the scene's code range needs.
     pub width: Option<Choice<u32>>,
@@ -96,6 +99,7 @@ impl Default for PixelConfig {
             zoom: 0,
             shift: 5,
             frac_bits: crate::DEFAULT_FRAC_BITS,
+            prefilter_rounding: Rounding::Floor,
             width: None,
             frame_pulses: None,
             rom_depth: None,
@@ -218,6 +222,14 @@ impl PixelConfig {
                 ));
             }
         };
+        if mode == Mode::Haar && self.prefilter_rounding != Rounding::Floor {
+            return Err(PixelError::invalid(
+                "prefilter_rounding",
+                format!("\"{}\"", self.prefilter_rounding),
+                "Haar mode has no prefilter (it accumulates the held depth itself)",
+                "\"floor\" (or leave it out)",
+            ));
+        }
         let mut params = PixelParams {
             mode,
             bins,
@@ -231,6 +243,7 @@ impl PixelConfig {
             width: MAX_WIDTH,
             frame_pulses,
             rom_depth,
+            prefilter_rounding: self.prefilter_rounding,
         };
         // Everything but the width first, so the sizing below sees valid parameters.
         params.validate()?;

@@ -10,8 +10,8 @@
 //! behaviour they break; the transaction model passes `None`, which compiles them away.
 
 use crate::fault::Fault;
-use crate::fixed::{mask, prefilter_step, sign_extend, wrap, zoomed};
-use crate::params::{Mode, PixelParams};
+use crate::fixed::{mask, prefilter_step_rounded, sign_extend, wrap, zoomed};
+use crate::params::{Mode, PixelParams, Rounding};
 
 /// The datapath's constants and its front-end state (`primed`, `held`, `x`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -20,6 +20,7 @@ pub struct Datapath {
     tdc_bits: u32,
     zoom: u32,
     shift: u32,
+    rounding: Rounding,
     frac_bits: u32,
     operand_bits: u32,
     width: u32,
@@ -36,6 +37,7 @@ impl Datapath {
             tdc_bits: p.tdc_bits,
             zoom: p.zoom,
             shift: p.shift,
+            rounding: p.prefilter_rounding,
             frac_bits: p.effective_frac_bits(),
             operand_bits: p.operand_bits(),
             width: p.width,
@@ -106,13 +108,13 @@ impl Datapath {
         op
     }
 
-    /// x + (((held << F) − x) >>> S).
+    /// x + ((((held << F) − x) + r) >>> S), r = 0 (floor) or 2^(S−1) (nearest).
     #[inline(always)]
     fn prefilter(&self, fault: Option<Fault>) -> i64 {
         if fault == Some(Fault::LogicalShift) {
             return self.logical_shift_prefilter();
         }
-        prefilter_step(self.x, self.held, self.frac_bits, self.shift)
+        prefilter_step_rounded(self.x, self.held, self.frac_bits, self.shift, self.rounding)
     }
 
     /// The LogicalShift fault: the T+2+F-bit difference shifted in as unsigned, the sum

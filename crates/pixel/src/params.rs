@@ -27,6 +27,36 @@ impl std::fmt::Display for Mode {
     }
 }
 
+/// How the prefilter's arithmetic shift rounds (`[pixel] prefilter_rounding`,
+/// docs/pixel-contract.md "Prefilter rounding").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Rounding {
+    /// `diff >>> S`: rounds towards −∞, so x settles up to 2^S − 1 LSBs below a constant
+    /// input (a −0.06-code bias at S = 5, F = 8). The committed default.
+    #[default]
+    Floor,
+    /// `(diff + 2^(S−1)) >>> S`: round half up; the same widths, no bias.
+    Nearest,
+}
+
+impl Rounding {
+    /// The default: left out of the configuration hash, so the hashes of every pixel
+    /// from before the knob stand.
+    pub fn is_floor(&self) -> bool {
+        *self == Rounding::Floor
+    }
+}
+
+impl std::fmt::Display for Rounding {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Rounding::Floor => "floor",
+            Rounding::Nearest => "nearest",
+        })
+    }
+}
+
 /// Largest register width: the models hold registers in `i64` and the readout bus in `u64`.
 pub const MAX_WIDTH: u32 = 63;
 /// Largest TDC width the contract allows.
@@ -72,6 +102,9 @@ pub struct PixelParams {
     pub frame_pulses: u64,
     /// L: ROM depth in entries (Fourier; the ROM is addressed by pulse index mod L).
     pub rom_depth: usize,
+    /// How the prefilter's shift rounds (Fourier; floor by default).
+    #[serde(default, skip_serializing_if = "Rounding::is_floor")]
+    pub prefilter_rounding: Rounding,
 }
 
 impl Default for PixelParams {
@@ -100,6 +133,7 @@ impl PixelParams {
             width,
             frame_pulses,
             rom_depth,
+            prefilter_rounding: Rounding::Floor,
         }
     }
 

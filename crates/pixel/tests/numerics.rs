@@ -179,3 +179,52 @@ proptest! {
         prop_assert_eq!(reg, goal);
     }
 }
+
+/// Issue 16, prefilter rounding, before and after: the stationary bias of x against the
+/// mean held depth, on a jittered static scene (held = 40 codes ± 3, uniform, so the
+/// residues of the shift are uniform). The closed forms: floor truncates a mean of
+/// (2^S − 1)/2^(S+1) LSB per step and the filter's DC gain 2^S multiplies it, so x settles
+/// (2^S − 1)/2 LSB = 15.5/256 = −0.0605 code low; nearest (round half up) leaves 1/2^(S+1)
+/// LSB per step, +1/2 LSB = +0.00195 code. 10^6 steps: the mean's sd is ≈ 1e-4 code (the
+/// filter's output noise ≈ 0.3 code over ≈ 10^6/64 independent samples), so ±0.002 code
+/// holds both with margin and fails a swap of the two roundings by 30×.
+#[test]
+fn nearest_rounding_removes_the_prefilter_bias() {
+    use tofprobe_pixel::Rounding;
+    use tofprobe_pixel::fixed::prefilter_step_rounded;
+    let (f, s) = (DEFAULT_FRAC_BITS, 5);
+    let bias = |rounding: Rounding| {
+        let mut rng = Rng(7);
+        let mut x: i64 = 40 << f;
+        let (mut sum_x, mut sum_held, mut count) = (0f64, 0f64, 0f64);
+        for n in 0..1_000_000u32 {
+            let held = 37 + rng.below(7) as i64;
+            x = prefilter_step_rounded(x, held, f, s, rounding);
+            if n >= 10_000 {
+                sum_x += x as f64 / f64::from(1u32 << f);
+                sum_held += held as f64;
+                count += 1.0;
+            }
+        }
+        (sum_x - sum_held) / count
+    };
+    let lsb = 1.0 / f64::from(1u32 << f);
+    let floor = bias(Rounding::Floor);
+    let nearest = bias(Rounding::Nearest);
+    let floor_closed = -f64::from((1u32 << s) - 1) / 2.0 * lsb;
+    let nearest_closed = 0.5 * lsb;
+    println!(
+        "prefilter bias (codes): floor {floor:+.4} (closed form {floor_closed:+.4}), nearest {nearest:+.5} (closed form {nearest_closed:+.5})"
+    );
+    assert!((floor - floor_closed).abs() < 2e-3, "floor {floor}");
+    assert!((nearest - nearest_closed).abs() < 2e-3, "nearest {nearest}");
+    assert!(
+        floor.abs() > 25.0 * nearest.abs(),
+        "floor {floor} nearest {nearest}"
+    );
+    // S = 0 is exact either way: no rounding constant.
+    assert_eq!(
+        prefilter_step_rounded(3, 5, 2, 0, Rounding::Nearest),
+        prefilter_step(3, 5, 2, 0)
+    );
+}

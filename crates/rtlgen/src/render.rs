@@ -164,6 +164,9 @@ struct PixelT<'a> {
     ib: u32,
     sw: u32,
     xw: u32,
+    /// Prefilter rounding constant added before the shift: 2^(S−1) for `nearest`, 0
+    /// (no adder rendered) for `floor`.
+    round_half: u64,
     opw: u32,
     /// The operand sign-extended to W bits.
     opx: String,
@@ -363,6 +366,10 @@ pub fn render(p: &PixelParams, rom: &[u64], o: &RenderOptions) -> Result<Vec<Rtl
         ib,
         sw,
         xw: p.operand_bits(),
+        round_half: match p.prefilter_rounding {
+            tofprobe_pixel::Rounding::Nearest if p.shift > 0 => 1u64 << (p.shift - 1),
+            _ => 0,
+        },
         opw: p.operand_bits(),
         opx: if p.width > p.operand_bits() {
             let opw = p.operand_bits();

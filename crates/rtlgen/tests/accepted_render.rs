@@ -59,6 +59,7 @@ fn valid(haar: bool, draws: [u64; 10]) -> PixelParams {
         width: pick(draws[9], u64::from(ob), 63) as u32,
         frame_pulses,
         rom_depth: small(draws[9] / 64, 1, 1 << 32) as usize,
+        prefilter_rounding: Default::default(),
     }
 }
 

@@ -150,11 +150,17 @@ proptest! {
     fn every_valid_configuration_renders(
         haar in any::<bool>(), b in 1usize..40, u in 0u32..6, a in 1usize..9, ec in 0usize..4,
         t in 1u32..17, s in 0u32..16, f in 0u32..17, ew in 0u32..30, ln in 6u32..24, l in 1usize..300,
+        nearest in any::<bool>(),
     ) {
         let mut p = PixelParams {
             mode: if haar { Mode::Haar } else { Mode::Fourier }, bins: b, haar_scales: u,
             adders: 1, cycles_per_pulse: 1, tdc_bits: t, zoom: 0, shift: s, frac_bits: f,
-            width: 8, frame_pulses: 1 << ln, rom_depth: l
+            width: 8, frame_pulses: 1 << ln, rom_depth: l,
+            prefilter_rounding: if nearest && !haar {
+                tofprobe_pixel::Rounding::Nearest
+            } else {
+                tofprobe_pixel::Rounding::Floor
+            },
         };
         p.adders = a.min(p.ops_per_pulse());
         p.cycles_per_pulse = p.slots() + ec;

@@ -57,6 +57,7 @@ pub fn random_params(rng: &mut Rng) -> PixelParams {
         width: 1,
         frame_pulses,
         rom_depth: 1 + rng.below(7) as usize,
+        prefilter_rounding: tofprobe_pixel::Rounding::Floor,
     };
     let ops = p.ops_per_pulse() as u64;
     p.adders = 1 + rng.below(ops) as usize;
