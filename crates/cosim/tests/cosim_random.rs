@@ -27,7 +27,10 @@ fn eight_random_configurations_pass_in_verilator() {
     }
     // ... and both prefilter roundings (a rounding the RTL got wrong fails at the first
     // primed pulse: crates/cli/tests/prefilter_rounding.rs).
-    for r in [tofprobe_pixel::Rounding::Floor, tofprobe_pixel::Rounding::Nearest] {
+    for r in [
+        tofprobe_pixel::Rounding::Floor,
+        tofprobe_pixel::Rounding::Nearest,
+    ] {
         assert!(
             cases.iter().any(|c| c.params.prefilter_rounding == r),
             "{r:?} not drawn"
