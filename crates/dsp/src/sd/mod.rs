@@ -4,6 +4,7 @@ pub mod config;
 pub mod fullband;
 pub mod fullband_check;
 pub mod fullband_spectrum;
+pub mod isa;
 pub mod lanes;
 pub mod modulator;
 pub mod ntf;
@@ -16,6 +17,7 @@ pub mod wrap;
 
 pub use config::{ProbeConfig, RomMode};
 pub use fullband::FullBandProber;
+pub use isa::KernelPath;
 pub use modulator::Modulator;
 pub use ntf::{Ntf, synthesize_ntf};
 pub use pairs::LanePrecision;
