@@ -10,6 +10,7 @@
 //! Y_k = (I − jQ)·2/(N·G·A) / H_pre(f_k) (1/(N·G·A) at k = 0, where the real probe is not
 //! split between ±k), so it reads the windowed DFT of the depth.
 
+use super::config::ProbeConvention;
 use super::isa::KernelPath;
 use super::pairs::{
     Coeffs, LANES_F32, LANES_F32_AVX2, LANES_F64, LANES_F64_AVX2, Lane, LanePrecision, PairGroup,
@@ -52,6 +53,9 @@ pub struct FullBandProber {
     coeffs: Coeffs,
     amplitude: f64,
     window: Window,
+    /// The window's convention (the rotators always pair cos θ and sin θ, so Q starts at
+    /// exactly 0 under either).
+    convention: ProbeConvention,
     frame: u64,
     bins: Vec<u64>,
     precision: LanePrecision,
@@ -120,6 +124,7 @@ impl FullBandProber {
             coeffs,
             amplitude: design.config.amplitude,
             window: design.config.window,
+            convention: design.config.convention,
             frame,
             bins: bins.to_vec(),
             precision,
@@ -142,9 +147,12 @@ impl FullBandProber {
         for block in x.chunks(BLOCK) {
             let n0 = self.n;
             let (frame, amp, window) = (self.frame as usize, self.amplitude, self.window);
+            let convention = self.convention;
             self.aw.clear();
-            self.aw
-                .extend((0..block.len()).map(|t| amp * window.value(n0 as usize + t, frame)));
+            self.aw.extend(
+                (0..block.len())
+                    .map(|t| amp * convention.window_value(window, n0 as usize + t, frame)),
+            );
             let k = &self.coeffs;
             let narrow = |v: &[f64]| v.iter().map(|&v| v as f32).collect::<Vec<f32>>();
             match &mut self.groups {

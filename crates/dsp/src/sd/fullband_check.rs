@@ -53,9 +53,13 @@ impl std::fmt::Display for Mismatch {
 
 /// A·w[n] for the first `len` samples of the frame.
 fn amplitude_window(design: &ProbeDesign, frame: u64, len: usize) -> Vec<f64> {
-    let (amp, window) = (design.config.amplitude, design.config.window);
+    let (amp, window, c) = (
+        design.config.amplitude,
+        design.config.window,
+        design.config.convention,
+    );
     (0..len)
-        .map(|n| amp * window.value(n, frame as usize))
+        .map(|n| amp * c.window_value(window, n, frame as usize))
         .collect()
 }
 
