@@ -65,7 +65,7 @@ impl ProbeConvention {
             "toolbox" => Ok(ProbeConvention::Toolbox),
             _ => Err(DspError::out_of_range(
                 "probe.convention",
-                format!("{name:?}"),
+                format!("{:?}", tofprobe_io::text::clip(name, 60)),
                 Self::ALLOWED,
             )),
         }
