@@ -71,3 +71,60 @@ fn a_band_beyond_the_modulator_band_is_refused() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("--max-hz") && err.contains("156250"), "{err}");
 }
+
+/// The instruction path is printed, the rate is set against the scalar reference loop of
+/// the same run, and every path reads the same spectrum bit for bit (the figures are
+/// functions of the sums, so equal sums give equal floats). A path this CPU lacks is
+/// refused with the option, the value and what works.
+#[test]
+fn every_path_reads_the_same_spectrum() {
+    let run = |path: &str| {
+        tofprobe(&[
+            "bench",
+            "fullband",
+            "--pulses",
+            "200000",
+            "--max-hz",
+            "5000",
+            "--step-hz",
+            "100",
+            "--path",
+            path,
+            "--json",
+        ])
+    };
+    let base = run("baseline");
+    assert!(
+        base.status.success(),
+        "{}",
+        String::from_utf8_lossy(&base.stderr)
+    );
+    let b: serde_json::Value = serde_json::from_slice(&base.stdout).expect("one JSON object");
+    assert_eq!(b["path"], "baseline");
+    assert_eq!(b["lanes_per_group"], 4);
+    let f = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap_or_else(|| panic!("{k}"));
+    assert!(f(&b, "scalar_reference_steps_per_s_per_core") > 0.0);
+    assert!(f(&b, "speedup_vs_scalar") > 0.0);
+    assert!(f(&b, "full_band_seconds_at_this_rate") > 0.0);
+    let avx2 = tofprobe_dsp::sd::KernelPath::Avx2.available();
+    let auto = run("auto");
+    assert!(
+        auto.status.success(),
+        "{}",
+        String::from_utf8_lossy(&auto.stderr)
+    );
+    let a: serde_json::Value = serde_json::from_slice(&auto.stdout).expect("one JSON object");
+    assert_eq!(a["path"], if avx2 { "avx2" } else { "baseline" });
+    for k in ["peak_sd_um", "noise_sd_um", "error_um", "peak_dft_um"] {
+        assert_eq!(f(&a["windowed"], k), f(&b["windowed"], k), "{k}");
+    }
+    if !avx2 {
+        let out = run("avx2");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains("--path") && err.contains("avx2") && err.contains("baseline"),
+            "{err}"
+        );
+    }
+}

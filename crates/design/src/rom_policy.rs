@@ -180,8 +180,13 @@ pub fn rtl_rom(design: &ResolvedDesign, p: &mut PixelParams) -> Result<RtlRom, D
         .wrap_summary()
         .map(|w| format!(", {w}"))
         .unwrap_or_default();
+    // Named only when not the default, so the committed headers keep their text.
+    let convention = match rom.convention {
+        tofprobe_dsp::sd::ProbeConvention::Tofprobe => String::new(),
+        c => format!(", {} convention", c.name()),
+    };
     let note = format!(
-        "ΣΔ probe ROM ({} {}, order {}, OSR {}, A_p {}, window gain {}), L = {}, bins k = {:?} (f_k = k·f_s/L){wrap}, content hash {:016x}",
+        "ΣΔ probe ROM ({} {}{convention}, order {}, OSR {}, A_p {}, window gain {}), L = {}, bins k = {:?} (f_k = k·f_s/L){wrap}, content hash {:016x}",
         rom.mode.name(),
         rom.window.name(),
         rom.order,

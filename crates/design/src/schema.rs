@@ -59,7 +59,7 @@ fn kind(table: &str, key: &str) -> Option<Kind> {
         ("probe", "osr" | "h_inf" | "amplitude") => Number,
         ("probe", "order" | "rom_depth") => Integer,
         ("probe", "optimised_zeros") => Bool,
-        ("probe", "window" | "rom_mode") => Text,
+        ("probe", "window" | "rom_mode" | "convention") => Text,
         ("motion", "kind") => Text,
         ("motion", "depths_mm") => Numbers,
         ("motion", _) => Number,

@@ -70,6 +70,7 @@ const KEYS: &[(&str, &[&str])] = &[
             "amplitude",
             "rom_mode",
             "rom_depth",
+            "convention",
         ],
     ),
     (
@@ -125,6 +126,8 @@ fn values() -> Vec<String> {
         "\"square\"",
         "\"step\"",
         "\"hann\"",
+        "\"toolbox\"",
+        "\"tofprobe\"",
     ]
     .iter()
     .map(|s| s.to_string())

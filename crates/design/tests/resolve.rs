@@ -108,3 +108,59 @@ proptest! {
         }
     }
 }
+
+/// `[probe] convention`: "toolbox" resolves into the design and changes its ROM's bits
+/// (docs/probe.md) but not its bins or readout normalisation; the
+/// default is "tofprobe", written or not; a bad value or type names the key, the value
+/// and the allowed values.
+#[test]
+fn probe_convention_is_resolved_and_a_bad_one_is_named() {
+    use tofprobe_dsp::sd::ProbeConvention;
+    let with = |line: &str| DEFAULT_TOML.replace("convention = \"tofprobe\"", line);
+    assert!(
+        DEFAULT_TOML.contains("convention = \"tofprobe\""),
+        "the default documents the key"
+    );
+    let plain = resolve(short(), "t").expect("resolves");
+    let doc = |text: &str| {
+        let mut d = Document::from_toml_str(text, "t").expect("parses");
+        d.acquisition.pulses = Some(20_000);
+        d.acquisition.duration_s = None;
+        d
+    };
+    let explicit = resolve(doc(&with("convention = \"tofprobe\"")), "t").expect("resolves");
+    assert_eq!(
+        explicit.probe_rom().expect("rom").expect("a Fourier ROM"),
+        plain.probe_rom().expect("rom").expect("a Fourier ROM")
+    );
+    let toolbox = resolve(doc(&with("convention = \"toolbox\"")), "t").expect("resolves");
+    let design = toolbox.probe_design.as_ref().expect("Fourier design");
+    assert_eq!(design.config.convention, ProbeConvention::Toolbox);
+    let (a, b) = (
+        toolbox.probe_rom().expect("rom").expect("a Fourier ROM"),
+        plain.probe_rom().expect("rom").expect("a Fourier ROM"),
+    );
+    assert_eq!(a.convention, ProbeConvention::Toolbox);
+    assert_eq!(
+        (a.coherent_gain, a.bin_indices.clone()),
+        (b.coherent_gain, b.bin_indices.clone())
+    );
+    // The default is periodic (rectangular window): the sine's rounding alone parts the
+    // streams, and the wrap search then keeps other cuts.
+    assert_ne!(a.image, b.image);
+    let e = Document::from_toml_str(&with("convention = \"numpy\""), "t")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("probe.convention = \"numpy\"")
+            && e.contains("\"tofprobe\" (the default) or \"toolbox\""),
+        "{e}"
+    );
+    let e = Document::from_toml_str(&with("convention = 3"), "t")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`probe.convention` = 3") && e.contains("a string"),
+        "{e}"
+    );
+}

@@ -228,6 +228,9 @@ pub struct RomManifest {
     pub osr: f64,
     pub h_inf: f64,
     pub optimised_zeros: bool,
+    /// The probe convention ("toolbox"); absent for tofprobe's default (docs/probe.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub convention: Option<String>,
     /// Probe amplitude A_p.
     pub amplitude: f64,
     pub window: String,
@@ -383,6 +386,7 @@ mod tests {
             osr: 32.0,
             h_inf: 1.5,
             optimised_zeros: false,
+            convention: None,
             amplitude: 0.5,
             window: "blackman".into(),
             coherent_gain: 0.42,

@@ -29,6 +29,24 @@ impl Window {
         }
     }
 
+    /// w[n] of the symmetric `len`-point window (f(2πn/(len − 1)), w[0] = w[len − 1]), as
+    /// numpy's `np.blackman` / `np.hanning` evaluate it: with m = 2n + 1 − len,
+    /// 0.42 + 0.5·cos(π·m/(len − 1)) + 0.08·cos(2π·m/(len − 1)), left to right (the
+    /// toolbox's convention, [`crate::sd::config::ProbeConvention::Toolbox`]).
+    #[inline]
+    pub fn symmetric_value(self, n: usize, len: usize) -> f64 {
+        if len <= 1 {
+            return 1.0;
+        }
+        let m = (2 * n) as f64 + 1.0 - len as f64;
+        let d = len as f64 - 1.0;
+        match self {
+            Window::Rectangular => 1.0,
+            Window::Hann => 0.5 + 0.5 * (PI * m / d).cos(),
+            Window::Blackman => 0.42 + 0.5 * (PI * m / d).cos() + 0.08 * (2.0 * PI * m / d).cos(),
+        }
+    }
+
     /// The whole window as a vector.
     pub fn samples(self, len: usize) -> Vec<f64> {
         (0..len).map(|n| self.value(n, len)).collect()
@@ -88,5 +106,35 @@ mod tests {
         }
         // The design's figure: N_eff = 0.5791 N for Blackman.
         assert!((Window::Blackman.effective_length_factor() - 0.5791).abs() < 5e-5);
+    }
+
+    /// The symmetric window against the textbook formula f(2πn/(L − 1)) written
+    /// independently: equal to a few ulps, not bit for bit (the two evaluate the cosines at
+    /// arguments up to 4π that round differently, ≤ 1 ulp of 4π = 1.8e-15 each, weighted
+    /// by 0.5 and 0.08, plus three roundings of the sum: |Δ| ≤ 1.5e-15), symmetric
+    /// exactly, zero at both ends to rounding, and not the periodic window.
+    #[test]
+    fn symmetric_window_is_the_textbook_formula() {
+        for len in [2usize, 3, 16, 1001, 4096] {
+            let d = (len - 1) as f64;
+            for n in 0..len {
+                let x = 2.0 * PI * n as f64 / d;
+                let black = 0.42 - 0.5 * x.cos() + 0.08 * (2.0 * x).cos();
+                let hann = 0.5 - 0.5 * x.cos();
+                let b = Window::Blackman.symmetric_value(n, len);
+                assert!(
+                    (b - black).abs() < 1.5e-15,
+                    "len {len} n {n}: {b} vs {black}"
+                );
+                assert!((Window::Hann.symmetric_value(n, len) - hann).abs() < 1.5e-15);
+                assert_eq!(b, Window::Blackman.symmetric_value(len - 1 - n, len));
+            }
+            assert!(Window::Blackman.symmetric_value(0, len).abs() < 1e-16);
+        }
+        assert_eq!(Window::Rectangular.symmetric_value(3, 10), 1.0);
+        assert_ne!(
+            Window::Blackman.symmetric_value(100, 1000),
+            Window::Blackman.value(100, 1000)
+        );
     }
 }

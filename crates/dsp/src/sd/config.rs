@@ -27,6 +27,71 @@ impl RomMode {
     }
 }
 
+/// How the probe waveform A·w[n]·cos/sin(2πkn/L) is written down (docs/probe.md). The
+/// modulator is the same under both; only the input samples differ, by rounding and by
+/// the window's symmetry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ProbeConvention {
+    /// tofprobe's own (the default, which the committed RTL and vectors use): the
+    /// periodic window w = f(2πn/L), whose L-point DFT leaks exactly like a periodic
+    /// frame's, and Q = cos(θ − π/2), so I and Q share one rotator (its first Q sample is
+    /// ≈ −4·10⁻³⁴, not 0).
+    #[default]
+    Tofprobe,
+    /// The standard ΣΔ toolbox's (python-deltasigma / numpy): the symmetric window
+    /// (`np.blackman(L)`, `np.hanning(L)`: f(2πn/(L − 1))) and Q = sin θ, exactly 0 at
+    /// θ = 0; every sample evaluated directly, for a bit-for-bit comparison.
+    Toolbox,
+}
+
+impl ProbeConvention {
+    /// Name as used in configuration files and manifests.
+    pub fn name(self) -> &'static str {
+        match self {
+            ProbeConvention::Tofprobe => "tofprobe",
+            ProbeConvention::Toolbox => "toolbox",
+        }
+    }
+
+    /// The values `probe.convention` accepts, for messages.
+    pub const ALLOWED: &'static str = "\"tofprobe\" (the default) or \"toolbox\"";
+
+    /// The convention named `name`, or an error naming the field, the value and the
+    /// allowed values.
+    pub fn parse(name: &str) -> Result<Self, DspError> {
+        match name {
+            "tofprobe" => Ok(ProbeConvention::Tofprobe),
+            "toolbox" => Ok(ProbeConvention::Toolbox),
+            _ => Err(DspError::out_of_range(
+                "probe.convention",
+                format!("{:?}", tofprobe_io::text::clip(name, 60)),
+                Self::ALLOWED,
+            )),
+        }
+    }
+
+    /// w[n] of an L-point window under this convention: periodic (tofprobe) or symmetric
+    /// as numpy evaluates it (toolbox).
+    pub fn window_value(self, window: Window, n: usize, len: usize) -> f64 {
+        match self {
+            ProbeConvention::Tofprobe => window.value(n, len),
+            ProbeConvention::Toolbox => window.symmetric_value(n, len),
+        }
+    }
+
+    fn is_default(&self) -> bool {
+        *self == ProbeConvention::default()
+    }
+}
+
+impl<'de> Deserialize<'de> for ProbeConvention {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        ProbeConvention::parse(&name).map_err(serde::de::Error::custom)
+    }
+}
+
 /// `[probe]`: the ΣΔ probe design.
 ///
 /// The struct's default is the paper's windowed frame (L = N, Blackman), which
@@ -55,6 +120,10 @@ pub struct ProbeConfig {
     pub rom_mode: RomMode,
     /// ROM depth L for the periodic mode (windowed mode uses L = N and ignores it).
     pub rom_depth: usize,
+    /// How the probe waveform is written down (window symmetry, the sine's phase); not
+    /// written out at its default, so documents and manifests without it stay as they were.
+    #[serde(skip_serializing_if = "ProbeConvention::is_default")]
+    pub convention: ProbeConvention,
 }
 
 impl Default for ProbeConfig {
@@ -68,6 +137,7 @@ impl Default for ProbeConfig {
             amplitude: 0.5,
             rom_mode: RomMode::Windowed,
             rom_depth: 1 << 16,
+            convention: ProbeConvention::Tofprobe,
         }
     }
 }
@@ -173,6 +243,33 @@ mod tests {
         assert_eq!(c.rom_mode, RomMode::Periodic);
         assert_eq!(c.depth(10_000_000), 4096);
         assert!(toml::from_str::<ProbeConfig>("ordr = 3").is_err());
+    }
+
+    #[test]
+    fn convention_parses_and_a_bad_one_names_field_value_and_allowed() {
+        let c: ProbeConfig = toml::from_str("convention = \"toolbox\"").unwrap();
+        assert_eq!(c.convention, ProbeConvention::Toolbox);
+        assert_eq!(
+            toml::from_str::<ProbeConfig>("").unwrap().convention,
+            ProbeConvention::Tofprobe
+        );
+        let e = toml::from_str::<ProbeConfig>("convention = \"numpy\"")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("probe.convention = \"numpy\"")
+                && e.contains("\"tofprobe\" (the default) or \"toolbox\""),
+            "{e}"
+        );
+        // The default is not written out: documents and manifests keep their text.
+        let text = toml::to_string(&ProbeConfig::default()).unwrap();
+        assert!(!text.contains("convention"), "{text}");
+        let text = toml::to_string(&ProbeConfig {
+            convention: ProbeConvention::Toolbox,
+            ..ProbeConfig::default()
+        })
+        .unwrap();
+        assert!(text.contains("convention = \"toolbox\""), "{text}");
     }
 
     #[test]

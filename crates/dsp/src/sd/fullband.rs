@@ -10,7 +10,11 @@
 //! Y_k = (I − jQ)·2/(N·G·A) / H_pre(f_k) (1/(N·G·A) at k = 0, where the real probe is not
 //! split between ±k), so it reads the windowed DFT of the depth.
 
-use super::pairs::{Coeffs, LANES_F32, LANES_F64, Lane, LanePrecision, PairGroup};
+use super::config::ProbeConvention;
+use super::isa::KernelPath;
+use super::pairs::{
+    Coeffs, LANES_F32, LANES_F32_AVX2, LANES_F64, LANES_F64_AVX2, Lane, LanePrecision, PairGroup,
+};
 use super::probe::ProbeDesign;
 use super::probing::prefilter_response;
 use crate::error::DspError;
@@ -22,10 +26,25 @@ use rustfft::num_complex::Complex64;
 /// every group reads them.
 pub const BLOCK: usize = 4096;
 
+/// The groups, their width set by the precision and the instruction path.
 #[derive(Debug, Clone)]
 enum Groups {
     F64(Vec<PairGroup<f64, LANES_F64>>),
     F32(Vec<PairGroup<f32, LANES_F32>>),
+    F64Avx2(Vec<PairGroup<f64, LANES_F64_AVX2>>),
+    F32Avx2(Vec<PairGroup<f32, LANES_F32_AVX2>>),
+}
+
+/// Groups of `L` lanes (L/2 bins each) for `bins`.
+fn groups<T: Lane, const L: usize>(
+    bins: &[u64],
+    frame: u64,
+    order: usize,
+    path: KernelPath,
+) -> Vec<PairGroup<T, L>> {
+    bins.chunks(L / 2)
+        .map(|c| PairGroup::new(c, frame, order, path))
+        .collect()
 }
 
 /// Streaming full-band prober: push the depth record in any chunking, read the sums.
@@ -34,9 +53,13 @@ pub struct FullBandProber {
     coeffs: Coeffs,
     amplitude: f64,
     window: Window,
+    /// The window's convention (the rotators always pair cos θ and sin θ, so Q starts at
+    /// exactly 0 under either).
+    convention: ProbeConvention,
     frame: u64,
     bins: Vec<u64>,
     precision: LanePrecision,
+    path: KernelPath,
     groups: Groups,
     n: u64,
     aw: Vec<f64>,
@@ -47,12 +70,26 @@ impl FullBandProber {
     /// `frame` pulses with the design's modulator, amplitude and window. The design's
     /// amplitude check (≤ 0.9 × the measured stable limit) is what keeps the lanes
     /// stable; a lane that still leaves the state bound is an error naming its bin.
+    /// Runs on the fastest instruction path of this CPU ([`KernelPath::detect`]).
     pub fn new(
         design: &ProbeDesign,
         frame: u64,
         bins: &[u64],
         precision: LanePrecision,
     ) -> Result<Self, DspError> {
+        Self::on_path(design, frame, bins, precision, KernelPath::detect())
+    }
+
+    /// Like [`FullBandProber::new`] on a chosen instruction path (an error if this CPU
+    /// cannot run it). Every path gives the same sums, bit for bit.
+    pub fn on_path(
+        design: &ProbeDesign,
+        frame: u64,
+        bins: &[u64],
+        precision: LanePrecision,
+        path: KernelPath,
+    ) -> Result<Self, DspError> {
+        let path = path.require()?;
         let coeffs = Coeffs::new(&design.modulator.ss)?;
         if frame < 16 {
             return Err(DspError::out_of_range("frame_pulses", frame, ">= 16"));
@@ -69,25 +106,29 @@ impl FullBandProber {
             ));
         }
         let order = coeffs.order;
-        let groups = match precision {
-            LanePrecision::F64 => Groups::F64(
-                bins.chunks(LANES_F64 / 2)
-                    .map(|c| PairGroup::new(c, frame, order))
-                    .collect(),
-            ),
-            LanePrecision::F32 => Groups::F32(
-                bins.chunks(LANES_F32 / 2)
-                    .map(|c| PairGroup::new(c, frame, order))
-                    .collect(),
-            ),
+        let groups = match (precision, path) {
+            (LanePrecision::F64, KernelPath::Baseline) => {
+                Groups::F64(groups(bins, frame, order, path))
+            }
+            (LanePrecision::F32, KernelPath::Baseline) => {
+                Groups::F32(groups(bins, frame, order, path))
+            }
+            (LanePrecision::F64, KernelPath::Avx2) => {
+                Groups::F64Avx2(groups(bins, frame, order, path))
+            }
+            (LanePrecision::F32, KernelPath::Avx2) => {
+                Groups::F32Avx2(groups(bins, frame, order, path))
+            }
         };
         Ok(FullBandProber {
             coeffs,
             amplitude: design.config.amplitude,
             window: design.config.window,
+            convention: design.config.convention,
             frame,
             bins: bins.to_vec(),
             precision,
+            path,
             groups,
             n: 0,
             aw: Vec::with_capacity(BLOCK),
@@ -106,17 +147,19 @@ impl FullBandProber {
         for block in x.chunks(BLOCK) {
             let n0 = self.n;
             let (frame, amp, window) = (self.frame as usize, self.amplitude, self.window);
+            let convention = self.convention;
             self.aw.clear();
-            self.aw
-                .extend((0..block.len()).map(|t| amp * window.value(n0 as usize + t, frame)));
+            self.aw.extend(
+                (0..block.len())
+                    .map(|t| amp * convention.window_value(window, n0 as usize + t, frame)),
+            );
             let k = &self.coeffs;
+            let narrow = |v: &[f64]| v.iter().map(|&v| v as f32).collect::<Vec<f32>>();
             match &mut self.groups {
                 Groups::F64(g) => run_all(g, k, n0, &self.aw, block)?,
-                Groups::F32(g) => {
-                    let aw: Vec<f32> = self.aw.iter().map(|&v| v as f32).collect();
-                    let xs: Vec<f32> = block.iter().map(|&v| v as f32).collect();
-                    run_all(g, k, n0, &aw, &xs)?
-                }
+                Groups::F64Avx2(g) => run_all(g, k, n0, &self.aw, block)?,
+                Groups::F32(g) => run_all(g, k, n0, &narrow(&self.aw), &narrow(block))?,
+                Groups::F32Avx2(g) => run_all(g, k, n0, &narrow(&self.aw), &narrow(block))?,
             }
             self.n += block.len() as u64;
         }
@@ -138,11 +181,18 @@ impl FullBandProber {
         self.precision
     }
 
+    /// The instruction path the lanes run on.
+    pub fn path(&self) -> KernelPath {
+        self.path
+    }
+
     /// Raw (I, Q) sums per bin, in `bins` order.
     pub fn sums(&self) -> Vec<(f64, f64)> {
         match &self.groups {
             Groups::F64(g) => g.iter().flat_map(PairGroup::sums).collect(),
             Groups::F32(g) => g.iter().flat_map(PairGroup::sums).collect(),
+            Groups::F64Avx2(g) => g.iter().flat_map(PairGroup::sums).collect(),
+            Groups::F32Avx2(g) => g.iter().flat_map(PairGroup::sums).collect(),
         }
     }
 

@@ -12,8 +12,11 @@
 //! against its own bound.
 
 use super::fullband::FullBandProber;
+use super::isa::KernelPath;
 use super::modulator::Modulator;
-use super::pairs::{Coeffs, LANES_F64, LanePrecision, PairGroup};
+use super::pairs::{
+    Coeffs, LANES_F32, LANES_F32_AVX2, LANES_F64, LANES_F64_AVX2, Lane, LanePrecision, PairGroup,
+};
 use super::probe::ProbeDesign;
 use crate::error::DspError;
 
@@ -50,9 +53,13 @@ impl std::fmt::Display for Mismatch {
 
 /// A·w[n] for the first `len` samples of the frame.
 fn amplitude_window(design: &ProbeDesign, frame: u64, len: usize) -> Vec<f64> {
-    let (amp, window) = (design.config.amplitude, design.config.window);
+    let (amp, window, c) = (
+        design.config.amplitude,
+        design.config.window,
+        design.config.convention,
+    );
     (0..len)
-        .map(|n| amp * window.value(n, frame as usize))
+        .map(|n| amp * c.window_value(window, n, frame as usize))
         .collect()
 }
 
@@ -77,7 +84,9 @@ pub fn naive_sums(
     let aw = amplitude_window(design, frame, x.len());
     bins.iter()
         .map(|&k| {
-            let inputs = PairGroup::<f64, LANES_F64>::new(&[k], frame, m.order).inputs(0, &aw);
+            let inputs =
+                PairGroup::<f64, LANES_F64>::new(&[k], frame, m.order, KernelPath::Baseline)
+                    .inputs(0, &aw);
             let mut sums = [0.0; 2];
             let mut bits = [Vec::new(), Vec::new()];
             for (q, (sum, b)) in sums.iter_mut().zip(bits.iter_mut()).enumerate() {
@@ -97,20 +106,49 @@ pub fn naive_sums(
         .collect()
 }
 
-/// The f64 fast path's bitstreams per bin (I, Q), from the same kernel with tracing on.
+/// The fast path's bitstreams per bin (I, Q), from the same kernel with tracing on, in a
+/// precision on an instruction path (an error if this CPU cannot run it).
 pub fn fast_bits(
     design: &ProbeDesign,
     frame: u64,
     bins: &[u64],
     x: &[f64],
+    precision: LanePrecision,
+    path: KernelPath,
 ) -> Result<Vec<[Vec<bool>; 2]>, DspError> {
+    let path = path.require()?;
     let k = Coeffs::new(&design.modulator.ss)?;
     let aw = amplitude_window(design, frame, x.len());
+    let narrow = |v: &[f64]| v.iter().map(|&v| v as f32).collect::<Vec<f32>>();
+    match (precision, path) {
+        (LanePrecision::F64, KernelPath::Baseline) => {
+            traced::<f64, LANES_F64>(&k, frame, bins, &aw, x, path)
+        }
+        (LanePrecision::F64, KernelPath::Avx2) => {
+            traced::<f64, LANES_F64_AVX2>(&k, frame, bins, &aw, x, path)
+        }
+        (LanePrecision::F32, KernelPath::Baseline) => {
+            traced::<f32, LANES_F32>(&k, frame, bins, &narrow(&aw), &narrow(x), path)
+        }
+        (LanePrecision::F32, KernelPath::Avx2) => {
+            traced::<f32, LANES_F32_AVX2>(&k, frame, bins, &narrow(&aw), &narrow(x), path)
+        }
+    }
+}
+
+fn traced<T: Lane, const L: usize>(
+    k: &Coeffs,
+    frame: u64,
+    bins: &[u64],
+    aw: &[T],
+    x: &[T],
+    path: KernelPath,
+) -> Result<Vec<[Vec<bool>; 2]>, DspError> {
     let mut out = Vec::new();
-    for chunk in bins.chunks(LANES_F64 / 2) {
-        let mut g = PairGroup::<f64, LANES_F64>::new(chunk, frame, k.order);
+    for chunk in bins.chunks(L / 2) {
+        let mut g = PairGroup::<T, L>::new(chunk, frame, k.order, path);
         let mut trace = vec![0u32; x.len()];
-        g.run(&k, 0, &aw, x, &mut trace)?;
+        g.run(k, 0, aw, x, &mut trace)?;
         for p in 0..chunk.len() {
             out.push([2 * p, 2 * p + 1].map(|l| trace.iter().map(|w| (w >> l) & 1 == 1).collect()));
         }
@@ -118,9 +156,10 @@ pub fn fast_bits(
     Ok(out)
 }
 
-/// Runs the f64 fast path over `x` (pushed in chunks of `chunk`) for `bins` and the naive
-/// reference for `naive_bins` (the same bins, unless a test breaks them on purpose), and
-/// returns the first stream whose sums differ, with the first sample where its bits differ.
+/// Runs the f64 fast path on `path` over `x` (pushed in chunks of `chunk`) for `bins` and
+/// the naive reference for `naive_bins` (the same bins, unless a test breaks them on
+/// purpose), and returns the first stream whose sums differ, with the first sample where
+/// its bits differ.
 pub fn compare(
     design: &ProbeDesign,
     frame: u64,
@@ -128,8 +167,9 @@ pub fn compare(
     naive_bins: &[u64],
     x: &[f64],
     chunk: usize,
+    path: KernelPath,
 ) -> Result<Option<Mismatch>, DspError> {
-    let mut fast = FullBandProber::new(design, frame, bins, LanePrecision::F64)?;
+    let mut fast = FullBandProber::on_path(design, frame, bins, LanePrecision::F64, path)?;
     for c in x.chunks(chunk.max(1)) {
         fast.push(c)?;
     }
@@ -138,7 +178,14 @@ pub fn compare(
         let (ni, nq) = nb.sums;
         for (q, (f, n)) in [(fi, ni), (fq, nq)].into_iter().enumerate() {
             if f.to_bits() != n.to_bits() {
-                let fb = fast_bits(design, frame, &bins[i..=i], x)?;
+                let fb = fast_bits(
+                    design,
+                    frame,
+                    &bins[i..=i],
+                    x,
+                    LanePrecision::F64,
+                    fast.path(),
+                )?;
                 let sample = fb[0][q].iter().zip(&nb.bits[q]).position(|(a, b)| a != b);
                 return Ok(Some(Mismatch {
                     bin: k,
@@ -198,13 +245,20 @@ mod tests {
         let d = design();
         let x = depths(N as usize, 100, 3.0, 0x9e37_79b9_7f4a_7c15);
         // Chunks of 1000 cross the anchor (1024) and block boundaries off-grid.
-        let m = compare(&d, N, &BINS, &BINS, &x, 1000).unwrap();
-        assert_eq!(
-            m,
-            None,
-            "{}",
-            m.as_ref().map(|m| m.to_string()).unwrap_or_default()
-        );
+        for path in [KernelPath::Baseline, KernelPath::Avx2] {
+            if !path.available() {
+                eprintln!("skipped: this CPU cannot run the {} path", path.name());
+                continue;
+            }
+            let m = compare(&d, N, &BINS, &BINS, &x, 1000, path).unwrap();
+            assert_eq!(
+                m,
+                None,
+                "{}: {}",
+                path.name(),
+                m.as_ref().map(|m| m.to_string()).unwrap_or_default()
+            );
+        }
     }
 
     /// A deliberately wrong input (the reference probes bin 8 where the fast path probes
@@ -215,7 +269,7 @@ mod tests {
         let x = depths(N as usize, 100, 3.0, 5);
         let mut wrong = BINS;
         wrong[3] = 8;
-        let m = compare(&d, N, &BINS, &wrong, &x, 4096)
+        let m = compare(&d, N, &BINS, &wrong, &x, 4096, KernelPath::detect())
             .unwrap()
             .expect("must differ");
         assert_eq!((m.bin, m.quadrature), (7, false), "{m}");

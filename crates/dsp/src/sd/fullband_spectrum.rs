@@ -12,6 +12,7 @@
 //!   correlates L values; the DFT of the folded record is the record's DFT at those bins.
 
 use super::fullband::{FullBandProber, bin_scale, gain};
+use super::isa::KernelPath;
 use super::pairs::LanePrecision;
 use super::probe::{ProbeDesign, ProbeRom};
 use super::probing::normalise;
@@ -68,8 +69,9 @@ pub struct BandSpectrum {
     pub window: Window,
 }
 
-/// Every bin of `bins` of a windowed frame (N = x.len()) by ΣΔ probing, beside the DFT.
-/// `progress(samples)` is called after every chunk.
+/// Every bin of `bins` of a windowed frame (N = x.len()) by ΣΔ probing on instruction
+/// path `path`, beside the DFT. `progress(samples)` is called after every chunk.
+#[allow(clippy::too_many_arguments)]
 pub fn windowed_band(
     x: &[f64],
     design: &ProbeDesign,
@@ -77,11 +79,12 @@ pub fn windowed_band(
     bins: &[u64],
     alpha: f64,
     precision: LanePrecision,
+    path: KernelPath,
     mut progress: impl FnMut(u64),
 ) -> Result<BandSpectrum, DspError> {
     let frame = x.len() as u64;
     let t0 = Instant::now();
-    let mut prober = FullBandProber::new(design, frame, bins, precision)?;
+    let mut prober = FullBandProber::on_path(design, frame, bins, precision, path)?;
     for c in x.chunks(CHUNK) {
         prober.push(c)?;
         progress(prober.samples());
@@ -281,7 +284,17 @@ mod tests {
         let x = record(n, 300.0, 1.0, 3.0);
         let d = ProbeDesign::with_known_limit(&ProbeConfig::default(), 0.77, 1e-4).unwrap();
         let bins: Vec<u64> = (0..256).map(|i| 2 * i).collect();
-        let s = windowed_band(&x, &d, 10e6, &bins, 1.0 / 32.0, LanePrecision::F64, |_| {}).unwrap();
+        let s = windowed_band(
+            &x,
+            &d,
+            10e6,
+            &bins,
+            1.0 / 32.0,
+            LanePrecision::F64,
+            KernelPath::detect(),
+            |_| {},
+        )
+        .unwrap();
         let sum = BandSummary::of(&s, n as u64).unwrap();
         assert_eq!(sum.peak_hz, 300.0 * 10e6 / n as f64);
         for a in [sum.peak_sd_um, sum.peak_dft_um] {

@@ -7,7 +7,15 @@
 //! integer phases (k·n mod L) every [`ANCHOR`] samples, so rounding never accumulates
 //! beyond ≈ ANCHOR·1e-16 and the input is an exact function of n mod L: every period of a
 //! periodic ROM sees bit-identical input.
+//!
+//! That is the default [`ProbeConvention::Tofprobe`]. Under
+//! [`ProbeConvention::Toolbox`] every sample is evaluated directly, as a toolbox script
+//! writes it: u[n] = (A · w_sym[m]) · trig(θ) with m = n mod L, θ = (2π·(k·m mod L))/L,
+//! trig = cos for I and sin for Q (exactly 0 at θ = 0), w_sym numpy's symmetric window
+//! ([`Window::symmetric_value`]); still an exact function of n mod L, at the cost of a
+//! sin or cos per sample and lane (≈ 20 ns: seconds for a windowed ROM of 10^7 pulses).
 
+use super::config::ProbeConvention;
 use super::modulator::STATE_BOUND;
 use super::realize::StateSpace;
 use crate::error::DspError;
@@ -35,6 +43,7 @@ pub struct LaneGroup {
     probes: [LaneProbe; LANES],
     period: u64,
     window: Window,
+    convention: ProbeConvention,
     /// states[i][lane]
     pub states: Vec<[f64; LANES]>,
 }
@@ -55,12 +64,22 @@ impl LaneGroup {
             probes: p,
             period,
             window,
+            convention: ProbeConvention::Tofprobe,
             states: vec![[0.0; LANES]; order],
         }
     }
 
+    /// The same group writing its probes in `convention` (the default is tofprobe's).
+    pub fn with_convention(mut self, convention: ProbeConvention) -> Self {
+        self.convention = convention;
+        self
+    }
+
     /// Fills `u[t][lane]` for samples n0 .. n0 + u.len() (u.len() ≤ ANCHOR).
     pub(crate) fn inputs(&self, n0: u64, u: &mut [[f64; LANES]]) {
+        if self.convention == ProbeConvention::Toolbox {
+            return self.toolbox_inputs(n0, u);
+        }
         let l = self.period;
         let two_pi_over_l = 2.0 * PI / l as f64;
         let mut c = [0.0; LANES];
@@ -100,6 +119,20 @@ impl LaneGroup {
             let nwc = wc * wcd - ws * wsd;
             ws = ws * wcd + wc * wsd;
             wc = nwc;
+        }
+    }
+
+    /// The toolbox's samples, each evaluated directly (see the module docs).
+    fn toolbox_inputs(&self, n0: u64, u: &mut [[f64; LANES]]) {
+        let l = self.period;
+        for (t, row) in u.iter_mut().enumerate() {
+            let m = (n0 + t as u64) % l;
+            let w = self.window.symmetric_value(m as usize, l as usize);
+            for (v, p) in row.iter_mut().zip(&self.probes) {
+                let km = ((p.bin % l) as u128 * m as u128 % l as u128) as f64;
+                let th = 2.0 * PI * km / l as f64;
+                *v = p.amplitude * w * if p.quadrature { th.sin() } else { th.cos() };
+            }
         }
     }
 
@@ -321,6 +354,63 @@ mod tests {
                 assert_eq!(row[LANES - 1], 0.0);
             }
         }
+    }
+
+    /// Under the toolbox convention the samples are the toolbox's formula, written here
+    /// independently: A·w[n]·cos/sin(2π·(kn mod N)/N) with the textbook symmetric
+    /// Blackman 0.42 − 0.5cos(2πn/(N−1)) + 0.08cos(4πn/(N−1)). The generator evaluates
+    /// numpy's centred form of the same window, so the two agree to the window's few ulps
+    /// (≤ 1.5e-15, see `window::tests`) × A ≤ 0.7, not bit for bit; sin(0) is exactly 0,
+    /// so Q starts at exactly 0, where tofprobe's cos(−π/2) leaves ≈ −4e-34.
+    #[test]
+    fn toolbox_inputs_are_the_toolbox_formula() {
+        let len = 3000usize;
+        let probes = [
+            LaneProbe {
+                bin: 17,
+                quadrature: false,
+                amplitude: 0.5,
+            },
+            LaneProbe {
+                bin: 17,
+                quadrature: true,
+                amplitude: 0.5,
+            },
+            LaneProbe {
+                bin: 1499,
+                quadrature: true,
+                amplitude: 0.7,
+            },
+        ];
+        let g = LaneGroup::new(&probes, len as u64, Window::Blackman, 3)
+            .with_convention(ProbeConvention::Toolbox);
+        let mut u = vec![[0.0; LANES]; ANCHOR];
+        let d = (len - 1) as f64;
+        for n0 in (0..len).step_by(ANCHOR) {
+            let m = (len - n0).min(ANCHOR);
+            g.inputs(n0 as u64, &mut u[..m]);
+            for (t, row) in u[..m].iter().enumerate() {
+                let n = n0 + t;
+                let x = 2.0 * PI * n as f64 / d;
+                let w = 0.42 - 0.5 * x.cos() + 0.08 * (2.0 * x).cos();
+                for (i, p) in probes.iter().enumerate() {
+                    let th = 2.0 * PI * ((p.bin * n as u64) % len as u64) as f64 / len as f64;
+                    let c = if p.quadrature { th.sin() } else { th.cos() };
+                    let want = p.amplitude * w * c;
+                    assert!(
+                        (row[i] - want).abs() < 1.1e-15,
+                        "n {n} lane {i}: {} vs {want}",
+                        row[i]
+                    );
+                }
+            }
+        }
+        g.inputs(0, &mut u[..1]);
+        assert_eq!(u[0][1], 0.0, "toolbox Q starts at exactly 0");
+        // tofprobe's convention: the periodic window and cos(θ − π/2), ≈ −4e-34 at n = 0.
+        let ours = LaneGroup::new(&probes, len as u64, Window::Blackman, 3);
+        ours.inputs(0, &mut u[..1]);
+        assert!(u[0][1] != 0.0 && u[0][1].abs() < 1e-33, "{}", u[0][1]);
     }
 
     /// The interleaved loop must produce exactly the scalar reference modulator's bits

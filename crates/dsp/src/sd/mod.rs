@@ -4,6 +4,7 @@ pub mod config;
 pub mod fullband;
 pub mod fullband_check;
 pub mod fullband_spectrum;
+pub mod isa;
 pub mod lanes;
 pub mod modulator;
 pub mod ntf;
@@ -14,8 +15,9 @@ pub mod quality;
 pub mod realize;
 pub mod wrap;
 
-pub use config::{ProbeConfig, RomMode};
+pub use config::{ProbeConfig, ProbeConvention, RomMode};
 pub use fullband::FullBandProber;
+pub use isa::KernelPath;
 pub use modulator::Modulator;
 pub use ntf::{Ntf, synthesize_ntf};
 pub use pairs::LanePrecision;

@@ -1,7 +1,9 @@
 //! The full-band probe kernel: many I/Q modulator pairs stepped together in a
-//! structure-of-arrays loop the compiler vectorises (SSE2 on the x86-64 baseline), each
-//! lane's ±1 output accumulated against the shared depth record x[n] in the same pass, so
-//! no bitstream is ever stored.
+//! structure-of-arrays loop the compiler vectorises (SSE2 on the x86-64 baseline; a second
+//! copy for AVX2 with twice the lanes, chosen at run time, [`super::isa`]), each lane's ±1
+//! output accumulated against the shared depth record x[n] in the same pass, so no
+//! bitstream is ever stored. The lane count only groups independent lanes: a lane's
+//! arithmetic, hence its bits and sums, is the same at every width.
 //!
 //! Lane 2p is the I stream of a bin, lane 2p + 1 its Q stream: their inputs are
 //! A·w[n]·cos θ and A·w[n]·sin θ with θ = 2πkn/N, so one complex rotation per pair and step
@@ -29,6 +31,7 @@
 // plain index form is what the vectoriser and the reader both follow best.
 #![allow(clippy::needless_range_loop)]
 
+use super::isa::KernelPath;
 use super::modulator::STATE_BOUND;
 use super::realize::StateSpace;
 use crate::error::DspError;
@@ -43,6 +46,14 @@ pub const ANCHOR: u64 = 1024;
 pub const LANES_F64: usize = 4;
 /// Lanes per f32 group: four SSE2 registers (8 lanes 1.1·10⁹, 16 lanes 1.3·10⁹, 32 spill).
 pub const LANES_F32: usize = 16;
+/// Lanes per f64 group on the AVX2 path ([`KernelPath::Avx2`]): two 256-bit registers,
+/// the register footprint of the baseline's four lanes (measured in one session, 401 bins
+/// of N = 2·10⁶: 8 lanes 1.0–1.09·10⁹ steps per CPU-second, 12 lanes 0.93–1.0·10⁹, the
+/// baseline's 4 lanes 0.59–0.65·10⁹).
+pub const LANES_F64_AVX2: usize = 8;
+/// Lanes per f32 group on the AVX2 path: four 256-bit registers (same run: 32 lanes
+/// 2.2–2.4·10⁹, 16 lanes 0.94–1.0·10⁹, the baseline's 16 lanes 0.73–0.77·10⁹).
+pub const LANES_F32_AVX2: usize = 32;
 
 /// Arithmetic of the modulator lanes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -63,7 +74,7 @@ impl LanePrecision {
         }
     }
 
-    /// Lanes per interleaved group.
+    /// Lanes per interleaved group on the baseline path ([`KernelPath::lanes`] for any).
     pub fn lanes(self) -> usize {
         match self {
             LanePrecision::F64 => LANES_F64,
@@ -205,12 +216,14 @@ pub(crate) struct PairGroup<T: Lane, const L: usize> {
     acc: [T; L],
     /// Accumulated spans (f32 lanes only).
     total: [f64; L],
+    /// The instruction path `run` steps on (same bits on either).
+    path: KernelPath,
 }
 
 impl<T: Lane, const L: usize> PairGroup<T, L> {
     /// A group at rest for `bins` (at most L/2), frame length `period` (the window's and
-    /// the bins' N).
-    pub fn new(bins: &[u64], period: u64, order: usize) -> Self {
+    /// the bins' N), stepping on `path` (the baseline where the CPU lacks it).
+    pub fn new(bins: &[u64], period: u64, order: usize, path: KernelPath) -> Self {
         let mut lane_bins = [0u64; L];
         for (l, b) in lane_bins.iter_mut().enumerate() {
             *b = bins.get(l / 2).copied().unwrap_or(0) % period;
@@ -232,6 +245,7 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
             sdm,
             acc: [T::default(); L],
             total: [0.0; L],
+            path,
         }
     }
 
@@ -336,11 +350,12 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
                 &mut trace[done..done + span]
             };
             let step = if tr.is_empty() {
-                step_span::<T, L, N, RES, false>
+                step_on::<T, L, N, RES, false>
             } else {
-                step_span::<T, L, N, RES, true>
+                step_on::<T, L, N, RES, true>
             };
             step(
+                self.path,
                 &mut s,
                 &mut self.rot,
                 &mut self.acc,
@@ -389,6 +404,51 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
         }
         Ok(())
     }
+}
+
+/// [`step_span`] on `path`: the AVX2 copy where asked for and the CPU has it (checked here,
+/// so no caller can run it on a CPU without), else the baseline's. The workspace's only
+/// unsafe code (see the root Cargo.toml): entering a `#[target_feature]` function.
+#[allow(clippy::too_many_arguments, unsafe_code)]
+#[inline(always)]
+fn step_on<T: Lane, const L: usize, const N: usize, const RES: bool, const TRACE: bool>(
+    path: KernelPath,
+    s: &mut [[T; L]; N],
+    rot: &mut [T; L],
+    acc: &mut [T; L],
+    rotation: (&[T; L], &[T; L]),
+    coeffs: (&[T; N], &[T; N], &[T; N]),
+    aw: &[T],
+    x: &[T],
+    trace: &mut [u32],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if path == KernelPath::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2, checked on the line above.
+        unsafe {
+            step_span_avx2::<T, L, N, RES, TRACE>(s, rot, acc, rotation, coeffs, aw, x, trace)
+        };
+        return;
+    }
+    let _ = path;
+    step_span::<T, L, N, RES, TRACE>(s, rot, acc, rotation, coeffs, aw, x, trace)
+}
+
+/// [`step_span`] compiled for AVX2 (not FMA: products and sums round as on the baseline).
+#[cfg(target_arch = "x86_64")]
+#[allow(clippy::too_many_arguments)]
+#[target_feature(enable = "avx2")]
+fn step_span_avx2<T: Lane, const L: usize, const N: usize, const RES: bool, const TRACE: bool>(
+    s: &mut [[T; L]; N],
+    rot: &mut [T; L],
+    acc: &mut [T; L],
+    rotation: (&[T; L], &[T; L]),
+    coeffs: (&[T; N], &[T; N], &[T; N]),
+    aw: &[T],
+    x: &[T],
+    trace: &mut [u32],
+) {
+    step_span::<T, L, N, RES, TRACE>(s, rot, acc, rotation, coeffs, aw, x, trace)
 }
 
 /// One anchor span of the interleaved loop (see the module docs for why each rewrite of
@@ -489,7 +549,7 @@ mod tests {
             .collect();
         let mut worst = 0.0f64;
         for chunk in bins.chunks(L / 2) {
-            let g = PairGroup::<T, L>::new(chunk, n, 3);
+            let g = PairGroup::<T, L>::new(chunk, n, 3, KernelPath::Baseline);
             for (t, u) in g.inputs(0, &aw).iter().enumerate() {
                 for (l, ul) in u.iter().enumerate().take(2 * chunk.len()) {
                     let th = 2.0 * PI * ((g.bins[l] * t as u64) % n) as f64 / n as f64;

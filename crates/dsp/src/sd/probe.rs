@@ -26,7 +26,7 @@
 //! than 8). A higher order, OSR or a short L (few in-band bins) can stay above 5%
 //! (order 5: ≈ 6%; L = 4096 at OSR 64: ≈ 50%), and the ROM says so.
 
-use super::config::{ProbeConfig, RomMode};
+use super::config::{ProbeConfig, ProbeConvention, RomMode};
 use super::lanes::{LANES, LaneGroup, LaneProbe};
 use super::modulator::{Modulator, SAFETY_MARGIN};
 use super::wrap::{WrapMetric, inband_error_energy};
@@ -165,6 +165,8 @@ pub struct ProbeRom {
     pub osr: f64,
     pub h_inf: f64,
     pub optimised_zeros: bool,
+    /// How the probe waveform was written down (docs/probe.md).
+    pub convention: ProbeConvention,
     /// Largest state mismatch max|s₀ − s_L| at the wrap of a kept period (0 in windowed mode).
     pub wrap_mismatch: f64,
     /// Worst lane's wrap transient in-band energy over its period's in-band error energy
@@ -268,7 +270,8 @@ impl ProbeRom {
         let results: Vec<Result<(Vec<u16>, WrapStats), DspError>> = groups
             .par_iter()
             .map(|probes| {
-                let mut g = LaneGroup::new(probes, depth as u64, window, order);
+                let mut g = LaneGroup::new(probes, depth as u64, window, order)
+                    .with_convention(cfg.convention);
                 match &metric {
                     None => {
                         let mut bits = vec![0u16; depth];
@@ -305,6 +308,7 @@ impl ProbeRom {
             osr: cfg.osr,
             h_inf: cfg.h_inf,
             optimised_zeros: cfg.optimised_zeros,
+            convention: cfg.convention,
             wrap_mismatch: wrap.mismatch,
             // Three significant digits: the ratio goes through an FFT whose last bits
             // depend on the CPU's SIMD path, and it is written into committed files.
@@ -335,6 +339,9 @@ impl ProbeRom {
             osr: self.osr,
             h_inf: self.h_inf,
             optimised_zeros: self.optimised_zeros,
+            // Written only when not the default, so existing manifests keep their text.
+            convention: (self.convention != ProbeConvention::Tofprobe)
+                .then(|| self.convention.name().to_string()),
             amplitude: self.amplitude,
             window: self.window.name().to_string(),
             coherent_gain: self.coherent_gain,

@@ -3,8 +3,9 @@
 //! orders 1–4 at OSR 8–128 against eq. 4, the default design's SNR at the 156 kHz band
 //! edge and the band edge where it reaches 12 bits, and the speed of a 16-bin ROM
 //! (32 bitstreams) for N = 10^7 on one thread and all threads (target ≤ 1 s), the
-//! full-band prober's steps/s per core (f64 and f32 lanes) against the scalar reference
-//! modulator with direct accumulation, measured in the same run. With
+//! full-band prober's steps/s per core (f64 and f32 lanes, on this CPU's instruction path
+//! and on the x86-64 baseline, whose sums must agree bit for bit) against the scalar
+//! reference modulator with direct accumulation, measured in the same run. With
 //! `--svg`, the spectrum of a 50 kHz probe (the paper's Fig. 2: the noise shaping).
 
 use std::path::PathBuf;
@@ -13,11 +14,10 @@ use std::time::Instant;
 use clap::Args;
 use plotters::prelude::*;
 use serde::Serialize;
-use tofprobe_dsp::sd::fullband_check::naive_sums;
 use tofprobe_dsp::sd::quality::{ToneSpectrum, eq4_snr_db, measured_snr_db};
-use tofprobe_dsp::sd::{
-    FullBandProber, LanePrecision, Modulator, ProbeConfig, ProbeDesign, ProbeRom,
-};
+use tofprobe_dsp::sd::{Modulator, ProbeConfig, ProbeDesign, ProbeRom};
+
+use super::lane_rates::fullband_rates;
 
 use crate::error::CliError;
 
@@ -103,45 +103,25 @@ struct Report {
     periodic_rom_wrap_summary: String,
     /// Full-band prober (`FullBandProber`, probe generated and accumulated in one pass)
     /// against the scalar reference (`Modulator::run` + direct accumulation), both on one
-    /// thread in this run: modulator steps per second per core.
+    /// thread in this run: modulator steps per second per core. `fullband_path` is the
+    /// instruction path `FullBandProber::new` runs on this CPU ("avx2" or "baseline"); the
+    /// `_baseline_` figures are the x86-64 baseline path in the same run.
     scalar_reference_steps_per_s_per_core: f64,
+    fullband_path: String,
     fullband_f64_steps_per_s_per_core: f64,
     fullband_f32_steps_per_s_per_core: f64,
+    fullband_f64_baseline_steps_per_s_per_core: f64,
+    fullband_f32_baseline_steps_per_s_per_core: f64,
     /// Ratios to the scalar reference (dimensionless).
     fullband_f64_speedup_vs_scalar: f64,
     fullband_f32_speedup_vs_scalar: f64,
+    fullband_f64_baseline_speedup_vs_scalar: f64,
+    fullband_f32_baseline_speedup_vs_scalar: f64,
     svg: Option<String>,
     pass: bool,
 }
 
-/// Samples of the full-band speed runs (64 bins) and of the scalar reference (1 bin).
-const N_FULLBAND: u64 = 1 << 20;
-
-/// (scalar reference, f64 lanes, f32 lanes) modulator steps/s on one thread.
-fn fullband_rates(design: &ProbeDesign) -> Result<(f64, f64, f64), CliError> {
-    let x: Vec<f64> = (0..N_FULLBAND)
-        .map(|n| 30.0 + (n as f64 * 0.001).sin())
-        .collect();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .map_err(err)?;
-    let t0 = Instant::now();
-    let naive = naive_sums(design, N_FULLBAND, &[4500], &x).map_err(err)?;
-    let scalar = 2.0 * N_FULLBAND as f64 / t0.elapsed().as_secs_f64();
-    let bins: Vec<u64> = (1..=64).map(|i| 70 * i).collect();
-    let rate = |p: LanePrecision| -> Result<f64, CliError> {
-        let t0 = Instant::now();
-        let mut prober = FullBandProber::new(design, N_FULLBAND, &bins, p).map_err(err)?;
-        pool.install(|| prober.push(&x)).map_err(err)?;
-        Ok(prober.steps() as f64 / t0.elapsed().as_secs_f64())
-    };
-    let (f64_rate, f32_rate) = (rate(LanePrecision::F64)?, rate(LanePrecision::F32)?);
-    drop(naive);
-    Ok((scalar, f64_rate, f32_rate))
-}
-
-fn err(e: impl std::fmt::Display) -> CliError {
+pub(super) fn err(e: impl std::fmt::Display) -> CliError {
     CliError::option(
         "bench sd",
         e.to_string(),
@@ -227,7 +207,8 @@ pub fn run(args: &SdBenchArgs) -> Result<(), CliError> {
     let chip = ProbeRom::generate(&chip_design, FS_HZ, N_ROM, &chip_bins).map_err(err)?;
     let chip_seconds = t0.elapsed().as_secs_f64();
 
-    let (scalar_rate, f64_rate, f32_rate) = fullband_rates(&design)?;
+    let rates = fullband_rates(&design)?;
+    let scalar_rate = rates.scalar;
 
     let svg = match &args.svg {
         Some(p) => {
@@ -267,10 +248,15 @@ pub fn run(args: &SdBenchArgs) -> Result<(), CliError> {
         periodic_rom_wrap_state_mismatch: chip.wrap_mismatch,
         periodic_rom_wrap_summary: chip.wrap_summary().unwrap_or_default(),
         scalar_reference_steps_per_s_per_core: scalar_rate,
-        fullband_f64_steps_per_s_per_core: f64_rate,
-        fullband_f32_steps_per_s_per_core: f32_rate,
-        fullband_f64_speedup_vs_scalar: f64_rate / scalar_rate,
-        fullband_f32_speedup_vs_scalar: f32_rate / scalar_rate,
+        fullband_path: rates.path.name().into(),
+        fullband_f64_steps_per_s_per_core: rates.fast[0],
+        fullband_f32_steps_per_s_per_core: rates.fast[1],
+        fullband_f64_baseline_steps_per_s_per_core: rates.baseline[0],
+        fullband_f32_baseline_steps_per_s_per_core: rates.baseline[1],
+        fullband_f64_speedup_vs_scalar: rates.fast[0] / scalar_rate,
+        fullband_f32_speedup_vs_scalar: rates.fast[1] / scalar_rate,
+        fullband_f64_baseline_speedup_vs_scalar: rates.baseline[0] / scalar_rate,
+        fullband_f32_baseline_speedup_vs_scalar: rates.baseline[1] / scalar_rate,
         svg,
         pass: all <= ROM_TARGET_S && chip.wrap_clean(),
     };
@@ -360,12 +346,18 @@ fn print_text(r: &Report) {
         r.periodic_rom_wrap_state_mismatch
     );
     println!(
-        "  full-band prober, one core: scalar reference {:.3e} steps/s; f64 lanes {:.3e} ({:.1}x), f32 lanes {:.3e} ({:.1}x)",
+        "  full-band prober, one core: scalar reference {:.3e} steps/s; {} path: f64 lanes {:.3e} ({:.1}x), f32 lanes {:.3e} ({:.1}x); \
+         baseline path: f64 {:.3e} ({:.1}x), f32 {:.3e} ({:.1}x)",
         r.scalar_reference_steps_per_s_per_core,
+        r.fullband_path,
         r.fullband_f64_steps_per_s_per_core,
         r.fullband_f64_speedup_vs_scalar,
         r.fullband_f32_steps_per_s_per_core,
-        r.fullband_f32_speedup_vs_scalar
+        r.fullband_f32_speedup_vs_scalar,
+        r.fullband_f64_baseline_steps_per_s_per_core,
+        r.fullband_f64_baseline_speedup_vs_scalar,
+        r.fullband_f32_baseline_steps_per_s_per_core,
+        r.fullband_f32_baseline_speedup_vs_scalar
     );
     if let Some(p) = &r.svg {
         println!("  spectrum of a 50 kHz probe: {p}");
