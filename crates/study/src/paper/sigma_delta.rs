@@ -80,6 +80,8 @@ pub fn probe_bins(n: u64) -> Vec<u64> {
 #[derive(Debug)]
 pub struct ProbeSetup {
     pub n: u64,
+    /// The probe design the ROM was generated from (the Fig. 2 and Fig. 8 modulator).
+    pub design: ProbeDesign,
     pub rom: ProbeRom,
     /// Per register (n₊, n₋) over the frame.
     pub sign_counts: Vec<(u64, u64)>,
@@ -102,6 +104,7 @@ impl ProbeSetup {
         let sign_counts = rom_sign_counts(&rom.image, rom.image.registers(), n);
         Ok(ProbeSetup {
             n,
+            design: design.clone(),
             rom,
             sign_counts,
         })
