@@ -51,6 +51,20 @@ fn quick_json_rows_carry_seeds_bands_and_z_scores() {
     for r in family("Table 2 ΣΔ noise") {
         assert_eq!(r["band_hz"], serde_json::json!([1000.0, 10000.0]), "{r}");
     }
+    // The figure points are multi-seed too: Fig. 4, the hold's corners (Fig. 6), the ΣΔ
+    // noise and amplitude rows, each with its seeds listed and a seed-to-seed sd.
+    for (f, count) in [
+        ("Fig. 4", 6),
+        ("1NN hold f_3dB", 3),
+        ("Table 2 ΣΔ noise", 18),
+        ("Table 2 ΣΔ amplitude", 14),
+    ] {
+        assert_eq!(family(f).count(), count, "{f}");
+        for r in family(f) {
+            assert!(r["seeds"].as_array().is_some_and(|s| s.len() >= 5), "{r}");
+            assert!(r["seed_sd"].as_f64().is_some_and(|s| s > 0.0), "{r}");
+        }
+    }
     assert_eq!(family("Table 2 amplitude").count(), 14);
 }
 
