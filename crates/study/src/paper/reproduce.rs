@@ -77,11 +77,11 @@ pub fn reproduce(quick: bool, out: &Path) -> Result<Reproduction, StudyError> {
     let mut charts: Vec<Chart> = vec![
         figures::fig2(&design.modulator, design.config.amplitude)?,
         figures::fig4_chart(&f4, n_f4),
-        figures::fig5(&results, quick),
+        plots::fig5(&results, quick),
         figures::fig6(&corners, quick),
     ];
     charts.extend(band_spectra::charts(&band, n_t2, quick)?);
-    charts.push(figures::fig9(&results, quick));
+    charts.push(plots::fig9(&results, quick));
     charts.extend(plots::charts(&results, quick));
     let mut files: Vec<(String, String)> = Vec::new();
     for c in &charts {
