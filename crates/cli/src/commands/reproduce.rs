@@ -1,6 +1,6 @@
 //! `tofprobe reproduce [--quick] [--json] [--out DIR]`: the paper's numbers, re-measured.
 //! Prints a Markdown table (paper | corrected | measured | closed form | tolerance | pass),
-//! writes the paper's figures (Fig. 2–9, 3 and 12) and Table 2's plots as SVG to DIR
+//! writes the paper's figures (Fig. 2–9 and 12) and Table 2's plots as SVG to DIR
 //! (one set, whole or absent), and exits with status 1 if any row misses its tolerance.
 //! The full run simulates 1 s records (10^7 pulses) for every Table 2 row; `--quick`
 //! uses 2^20-pulse records (the paper's noise values are then not shown). Every Table 2
