@@ -228,3 +228,27 @@ fn figure_checks_catch_broken_files() {
     assert!(check_svg("f", &inf, "Fig. 5:", &[]).is_err());
     assert!(check_svg("f", "<html></html>", "Fig. 5:", &[]).is_err());
 }
+
+/// `--out` that cannot be a directory (a regular file) fails at once with status 2, names
+/// the path, and leaves the file as it was: the output set is begun before the simulation.
+#[test]
+fn unusable_out_fails_before_simulating() {
+    let file = std::env::temp_dir().join(format!("tofprobe-reproduce-file-{}", std::process::id()));
+    std::fs::write(&file, b"not a directory").expect("write");
+    let t = std::time::Instant::now();
+    let out = tofprobe(&[
+        "reproduce",
+        "--quick",
+        "--out",
+        file.to_str().expect("utf-8 path"),
+    ]);
+    let secs = t.elapsed().as_secs_f64();
+    let kept = std::fs::read(&file).expect("read");
+    let _ = std::fs::remove_file(&file);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains(file.to_str().unwrap_or_default()), "{err}");
+    assert_eq!(kept, b"not a directory");
+    // The quick run simulates for ≈ 30 s; failing first takes well under that.
+    assert!(secs < 10.0, "{secs} s");
+}

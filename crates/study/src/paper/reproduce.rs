@@ -37,14 +37,17 @@ pub fn figure_of(file: &str) -> Option<String> {
 }
 
 /// Runs the reproduction (`quick`: short records) and writes the plots into `out`: every
-/// SVG is rendered first and the set is moved into place together
-/// (`tofprobe_io::OutputSet`), so a failed run leaves the old set, never part of a new one.
+/// SVG is rendered, staged and moved into place together (`tofprobe_io::OutputSet`, begun
+/// before the simulation), so a failed run leaves the old set, never part of a new one.
 pub fn reproduce(quick: bool, out: &Path) -> Result<Reproduction, StudyError> {
     let (n_t2, n_f4, n_bw) = if quick {
         (1 << 20, 1 << 17, 1 << 21)
     } else {
         (10_000_000, fig4::N, bandwidth::N)
     };
+    // The set is begun first: an unusable --out fails before minutes of simulation, and a
+    // failure anywhere below drops it (its stage, and the directory if it made it, removed).
+    let mut set = tofprobe_io::OutputSet::begin(out).map_err(|e| io(out, e))?;
     let t_rom = Instant::now();
     // Generated once here; every row's ΣΔ columns read it.
     let probe = ProbeSetup::new(n_t2)?;
@@ -88,7 +91,10 @@ pub fn reproduce(quick: bool, out: &Path) -> Result<Reproduction, StudyError> {
         files.push((c.file.clone(), c.render()?));
     }
     files.extend(transients::svgs(&figs)?);
-    write_set(out, &files)?;
+    for (name, text) in &files {
+        set.add(name, text.as_bytes()).map_err(|e| io(out, e))?;
+    }
+    set.commit(None).map_err(|e| io(out, e))?;
     let path = |name: &str| out.join(name).display().to_string();
     Ok(Reproduction {
         rows,
@@ -104,17 +110,11 @@ pub fn reproduce(quick: bool, out: &Path) -> Result<Reproduction, StudyError> {
     })
 }
 
-/// Stages every file in one `OutputSet` for `dir` and commits it.
-fn write_set(dir: &Path, files: &[(String, String)]) -> Result<(), StudyError> {
-    let io = |e: std::io::Error| StudyError::Output {
+fn io(dir: &Path, e: std::io::Error) -> StudyError {
+    StudyError::Output {
         path: dir.to_path_buf(),
         message: e.to_string(),
-    };
-    let mut set = tofprobe_io::OutputSet::begin(dir).map_err(io)?;
-    for (name, text) in files {
-        set.add(name, text.as_bytes()).map_err(io)?;
     }
-    set.commit(None).map_err(io)
 }
 
 #[cfg(test)]
