@@ -1,6 +1,7 @@
 //! `tofprobe reproduce [--quick] [--json] [--out DIR]`: the paper's numbers, re-measured.
 //! Prints a Markdown table (paper | corrected | measured | closed form | tolerance | pass),
-//! writes SVG plots to DIR, and exits with status 1 if any row misses its tolerance.
+//! writes the paper's figures (Fig. 2–9 and 12) and Table 2's plots as SVG to DIR
+//! (one set, whole or absent), and exits with status 1 if any row misses its tolerance.
 //! The full run simulates 1 s records (10^7 pulses) for every Table 2 row; `--quick`
 //! uses 2^20-pulse records (the paper's noise values are then not shown). Every Table 2
 //! noise and amplitude row is the mean over 5 seeds, judged |closed form − mean| ≤ 3·se
@@ -42,8 +43,13 @@ struct Report<'a> {
     rom_seconds: f64,
     /// All Table 2 rows (every column, every seed).
     table2_seconds: f64,
+    /// Fig. 7/8's full-band ΣΔ probing and DFT.
+    band_seconds: f64,
     rows: &'a [Row],
+    /// Every SVG written.
     plots: Vec<String>,
+    /// The paper's figures among them, by figure ("Fig. 4" → path).
+    figures: std::collections::BTreeMap<String, String>,
     rows_failed: usize,
     pass: bool,
 }
@@ -69,7 +75,9 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
             seconds,
             rom_seconds: r.rom_seconds,
             table2_seconds: r.table2_seconds,
+            band_seconds: r.band_seconds,
             rows: &rows,
+            figures: r.figures.iter().cloned().collect(),
             plots,
             rows_failed: failed,
             pass: failed == 0,
@@ -96,12 +104,18 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
             table2::SEEDS
         );
         print!("{}", paper::markdown(&rows));
-        println!("\nplots: {}", plots.join(", "));
+        println!("\nfigures:");
+        for (fig, path) in &r.figures {
+            println!("  {fig}: {path}");
+        }
+        println!("plots: {}", plots.join(", "));
         println!(
-            "{} rows, {failed} failed, {seconds:.1} s (ΣΔ ROM {:.1} s, Table 2 rows {:.1} s)",
+            "{} rows, {failed} failed, {seconds:.1} s (ΣΔ ROM {:.1} s, Table 2 rows {:.1} s, \
+             Fig. 7/8 band {:.1} s)",
             rows.len(),
             r.rom_seconds,
-            r.table2_seconds
+            r.table2_seconds,
+            r.band_seconds
         );
     }
     if failed > 0 {

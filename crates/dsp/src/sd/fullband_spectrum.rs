@@ -35,7 +35,19 @@ pub fn prefiltered_record(
     pulses: u64,
     alpha: f64,
 ) -> Result<Vec<f64>, DspError> {
-    let mut fe = FrontEnd::new(0.0, FrontEndOutput::Prefiltered { alpha })?;
+    prefiltered_record_zoomed(source, pulses, alpha, 0.0)
+}
+
+/// [`prefiltered_record`] with the pixel's zoom: `zoom_mm` subtracted from every detected
+/// depth (a static depth zoomed out leaves no DC for the probes' quantisation noise to mix
+/// into every bin).
+pub fn prefiltered_record_zoomed(
+    source: &PhotonSource,
+    pulses: u64,
+    alpha: f64,
+    zoom_mm: f64,
+) -> Result<Vec<f64>, DspError> {
+    let mut fe = FrontEnd::new(zoom_mm, FrontEndOutput::Prefiltered { alpha })?;
     let mut x = Vec::with_capacity(pulses as usize);
     let mut buf = vec![None; 16 * CHUNK];
     let mut first = 0u64;

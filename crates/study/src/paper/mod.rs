@@ -8,8 +8,11 @@
 //! background matters, wider windows (12·σ_s) for ρ_b = 0 rows so the window never clips
 //! the jitter. The DFT columns transform the raw held depth (1NN hold, no prefilter).
 
+pub mod band_spectra;
 pub mod bandwidth;
+pub mod chart;
 pub mod fig4;
+pub mod figures;
 pub mod plots;
 pub mod reproduce;
 pub mod setup;

@@ -298,15 +298,35 @@ pub fn measure_spectrum(spectrum: &[f64], n: usize, tone: bool) -> Result<Measur
     })
 }
 
-/// Noise floor and amplitude of one seed's record (DFT column alone), µm.
-fn seed_measurement(spec: &Spec, n: u64, seed: u64) -> Result<Measurement, StudyError> {
+/// One seed's record: the DFT column's noise floor and amplitude (µm) and, when the ΣΔ
+/// column runs (`probe_sd`), the DFT and float-ΣΔ measurements at the shared probe bins.
+fn seed_measurement(
+    spec: &Spec,
+    n: u64,
+    seed: u64,
+    probe_sd: Option<&ProbeSetup>,
+) -> Result<(Measurement, Option<Measurement>), StudyError> {
     let source = spec.setup().source(seed)?;
     let detections = source.record(n);
+    if let Some(probe) = probe_sd {
+        let rec = RowRecord {
+            spec,
+            source: &source,
+            detections: &detections,
+            probe: Some(probe),
+        };
+        let dft = dft_column(&rec)?.ok_or_else(|| StudyError::option("columns", DFT, "DFT"))?;
+        let sd = sd_column(&rec)?;
+        return Ok((dft, sd));
+    }
     let held = crate::records::held_record(&source, &detections, 0.0)?;
     drop(detections);
     let spectrum = amplitude_spectrum(&held, WINDOW)?;
     drop(held);
-    measure_spectrum(&spectrum, n as usize, spec.amp_um.is_some())
+    Ok((
+        measure_spectrum(&spectrum, n as usize, spec.amp_um.is_some())?,
+        None,
+    ))
 }
 
 /// Number of DFT bins the noise floor of a row averages (the band minus DC and tone).
@@ -390,11 +410,17 @@ pub struct RowResult {
     pub amp_closed_um: Option<f64>,
     /// Seed-0 spectrum, decimated for plotting: (Hz, µm).
     pub spectrum: Vec<(f64, f64)>,
+    /// Per seed of [`SEEDS`] (when the ΣΔ column ran): the DFT and the float ΣΔ (with the
+    /// prefilter) of that seed's record at the shared probe bins.
+    pub probe_seeds: Vec<(Measurement, Measurement)>,
 }
 
 /// Runs one row with the given columns ([`COLUMNS`] for the full table; the first must be
 /// the DFT column, which the seed statistics use): seed 0 in full, the other seeds of
-/// [`SEEDS`] through the DFT column alone (noise floor and amplitude). `bench dsp` times the DFT rows alone this way.
+/// [`SEEDS`] through the DFT column (noise floor and amplitude) and, if the ΣΔ column is
+/// among `columns_to_run`, the float ΣΔ column too (the ΣΔ rows are means over the seeds;
+/// the unprefiltered and bit-true columns stay seed 0). `bench dsp` times the DFT rows
+/// alone this way.
 pub fn run_row_with(
     spec: &Spec,
     n: u64,
@@ -423,12 +449,25 @@ pub fn run_row_with(
     let spectrum = amplitude_spectrum(&held, WINDOW)?;
     drop(held);
     let plot = decimate(&spectrum, n as usize);
-    let rest: Result<Vec<Measurement>, StudyError> = SEEDS[1..]
+    let probe_sd = probe.filter(|_| columns_to_run.iter().any(|c| c.name == SD));
+    let rest: Result<Vec<(Measurement, Option<Measurement>)>, StudyError> = SEEDS[1..]
         .par_iter()
-        .map(|&s| seed_measurement(spec, n, s))
+        .map(|&s| seed_measurement(spec, n, s, probe_sd))
         .collect();
     let rest = rest?;
-    let seed_ms: Vec<&Measurement> = std::iter::once(&columns[0].1).chain(&rest).collect();
+    let seed_ms: Vec<&Measurement> = std::iter::once(&columns[0].1)
+        .chain(rest.iter().map(|r| &r.0))
+        .collect();
+    let seed0_sd = columns.iter().find(|(c, _)| *c == SD).map(|(_, m)| m);
+    let probe_seeds: Vec<(Measurement, Measurement)> = match seed0_sd {
+        Some(sd0) if probe_sd.is_some() => std::iter::once((columns[0].1.clone(), sd0.clone()))
+            .chain(
+                rest.iter()
+                    .filter_map(|(d, sd)| sd.as_ref().map(|sd| (d.clone(), sd.clone()))),
+            )
+            .collect(),
+        _ => Vec::new(),
+    };
     let noises_um: Vec<f64> = seed_ms.iter().map(|m| m.noise_um).collect();
     let amps_um: Vec<f64> = seed_ms.iter().filter_map(|m| m.amp_um).collect();
     Ok(RowResult {
@@ -440,6 +479,7 @@ pub fn run_row_with(
         closed_form_um: closed_form_noise_um(spec, n as usize)?,
         amp_closed_um: closed_form_amp_um(spec)?,
         spectrum: plot,
+        probe_seeds,
     })
 }
 
@@ -601,7 +641,8 @@ mod tests {
 
     /// A short record (2^18 pulses, 38 Hz bins) of the σ_s = 7.5 mm, ρ_s = 0.3 row: the
     /// band holds ≈ 220 bins, ≈ 110 independent ones under Blackman, so the mean Rayleigh
-    /// magnitude has a standard error ≈ 0.52/sqrt(110) ≈ 5%; 15% is 3σ.
+    /// magnitude has a standard error ≈ 0.52/sqrt(110) ≈ 5%; 15% is 3σ. The ΣΔ column runs
+    /// on every seed.
     #[test]
     fn short_row_matches_closed_form() {
         let spec = ROWS[9];
@@ -617,6 +658,17 @@ mod tests {
         );
         assert_eq!(r.amps_um.len(), SEEDS.len());
         assert_eq!(r.noises_um.len(), SEEDS.len());
+        // The ΣΔ noise and amplitude rows are means over every seed, each seed's ΣΔ read
+        // against the DFT of its own record (the 3% / 3ē tolerances of `sigma_delta`).
+        assert_eq!(r.probe_seeds.len(), SEEDS.len());
+        let sd_rows = crate::paper::sigma_delta::rows(&r);
+        for fam in ["Table 2 ΣΔ noise", "Table 2 ΣΔ amplitude"] {
+            let row = sd_rows.iter().find(|x| x.family == fam).expect(fam);
+            assert_eq!(row.seeds, SEEDS, "{row:?}");
+            assert!(row.pass && row.seed_sd.is_some_and(|s| s > 0.0), "{row:?}");
+        }
+        let dft_only = run_row_with(&spec, n, Some(&probe), &COLUMNS[..1]).unwrap();
+        assert!(dft_only.probe_seeds.is_empty());
     }
 
     /// Deliberately wrong pipelines fail the noise row (2^16 pulses, DFT column only, the

@@ -8,8 +8,6 @@
 //! note) that the dsp crate evaluates; the row keeps that verdict ([`Tolerance::Bound`],
 //! the tolerance written into the note) and shows its reference in the closed-form column.
 
-use std::path::Path;
-
 use tofprobe_dsp::haar::paper::{TransientFigure, TransientRow, fig3, fig12};
 
 use super::{Row, Tolerance};
@@ -78,9 +76,10 @@ pub fn rows(figs: &[TransientFigure]) -> Vec<Row> {
     figs.iter().flat_map(|f| f.rows.iter().map(row)).collect()
 }
 
-/// Writes `fig3_scalogram.svg` and `fig12_scalogram.svg` into `dir`; returns their paths.
-pub fn write_svgs(dir: &Path, figs: &[TransientFigure]) -> Result<Vec<String>, StudyError> {
-    let mut written = Vec::new();
+/// Renders `fig3_scalogram.svg` and `fig12_scalogram.svg`: (file name, SVG text), staged
+/// by the caller with the other figures.
+pub fn svgs(figs: &[TransientFigure]) -> Result<Vec<(String, String)>, StudyError> {
+    let mut out = Vec::new();
     for f in figs {
         let name = match f.rows.first().map(|r| r.figure.as_str()) {
             Some("Fig. 3") => "fig3_scalogram.svg",
@@ -92,11 +91,14 @@ pub fn write_svgs(dir: &Path, figs: &[TransientFigure]) -> Result<Vec<String>, S
             f.scalogram.pulses,
             f.scalogram.scales
         );
-        let p = dir.join(name);
-        tofprobe_report::scalogram::write_scalogram_svg(&f.scalogram, &title, Some(&f.events), &p)?;
-        written.push(p.display().to_string());
+        let svg = tofprobe_report::scalogram::scalogram_svg(&f.scalogram, &title, Some(&f.events))
+            .map_err(|message| StudyError::Plot {
+                path: name.to_string(),
+                message,
+            })?;
+        out.push((name.to_string(), svg));
     }
-    Ok(written)
+    Ok(out)
 }
 
 #[cfg(test)]
