@@ -58,6 +58,9 @@ pub fn measure(probe: &ProbeSetup, step_hz: f64) -> Result<BandSpectrum, StudyEr
         &grid(probe.n, step_hz),
         alpha(),
         LanePrecision::F64,
+        // The fastest kernel this CPU runs: bit-identical to the baseline
+        // (crates/dsp/tests/fullband_isa.rs).
+        tofprobe_dsp::sd::KernelPath::detect(),
         |_| {},
     )?)
 }
