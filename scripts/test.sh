@@ -7,6 +7,8 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
 scripts/install-tools.sh
 cargo fmt --all --check
-cargo clippy --workspace --all-targets -- -D warnings
+# Release profile, like the tests below: the proc-macros and build scripts clippy compiles are
+# then the ones the test build reuses (in the dev profile they were built twice, ≈ 1 min).
+cargo clippy --workspace --all-targets --release -- -D warnings
 cargo test --workspace --release
 scripts/users-tools.sh

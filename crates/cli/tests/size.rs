@@ -232,13 +232,17 @@ fn default_pixel_fits_its_clock_with_margin() {
         "--sweep-widths",
         "39",
     ];
-    let out = size(&args, &[], &dir.join("cache"));
-    let text = String::from_utf8_lossy(&out.stdout);
+    // One run writes the Markdown and the JSON report (`--out`).
+    let set = dir.join("report");
+    let mut run_args = args.to_vec();
+    run_args.extend(["--out", set.to_str().unwrap()]);
+    let out = size(&run_args, &[], &dir.join("cache"));
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    let text = std::fs::read_to_string(set.join("size-report.md")).expect("size-report.md");
     // The primary verdict, then one row per liberty and corner with its own verdict.
     assert!(text.contains("verdict: **fits"), "{text}");
     for row in [
@@ -254,10 +258,10 @@ fn default_pixel_fits_its_clock_with_margin() {
             "{line}"
         );
     }
-    let mut json_args = args.to_vec();
-    json_args.push("--json");
-    let out = size(&json_args, &[], &dir.join("cache"));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    let v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(set.join("size-report.json")).expect("size-report.json"),
+    )
+    .expect("one JSON object");
     let corners = v["timing_corners"].as_array().expect("timing_corners");
     for (lib, corner) in [
         ("osu018_stdcells", "typical"),
