@@ -15,7 +15,7 @@ use serde::Serialize;
 use tofprobe_pixel::config::Choice;
 use tofprobe_pixel::{PixelConfig, PixelContext, PixelError, PixelParams};
 use tofprobe_report::analysis::analyse_point;
-use tofprobe_report::corners::MARGIN_PERCENT;
+use tofprobe_report::corners::{CornerTiming, MARGIN_PERCENT};
 use tofprobe_report::fsutil::synth_cache_dir;
 use tofprobe_report::generated::GeneratedPixel;
 use tofprobe_report::liberty::Liberty;
@@ -173,15 +173,22 @@ pub fn choose(
             ))
         })?;
         let timing = point.timing.expect("a liberty with timing is timed");
-        let period = 1e3 / clock_mhz;
-        let slack = period - timing.critical_path_ns;
+        // The size report's verdict, so `size` and `adders = "auto"` judge slack alike.
+        let verdict = CornerTiming::new(
+            &lib.name,
+            "typical",
+            &lib.path,
+            &timing,
+            clock_mhz,
+            ctx.laser_rate_hz,
+        );
         let trial = AdderTrial {
             adders: a,
             cycles_per_pulse: k,
             clock_mhz,
             f_max_mhz: timing.f_max_mhz,
-            slack_percent: (slack / period * 1e3).round() / 10.0,
-            meets: slack >= period * MARGIN_PERCENT / 100.0,
+            slack_percent: verdict.slack_percent,
+            meets: verdict.meets_margin,
         };
         let meets = trial.meets;
         trials.push(trial);

@@ -47,13 +47,14 @@ pub fn zoomed(tdc: u32, tdc_bits: u32, zoom: u32) -> i64 {
 /// than T+1+F bits.
 #[inline(always)]
 pub fn prefilter_step(x: i64, held: i64, frac_bits: u32, shift: u32) -> i64 {
-    x + (((held << frac_bits) - x) >> shift)
+    prefilter_step_rounded(x, held, frac_bits, shift, crate::params::Rounding::Floor)
 }
 
 /// [`prefilter_step`] with the shift rounded as `rounding` says: `Nearest` adds 2^(S−1)
 /// before the arithmetic shift (round half up; S = 0 is exact either way). The step still
 /// lies between 0 and the difference, so x_new stays between x and held << F and keeps
 /// its width.
+#[inline(always)]
 pub fn prefilter_step_rounded(
     x: i64,
     held: i64,
@@ -61,9 +62,5 @@ pub fn prefilter_step_rounded(
     shift: u32,
     rounding: crate::params::Rounding,
 ) -> i64 {
-    let half = match rounding {
-        crate::params::Rounding::Nearest if shift > 0 => 1i64 << (shift - 1),
-        _ => 0,
-    };
-    x + ((((held << frac_bits) - x) + half) >> shift)
+    x + ((((held << frac_bits) - x) + rounding.half(shift)) >> shift)
 }

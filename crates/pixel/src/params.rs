@@ -46,6 +46,16 @@ impl Rounding {
     pub fn is_floor(&self) -> bool {
         *self == Rounding::Floor
     }
+
+    /// The constant added before a shift by `shift`: 2^(S−1) for `Nearest` (S ≥ 1), else 0
+    /// (floor, and S = 0, which is exact either way). The datapath and the template both
+    /// take it from here.
+    pub fn half(self, shift: u32) -> i64 {
+        match self {
+            Rounding::Nearest if shift > 0 => 1i64 << (shift - 1),
+            _ => 0,
+        }
+    }
 }
 
 impl std::fmt::Display for Rounding {

@@ -245,13 +245,18 @@ impl Liberty {
     }
 
     /// The smallest buffer synthesis may use (a combinational cell whose output is one of
-    /// its inputs, not `dont_use`; the first by name among equals): ABC's model of what
-    /// drives a flop's output (see `synth::abc_constraints`).
+    /// its inputs, neither `dont_use` nor [`NOT_FOR_SYNTHESIS`]; the first by name among
+    /// equals): ABC's model of what drives a flop's output (see `synth::abc_constraints`).
     pub fn drive_cell(&self) -> Option<&str> {
         self.cells
             .iter()
-            .filter(|(_, c)| {
-                c.identity && c.inputs == 1 && !c.sequential && !c.dont_use && c.area > 0.0
+            .filter(|(n, c)| {
+                c.identity
+                    && c.inputs == 1
+                    && !c.sequential
+                    && !c.dont_use
+                    && c.area > 0.0
+                    && !NOT_FOR_SYNTHESIS.iter().any(|p| n.contains(p))
             })
             .min_by(|a, b| a.1.area.total_cmp(&b.1.area))
             .map(|(n, _)| n.as_str())
@@ -349,6 +354,14 @@ library (tiny) {
         );
         let lib = Liberty::parse(Path::new("bufs.lib"), &text).unwrap();
         // TIEHI and ISO are smaller, but a constant and dont_use; BUFX2 beats BUFX4.
+        assert_eq!(lib.drive_cell(), Some("BUFX2"));
+        // A not-for-synthesis cell is skipped even where the liberty does not mark it.
+        let text = text.replacen(
+            "  cell (INV)",
+            &(buf("x__lpflow_isobuf_1", 1.0, "") + "  cell (INV)"),
+            1,
+        );
+        let lib = Liberty::parse(Path::new("bufs.lib"), &text).unwrap();
         assert_eq!(lib.drive_cell(), Some("BUFX2"));
     }
 

@@ -208,11 +208,8 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
     let mut constrained = false;
     if let Some(d) = spec.delay_target_ps {
         write_atomic(&dir.join("abc.script"), abc_timing_script(d).as_bytes())?;
-        let map_lib = match &marked {
-            Some(m) => Liberty::parse(&map_spec.liberty, m)?,
-            None => lib.clone(),
-        };
-        if let Some(cell) = map_lib.drive_cell() {
+        // `drive_cell` already skips the cells the map copy marks: no second parse.
+        if let Some(cell) = lib.drive_cell() {
             write_atomic(&dir.join("abc.constr"), abc_constraints(cell).as_bytes())?;
             constrained = true;
         }

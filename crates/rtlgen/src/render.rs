@@ -366,10 +366,7 @@ pub fn render(p: &PixelParams, rom: &[u64], o: &RenderOptions) -> Result<Vec<Rtl
         ib,
         sw,
         xw: p.operand_bits(),
-        round_half: match p.prefilter_rounding {
-            tofprobe_pixel::Rounding::Nearest if p.shift > 0 => 1u64 << (p.shift - 1),
-            _ => 0,
-        },
+        round_half: p.prefilter_rounding.half(p.shift) as u64,
         opw: p.operand_bits(),
         opx: if p.width > p.operand_bits() {
             let opw = p.operand_bits();
