@@ -55,6 +55,8 @@ pub fn random_case(seed: u64, i: u64) -> RandomCase {
         frame_pulses: 1 << ln,
         rom_depth: pick(&mut rng, 1, 48) as usize,
         prefilter_rounding: Rounding::Floor,
+        register_frac_bits: None,
+        register_file: Default::default(),
     };
     p.adders = (pick(&mut rng, 1, 4) as usize).min(p.ops_per_pulse());
     p.cycles_per_pulse = p.slots() + pick(&mut rng, 0, 2) as usize;

@@ -54,5 +54,7 @@ pub fn directed_config(mode: Mode) -> PixelParams {
         frame_pulses: 16,
         rom_depth: 16,
         prefilter_rounding: Default::default(),
+        register_frac_bits: None,
+        register_file: Default::default(),
     }
 }

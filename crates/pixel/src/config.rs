@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::autobins::choose_bins;
 use crate::error::PixelError;
-use crate::params::{MAX_WIDTH, Mode, PixelParams, Rounding, ceil_log2};
+use crate::params::{MAX_WIDTH, Mode, PixelParams, RegisterFile, Rounding, ceil_log2};
 use crate::sizing;
 
 /// The keyword `"auto"` of a `[pixel]` key that can be chosen from the scene.
@@ -76,6 +76,11 @@ pub struct PixelConfig {
     /// How the prefilter's shift rounds: `"floor"` (default) or `"nearest"` (no bias,
     /// same widths).
     pub prefilter_rounding: Rounding,
+    /// G: fraction bits of x kept in the registers' operand (default: all F); fewer
+    /// narrow every register by F − G bits.
+    pub register_frac_bits: Option<u32>,
+    /// What the register file is built of: `"flops"` (default) or `"clock_gated"`.
+    pub register_file: RegisterFile,
     /// W: register width in bits; default: what the whole timing window needs (safe with
     /// any background); `"auto"`: what the scene's code range needs.
     pub width: Option<Choice<u32>>,
@@ -100,6 +105,8 @@ impl Default for PixelConfig {
             shift: 5,
             frac_bits: crate::DEFAULT_FRAC_BITS,
             prefilter_rounding: Rounding::Floor,
+            register_frac_bits: None,
+            register_file: RegisterFile::Flops,
             width: None,
             frame_pulses: None,
             rom_depth: None,
@@ -230,6 +237,16 @@ impl PixelConfig {
                 "\"floor\" (or leave it out)",
             ));
         }
+        if mode == Mode::Haar
+            && let Some(g) = self.register_frac_bits
+        {
+            return Err(PixelError::invalid(
+                "register_frac_bits",
+                g,
+                "Haar mode has no prefilter fraction: it accumulates the held depth itself",
+                "leave it out",
+            ));
+        }
         let mut params = PixelParams {
             mode,
             bins,
@@ -244,6 +261,8 @@ impl PixelConfig {
             frame_pulses,
             rom_depth,
             prefilter_rounding: self.prefilter_rounding,
+            register_frac_bits: self.register_frac_bits,
+            register_file: self.register_file,
         };
         // Everything but the width first, so the sizing below sees valid parameters.
         params.validate()?;

@@ -43,7 +43,7 @@ pub use datapath::Datapath;
 pub use directed::{DirectedOptions, Program, directed_program};
 pub use error::PixelError;
 pub use fault::Fault;
-pub use params::{Mode, PixelParams, Rounding};
+pub use params::{Mode, PixelParams, RegisterFile, Rounding};
 pub use readout::{Readout, ReadoutCollector};
 pub use schedule::{Operation, Schedule};
 pub use sequencer::Sequencer;

@@ -58,6 +58,37 @@ impl Rounding {
     }
 }
 
+/// What the register file is built of (`[pixel] register_file`, docs/pixel-contract.md
+/// "Register file"). Every kind updates a register at the same clock edge, so the models
+/// and the vectors are the same for all of them; only the RTL and its area differ.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum RegisterFile {
+    /// Flops with a write-enable multiplexer per bit. The committed default.
+    #[default]
+    Flops,
+    /// Flops without the multiplexer, each register's clock gated by its write enable
+    /// (one clock-gating cell per register: the liberty's integrated clock gate, or a
+    /// latch and an AND gate where it has none).
+    ClockGated,
+}
+
+impl RegisterFile {
+    /// The default: left out of the configuration hash.
+    pub fn is_flops(&self) -> bool {
+        *self == RegisterFile::Flops
+    }
+}
+
+impl std::fmt::Display for RegisterFile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            RegisterFile::Flops => "flops",
+            RegisterFile::ClockGated => "clock_gated",
+        })
+    }
+}
+
 impl std::fmt::Display for Rounding {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
@@ -115,6 +146,13 @@ pub struct PixelParams {
     /// How the prefilter's shift rounds (Fourier; floor by default).
     #[serde(default, skip_serializing_if = "Rounding::is_floor")]
     pub prefilter_rounding: Rounding,
+    /// G: fraction bits of x kept in the operand added to the registers (Fourier; `None`
+    /// = F, the whole filter state). The operand is x >>> (F − G).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub register_frac_bits: Option<u32>,
+    /// What the register file is built of (flops by default).
+    #[serde(default, skip_serializing_if = "RegisterFile::is_flops")]
+    pub register_file: RegisterFile,
 }
 
 impl Default for PixelParams {
@@ -144,6 +182,8 @@ impl PixelParams {
             frame_pulses,
             rom_depth,
             prefilter_rounding: Rounding::Floor,
+            register_frac_bits: None,
+            register_file: RegisterFile::Flops,
         }
     }
 
@@ -176,9 +216,26 @@ impl PixelParams {
         }
     }
 
-    /// Width of the operand added to the registers: T+1+F (Fourier x) or T+1 (Haar held).
-    pub fn operand_bits(&self) -> u32 {
+    /// G: fraction bits of the operand added to the registers, F unless
+    /// `register_frac_bits` keeps fewer (0 in Haar mode).
+    pub fn register_frac_bits(&self) -> u32 {
+        match self.mode {
+            Mode::Fourier => self
+                .register_frac_bits
+                .map_or(self.frac_bits, |g| g.min(self.frac_bits)),
+            Mode::Haar => 0,
+        }
+    }
+
+    /// Width of the prefilter state x: T+1+F (Fourier) or T+1 (Haar, no prefilter).
+    pub fn prefilter_bits(&self) -> u32 {
         self.tdc_bits + 1 + self.effective_frac_bits()
+    }
+
+    /// Width of the operand added to the registers: T+1+G (Fourier x >>> (F − G)) or T+1
+    /// (Haar held).
+    pub fn operand_bits(&self) -> u32 {
+        self.tdc_bits + 1 + self.register_frac_bits()
     }
 
     /// Width of the `rd_index` output: ceil(log2(R + 2)) (indices 0..R, R = status word).
@@ -251,6 +308,19 @@ impl PixelParams {
                         self.frac_bits,
                         format!("the prefilter fraction bits must be 0..={MAX_FRAC_BITS}"),
                         MAX_FRAC_BITS,
+                    ));
+                }
+                if let Some(g) = self.register_frac_bits
+                    && g > self.frac_bits
+                {
+                    return Err(PixelError::invalid(
+                        "register_frac_bits",
+                        g,
+                        format!(
+                            "the registers keep at most the prefilter's F = {} fraction bits: 0..={}",
+                            self.frac_bits, self.frac_bits
+                        ),
+                        self.frac_bits,
                     ));
                 }
                 if self.rom_depth == 0 || self.rom_depth > MAX_ROM_DEPTH {

@@ -60,6 +60,8 @@ fn valid(haar: bool, draws: [u64; 10]) -> PixelParams {
         frame_pulses,
         rom_depth: small(draws[9] / 64, 1, 1 << 32) as usize,
         prefilter_rounding: Default::default(),
+        register_frac_bits: None,
+        register_file: Default::default(),
     }
 }
 

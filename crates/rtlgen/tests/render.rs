@@ -161,6 +161,8 @@ proptest! {
             } else {
                 tofprobe_pixel::Rounding::Floor
             },
+            register_frac_bits: None,
+            register_file: Default::default(),
         };
         p.adders = a.min(p.ops_per_pulse());
         p.cycles_per_pulse = p.slots() + ec;

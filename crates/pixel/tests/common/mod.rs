@@ -58,6 +58,8 @@ pub fn random_params(rng: &mut Rng) -> PixelParams {
         frame_pulses,
         rom_depth: 1 + rng.below(7) as usize,
         prefilter_rounding: tofprobe_pixel::Rounding::Floor,
+        register_frac_bits: None,
+        register_file: Default::default(),
     };
     let ops = p.ops_per_pulse() as u64;
     p.adders = 1 + rng.below(ops) as usize;
