@@ -46,6 +46,9 @@ pub struct FlowOptions {
     /// Sign off the co-simulated RTL: synthesis, gate-level replay of the same vectors and
     /// equivalence on every library found ([`crate::signoff`]); short frames only.
     pub signoff: bool,
+    /// The options study that chose this design (`flow --recommended`): the report opens
+    /// with the recommendation and carries the options table.
+    pub options: Option<crate::options::OptionsReport>,
 }
 
 /// What the flow found.
@@ -169,6 +172,13 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
         p.rom_depth,
         rom.note
     );
+    if let Some(o) = &a.options {
+        let _ = writeln!(
+            md,
+            "## Recommended architecture\n\nThis pixel is the option `{}` that `tofprobe size --options` recommends (target: tone error ≤ {} µm against the float DFT; the table below).\n",
+            o.recommendation.option, o.target_error_um
+        );
+    }
     let _ = writeln!(md, "## Verdict\n");
     let _ = writeln!(
         md,
@@ -236,6 +246,10 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
             " (sky130 skipped; --sky130 includes it)"
         }
     );
+    if let Some(o) = &a.options {
+        md += &crate::options::markdown::render(o);
+        md += "\n";
+    }
     let mut signoff = Vec::new();
     if a.signoff {
         let _ = writeln!(md, "## Sign-off\n");

@@ -6,6 +6,7 @@
 
 pub mod error;
 pub mod flow;
+pub mod options;
 pub mod paper;
 pub mod records;
 pub mod replay;

@@ -135,3 +135,30 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
     };
     Ok(build_with(&req, sky130.as_ref())?)
 }
+
+/// The options study's request for `design` on the libraries `tofprobe size` uses: the
+/// timing liberty, then sky130 tt when the timed PDK is found (not the area-only
+/// fallback: an option's verdict needs timing).
+pub fn options_request(
+    a: &SizeOptions,
+    only: Vec<String>,
+    seeds: Vec<u64>,
+    target_error_um: f64,
+) -> Result<crate::options::OptionsRequest, StudyError> {
+    let cache = cache_dir(a.cache.as_deref());
+    let mut liberties = vec![a.liberty.clone().unwrap_or_else(|| OSU018.into())];
+    if !a.no_sky130
+        && let Some(pdk) = tofprobe_report::pdk::Sky130Pdk::discover(a.sky130_pdk.as_deref())?
+    {
+        liberties.push(pdk.typical(&cache)?);
+    }
+    Ok(crate::options::OptionsRequest {
+        only,
+        seeds,
+        target_error_um,
+        liberties,
+        cache,
+        node_nm: a.node_nm,
+        pixel_sides_um: vec![(30.0, Some(6)), (40.0, Some(13))],
+    })
+}

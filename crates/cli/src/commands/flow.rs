@@ -40,6 +40,20 @@ pub struct FlowArgs {
     /// OUT/signoff. Short frames only (≤ 100,000 cycles, e.g. --frame-pulses 64 --frames 2).
     #[arg(long)]
     pub signoff: bool,
+    /// Build the pixel `tofprobe size --options` recommends for this scene instead of the
+    /// configuration as written: the architecture options are measured first (accuracy
+    /// over seeds, synthesis and timing on osu018 and the sky130 PDK when found; minutes
+    /// cold, seconds cached), the recommended option's `[pixel]` keys are applied, and the
+    /// report carries the options table.
+    #[arg(long)]
+    pub recommended: bool,
+    /// With --recommended: the largest tone error (µm, against the float DFT) accepted.
+    #[arg(long, requires = "recommended", default_value_t = tofprobe_study::options::DEFAULT_TARGET_ERROR_UM)]
+    pub target_error_um: f64,
+    /// With --recommended: choose among these options only (repeatable; names as in
+    /// `tofprobe size --options`; the baseline is always a candidate).
+    #[arg(long = "option", value_name = "NAME", requires = "recommended")]
+    pub only: Vec<String>,
 }
 
 /// Runs `tofprobe flow`.
@@ -47,7 +61,37 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
     if a.frames == 0 || a.frames > 100 {
         return Err(CliError::option("frames", a.frames.to_string(), "1..=100"));
     }
-    let design = tofprobe_design::load(a.config.as_deref())?;
+    let mut design = tofprobe_design::load(a.config.as_deref())?;
+    let options = if a.recommended {
+        let size = tofprobe_study::sizing::SizeOptions {
+            liberty: None,
+            no_sky130: false,
+            sky130_pdk: None,
+            node_nm: 40.0,
+            sweep_bins: None,
+            sweep_widths: None,
+            cache: None,
+        };
+        let req = tofprobe_study::sizing::options_request(
+            &size,
+            a.only.clone(),
+            tofprobe_study::options::DEFAULT_SEEDS.to_vec(),
+            a.target_error_um,
+        )?;
+        let report = tofprobe_study::options::run(&design, &req)?;
+        design = tofprobe_study::options::recommended_design(&design, &report)?;
+        println!(
+            "recommended: {} ({:.0} µm² on {}, tone error {:.3} µm ≤ {} µm)",
+            report.recommendation.option,
+            report.recommendation.total_area_um2,
+            report.recommendation.library,
+            report.recommendation.tone_error_um,
+            report.recommendation.target_error_um
+        );
+        Some(report)
+    } else {
+        None
+    };
     let o = run_flow(
         &design,
         &FlowOptions {
@@ -58,6 +102,7 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
             no_size: a.no_size,
             sky130: a.sky130,
             signoff: a.signoff,
+            options,
         },
     )?;
     println!(

@@ -6,9 +6,13 @@
 use std::path::PathBuf;
 
 use clap::Args;
+use serde::Serialize;
 use tofprobe_report::report::SizeReport;
 use tofprobe_report::{markdown, plot};
-use tofprobe_study::sizing::{SizeOptions, size_report};
+use tofprobe_study::options::OptionsReport;
+use tofprobe_study::options::markdown::render as options_markdown;
+use tofprobe_study::options::plot::front_svg;
+use tofprobe_study::sizing::{SizeOptions, options_request, size_report};
 
 use crate::error::CliError;
 
@@ -48,12 +52,59 @@ pub struct SizeArgs {
     /// Synthesis cache (default: $TOFPROBE_CACHE or ~/.cache/tofprobe, then /synth).
     #[arg(long)]
     pub cache: Option<PathBuf>,
+    /// Also measure the architecture options (docs/architecture-options.md): each
+    /// option's tone error against the float DFT on the scene over several seeds, its area,
+    /// timing and bins per pitch on osu018 and sky130, the Pareto front and the
+    /// recommended pixel. Minutes cold (two syntheses per option and library), seconds
+    /// from the synthesis cache.
+    #[arg(long)]
+    pub options: bool,
+    /// With --options: measure only this option (repeatable; the baseline is always kept).
+    #[arg(long = "option", value_name = "NAME", requires = "options")]
+    pub only: Vec<String>,
+    /// With --options: the largest tone error (µm, worst seed, against the float DFT) the
+    /// recommendation accepts.
+    #[arg(long, requires = "options", default_value_t = tofprobe_study::options::DEFAULT_TARGET_ERROR_UM)]
+    pub target_error_um: f64,
+    /// With --options: seeds of the accuracy measurement (comma-separated).
+    #[arg(long, value_delimiter = ',', requires = "options", default_values_t = tofprobe_study::options::DEFAULT_SEEDS)]
+    pub seeds: Vec<u64>,
+}
+
+/// The report with the options study when asked (JSON: the size report's keys, plus
+/// `options`).
+#[derive(Debug, Serialize)]
+pub struct FullReport {
+    /// The size report.
+    #[serde(flatten)]
+    pub size: SizeReport,
+    /// The architecture options, with `--options`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub options: Option<OptionsReport>,
 }
 
 /// Builds the report for the arguments (no printing).
-pub fn report(a: &SizeArgs) -> Result<SizeReport, CliError> {
+pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
     let design = tofprobe_design::load(a.config.as_deref())?;
-    let options = SizeOptions {
+    let options = size_options(a);
+    let req = if a.options {
+        let req = options_request(&options, a.only.clone(), a.seeds.clone(), a.target_error_um)?;
+        // Before minutes of synthesis: an unknown option or target fails now.
+        tofprobe_study::options::check(&design, &req)?;
+        Some(req)
+    } else {
+        None
+    };
+    let size = size_report(&design, &options)?;
+    let options = match &req {
+        Some(req) => Some(tofprobe_study::options::run(&design, req)?),
+        None => None,
+    };
+    Ok(FullReport { size, options })
+}
+
+fn size_options(a: &SizeArgs) -> SizeOptions {
+    SizeOptions {
         liberty: a.liberty.clone(),
         no_sky130: a.no_sky130,
         sky130_pdk: a.sky130_pdk.clone(),
@@ -61,32 +112,48 @@ pub fn report(a: &SizeArgs) -> Result<SizeReport, CliError> {
         sweep_bins: a.sweep_bins.clone(),
         sweep_widths: a.sweep_widths.clone(),
         cache: a.cache.clone(),
-    };
-    Ok(size_report(&design, &options)?)
+    }
 }
 
 /// Runs `tofprobe size`.
 pub fn run(a: &SizeArgs) -> Result<(), CliError> {
-    let r = report(a)?;
+    let full = report(a)?;
+    let r = &full.size;
+    let md = || {
+        let mut m = markdown::render(r);
+        if let Some(o) = &full.options {
+            m += &options_markdown(o);
+        }
+        m
+    };
     if let Some(dir) = &a.out {
         // One set, whole or absent (tofprobe_io::OutputSet), the JSON report last.
-        let json = serde_json::to_vec_pretty(&r)?;
-        let svg = plot::sweep_svg(&r)
+        let json = serde_json::to_vec_pretty(&full)?;
+        let svg = plot::sweep_svg(r)
             .map_err(|reason| CliError::output(dir.join("size-sweep.svg"), reason))?;
+        let front = match &full.options {
+            Some(o) => Some(front_svg(&dir.join("size-options.svg"), o)?),
+            None => None,
+        };
         let io = |e: std::io::Error| CliError::output(dir.clone(), e.to_string());
         let mut set = tofprobe_io::OutputSet::begin(dir).map_err(io)?;
         set.add("size-sweep.svg", svg.as_bytes()).map_err(io)?;
-        set.add("size-report.md", markdown::render(&r).as_bytes())
-            .map_err(io)?;
+        if let Some(front) = &front {
+            set.add("size-options.svg", front.as_bytes()).map_err(io)?;
+        }
+        set.add("size-report.md", md().as_bytes()).map_err(io)?;
         set.add("size-report.json", &json).map_err(io)?;
         set.commit(Some("size-report.json")).map_err(io)?;
     }
     if a.json {
-        println!("{}", serde_json::to_string(&r)?);
+        println!("{}", serde_json::to_string(&full)?);
     } else if a.out.is_none() {
-        print!("{}", markdown::render(&r));
+        print!("{}", md());
     } else {
-        println!("{}", markdown::summary(&r));
+        println!("{}", markdown::summary(r));
+        if let Some(o) = &full.options {
+            println!("recommended: {}", o.recommendation.option);
+        }
     }
     Ok(())
 }
