@@ -34,12 +34,13 @@ pub fn fractions(frac_bits: u32) -> Vec<u32> {
     g
 }
 
-/// The catalogue for a pixel with `frac_bits` = F: the configuration as it is, each
-/// option alone (nearest rounding, each G, the clock-gated register file), and the
+/// The catalogue for a pixel with `frac_bits` = F and P operations per pulse: the
+/// configuration as it is, each option alone (nearest rounding, each G, the clock-gated
+/// register file, one adder shared by I and Q at C = P cycles per pulse), and the
 /// combinations a recommendation would pick from (nearest rounding, a clock-gated file and
 /// each G). The prefilter rounding costs one adder of fixed area, so every combination
 /// carries it.
-pub fn catalogue(frac_bits: u32) -> Vec<ArchOption> {
+pub fn catalogue(frac_bits: u32, ops_per_pulse: usize) -> Vec<ArchOption> {
     let nearest = ("pixel.prefilter_rounding", "\"nearest\"".to_string());
     let gated = ("pixel.register_file", "\"clock_gated\"".to_string());
     let g_key = |g: u32| ("pixel.register_frac_bits", g.to_string());
@@ -52,6 +53,13 @@ pub fn catalogue(frac_bits: u32) -> Vec<ArchOption> {
         v.push(opt(&format!("G={g}"), &[g_key(g)]));
     }
     v.push(opt("clock-gated", std::slice::from_ref(&gated)));
+    v.push(opt(
+        "one-adder",
+        &[
+            ("pixel.adders", "1".to_string()),
+            ("pixel.cycles_per_pulse", ops_per_pulse.to_string()),
+        ],
+    ));
     v.push(opt(
         "nearest+clock-gated",
         &[nearest.clone(), gated.clone()],
@@ -90,7 +98,7 @@ mod tests {
 
     #[test]
     fn catalogue_of_the_default_f() {
-        let c = catalogue(8);
+        let c = catalogue(8, 32);
         let names: Vec<&str> = c.iter().map(|o| o.name.as_str()).collect();
         assert_eq!(
             names,
@@ -101,6 +109,7 @@ mod tests {
                 "G=2",
                 "G=0",
                 "clock-gated",
+                "one-adder",
                 "nearest+clock-gated",
                 "nearest+G=4+clock-gated",
                 "nearest+G=2+clock-gated",
@@ -110,13 +119,19 @@ mod tests {
         // F = 1 leaves only G = 0; F = 0 no G at all.
         assert_eq!(fractions(1), [0]);
         assert!(fractions(0).is_empty());
+        // One adder serves all P = 32 operations: C = 32 cycles per pulse.
+        let one = c.iter().find(|o| o.name == "one-adder").unwrap();
+        assert!(
+            one.overrides
+                .contains(&("pixel.cycles_per_pulse".into(), "32".into()))
+        );
     }
 
     #[test]
     fn select_names_the_unknown_option() {
-        let e = select(catalogue(8), &["G=3".into()]).unwrap_err();
+        let e = select(catalogue(8, 32), &["G=3".into()]).unwrap_err();
         assert!(e.contains("\"G=3\"") && e.contains("G=2"), "{e}");
-        let s = select(catalogue(8), &["G=2".into(), "baseline".into()]).unwrap();
+        let s = select(catalogue(8, 32), &["G=2".into(), "baseline".into()]).unwrap();
         assert_eq!(s.len(), 2);
     }
 }

@@ -121,8 +121,11 @@ pub fn check(design: &ResolvedDesign, req: &OptionsRequest) -> Result<Vec<ArchOp
     if !only.is_empty() && !only.iter().any(|o| o == "baseline") {
         only.insert(0, "baseline".into());
     }
-    catalogue::select(catalogue::catalogue(design.pixel.frac_bits), &only)
-        .map_err(|e| StudyError::option("option", only.join(","), &e))
+    catalogue::select(
+        catalogue::catalogue(design.pixel.frac_bits, design.pixel.ops_per_pulse()),
+        &only,
+    )
+    .map_err(|e| StudyError::option("option", only.join(","), &e))
 }
 
 /// Runs the study on `design`.
