@@ -87,6 +87,13 @@ module {{ name }} (
     wire [{{ xw }}:0] x_sum = {x[{{ xw - 1 }}], x} + step;
     /* verilator lint_on UNUSEDSIGNAL */
     wire [{{ xw - 1 }}:0] x_new = x_sum[{{ xw - 1 }}:0];
+{%- if gs > 0 %}
+    // Register operand (contract "register_frac_bits"): op = x_new >>> (F-G), G = {{ g }} of
+    // the F = {{ f }} fraction bits. An arithmetic (floor) shift of a value that is then
+    // sign-extended is the slice above its {{ gs }} low bits, so op and every register are
+    // {{ gs }} bits narrower than x; the prefilter itself keeps all F bits.
+    wire [{{ opw - 1 }}:0] op_new = x_new[{{ xw - 1 }}:{{ gs }}];
+{%- endif %}
 {%- else %}
 
     // ---- 1NN hold value of this pulse (Haar uses it directly as the operand) ----
@@ -289,7 +296,7 @@ module {{ name }} (
 {%- if fourier %}
                 if (primed) begin
                     x <= x_new;
-                    op <= x_new;
+                    op <= {% if gs > 0 %}op_new{% else %}x_new{% endif %};
                     acc_en <= 1'b1;
                 end else begin
                     acc_en <= 1'b0;

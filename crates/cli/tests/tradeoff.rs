@@ -106,6 +106,7 @@ fn tradeoff_knob_table_and_skips_on_a_tiny_frame() {
         c.args(["tradeoff", cfg.to_str().unwrap(), "--knobs", "--skips"])
             .args(["--sweep-pulses", &n.to_string(), "--reps", "1"])
             .args(["--knob", "W", "--knob", "F", "--knob", "S", "--knob", "B"])
+            .args(["--knob", "G"])
             .arg("--out")
             .arg(&dir);
         c.arg("--json");
@@ -122,7 +123,7 @@ fn tradeoff_knob_table_and_skips_on_a_tiny_frame() {
     assert_eq!(sweep["pulses"].as_u64(), Some(n));
     assert_eq!(sweep["shortened"].as_bool(), Some(false));
     let rows = sweep["rows"].as_array().expect("rows");
-    for knob in ["baseline", "W", "F", "S", "B"] {
+    for knob in ["baseline", "W", "F", "S", "B", "G"] {
         assert!(
             rows.iter().any(|r| r["knob"] == knob),
             "knob {knob} missing"
@@ -187,6 +188,16 @@ fn tradeoff_knob_table_and_skips_on_a_tiny_frame() {
             - row("F", "4")["width_bits"].as_u64().expect("W"),
         8
     );
+    // G: the registers keep G of the baseline's F = 8 fraction bits, so the default width
+    // (sized for the whole window) shrinks by F − G bits.
+    let base_w = base["width_bits"].as_u64().expect("W");
+    for (g, drop) in [("0", 8), ("2", 6), ("4", 4)] {
+        assert_eq!(
+            row("G", g)["width_bits"].as_u64(),
+            Some(base_w - drop),
+            "G = {g}"
+        );
+    }
     assert_eq!(
         num(row("S", "3"), "float_dft_amplitude_um"),
         num(base, "float_dft_amplitude_um")

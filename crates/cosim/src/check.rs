@@ -1,7 +1,7 @@
 //! `--rtl DIR` is exact and its ROM is checked, not trusted: before any simulation, the
 //! parameters the RTL was rendered for (its header's `Configuration hash:` line: mode,
-//! B, U, A, C, T, Z, S, F, W, N, L and the hash) are compared with the configuration being
-//! run, and the probe ROM image in DIR is read strictly (every line, depth = L), checked
+//! B, U, A, C, T, Z, S, F, W, N, L, G where it differs from F, and the hash) are compared
+//! with the configuration being run, and the probe ROM image in DIR is read strictly (every line, depth = L), checked
 //! against its manifest's content hash and compared, entry by entry, with the
 //! configuration's ROM. A difference is an error naming the parameter (or the ROM entry
 //! and its bits) and both values: it never reaches the simulator as an ordinary FAIL.
@@ -28,7 +28,7 @@ pub fn header_params(p: &PixelParams) -> Vec<(String, String)> {
         Mode::Fourier => "Fourier",
         Mode::Haar => "Haar",
     };
-    [
+    let mut list: Vec<(&str, String)> = vec![
         ("mode", mode.to_string()),
         ("B", p.bins.to_string()),
         ("U", p.haar_scales.to_string()),
@@ -41,10 +41,12 @@ pub fn header_params(p: &PixelParams) -> Vec<(String, String)> {
         ("W", p.width.to_string()),
         ("N", p.frame_pulses.to_string()),
         ("L", p.rom_depth.to_string()),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_string(), v))
-    .collect()
+    ];
+    // G is in the header only when the registers keep fewer fraction bits than x.
+    if p.register_frac_bits() < p.effective_frac_bits() {
+        list.push(("G", p.register_frac_bits().to_string()));
+    }
+    list.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
 }
 
 /// What each header key means, for the error message.
@@ -59,6 +61,7 @@ fn meaning(key: &str) -> &'static str {
         "Z" => "zoom (window start code)",
         "S" => "prefilter shift",
         "F" => "prefilter fraction bits",
+        "G" => "register fraction bits",
         "W" => "register width",
         "N" => "pulses per frame",
         "L" => "probe ROM depth",

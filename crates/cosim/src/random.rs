@@ -1,6 +1,6 @@
 //! Random valid configurations for `tofprobe cosim --random N --seed S` and the CI's eight:
 //! both modes and every knob of the pixel (B or U, A, C, T, Z, S, F, W, N, L, the prefilter's
-//! rounding), the register
+//! rounding, the registers' fraction bits G), the register
 //! width either drawn or `auto` (sized by `tofprobe_pixel::sizing::required_width` for the
 //! whole TDC range and the sign probe ROM actually replayed), and sometimes sized for a
 //! frame 16× shorter than the one simulated, so the wrapping accumulators really wrap.
@@ -80,6 +80,13 @@ pub fn random_case(seed: u64, i: u64) -> RandomCase {
     // Drawn last, so every other field of a case is what it was before the knob existed.
     if p.mode == Mode::Fourier && rng.next_u64() & 1 == 1 {
         p.prefilter_rounding = Rounding::Nearest;
+    }
+    // G after that, for the same reason: the registers keep G of the F fraction bits
+    // (0..=F, G = F left out). The width stays the one drawn or sized for G = F, which
+    // still holds one operand and leaves the registers F − G bits of headroom.
+    if p.mode == Mode::Fourier && p.frac_bits > 0 {
+        let g = pick(&mut rng, 0, u64::from(p.frac_bits)) as u32;
+        p.register_frac_bits = (g < p.frac_bits).then_some(g);
     }
     RandomCase {
         params: p,

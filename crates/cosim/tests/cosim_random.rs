@@ -1,5 +1,5 @@
 //! Eight random valid configurations (`tofprobe_cosim::random`, the stream `tofprobe cosim
-//! --random N --seed S` draws from: both modes, B or U, A, C, T, Z, S, F, N, L, and the
+//! --random N --seed S` draws from: both modes, B or U, A, C, T, Z, S, F, G, N, L, and the
 //! width drawn, `auto`, or sized for a 16× shorter frame so it wraps) pass in Verilator,
 //! bit for bit, over 2 frames, each under its own random-reset seed.
 
@@ -36,6 +36,15 @@ fn eight_random_configurations_pass_in_verilator() {
             "{r:?} not drawn"
         );
     }
+    // ... and registers keeping fewer fraction bits than x (G < F: the operand is a slice of
+    // x, a slice the RTL got wrong fails at the first primed pulse:
+    // crates/cli/tests/register_frac_bits.rs).
+    assert!(
+        cases
+            .iter()
+            .any(|c| c.params.register_frac_bits() < c.params.effective_frac_bits()),
+        "no case with G < F drawn"
+    );
     for w in [
         WidthChoice::Drawn,
         WidthChoice::Auto,

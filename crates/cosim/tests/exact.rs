@@ -98,6 +98,16 @@ fn every_rendered_parameter_is_checked_before_simulating() {
             "0",
             "3",
         ),
+        // G is in the header only when below F: the committed RTL has none.
+        (
+            PixelParams {
+                register_frac_bits: Some(2),
+                ..short_params()
+            },
+            "G (register fraction bits)",
+            "(absent)",
+            "2",
+        ),
     ];
     for (p, param, rtl, config) in cases {
         match run(&p, &dir, None, "params") {

@@ -44,39 +44,70 @@ fn config_k1() -> PixelParams {
 }
 
 /// The configuration each fault is tested on: the pipeline's missing forward shows only
-/// when K = 1 with back-to-back pulses; every other fault on the K = 2 pixel.
-fn config_for(fault: Fault) -> PixelParams {
-    match fault {
+/// when K = 1 with back-to-back pulses; every other fault on the K = 2 pixel. `g`: the
+/// registers' fraction bits (`None`: all F), W one bit above their operand as in
+/// [`config`].
+fn config_for(fault: Fault, g: Option<u32>) -> PixelParams {
+    let mut p = match fault {
         Fault::MissingForward => config_k1(),
         _ => config(),
-    }
+    };
+    p.register_frac_bits = g;
+    p.width = p.operand_bits() + 1;
+    p
 }
 
 #[test]
 fn every_fault_is_caught_at_its_first_cycle() {
+    faults_caught(&Fault::ALL, None, "");
+}
+
+/// The faults of the operand's path with registers keeping G = 0 of the F = 2 fraction
+/// bits (the operand a slice of x, W one bit above it): the prefilter's logical shift and
+/// the hold change x, the narrow register wraps the narrower sums; each still shows at the
+/// cycle the model predicts. (The sign, schedule and forward faults do not see G.)
+#[test]
+fn operand_faults_are_caught_at_their_first_cycle_with_g_below_f() {
+    faults_caught(
+        &[
+            Fault::LogicalShift,
+            Fault::HoldInvalid,
+            Fault::NarrowRegister,
+        ],
+        Some(0),
+        "-g0",
+    );
+}
+
+fn faults_caught(faults: &[Fault], g: Option<u32>, tag: &str) {
     if !tools_or_skip(&["verilator"], "every_fault_is_caught_at_its_first_cycle") {
         return;
     }
     let seed = 7;
     let frames = 2;
     // The clean RTL passes on the same stimulus (so a failure below is the fault's).
-    for (name, p) in [("clean", config()), ("clean-k1", config_k1())] {
+    let k1 = faults.contains(&Fault::MissingForward);
+    let clean = [
+        ("clean", config_for(Fault::SignFlip, g)),
+        ("clean-k1", config_for(Fault::MissingForward, g)),
+    ];
+    for (name, p) in clean.into_iter().filter(|(n, _)| k1 || *n == "clean") {
         p.validate().expect("valid configuration");
-        let mut o = CosimOptions::new(work_dir(&format!("mutation-{name}")));
+        let mut o = CosimOptions::new(work_dir(&format!("mutation-{name}{tag}")));
         o.frames = frames;
         o.seed = seed;
         let clean = cosim(&p, &o).expect("clean co-simulation runs");
         assert!(clean.pass, "{name}: clean RTL must pass: {:?}", clean.first);
     }
     assert_eq!(config_k1().slots(), 1);
-    for fault in Fault::ALL {
-        let p = config_for(fault);
+    for &fault in faults {
+        let p = config_for(fault, g);
         let stim = random_stimulus(&p, frames * p.frame_pulses, seed);
         let rom = sign_probe_rom(&p);
         let (cycle, pulse) = first_divergence(&p, &stim, &rom, frames, fault)
             .expect("the model accepts the configuration")
             .unwrap_or_else(|| panic!("{fault:?} never shows on this stimulus"));
-        let mut o = CosimOptions::new(work_dir(&format!("mutation-{}", fault.name())));
+        let mut o = CosimOptions::new(work_dir(&format!("mutation-{}{tag}", fault.name())));
         o.frames = frames;
         o.seed = seed;
         o.mutation = Some(fault);

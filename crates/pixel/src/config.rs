@@ -283,7 +283,7 @@ impl PixelConfig {
                 "width",
                 needed,
                 format!(
-                    "codes {lo}..={hi} over N = {frame_pulses} pulses need {needed}-bit registers, more than {MAX_WIDTH}; shorten the frame, lower frac_bits or zoom/centre the window"
+                    "codes {lo}..={hi} over N = {frame_pulses} pulses need {needed}-bit registers, more than {MAX_WIDTH}; shorten the frame, lower frac_bits or register_frac_bits, or zoom/centre the window"
                 ),
                 MAX_WIDTH,
             ));

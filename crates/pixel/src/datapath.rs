@@ -22,7 +22,10 @@ pub struct Datapath {
     shift: u32,
     rounding: Rounding,
     frac_bits: u32,
-    operand_bits: u32,
+    /// F − G: the fraction bits of x the register operand drops (x >>> (F − G)).
+    register_shift: u32,
+    /// T+1+F: the width of x.
+    prefilter_bits: u32,
     width: u32,
     primed: bool,
     held: i64,
@@ -39,7 +42,8 @@ impl Datapath {
             shift: p.shift,
             rounding: p.prefilter_rounding,
             frac_bits: p.effective_frac_bits(),
-            operand_bits: p.operand_bits(),
+            register_shift: p.effective_frac_bits() - p.register_frac_bits(),
+            prefilter_bits: p.prefilter_bits(),
             width: p.width,
             primed: false,
             held: 0,
@@ -88,12 +92,13 @@ impl Datapath {
     }
 
     /// [`Datapath::pulse`] of a Fourier pixel (prefiltered operand), without the mode
-    /// test: the transaction model's streaming loop calls it directly.
+    /// test: the transaction model's streaming loop calls it directly. The operand is
+    /// x >>> (F − G): the registers keep G of the prefilter's F fraction bits (floor).
     #[inline(always)]
     pub fn fourier_pulse(&mut self, valid: bool, tdc: u32, fault: Option<Fault>) -> Option<i64> {
         let op = if self.primed {
             self.x = self.prefilter(fault);
-            Some(self.x)
+            Some(self.x >> self.register_shift)
         } else {
             None
         };
@@ -122,8 +127,8 @@ impl Datapath {
     #[cold]
     fn logical_shift_prefilter(&self) -> i64 {
         let diff = (self.held << self.frac_bits) - self.x;
-        let step = ((diff as u64 & mask(self.operand_bits + 1)) >> self.shift) as i64;
-        sign_extend((self.x + step) as u64, self.operand_bits)
+        let step = ((diff as u64 & mask(self.prefilter_bits + 1)) >> self.shift) as i64;
+        sign_extend((self.x + step) as u64, self.prefilter_bits)
     }
 
     /// One register operation: Y ± op (`add`: +), wrapped to W bits.

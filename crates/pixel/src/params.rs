@@ -413,7 +413,11 @@ impl PixelParams {
                 self.width,
                 format!(
                     "W must hold one operand (T+1{} = {ob} bits) and be at most {MAX_WIDTH}",
-                    if self.mode == Mode::Fourier { "+F" } else { "" }
+                    match self.mode {
+                        Mode::Fourier if self.register_frac_bits() < self.frac_bits => "+G",
+                        Mode::Fourier => "+F",
+                        Mode::Haar => "",
+                    }
                 ),
                 self.width.clamp(ob, MAX_WIDTH),
             ));

@@ -70,11 +70,13 @@ pub fn rom_sign_counts(rom: &RomImage, registers: usize, n: u64) -> Vec<(u64, u6
         .collect()
 }
 
-/// The operand range [a, b] (in operand LSBs: codes·2^F in Fourier mode) for depths whose
-/// TDC codes lie in [`code_min`, `code_max`], after the zoom Z. The prefilter output always
-/// lies between held values, so the held range bounds it.
+/// The operand range [a, b] (in operand LSBs: codes·2^G in Fourier mode, G = the register
+/// fraction bits) for depths whose TDC codes lie in [`code_min`, `code_max`], after the zoom
+/// Z. The prefilter output always lies between held values, so the held range bounds it;
+/// the operand x >>> (F − G) floors x, and a held value times 2^F floors to itself times
+/// 2^G, so the bound holds at G bits too.
 pub fn operand_range(params: &PixelParams, code_min: u32, code_max: u32) -> (i64, i64) {
-    let f = params.effective_frac_bits();
+    let f = params.register_frac_bits();
     let z = i64::from(params.zoom);
     (
         (i64::from(code_min) - z) << f,

@@ -61,7 +61,8 @@ pub fn spectrum_from_readout(
             format!("2 per ROM bin ({} bins)", rom.bins.len()),
         ));
     }
-    let scale = f64::from(1u32 << params.frac_bits);
+    // Register words count operands of G fraction bits (x >>> (F − G)).
+    let scale = f64::from(1u32 << params.register_frac_bits());
     let sums: Vec<(f64, f64)> = readout
         .words
         .chunks(2)

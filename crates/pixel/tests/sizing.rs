@@ -97,6 +97,31 @@ fn sized_width_holds_the_worst_case_and_one_less_wraps() {
     }
 }
 
+/// The same with F = 4 fraction bits of which the registers keep G = 1: at S = 0 x is the
+/// held code times 2^4 = 160, the operand 160 >>> 3 = 20 (10·2^G), so Y = 999·20 = 19980:
+/// W = 16 holds it and W = 15 (max 16383) wraps it to 19980 − 32768. Keeping all F bits
+/// (G = 4: operands of 160) needs F − G = 3 bits more, 19.
+#[test]
+fn sizing_follows_the_register_fraction_bits() {
+    let mut p = PixelParams::fourier_default(16, 1000, 1);
+    p.bins = 1;
+    p.adders = 2;
+    p.tdc_bits = 4;
+    p.frac_bits = 4;
+    p.shift = 0;
+    assert_eq!(required_width(&p, 0, 10, None), 19);
+    p.register_frac_bits = Some(1);
+    assert_eq!(required_width(&p, 0, 10, None), 16);
+    let stimuli = vec![Some(10u32); 1000];
+    let rom = RomImage::from_fn(1, 2, |_, _| true);
+    for (w, expected) in [(16, 19980), (15, 19980 - 32768)] {
+        p.width = w;
+        let mut tm = TransactionModel::new(&p).unwrap();
+        let r = tm.run_frames(&stimuli, Some(&rom)).unwrap();
+        assert_eq!(r[0].words, vec![expected; 2], "W = {w}");
+    }
+}
+
 fn default_context() -> PixelContext {
     // The default scene's sensor: 400 ps window / 5 ps LSB = 80 codes, 10 MHz, 1 s.
     PixelContext {

@@ -104,8 +104,9 @@ pub fn scene_codes(
     )
 }
 
-/// Largest operand magnitude for codes in [lo, hi] after the zoom Z and the prefilter's
-/// 2^F: max(|lo − Z|, |hi − Z|)·2^F.
+/// Largest operand magnitude for codes in [lo, hi] after the zoom Z, with `frac_bits`
+/// fraction bits in the registers' operand (G, F unless `register_frac_bits` keeps fewer):
+/// max(|lo − Z|, |hi − Z|)·2^G.
 pub fn operand_from_codes(lo: u32, hi: u32, zoom: u32, frac_bits: u32) -> u64 {
     let m = u64::from(lo.abs_diff(zoom).max(hi.abs_diff(zoom)));
     m << frac_bits.min(32)

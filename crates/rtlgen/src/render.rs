@@ -67,7 +67,7 @@ pub(crate) fn header(p: &PixelParams, template: &str, o: &RenderOptions) -> Stri
     let mut h = format!(
         "{HEADER_MARK} {} from template templates/{template}.\n\
          // DO NOT EDIT: regenerate with `{}`.\n\
-         // Configuration hash: {} ({:?}, B={}, U={}, A={}, C={}, T={}, Z={}, S={}, F={}, W={}, N={}, L={}).\n",
+         // Configuration hash: {} ({:?}, B={}, U={}, A={}, C={}, T={}, Z={}, S={}, F={}, W={}, N={}, L={}{}).\n",
         env!("CARGO_PKG_VERSION"),
         // The command comes from the command line: one safe line, whatever it holds.
         tofprobe_io::text::sanitize(&o.command),
@@ -83,7 +83,13 @@ pub(crate) fn header(p: &PixelParams, template: &str, o: &RenderOptions) -> Stri
         p.frac_bits,
         p.width,
         p.frame_pulses,
-        p.rom_depth
+        p.rom_depth,
+        // G only when the registers keep fewer fraction bits than x: the default's header
+        // (and the committed RTL) reads as before.
+        match p.register_frac_bits() {
+            g if g < p.effective_frac_bits() => format!(", G={g}"),
+            _ => String::new(),
+        }
     );
     if !o.rom_note.is_empty() {
         // One comment line whatever the note holds: no line break can end the comment.
@@ -163,10 +169,16 @@ struct PixelT<'a> {
     nlw: u32,
     ib: u32,
     sw: u32,
+    /// Width of the prefilter state x: T+1+F.
     xw: u32,
+    /// F − G: the low bits of x the register operand drops (0: op = x, the default's text).
+    gs: u32,
+    /// G: fraction bits of the register operand.
+    g: u32,
     /// Prefilter rounding constant added before the shift: 2^(S−1) for `nearest`, 0
     /// (no adder rendered) for `floor`.
     round_half: u64,
+    /// Width of the register operand: T+1+G.
     opw: u32,
     /// The operand sign-extended to W bits.
     opx: String,
@@ -365,7 +377,9 @@ pub fn render(p: &PixelParams, rom: &[u64], o: &RenderOptions) -> Result<Vec<Rtl
         nlw: p.haar_scales + 1,
         ib,
         sw,
-        xw: p.operand_bits(),
+        xw: p.prefilter_bits(),
+        gs: p.effective_frac_bits() - p.register_frac_bits(),
+        g: p.register_frac_bits(),
         round_half: p.prefilter_rounding.half(p.shift) as u64,
         opw: p.operand_bits(),
         opx: if p.width > p.operand_bits() {

@@ -1,5 +1,5 @@
 //! Quality gates on the rendered RTL of several configurations (both modes, odd widths,
-//! A > 1, case-table and `$readmemh` ROMs): `verilator --lint-only -Wall` with zero
+//! A > 1, registers keeping G < F fraction bits, case-table and `$readmemh` ROMs): `verilator --lint-only -Wall` with zero
 //! warnings (the top with either sequencer), yosys `synth -top` with no latches and no warnings beyond the register file's
 //! memory-to-registers note, and `iverilog -g2005` compiles. Skipped loudly only when a tool
 //! is missing (CI installs them).
@@ -51,6 +51,8 @@ fn configs() -> Vec<(&'static str, PixelParams)> {
                 zoom: 7,
                 shift: 0,
                 frac_bits: 3,
+                // The registers keep 1 of x's 3 fraction bits: op is a slice of x.
+                register_frac_bits: Some(1),
                 width: 17,
                 frame_pulses: 1000,
                 rom_depth: 37,

@@ -150,7 +150,7 @@ proptest! {
     fn every_valid_configuration_renders(
         haar in any::<bool>(), b in 1usize..40, u in 0u32..6, a in 1usize..9, ec in 0usize..4,
         t in 1u32..17, s in 0u32..16, f in 0u32..17, ew in 0u32..30, ln in 6u32..24, l in 1usize..300,
-        nearest in any::<bool>(),
+        nearest in any::<bool>(), g in 0u32..17,
     ) {
         let mut p = PixelParams {
             mode: if haar { Mode::Haar } else { Mode::Fourier }, bins: b, haar_scales: u,
@@ -161,7 +161,7 @@ proptest! {
             } else {
                 tofprobe_pixel::Rounding::Floor
             },
-            register_frac_bits: None,
+            register_frac_bits: (!haar && g < f).then_some(g),
             register_file: Default::default(),
         };
         p.adders = a.min(p.ops_per_pulse());
@@ -174,5 +174,14 @@ proptest! {
         prop_assert_eq!(writes, p.registers());
         let adders = pixel.matches("    reg add_").count();
         prop_assert_eq!(adders, p.adders);
+        // G < F: the operand is the top T+1+G bits of the T+1+F-bit x, nothing else.
+        let slice = format!(
+            "wire [{}:0] op_new = x_new[{}:{}];",
+            p.operand_bits() - 1,
+            p.prefilter_bits() - 1,
+            p.frac_bits.saturating_sub(g),
+        );
+        prop_assert_eq!(pixel.contains(&slice), !haar && g < f, "{}", slice);
+        prop_assert_eq!(pixel.contains("op_new"), !haar && g < f);
     }
 }

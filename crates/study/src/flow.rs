@@ -199,13 +199,19 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
     let _ = writeln!(md, "## Register widths\n");
     let _ = writeln!(
         md,
-        "{} registers x W = {} bits ({} bits of readout per frame); operand {} bits (T = {}, F = {}); TDC LSB {:.4} mm.\n",
+        "{} registers x W = {} bits ({} bits of readout per frame); operand {} bits (T = {}, F = {}{}); TDC LSB {:.4} mm.\n",
         p.registers(),
         p.width,
         p.registers() as u64 * u64::from(p.width),
         p.operand_bits(),
         p.tdc_bits,
         p.effective_frac_bits(),
+        // G only where it differs from F, so the default's report reads as before.
+        if p.register_frac_bits() < p.effective_frac_bits() {
+            format!(", G = {}", p.register_frac_bits())
+        } else {
+            String::new()
+        },
         lsb_mm
     );
     let mut headline = String::new();
@@ -325,7 +331,7 @@ pub fn normalised_bins(
     rom: &tofprobe_dsp::sd::ProbeRom,
     lsb_mm: f64,
 ) -> Vec<BinReading> {
-    let frac = f64::from(1u32 << p.effective_frac_bits());
+    let frac = f64::from(1u32 << p.register_frac_bits());
     let sums: Vec<(f64, f64)> = (0..p.bins.min(rom.bins.len()))
         .map(|k| {
             (
@@ -367,7 +373,7 @@ fn spectrum(
     lsb_mm: f64,
 ) -> String {
     let Some(rom) = sd else {
-        let frac = f64::from(1u32 << p.effective_frac_bits());
+        let frac = f64::from(1u32 << p.register_frac_bits());
         let _ = writeln!(
             md,
             "## Spectrum at the bins (frame 0, sign-of-cosine probes: unnormalised)\n"
@@ -497,13 +503,29 @@ mod tests {
                 *s += if rom.image.bit(i, r) { x } else { -x };
             }
         }
-        let words: Vec<u64> = sums
-            .iter()
-            .map(|s| ((s * 256.0).round() as i64 as u64) & ((1u64 << 40) - 1))
-            .collect();
+        let words = |frac: f64| -> Vec<u64> {
+            sums.iter()
+                .map(|s| ((s * frac).round() as i64 as u64) & ((1u64 << 40) - 1))
+                .collect()
+        };
         let lsb_mm = 0.75;
-        let b = normalised_bins(&p, &words, &rom, lsb_mm);
+        let b = normalised_bins(&p, &words(256.0), &rom, lsb_mm);
         let want_um = amp * lsb_mm * 1000.0;
+        // Registers keeping G = 2 of the F = 8 fraction bits count in 2^−2 codes: the same
+        // sums as G-bit words must read back the same amplitude (the word rounding, 2^−2/N
+        // relative, is far below the 1 %), and read as F-bit words they would be 2^6 low.
+        let pg = PixelParams {
+            register_frac_bits: Some(2),
+            ..p.clone()
+        };
+        let bg = normalised_bins(&pg, &words(4.0), &rom, lsb_mm);
+        assert!(
+            (bg[0].amplitude_um / want_um - 1.0).abs() < 0.01,
+            "G = 2: {} vs {want_um}",
+            bg[0].amplitude_um
+        );
+        let wrong = normalised_bins(&p, &words(4.0), &rom, lsb_mm);
+        assert!(wrong[0].amplitude_um < 0.02 * want_um);
         assert!(
             (b[0].amplitude_um / want_um - 1.0).abs() < 0.01,
             "{} vs {want_um}",

@@ -53,7 +53,8 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
         ));
     }
 
-    // Memory: the codes the scene can produce, relative to the zoom, times 2^F.
+    // Memory: the codes the scene can produce, relative to the zoom, times 2^G (the
+    // registers' fraction bits).
     let s = design.sensor();
     let scene = Scene::new(&design.document.scene)?;
     let (lo, hi) = scene_codes(
@@ -67,7 +68,7 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
     let mem_in = MemoryInput {
         registers: pixel.registers() as u64,
         frame_pulses: pixel.frame_pulses,
-        max_abs_operand: operand_from_codes(lo, hi, pixel.zoom, pixel.effective_frac_bits()),
+        max_abs_operand: operand_from_codes(lo, hi, pixel.zoom, pixel.register_frac_bits()),
         configured_width: Some(pixel.width),
         convention: WidthConvention::TwosComplement,
         timestamp_bits: s.tdc_bits(),
@@ -96,7 +97,7 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
         return Err(StudyError::option(
             "sweep-widths",
             x,
-            &format!("{min_w}..=63 (W ≥ T+1+F)"),
+            &format!("{min_w}..=63 (W ≥ T+1+G, one register operand)"),
         ));
     }
     // The timed PDK when one is found (explicit, environment, search path); only without

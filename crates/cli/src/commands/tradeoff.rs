@@ -33,11 +33,13 @@ pub struct TradeoffArgs {
     /// verilator).
     #[arg(long)]
     verilator: bool,
-    /// Also sweep the bit-true knobs (W, F, S, ROM mode and L, ΣΔ order, OSR, B).
+    /// Also sweep the bit-true knobs (W, F, G, prefilter rounding, S, ROM mode and L, ΣΔ
+    /// order, OSR, B).
     #[arg(long)]
     knobs: bool,
-    /// With `--knobs`: sweep only this knob (repeatable; names as in the table: W, F, S,
-    /// "ROM mode, L", "ΣΔ order", OSR, B); the baseline row is always run.
+    /// With `--knobs`: sweep only this knob (repeatable; names as in the table: W, F, G,
+    /// "prefilter rounding", S, "ROM mode, L", "ΣΔ order", OSR, B); the baseline row is
+    /// always run.
     #[arg(long = "knob", value_name = "NAME")]
     only_knobs: Vec<String>,
     /// Also time the skipped stages (background, hold, selected bins, full DFT).

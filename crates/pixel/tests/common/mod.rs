@@ -28,7 +28,7 @@ impl Rng {
 }
 
 /// Random valid parameters: both modes, A > 1, K < C, odd and tight widths (so the
-/// registers wrap often), any zoom, short frames.
+/// registers wrap often), any zoom, short frames, registers keeping G ≤ F fraction bits.
 pub fn random_params(rng: &mut Rng) -> PixelParams {
     let haar = rng.chance(35);
     let tdc_bits = 1 + rng.below(8) as u32;
@@ -64,6 +64,11 @@ pub fn random_params(rng: &mut Rng) -> PixelParams {
     let ops = p.ops_per_pulse() as u64;
     p.adders = 1 + rng.below(ops) as usize;
     p.cycles_per_pulse = p.slots() + rng.below(3) as usize;
+    // Registers keeping G ≤ F fraction bits (G = F half the time), before the width so
+    // the tight widths are tight for the narrower operand too.
+    if mode == Mode::Fourier && rng.chance(50) {
+        p.register_frac_bits = Some(rng.below(u64::from(p.frac_bits) + 1) as u32);
+    }
     p.width = p.operand_bits() + rng.below(10) as u32;
     p.validate()
         .expect("random parameters are valid by construction");

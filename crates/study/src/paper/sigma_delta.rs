@@ -189,7 +189,7 @@ pub fn bit_true(
         tm.run(chunk, Some(&setup.rom.image), (i as u64) << 16)?;
     }
     let words = tm.readout().words;
-    let scale = f64::from(1u32 << p.frac_bits);
+    let scale = f64::from(1u32 << p.register_frac_bits());
     let bit_sums: Vec<(f64, f64)> = words
         .chunks(2)
         .map(|c| (c[0] as f64 / scale, c[1] as f64 / scale))

@@ -1,8 +1,8 @@
-//! The knobs within the bit-true level (issue 8, point 1): a list of settings — W, F, S,
-//! the ROM's depth L and mode, the ΣΔ order and OSR, the number of bins — each applied to
-//! the scene as TOML overrides ([`super::overrides`]), then measured like the levels table:
-//! the bit-true model's wall time per simulated second (median of several runs) and its
-//! amplitude and noise floor against the float full DFT on the same bins, the scene's true
+//! The knobs within the bit-true level (issue 8, point 1): a list of settings — W, F, the
+//! registers' fraction bits G, the prefilter's rounding, S, the ROM's depth L and mode, the
+//! ΣΔ order and OSR, the number of bins — each applied to the scene as TOML overrides
+//! ([`super::overrides`]), then measured like the levels table: the bit-true model's wall
+//! time per simulated second (median of several runs) and its amplitude and noise floor against the float full DFT on the same bins, the scene's true
 //! amplitude and the closed-form noise floor. A setting the configuration checks refuse
 //! (e.g. W below the sizing) is a row with the refusal, not a failed command.
 
@@ -62,6 +62,16 @@ pub const DEFAULT_SWEEP: &[KnobSetting] = &[
     k("F", "0", &[("pixel.frac_bits", "0")]),
     k("F", "4", &[("pixel.frac_bits", "4")]),
     k("F", "12", &[("pixel.frac_bits", "12")]),
+    // The registers' fraction bits G ≤ F (issue 16): each bit dropped narrows every
+    // register by one; what it costs in amplitude is this row against the baseline.
+    k("G", "0", &[("pixel.register_frac_bits", "0")]),
+    k("G", "2", &[("pixel.register_frac_bits", "2")]),
+    k("G", "4", &[("pixel.register_frac_bits", "4")]),
+    k(
+        "prefilter rounding",
+        "nearest",
+        &[("pixel.prefilter_rounding", "\"nearest\"")],
+    ),
     k("S", "3", &[("pixel.shift", "3")]),
     k("S", "7", &[("pixel.shift", "7")]),
     k(
