@@ -38,6 +38,15 @@ pub struct SizeOptions {
     pub cache: Option<PathBuf>,
 }
 
+/// The B sweep: `a.sweep_bins`, or 4, 8 and the configured B (those ≤ B).
+fn sweep_bins_of(a: &SizeOptions, bins: u64) -> Vec<u64> {
+    a.sweep_bins.clone().unwrap_or_else(|| {
+        let mut v: Vec<u64> = [4, 8, bins].into_iter().filter(|&b| b <= bins).collect();
+        v.dedup();
+        v
+    })
+}
+
 fn cache_dir(arg: Option<&Path>) -> PathBuf {
     tofprobe_report::fsutil::synth_cache_dir(arg)
 }
@@ -79,11 +88,7 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
     let bins = pixel.bins as u64;
     let w = pixel.width;
     let min_w = pixel.operand_bits();
-    let sweep_bins = a.sweep_bins.clone().unwrap_or_else(|| {
-        let mut v: Vec<u64> = [4, 8, bins].into_iter().filter(|&b| b <= bins).collect();
-        v.dedup();
-        v
-    });
+    let sweep_bins = sweep_bins_of(a, bins);
     let sweep_widths = a.sweep_widths.clone().unwrap_or_else(|| {
         [w.saturating_sub(8), w, w + 8]
             .into_iter()
@@ -139,8 +144,10 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
 
 /// The options study's request for `design` on the libraries `tofprobe size` uses: the
 /// timing liberty, then sky130 tt when the timed PDK is found (not the area-only
-/// fallback: an option's verdict needs timing).
+/// fallback: an option's verdict needs timing), and the same B sweep, so the baseline's
+/// bins per pitch are the size report's.
 pub fn options_request(
+    design: &ResolvedDesign,
     a: &SizeOptions,
     only: Vec<String>,
     seeds: Vec<u64>,
@@ -154,6 +161,7 @@ pub fn options_request(
         liberties.push(pdk.typical(&cache)?);
     }
     Ok(crate::options::OptionsRequest {
+        sweep_bins: sweep_bins_of(a, design.pixel.bins as u64),
         only,
         seeds,
         target_error_um,

@@ -73,6 +73,7 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
             cache: None,
         };
         let req = tofprobe_study::sizing::options_request(
+            &design,
             &size,
             a.only.clone(),
             tofprobe_study::options::DEFAULT_SEEDS.to_vec(),

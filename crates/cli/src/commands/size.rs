@@ -88,7 +88,13 @@ pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
     let design = tofprobe_design::load(a.config.as_deref())?;
     let options = size_options(a);
     let req = if a.options {
-        let req = options_request(&options, a.only.clone(), a.seeds.clone(), a.target_error_um)?;
+        let req = options_request(
+            &design,
+            &options,
+            a.only.clone(),
+            a.seeds.clone(),
+            a.target_error_um,
+        )?;
         // Before minutes of synthesis: an unknown option or target fails now.
         tofprobe_study::options::check(&design, &req)?;
         Some(req)

@@ -58,19 +58,39 @@ pub struct AreaRequest<'a> {
     pub node_nm: f64,
     /// Pitches (µm) with the paper's estimate where it gave one.
     pub pixel_sides_um: &'a [(f64, Option<u64>)],
+    /// The B sweep of the area model (see [`model_bins`]).
+    pub sweep_bins: &'a [u64],
 }
 
-/// Synthesises `pixel` (at its B and at ⌈B/4⌉) on `req.lib` and answers for it.
+/// The B points of the area model: the configured B and the sweep's points up to it; when
+/// that is one point, ⌈B/4⌉ beside it (none for B = 1).
+pub fn model_bins(bins: u64, sweep: &[u64]) -> Vec<u64> {
+    let mut v: Vec<u64> = sweep
+        .iter()
+        .copied()
+        .filter(|&b| b >= 1 && b <= bins)
+        .collect();
+    v.push(bins);
+    if v.iter().all(|&b| b == bins) {
+        v.push(bins.div_ceil(4).max(1));
+    }
+    v.sort_unstable();
+    v.dedup();
+    v.reverse();
+    v
+}
+
+/// Synthesises `pixel` at the [`model_bins`] on `req.lib` and answers for it.
 pub fn measure(pixel: &PixelParams, req: &AreaRequest<'_>) -> Result<LibraryArea, StudyError> {
     let provider = GeneratedPixel {
         base: pixel.clone(),
     };
     let b = pixel.bins as u64;
-    let small = b.div_ceil(4).max(1).min(b.saturating_sub(1)).max(1);
-    let mut points = vec![(b, pixel.width)];
-    if small != b {
-        points.push((small, pixel.width));
-    }
+    // The configured B first: `results[0]` is the pixel itself.
+    let points: Vec<(u64, u32)> = model_bins(b, req.sweep_bins)
+        .into_iter()
+        .map(|x| (x, pixel.width))
+        .collect();
     let clock_mhz = pixel.cycles_per_pulse as f64 * req.laser_rate_hz / 1e6;
     let results = analyse_points(
         &provider,
@@ -137,6 +157,15 @@ pub fn measure(pixel: &PixelParams, req: &AreaRequest<'_>) -> Result<LibraryArea
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn model_points() {
+        assert_eq!(model_bins(16, &[4, 8, 16]), [16, 8, 4]);
+        assert_eq!(model_bins(16, &[16]), [16, 4]);
+        assert_eq!(model_bins(2, &[2]), [2, 1]);
+        assert_eq!(model_bins(1, &[1]), [1]);
+        assert_eq!(model_bins(8, &[32, 4]), [8, 4]);
+    }
 
     #[test]
     fn nodes_from_library_names() {

@@ -47,6 +47,9 @@ pub struct OptionsRequest {
     pub cache: PathBuf,
     /// Node of the bins-per-pitch answer (nm).
     pub node_nm: f64,
+    /// The B points of each option's area model, besides the configured B (the size
+    /// report's B sweep; ⌈B/4⌉ is added when that leaves one point).
+    pub sweep_bins: Vec<u64>,
     /// Pitches (µm) with the paper's estimate.
     pub pixel_sides_um: Vec<(f64, Option<u64>)>,
 }
@@ -152,6 +155,7 @@ pub fn run(design: &ResolvedDesign, req: &OptionsRequest) -> Result<OptionsRepor
                     laser_rate_hz: laser,
                     node_nm: req.node_nm,
                     pixel_sides_um: &req.pixel_sides_um,
+                    sweep_bins: &req.sweep_bins,
                 },
             )
             .map_err(|e| {
@@ -187,7 +191,10 @@ pub fn run(design: &ResolvedDesign, req: &OptionsRequest) -> Result<OptionsRepor
             "Tone error: |bit-true − float full DFT| tone amplitude at the scene's tone bin, on the scene's frame of {} pulses, over seeds {:?} of the photon source (the table shows the mean and the range; the recommendation holds the worst seed against the target).",
             design.pixel.frame_pulses, req.seeds
         ),
-        "Area: yosys and ABC's delay-driven mapping for C·f_laser (as `tofprobe size`), cell area only; the model A(B) = fixed + per_bin·B is the line through the configured B and ⌈B/4⌉ at the option's W.".into(),
+        format!(
+            "Area: yosys and ABC's delay-driven mapping for C·f_laser (as `tofprobe size`), cell area only; the model A(B) = fixed + per_bin·B is the least-squares line through B = {:?} (the size report's B sweep) at the option's W, so the baseline's bins per pitch are the size report's.",
+            area::model_bins(design.pixel.bins as u64, &req.sweep_bins)
+        ),
         format!(
             "Bins per pitch: area scaled from the library's node by (node / library node)² to {} nm (osu018 180 nm, sky130 130 nm; first-order, an upper bound), the whole pitch given to the digital logic as the paper's estimate did.",
             req.node_nm
