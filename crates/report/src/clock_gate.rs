@@ -262,6 +262,32 @@ impl ClockGateCells {
     }
 }
 
+/// Behavioural Verilog of the `latch_posedge` integrated clock gates of `lib` that
+/// `netlist` instantiates (the latch open while the clock is low, ANDed with the clock: what
+/// `clock_gating_integrated_cell : "latch_posedge"` declares), for the equivalence check;
+/// `None` when it uses none.
+pub fn icg_models(lib: &Liberty, netlist: &str) -> Option<String> {
+    let mut s = String::new();
+    for (name, c) in &lib.cells {
+        if c.clock_gating.as_deref() != Some("latch_posedge") || !netlist.contains(name.as_str()) {
+            continue;
+        }
+        let role = |r| {
+            c.pins
+                .iter()
+                .find(|p| p.clock_gate_role == r)
+                .map(|p| &p.name)
+        };
+        let (Some(ck), Some(en), Some(out)) = (role("clock"), role("enable"), role("out")) else {
+            continue;
+        };
+        s += &format!(
+            "module {name} ({ck}, {en}, {out});\n    input {ck};\n    input {en};\n    output {out};\n    reg m;\n    always @({ck} or {en}) if (!{ck}) m = {en};\n    assign {out} = {ck} & m;\nendmodule\n"
+        );
+    }
+    (!s.is_empty()).then_some(s)
+}
+
 /// Whether `verilog` defines the clock-gate module of pixel `top` (`<top>_clock_gate`):
 /// the pixel was rendered with `register_file = "clock_gated"`.
 pub fn module_in(verilog: &str, top: &str) -> Option<String> {
@@ -382,6 +408,16 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(msg.contains("AND gate"), "{msg}");
+    }
+
+    #[test]
+    fn icg_models_cover_the_used_integrated_cells() {
+        let l = lib(&[BASE, LATCH, ICG]);
+        let m = icg_models(&l, "CG_2 cg_0.icg (.CLK(clk));").unwrap();
+        assert!(m.contains("module CG_2 (CLK, GATE, GCLK);"), "{m}");
+        assert!(m.contains("if (!CLK) m = GATE;") && m.contains("assign GCLK = CLK & m;"));
+        assert!(!m.contains("module CG_1 "), "unused cell modelled: {m}");
+        assert_eq!(icg_models(&l, "DFF f (.CK(clk));"), None);
     }
 
     #[test]
