@@ -36,7 +36,15 @@ module {{ name }} (
     reg [{{ ln }}:0] pcount;
 {%- endif %}
     // The register file. Public so the co-simulation harness can observe its writes.
+{%- if clock_gated %}
+    // One clock per register: written from R processes, one element each (mem2reg: yosys
+    // keeps each register as flops on its own gated clock).
+    /* verilator lint_off MULTIDRIVEN */
+    (* mem2reg *) reg [{{ w - 1 }}:0] y [0:{{ r - 1 }}] /*verilator public_flat_rd*/;
+    /* verilator lint_on MULTIDRIVEN */
+{%- else %}
     reg [{{ w - 1 }}:0] y [0:{{ r - 1 }}] /*verilator public_flat_rd*/;
+{%- endif %}
 
     // ---- accept rule ----
     wire free = !rd_active && (!active || slot == {{ sw }}'d{{ k - 1 }});
@@ -202,6 +210,26 @@ module {{ name }} (
 {%- else %}
     wire [{{ r - 1 }}:0] we /*verilator public_flat_rd*/ = we_c;
 {%- endif %}
+{%- if clock_gated %}
+    // Clock-gated register file (pixel.register_file = "clock_gated", docs/pixel-contract.md
+    // "Register file"): register r is clocked by clk gated by its write enable (and by
+    // reset, so reset still clears it), so its flops have no enable multiplexer. The gate
+    // passes the same clk edge at which a flop with enable would load: same update.
+{%- for g in regs %}
+    wire gclk_{{ g.r }};
+    {{ name }}_clock_gate cg_{{ g.r }} (.clk(clk), .en(we[{{ g.r }}] | rst), .gclk(gclk_{{ g.r }}));
+    always @(posedge gclk_{{ g.r }}) begin
+        if (rst) y[{{ g.r }}] <= {{ w }}'d0;
+{%- if mutation == "schedule_late" %}
+        else y[{{ g.r }}] <= wlate_{{ g.r }};
+{%- else if mutation == "narrow_register" && g.r == 0 %}
+        else y[0] <= {wval_0[{{ w - 2 }}], wval_0[{{ w - 2 }}:0]};
+{%- else %}
+        else y[{{ g.r }}] <= wval_{{ g.r }};
+{%- endif %}
+    end
+{%- endfor %}
+{%- else %}
     always @(posedge clk) begin
         if (rst) begin
 {%- for g in regs %}
@@ -219,6 +247,7 @@ module {{ name }} (
 {%- endfor %}
         end
     end
+{%- endif %}
 
     // ---- readout multiplexer ----
     reg [{{ w - 1 }}:0] rd_mux;
@@ -333,3 +362,27 @@ module {{ name }} (
         end
     end
 endmodule
+{%- if clock_gated %}
+
+// The clock gate of one register (pixel.register_file = "clock_gated"): the standard
+// latch-based integrated clock gate. The latch is transparent while clk is low, so the
+// enable settled during a cycle is held through the high phase and gclk carries exactly
+// the rising edges of clk the enable selects, without glitches. This body is for
+// simulation; synthesis maps the module onto the liberty's clock-gating cell (or its
+// latch and an AND gate). A second module in the file: named after the pixel, not the file.
+/* verilator lint_off DECLFILENAME */
+module {{ name }}_clock_gate (
+    input  wire clk,
+    input  wire en,
+    output wire gclk
+);
+    reg en_l;
+    /* verilator lint_off LATCH */
+    always @(clk or en) begin
+        if (!clk) en_l = en;
+    end
+    /* verilator lint_on LATCH */
+    assign gclk = clk & en_l;
+endmodule
+/* verilator lint_on DECLFILENAME */
+{%- endif %}

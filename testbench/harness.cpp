@@ -220,6 +220,9 @@ int main(int argc, char** argv) {
     uint64_t window_from_cycle = 0;
     uint64_t ro_word = 0;
     std::vector<std::pair<uint32_t, uint64_t>> act_w, exp_w;
+    // Register values after the previous edge of the checked window (for unenabled writes).
+    std::vector<uint64_t> y_held(R, 0);
+    bool held_known = false;
     auto close_window = [&](uint64_t end_cycle) {
         if (window < digests.size()) {
             if (digests[window].first != dcount || digests[window].second != dh) {
@@ -337,6 +340,19 @@ int main(int argc, char** argv) {
                     break;
                 }
             }
+            // A register whose write enable is low keeps its value: a write `we` does not
+            // show (a clock gate on the wrong enable, a gate that glitches) fails at its edge.
+            if (held_known && !top->rst) {
+                for (uint64_t r = 0; r < R; ++r) {
+                    const uint64_t v = static_cast<uint64_t>(PIX_Y[r]);
+                    if (((we >> r) & 1) == 0 && v != y_held[r]) {
+                        report(c, "y[" + std::to_string(r) + "]", "none", hexs(v));
+                        break;
+                    }
+                }
+            }
+            for (uint64_t r = 0; r < R; ++r) y_held[r] = static_cast<uint64_t>(PIX_Y[r]);
+            held_known = true;
         }
     }
     close_window(cycles);

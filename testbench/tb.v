@@ -43,6 +43,9 @@ module tb;
     reg exp_ready, exp_valid;
     reg [11:0] exp_index;
     reg reported;
+    // Register values after the previous edge (a register without its enable keeps them).
+    reg [63:0] y_held [0:TB_REGISTERS-1];
+    reg held_known;
 
     task mismatch;
         input [8*24-1:0] signal;
@@ -74,6 +77,7 @@ module tb;
         end
         clk = 0; rst = 1; valid = 0; tdc = 0;
         np = 0; tp = 0; pp = 0; ro_i = 0; mism = 0; frames = 0; cur = 0; reported = 0;
+        held_known = 0;
         exp_ready = 0; exp_valid = 0; exp_index = 0; exp_data = 0;
         for (c = 0; c < TB_CYCLES; c = c + 1) begin
             rst = (c < 2);
@@ -129,6 +133,15 @@ module tb;
                 mismatch("write", trace[tp][79:64], trace[tp][63:0], 64'hffffffffffffffff);
                 tp = tp + 1;
             end
+            // A register whose write enable is low keeps its value: a write `we` does not
+            // show (a clock gate on the wrong enable, a gate that glitches) fails at its edge.
+            for (r = 0; r < TB_REGISTERS; r = r + 1) begin
+                v = dut.u_pixel.y[r];
+                if (held_known && !rst && !we[r] && v !== y_held[r])
+                    mismatch("write", r, 64'hffffffffffffffff, v);
+                y_held[r] = v;
+            end
+            held_known = 1;
             clk = 0;
         end
         if (ro_i != TB_READOUT_WORDS) mismatch("readout_words", -1, TB_READOUT_WORDS, ro_i);

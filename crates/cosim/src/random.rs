@@ -1,13 +1,13 @@
 //! Random valid configurations for `tofprobe cosim --random N --seed S` and the CI's eight:
 //! both modes and every knob of the pixel (B or U, A, C, T, Z, S, F, W, N, L, the prefilter's
-//! rounding, the registers' fraction bits G), the register
+//! rounding, the registers' fraction bits G, the register file's kind), the register
 //! width either drawn or `auto` (sized by `tofprobe_pixel::sizing::required_width` for the
 //! whole TDC range and the sign probe ROM actually replayed), and sometimes sized for a
 //! frame 16× shorter than the one simulated, so the wrapping accumulators really wrap.
 //! Kept small (R ≤ 15, N ≤ 64) because every configuration is a Verilator build.
 
 use tofprobe_pixel::sizing::required_width;
-use tofprobe_pixel::{Mode, PixelParams, Rounding};
+use tofprobe_pixel::{Mode, PixelParams, RegisterFile, Rounding};
 use tofprobe_rtlgen::golden::rom_image;
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 use tofprobe_scene::SplitMix64;
@@ -87,6 +87,11 @@ pub fn random_case(seed: u64, i: u64) -> RandomCase {
     if p.mode == Mode::Fourier && p.frac_bits > 0 {
         let g = pick(&mut rng, 0, u64::from(p.frac_bits)) as u32;
         p.register_frac_bits = (g < p.frac_bits).then_some(g);
+    }
+    // The register file's kind is drawn after every other field (keep it last when a knob
+    // is added), so the cases drawn before it existed keep their other fields.
+    if rng.next_u64() & 1 == 1 {
+        p.register_file = RegisterFile::ClockGated;
     }
     RandomCase {
         params: p,

@@ -102,7 +102,7 @@ pub fn analyse_point(
     // (the name rules are fixed per crate version and W, both in the file name).
     let split_path = synthesis
         .netlist_json
-        .with_file_name(format!("split-v1-w{width}.json"));
+        .with_file_name(format!("split-v2-w{width}.json"));
     let split = cached_json(&split_path, || {
         split_area(
             &synthesis.netlist_json,
@@ -117,7 +117,7 @@ pub fn analyse_point(
             .parent()
             .map(Path::to_path_buf)
             .unwrap_or_else(|| cache.to_path_buf());
-        let cached = dir.join("timing-v2.json");
+        let cached = dir.join("timing-v3.json");
         Some(cached_json(&cached, || {
             time_netlist(
                 &lib.path,

@@ -126,7 +126,7 @@ pub fn time_cached(
         .parent()
         .map(Path::to_path_buf)
         .unwrap_or_default();
-    let cached = dir.join(format!("timing-v2-{corner}.json"));
+    let cached = dir.join(format!("timing-v3-{corner}.json"));
     cached_json(&cached, || {
         time_netlist(
             liberty,

@@ -12,6 +12,15 @@
 //! Both sides get `async2sync; dffunmap` (plain flops: `equiv_simple -seq` steps
 //! through `$dff` only). `equiv_induct` then proves every register and output pair by
 //! one-step induction: all pairs equal at t ⇒ equal at t + 1.
+//!
+//! A clock-gated register file (`register_file = "clock_gated"`): yosys's model steps every
+//! flop at every step whatever drives its clock, so a gated register's update is proven
+//! through the signals its clock is made of, which both sides name alike and `equiv_make`
+//! pairs: each gate's latched enable (`cg_<r>.en_l`, a latch on both sides) and gated clock
+//! (`gclk_<r>`), besides the flops' D logic. A gate on the wrong enable fails as an
+//! unproven `cg_<r>.en_l` pair. An integrated clock-gating cell is read as the behaviour its
+//! liberty declares (`latch_posedge`: latch open while CLK is low, AND with CLK), so the
+//! proof covers the netlist's wiring of the cells, not the cells' transistors.
 
 use crate::error::{ReportError, Result};
 use crate::fsutil::write_atomic;
@@ -50,6 +59,13 @@ pub struct Equivalence {
 
 /// The yosys script comparing `spec`.
 pub fn equiv_script(spec: &EquivSpec) -> String {
+    equiv_script_with(spec, None)
+}
+
+/// [`equiv_script`], with `icg_models` (a clock-gated register file's integrated clock
+/// gates as Verilog, [`crate::clock_gate::icg_models`]) read on the gate side: a liberty
+/// describes those cells by a `statetable`, which `read_liberty` cannot turn into logic.
+pub fn equiv_script_with(spec: &EquivSpec, icg_models: Option<&Path>) -> String {
     let top = &spec.top;
     let mut s = String::new();
     for src in &spec.rtl {
@@ -71,7 +87,7 @@ pub fn equiv_script(spec: &EquivSpec) -> String {
          rename {top} gold\n\
          design -stash gold\n\
          read_liberty -ignore_miss_func {lib}\n\
-         read_verilog {net}\n\
+         {icg}read_verilog {net}\n\
          prep -top {top} -flatten\n\
          async2sync\n\
          dffunmap\n\
@@ -86,6 +102,10 @@ pub fn equiv_script(spec: &EquivSpec) -> String {
          equiv_status -assert\n",
         lib = spec.liberty.display(),
         net = spec.netlist.display(),
+        icg = icg_models.map_or(String::new(), |m| format!(
+            "read_verilog -overwrite {}\n",
+            m.display()
+        )),
     );
     s
 }
@@ -132,9 +152,19 @@ pub fn check_equivalence(spec: &EquivSpec, work: &Path) -> Result<Equivalence> {
             path: spec.netlist.clone(),
         });
     }
-    crate::liberty::Liberty::load(&spec.liberty)?;
+    let lib = crate::liberty::Liberty::load(&spec.liberty)?;
+    let netlist = std::fs::read_to_string(&spec.netlist)
+        .map_err(|e| ReportError::io("reading", &spec.netlist, e))?;
+    let models = crate::clock_gate::icg_models(&lib, &netlist);
+    let models_path = work.join("icg_models.v");
+    if let Some(m) = &models {
+        write_atomic(&models_path, m.as_bytes())?;
+    }
     let script = work.join("equiv.ys");
-    write_atomic(&script, equiv_script(spec).as_bytes())?;
+    write_atomic(
+        &script,
+        equiv_script_with(spec, models.as_ref().map(|_| models_path.as_path())).as_bytes(),
+    )?;
     let log_path = work.join("equiv.log");
     let start = std::time::Instant::now();
     let out = Command::new(&yosys)

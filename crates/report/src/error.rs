@@ -29,6 +29,14 @@ pub enum ReportError {
         what: &'static str,
         why: &'static str,
     },
+    /// `register_file = "clock_gated"` on a liberty with no cells for a clock gate.
+    #[error(
+        "liberty {path} has no {missing}: `pixel.register_file = \"clock_gated\"` gates each register's clock with the liberty's integrated clock-gating cell or a latch and an AND gate; pass a liberty that has them (sky130_fd_sc_hd has `dlclkp`, osu018 a LATCH and AND2X1) or set `register_file = \"flops\"`"
+    )]
+    ClockGateCells {
+        path: PathBuf,
+        missing: &'static str,
+    },
     /// The synthesised netlist still contains generic cells the liberty could not map.
     #[error(
         "liberty {path} cannot implement {cells}: yosys left these generic cells unmapped; pass a liberty with those functions"

@@ -24,6 +24,25 @@ pub struct LibCell {
     pub inputs: u32,
     /// Marked `dont_use : true`: synthesis must not map onto it.
     pub dont_use: bool,
+    /// Its pins, in the liberty's order (what the clock-gate mapping needs to know).
+    pub pins: Vec<LibPin>,
+    /// `clock_gating_integrated_cell` (e.g. `latch_posedge`): an integrated clock gate.
+    pub clock_gating: Option<String>,
+    /// A `latch` group's `(enable, data_in)` expressions.
+    pub latch: Option<(String, String)>,
+}
+
+/// One pin of a liberty cell.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LibPin {
+    pub name: String,
+    /// `direction`: `input`, `output`, `internal`, ...
+    pub direction: String,
+    /// `function` of an output, as written (empty for none).
+    pub function: String,
+    /// The integrated clock gate's role: `clock`, `enable` or `out` (from
+    /// `clock_gate_clock_pin` / `clock_gate_enable_pin` / `clock_gate_out_pin`), else empty.
+    pub clock_gate_role: &'static str,
 }
 
 /// A parsed liberty file.
@@ -170,13 +189,27 @@ impl Liberty {
                         identity: false,
                         inputs: 0,
                         dont_use: false,
+                        pins: Vec::new(),
+                        clock_gating: None,
+                        latch: None,
                     },
                 );
+            }
+            "pin" if stack.len() == 2 => {
+                if let Some(c) = self.current_cell(stack) {
+                    c.pins.push(LibPin {
+                        name: arg.to_string(),
+                        ..LibPin::default()
+                    });
+                }
             }
             "ff" | "latch" | "statetable" => {
                 if let Some(c) = self.current_cell(stack) {
                     c.sequential = true;
                     c.flop |= kind == "ff";
+                    if kind == "latch" {
+                        c.latch = Some((String::new(), String::new()));
+                    }
                 }
             }
             "timing" if stack.iter().any(|(k, _)| k == "cell") => self.has_timing = true,
@@ -186,6 +219,35 @@ impl Liberty {
 
     fn attribute(&mut self, key: &str, value: &str, stack: &[(String, String)]) {
         let depth = stack.len();
+        let in_group = |kind: &str| depth == 3 && stack.last().is_some_and(|(k, _)| k == kind);
+        // What the clock-gate mapping reads: pin roles, functions, the latch's enable.
+        if in_group("pin")
+            && let Some(pin) = self.current_cell(stack).and_then(|c| c.pins.last_mut())
+        {
+            match key {
+                "direction" => pin.direction = value.to_string(),
+                "function" => pin.function = value.to_string(),
+                "clock_gate_clock_pin" if value == "true" => pin.clock_gate_role = "clock",
+                "clock_gate_enable_pin" if value == "true" => pin.clock_gate_role = "enable",
+                "clock_gate_out_pin" if value == "true" => pin.clock_gate_role = "out",
+                _ => {}
+            }
+        }
+        if in_group("latch")
+            && let Some((enable, data)) = self.current_cell(stack).and_then(|c| c.latch.as_mut())
+        {
+            match key {
+                "enable" => *enable = value.to_string(),
+                "data_in" => *data = value.to_string(),
+                _ => {}
+            }
+        }
+        if key == "clock_gating_integrated_cell"
+            && depth == 2
+            && let Some(c) = self.current_cell(stack)
+        {
+            c.clock_gating = Some(value.to_string());
+        }
         match key {
             "area" if depth == 2 => {
                 if let (Some(c), Ok(a)) = (self.current_cell(stack), value.parse::<f64>())

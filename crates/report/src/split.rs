@@ -17,6 +17,11 @@
 //!      registers share an adder);
 //!    - control otherwise (counters, readout mux, status).
 //!
+//! A clock-gated register file's gates (`cg_<r>.icg`, or its latch, inverter and AND) are
+//! charged to the register file and are not flops; the logic behind a gate feeds only its
+//! register's flops, so the enable decode lands in the register file as the enable
+//! multiplexer's does.
+//!
 //! The split is a structural attribution, not a layout: logic that serves two purposes is
 //! charged to the first class in the order above.
 
@@ -109,6 +114,16 @@ fn matches(base: &str, names: &[String]) -> bool {
     })
 }
 
+/// A cell of a clock-gated register file's gate: flattening names it `cg_<r>.<instance>`
+/// after the pixel's gate instance and the mapped module's cell (crate::clock_gate).
+fn is_clock_gate(cell: &str) -> bool {
+    cell.split_once('.').is_some_and(|(inst, leaf)| {
+        inst.strip_prefix(crate::clock_gate::INSTANCE_PREFIX)
+            .is_some_and(|r| !r.is_empty() && r.chars().all(|c| c.is_ascii_digit()))
+            && crate::clock_gate::INSTANCES.contains(&leaf)
+    })
+}
+
 fn bit_id(v: &serde_json::Value) -> Option<u64> {
     v.as_u64()
 }
@@ -157,18 +172,23 @@ pub fn split_area(
     struct Cell {
         area: f64,
         flop: bool,
+        /// A cell of a register's clock gate (charged to the register file, traversed like
+        /// logic: the enable logic behind it belongs to the register it clocks).
+        clock_gate: bool,
         inputs: Vec<u64>,
         outputs: Vec<u64>,
     }
     let mut cells = Vec::new();
     if let Some(cs) = module.get("cells").and_then(|c| c.as_object()) {
-        for c in cs.values() {
+        for (name, c) in cs {
             let ty = c.get("type").and_then(|t| t.as_str()).unwrap_or_default();
             let lc = lib.cells.get(ty);
             let dirs = c.get("port_directions").and_then(|d| d.as_object());
+            let clock_gate = is_clock_gate(name);
             let mut cell = Cell {
                 area: lc.map_or(0.0, |l| l.area),
-                flop: lc.is_some_and(|l| l.sequential),
+                flop: lc.is_some_and(|l| l.sequential) && !clock_gate,
+                clock_gate,
                 inputs: vec![],
                 outputs: vec![],
             };
@@ -260,6 +280,7 @@ pub fn split_area(
     };
     for (i, c) in cells.iter().enumerate() {
         let block = match flop_sink.get(&i) {
+            _ if c.clock_gate => &mut split.register_file,
             Some(Sink::Reg(_)) => &mut split.register_file,
             Some(Sink::Hold) => &mut split.hold_prefilter,
             Some(Sink::Control) => &mut split.control,
@@ -299,6 +320,9 @@ mod tests {
     fn names_match_contract_state() {
         let n = BlockNames::contract(8);
         assert!(matches(base_name("Y[3]"), &n.register_file));
+        // The clock gates' own cells, not the enable logic autoname puts under `cg_<r>.`.
+        assert!(is_clock_gate("cg_12.icg") && is_clock_gate("cg_0.enable_latch"));
+        assert!(!is_clock_gate("cg_0.en_NAND2X1_Y") && !is_clock_gate("cgx_0.icg"));
         assert!(matches(base_name("Y_12"), &n.register_file));
         assert!(matches(base_name("\\u_pix.held"), &n.hold_prefilter));
         assert!(!matches(base_name("x_lat_enable"), &n.hold_prefilter));

@@ -96,12 +96,21 @@ fn yosys_version(yosys: &Path) -> String {
 }
 
 /// The yosys script for `spec`, writing into `dir`; `constrained`: a timed run passes
-/// `dir/abc.constr` ([`abc_constraints`]) to ABC.
-pub fn yosys_script(spec: &SynthSpec, dir: &Path, constrained: bool) -> String {
+/// `dir/abc.constr` ([`abc_constraints`]) to ABC; `clock_gate_map`: the clock-gate module
+/// on the liberty's cells ([`crate::clock_gate`]), read over the behavioural one.
+pub fn yosys_script(
+    spec: &SynthSpec,
+    dir: &Path,
+    constrained: bool,
+    clock_gate_map: Option<&Path>,
+) -> String {
     let lib = spec.liberty.display();
     let mut s = format!("read_liberty -lib {lib}\n");
     for src in &spec.sources {
         s += &format!("read_verilog -sv {}\n", src.display());
+    }
+    if let Some(map) = clock_gate_map {
+        s += &format!("read_verilog -overwrite {}\n", map.display());
     }
     if !spec.params.is_empty() {
         s += "chparam";
@@ -155,9 +164,21 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
     };
     let mut h = Fnv64::default();
     h.feed(b"tofprobe-synth-v2").feed(spec.top.as_bytes());
+    // A clock-gated register file's gates become the liberty's cells (refused, naming the
+    // option, on a liberty without them).
+    let mut clock_gate_map = None;
     for src in &spec.sources {
         let text = std::fs::read(src).map_err(|_| ReportError::RtlMissing { path: src.clone() })?;
         h.feed(&text);
+        if let Some(module) =
+            crate::clock_gate::module_in(&String::from_utf8_lossy(&text), &spec.top)
+        {
+            let cells = crate::clock_gate::ClockGateCells::from_liberty(&lib)?;
+            clock_gate_map = Some(cells.module_verilog(&module));
+        }
+    }
+    if let Some(m) = &clock_gate_map {
+        h.feed(b"clock_gate").feed(m.as_bytes());
     }
     for (k, v) in &spec.params {
         h.feed(k.as_bytes()).feed(&v.to_le_bytes());
@@ -214,10 +235,20 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
             constrained = true;
         }
     }
+    let map_path = dir.join("clock_gate_map.v");
+    if let Some(m) = &clock_gate_map {
+        write_atomic(&map_path, m.as_bytes())?;
+    }
     let script_path = dir.join("synth.ys");
     write_atomic(
         &script_path,
-        yosys_script(&map_spec, &dir, constrained).as_bytes(),
+        yosys_script(
+            &map_spec,
+            &dir,
+            constrained,
+            clock_gate_map.as_ref().map(|_| map_path.as_path()),
+        )
+        .as_bytes(),
     )?;
     let start = std::time::Instant::now();
     let out = Command::new(&yosys)
@@ -351,8 +382,8 @@ mod tests {
             delay_target_ps: None,
             keep: vec![],
         };
-        let s = yosys_script(&spec, Path::new("/d"), false);
-        assert!(!s.contains("setattr"));
+        let s = yosys_script(&spec, Path::new("/d"), false, None);
+        assert!(!s.contains("setattr") && !s.contains("-overwrite"));
         assert!(s.contains("chparam -set B 4 -set W 12 pixel"));
         assert!(s.contains("synth -top pixel -flatten"));
         assert!(s.contains("abc -liberty l.lib"));
@@ -360,12 +391,18 @@ mod tests {
             delay_target_ps: Some(6250.0),
             ..spec
         };
-        let s = yosys_script(&timed, Path::new("/d"), false);
+        let s = yosys_script(&timed, Path::new("/d"), false, None);
         assert!(
             s.contains("abc -script /d/abc.script -liberty l.lib"),
             "{s}"
         );
-        let s = yosys_script(&timed, Path::new("/d"), true);
+        let s = yosys_script(&timed, Path::new("/d"), true, Some(Path::new("/d/cg.v")));
+        // The clock gates' cells are read over the behavioural module, before synthesis.
+        let (read, synth) = (
+            s.find("-overwrite /d/cg.v").unwrap(),
+            s.find("synth -top").unwrap(),
+        );
+        assert!(read < synth, "{s}");
         assert!(
             s.contains("abc -script /d/abc.script -constr /d/abc.constr -liberty l.lib"),
             "{s}"

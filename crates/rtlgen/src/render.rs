@@ -9,7 +9,7 @@ use crate::naming::{
 };
 use askama::Template;
 use tofprobe_pixel::{
-    DirectedOptions, Fault, Mode, Operation, PixelParams, Schedule, directed_program,
+    DirectedOptions, Fault, Mode, Operation, PixelParams, RegisterFile, Schedule, directed_program,
 };
 
 /// First line of every generated file: how `tofprobe rtl` recognises its own output.
@@ -91,6 +91,13 @@ pub(crate) fn header(p: &PixelParams, template: &str, o: &RenderOptions) -> Stri
             _ => String::new(),
         }
     );
+    // Only a non-default register file is named, so the default's files stay as committed.
+    if p.register_file != RegisterFile::Flops {
+        h.push_str(&format!(
+            "// Register file: {} (docs/pixel-contract.md \"Register file\").\n",
+            p.register_file
+        ));
+    }
     if !o.rom_note.is_empty() {
         // One comment line whatever the note holds: no line break can end the comment.
         let note: String = o
@@ -184,6 +191,9 @@ struct PixelT<'a> {
     opx: String,
     adders: Vec<Adder>,
     regs: Vec<Reg>,
+    /// `register_file = "clock_gated"`: one clock gate per register (the `_clock_gate`
+    /// module rendered after the pixel), no enable multiplexer.
+    clock_gated: bool,
     mutation: &'a str,
 }
 
@@ -390,6 +400,7 @@ pub fn render(p: &PixelParams, rom: &[u64], o: &RenderOptions) -> Result<Vec<Rtl
         },
         adders,
         regs,
+        clock_gated: p.register_file == RegisterFile::ClockGated,
         mutation: o.mutation.map(Fault::name).unwrap_or(""),
     };
     files.push(RtlFile {
