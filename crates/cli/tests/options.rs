@@ -49,7 +49,7 @@ fn run(args: &[&str], cache: &Path) -> Output {
 }
 
 fn options_args<'a>(cfg: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
-    let mut v = vec!["size", cfg, "--sweep-bins", "2", "--no-sky130", "--options"];
+    let mut v = vec!["size", cfg, "--sweep-bins", "1,2", "--options"];
     for o in OPTIONS {
         v.extend(["--option", o]);
     }
@@ -61,23 +61,34 @@ fn f(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
+/// One test, in order, so the syntheses of the first command are the cache of the others:
+/// the refusals that come before any synthesis, the study on both libraries, an
+/// unreachable target, then `flow --recommended`.
 #[test]
-fn options_front_and_recommendation() {
-    if !have_tools(&["yosys", "sta"]) {
+fn options_study_recommendation_and_flow() {
+    if !have_tools(&["yosys", "sta", "verilator"]) {
         return;
     }
-    let dir = scratch("size");
+    let dir = scratch("study");
     let cfg = small_config(&dir);
-    let cfg = cfg.to_str().unwrap();
-    let cache = dir.join("cache");
-    let out_dir = dir.join("set");
+    let cfg_s = cfg.to_str().unwrap();
+    // `--cache DIR` is the synthesis cache itself; $TOFPROBE_CACHE (flow has no --cache) is
+    // its parent.
+    let cache = dir.join("cache").join("synth");
+    refusals(cfg_s, &cache);
+    let rec = front_and_recommendation(cfg_s, &cache, &dir.join("set"));
+    unreachable_target_names_the_closest_option(cfg_s, &cache);
+    flow_recommended_builds_and_cosimulates_the_choice(cfg_s, &cache, &dir.join("out"), &rec);
+}
+
+/// The recommended option's name.
+fn front_and_recommendation(cfg: &str, cache: &Path, out_dir: &Path) -> String {
     // A 20,000-pulse frame leaves ~3–12 µm of ΣΔ and photon noise in the tone (measured:
     // baseline 6.8 µm mean over the five seeds, worst 11.4): a 30 µm target every option
     // meets, so the choice is the area's.
-    let args = options_args(cfg, &["--target-error-um", "30", "--json", "--out"]);
-    let mut args = args;
+    let mut args = options_args(cfg, &["--target-error-um", "30", "--json", "--out"]);
     args.push(out_dir.to_str().unwrap());
-    let o = run(&args, &cache);
+    let o = run(&args, cache);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     common::finite::assert_finite_output("size --options --json", &o.stdout);
     let j = common::last_json(&o);
@@ -88,8 +99,18 @@ fn options_front_and_recommendation() {
         .map(|r| r["option"]["name"].as_str().unwrap())
         .collect();
     assert_eq!(names, ["baseline", OPTIONS[0], OPTIONS[1]]);
-    let lib = rows[0]["libraries"].as_array().unwrap().len() - 1;
-    assert_eq!(lib, 0, "--no-sky130: osu018 only");
+    // osu018, then sky130 tt (CI has the PDK at ../shared): the front is read on sky130.
+    let libs: Vec<&str> = rows[0]["libraries"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["library"].as_str().unwrap())
+        .collect();
+    assert_eq!(libs, ["osu018_stdcells", "sky130_fd_sc_hd__tt_025C_1v80"]);
+    let lib = 1;
+    assert_eq!(opts["front_library"], libs[1]);
+    // The baseline's bins per pitch on sky130 are the size report's own.
+    assert_eq!(rows[0]["libraries"][lib]["fits"], j["sky130"]["fits"]);
 
     // Every row: five seeds, a spread that contains its mean, a timing verdict.
     for r in rows {
@@ -163,31 +184,26 @@ fn options_front_and_recommendation() {
     ] {
         assert!(md.contains(part), "`{part}` missing from the report");
     }
+    opts["recommendation"]["option"]
+        .as_str()
+        .unwrap()
+        .to_string()
 }
 
-#[test]
-fn unreachable_target_names_the_closest_option() {
-    if !have_tools(&["yosys", "sta"]) {
-        return;
-    }
-    let dir = scratch("target");
-    let cfg = small_config(&dir);
-    let cfg = cfg.to_str().unwrap();
-    let cache = dir.join("cache");
+fn unreachable_target_names_the_closest_option(cfg: &str, cache: &Path) {
     let o = run(
         &[
             "size",
             cfg,
             "--sweep-bins",
-            "2",
-            "--no-sky130",
+            "1,2",
             "--options",
             "--option",
             "G=2",
             "--target-error-um",
             "0.001",
         ],
-        &cache,
+        cache,
     );
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -200,10 +216,14 @@ fn unreachable_target_names_the_closest_option() {
     ] {
         assert!(err.contains(part), "`{part}` missing from: {err}");
     }
+}
+
+/// Refused before any synthesis: an unknown option, a target that is no tone error.
+fn refusals(cfg: &str, cache: &Path) {
     // An unknown option lists the catalogue.
     let o = run(
         &["size", cfg, "--no-sky130", "--options", "--option", "G=3"],
-        &cache,
+        cache,
     );
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -220,7 +240,7 @@ fn unreachable_target_names_the_closest_option() {
             "--options",
             "--target-error-um=-1",
         ],
-        &cache,
+        cache,
     );
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -230,16 +250,12 @@ fn unreachable_target_names_the_closest_option() {
     );
 }
 
-#[test]
-fn flow_recommended_builds_and_cosimulates_the_choice() {
-    if !have_tools(&["yosys", "sta", "verilator"]) {
-        return;
-    }
-    let dir = scratch("flow");
-    let cfg = small_config(&dir);
-    let cfg = cfg.to_str().unwrap();
-    let cache = dir.join("cache");
-    let out = dir.join("out");
+fn flow_recommended_builds_and_cosimulates_the_choice(
+    cfg: &str,
+    cache: &Path,
+    out: &Path,
+    recommended: &str,
+) {
     let mut args = vec!["flow", cfg, "--out", out.to_str().unwrap(), "--recommended"];
     for o in OPTIONS {
         args.extend(["--option", o]);
@@ -252,8 +268,8 @@ fn flow_recommended_builds_and_cosimulates_the_choice() {
         "--no-size",
     ]);
     let mut c = Command::new(env!("CARGO_BIN_EXE_tofprobe"));
-    // flow has no --cache: the environment points the synthesis cache at the scratch dir.
-    c.args(&args).env("TOFPROBE_CACHE", &cache);
+    // flow has no --cache: the environment points it at the study's synthesis cache.
+    c.args(&args).env("TOFPROBE_CACHE", cache.parent().unwrap());
     let o = c.output().expect("run tofprobe");
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
@@ -268,6 +284,8 @@ fn flow_recommended_builds_and_cosimulates_the_choice() {
         .and_then(|l| l.split(' ').next())
         .expect("the recommendation line")
         .to_string();
+    // The same study on the same cache: the same choice as `size --options`.
+    assert_eq!(chosen, recommended);
     let report = std::fs::read_to_string(out.join("report.md")).expect("report.md");
     assert!(report.contains("## Recommended architecture"), "{report}");
     assert!(report.contains(&format!("option `{chosen}`")), "{report}");

@@ -177,10 +177,14 @@ pub fn render(r: &SizeReport) -> String {
         if let Some(p) = &s.paper_implied {
             let _ = writeln!(
                 out,
-                "\nThe paper's two estimates imply ≈ {:.0} µm² per bin and {:.0} µm² fixed in sky130 (before scaling); a bin of this pixel costs {:.0} µm² (slope of the sky130 B sweep). The paper's per-bin figure is about the area of a bin's flops alone (2 × 26 bits × 20.02 µm² = 1041 µm²): enable, clear and readout multiplexing, the adders and the control are not in it.",
+                "\nThe paper's two estimates imply ≈ {:.0} µm² per bin and {:.0} µm² fixed in sky130 (before scaling); {}. The paper's per-bin figure is about the area of a bin's flops alone (2 × 26 bits × 20.02 µm² = 1041 µm²): enable, clear and readout multiplexing, the adders and the control are not in it.",
                 p.per_bin_um2,
                 p.fixed_um2,
-                s.area.model.map_or(f64::NAN, |m| m.per_bin_um2),
+                // A one-point B sweep has no slope: say so rather than print NaN.
+                s.area.model.map_or(
+                    "this pixel's cost per bin needs a B sweep of two or more points (--sweep-bins)".to_string(),
+                    |m| format!("a bin of this pixel costs {:.0} µm² (slope of the sky130 B sweep)", m.per_bin_um2)
+                ),
             );
         }
     }
