@@ -14,7 +14,7 @@ use common::{default_text, edit, have_tools};
 use serde_json::Value;
 
 /// Options the tests measure (with the baseline, always kept).
-const OPTIONS: [&str; 2] = ["G=2", "nearest+G=2+clock-gated"];
+const OPTIONS: [&str; 2] = ["G=2", "G=2+clock-gated"];
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("tofprobe-options-{}-{name}", std::process::id()));
@@ -228,7 +228,7 @@ fn refusals(cfg: &str, cache: &Path) {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("\"G=3\"") && err.contains("nearest+G=2+clock-gated"),
+        err.contains("\"G=3\"") && err.contains("G=2+clock-gated"),
         "{err}"
     );
     // So does a target that is no number of µm.
