@@ -147,3 +147,55 @@ fn clock_gated_register_file_passes_in_icarus_and_a_glitching_gate_does_not() {
     assert_eq!(code, 1, "{text}");
     assert_eq!(failure(&text), (18, "y[0]".to_string()), "{text}");
 }
+
+/// osu018's liberty without its `LATCH` cell (and it has no integrated clock gate): a
+/// clock-gated pixel cannot be built from it, and `tofprobe size` says so naming the
+/// option and the missing function, before any area is reported.
+#[test]
+fn a_liberty_without_latch_or_clock_gate_is_refused_naming_the_option() {
+    if !have_tools(&["yosys"]) {
+        return;
+    }
+    let dir = scratch("nolatch");
+    let text = std::fs::read_to_string("/usr/share/qflow/tech/osu018/osu018_stdcells.lib")
+        .expect("osu018 liberty");
+    let start = text.find("cell (LATCH)").expect("osu018 has a LATCH cell");
+    // The cell's group ends at the brace that balances its first one.
+    let open = start + text[start..].find('{').unwrap();
+    let mut depth = 0;
+    let mut end = open;
+    for (i, c) in text[open..].char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => {
+                depth -= 1;
+                if depth == 0 {
+                    end = open + i + 1;
+                    break;
+                }
+            }
+            _ => {}
+        }
+    }
+    let lib = dir.join("nolatch.lib");
+    std::fs::write(&lib, format!("{}{}", &text[..start], &text[end..])).unwrap();
+    let cfg = clock_gated_config(&dir);
+    let out = tofprobe(&[
+        "size",
+        cfg.to_str().unwrap(),
+        "--no-sky130",
+        "--sweep-bins",
+        "16",
+        "--sweep-widths",
+        "39",
+        "--liberty",
+        lib.to_str().unwrap(),
+        "--cache",
+        dir.join("cache").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    for part in ["register_file", "clock_gated", "latch", "nolatch.lib"] {
+        assert!(err.contains(part), "`{part}` missing from: {err}");
+    }
+}
