@@ -43,12 +43,12 @@ pub fn render(r: &OptionsReport) -> String {
     rule += "---|";
     let _ = writeln!(s, "{head}\n{rule}");
     for row in &r.rows {
-        let mark = if row.option.name == r.recommendation.option {
-            "**recommended**"
-        } else if row.on_front {
-            "on front"
-        } else {
-            ""
+        let recommended = row.option.name == r.recommendation.option;
+        let mark = match (recommended, row.on_front) {
+            (true, true) => "**recommended**, on front",
+            (true, false) => "**recommended**",
+            (false, true) => "on front",
+            (false, false) => "",
         };
         let e = &row.tone_error_um;
         let _ = write!(

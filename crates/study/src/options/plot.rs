@@ -10,6 +10,9 @@ use plotters::prelude::*;
 use super::OptionsReport;
 use crate::error::StudyError;
 
+/// Label heights (factors of the point's error, log axis) for points of equal x.
+const LABEL_STEPS: [f64; 4] = [1.12, 0.8, 0.6, 0.45];
+
 /// The SVG text; `path` only names the file in errors.
 pub fn front_svg(path: &Path, r: &OptionsReport) -> Result<String, StudyError> {
     let err = |e: &dyn std::fmt::Display| StudyError::Output {
@@ -45,6 +48,12 @@ pub fn front_svg(path: &Path, r: &OptionsReport) -> Result<String, StudyError> {
     let y0 = pts.iter().map(|p| p.3).fold(r.target_error_um, f64::min);
     let y1 = pts.iter().map(|p| p.4).fold(r.target_error_um, f64::max);
     let pad = ((x1 - x0) * 0.15).max(x1.abs() * 0.05).max(1.0);
+    let same_x = |i: usize| {
+        pts[..i]
+            .iter()
+            .filter(|q| (q.1 - pts[i].1).abs() < 0.02 * (x1 - x0 + 1.0))
+            .count()
+    };
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (900, 560)).into_drawing_area();
@@ -84,7 +93,7 @@ pub fn front_svg(path: &Path, r: &OptionsReport) -> Result<String, StudyError> {
             .map_err(|e| err(&e))?
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLUE));
-        for p in &pts {
+        for (i, p) in pts.iter().enumerate() {
             chart
                 .draw_series(std::iter::once(PathElement::new(
                     [(p.1, p.3), (p.1, p.4)],
@@ -96,9 +105,12 @@ pub fn front_svg(path: &Path, r: &OptionsReport) -> Result<String, StudyError> {
                 .draw_series(std::iter::once(Circle::new((p.1, p.2), 5, colour.filled())))
                 .map_err(|e| err(&e))?;
             chart
+                // Options of (nearly) equal area per bin, like the baseline and one adder,
+                // would print their labels over each other: the k-th such point's label
+                // steps down.
                 .draw_series(std::iter::once(Text::new(
                     p.0.clone(),
-                    (p.1, p.2),
+                    (p.1, p.2 * LABEL_STEPS[same_x(i) % LABEL_STEPS.len()]),
                     ("sans-serif", 12).into_font(),
                 )))
                 .map_err(|e| err(&e))?;
@@ -114,6 +126,7 @@ pub fn front_svg(path: &Path, r: &OptionsReport) -> Result<String, StudyError> {
         }
         chart
             .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
             .background_style(WHITE)
             .border_style(BLACK)
             .draw()
