@@ -289,15 +289,11 @@ fn flow_recommended_builds_and_cosimulates_the_choice(
     let report = std::fs::read_to_string(out.join("report.md")).expect("report.md");
     assert!(report.contains("## Recommended architecture"), "{report}");
     assert!(report.contains(&format!("option `{chosen}`")), "{report}");
-    // The RTL is the chosen option's: G = 2 renders the operand slice.
+    // On this pixel the smallest option is G = 2 with clock gates (both areas shrink, and
+    // every row meets the 30 µm target): its RTL has the operand slice and the gates, so
+    // the checks below cannot pass vacuously on another choice.
+    assert_eq!(chosen, OPTIONS[1]);
     let rtl = std::fs::read_to_string(out.join("rtl").join("tofprobe_pixel.v")).expect("rtl");
-    if chosen.contains("G=2") {
-        assert!(rtl.contains("x_new["), "the G = 2 operand slice is missing");
-    }
-    if chosen.contains("clock-gated") {
-        assert!(
-            rtl.to_lowercase().contains("gclk"),
-            "the clock gates are missing"
-        );
-    }
+    assert!(rtl.contains("x_new["), "the G = 2 operand slice is missing");
+    assert!(rtl.contains("gclk_"), "the clock gates are missing");
 }
