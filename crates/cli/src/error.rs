@@ -12,9 +12,12 @@ pub enum CliError {
     /// the value and a valid one).
     #[error(transparent)]
     Design(Box<tofprobe_design::DesignError>),
-    /// A study (spectrum, flow, sizing, reproduction, trade-off) failed.
+    /// An experiment (spectrum, transients, reproduction, trade-off, options) failed.
     #[error(transparent)]
-    Study(#[from] tofprobe_study::StudyError),
+    Experiment(#[from] tofprobe_experiments::ExperimentError),
+    /// The hardware flow (RTL, vectors, co-simulation, sizing, sign-off) failed.
+    #[error(transparent)]
+    Flow(Box<tofprobe_flow::FlowError>),
     /// JSON serialisation failed (should not happen for plain numbers).
     #[error("cannot serialise JSON output: {0}")]
     Json(#[from] serde_json::Error),
@@ -23,7 +26,7 @@ pub enum CliError {
 impl CliError {
     /// A command-line option out of range.
     pub fn option(option: impl ToString, value: impl ToString, allowed: impl ToString) -> Self {
-        CliError::Study(tofprobe_study::StudyError::Option {
+        CliError::Experiment(tofprobe_experiments::ExperimentError::Option {
             option: option.to_string(),
             value: value.to_string(),
             allowed: allowed.to_string(),
@@ -32,7 +35,7 @@ impl CliError {
 
     /// An output file that cannot be written.
     pub fn output(path: PathBuf, message: String) -> Self {
-        CliError::Study(tofprobe_study::StudyError::Output { path, message })
+        CliError::Experiment(tofprobe_experiments::ExperimentError::Output { path, message })
     }
 }
 
@@ -42,7 +45,7 @@ macro_rules! through_study {
     ($($t:ty),*) => {$(
         impl From<$t> for CliError {
             fn from(e: $t) -> Self {
-                CliError::Study(e.into())
+                CliError::Experiment(e.into())
             }
         }
     )*};
@@ -50,8 +53,17 @@ macro_rules! through_study {
 through_study!(
     tofprobe_rtlgen::RtlError,
     tofprobe_cosim::CosimError,
-    tofprobe_report::ReportError
+    tofprobe_eda::EdaError
 );
+
+impl From<tofprobe_flow::FlowError> for CliError {
+    fn from(e: tofprobe_flow::FlowError) -> Self {
+        match e {
+            tofprobe_flow::FlowError::Design(d) => CliError::Design(d),
+            other => CliError::Flow(Box::new(other)),
+        }
+    }
+}
 
 // Boxed: the design error names the file, key and value inline (clippy::result_large_err).
 impl From<tofprobe_design::DesignError> for CliError {

@@ -147,7 +147,7 @@ pub fn netlist_shape(path: &Path, text: &str, pixel: &str) -> Result<NetlistShap
         .ok_or_else(|| {
             invalid(
                 path,
-                "has no `we` net: synthesise the pixel with `keep` on `we` (tofprobe_report::signoff) so the testbench can watch the register writes".into(),
+                "has no `we` net: synthesise the pixel with `keep` on `we` (tofprobe_eda::signoff) so the testbench can watch the register writes".into(),
             )
         })?;
     let registers = range_width(we);

@@ -5,22 +5,22 @@
 //! at the slowest clock K·f_laser with C = K cycles per pulse. More adders for the same K
 //! only cost area, so the candidates are the A where K changes, fewest first. Each
 //! candidate's pixel is rendered, synthesised with the delay-driven script for its clock
-//! and timed with OpenSTA (`tofprobe_report::analysis`, cached by the RTL's hash, as the
+//! and timed with OpenSTA (`tofprobe_eda::analysis`, cached by the RTL's hash, as the
 //! size report's points are); the first whose slack keeps [`MARGIN_PERCENT`] of the
 //! period wins. Typically two syntheses: A = 1 (P cycles: too fast a clock) and A = 2.
 
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
+use tofprobe_eda::analysis::analyse_point;
+use tofprobe_eda::corners::{CornerTiming, MARGIN_PERCENT};
+use tofprobe_eda::fsutil::synth_cache_dir;
+use tofprobe_eda::generated::GeneratedPixel;
+use tofprobe_eda::liberty::Liberty;
+use tofprobe_eda::pdk::Sky130Pdk;
+use tofprobe_eda::signoff::OSU018_LIBERTY;
 use tofprobe_pixel::config::Choice;
 use tofprobe_pixel::{PixelConfig, PixelContext, PixelError, PixelParams};
-use tofprobe_report::analysis::analyse_point;
-use tofprobe_report::corners::{CornerTiming, MARGIN_PERCENT};
-use tofprobe_report::fsutil::synth_cache_dir;
-use tofprobe_report::generated::GeneratedPixel;
-use tofprobe_report::liberty::Liberty;
-use tofprobe_report::pdk::Sky130Pdk;
-use tofprobe_report::signoff::OSU018_LIBERTY;
 
 use crate::error::DesignError;
 

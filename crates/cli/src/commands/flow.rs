@@ -1,4 +1,4 @@
-//! `tofprobe flow [CONFIG]`: the main flow (`tofprobe_study::flow`). Scene → bit-true
+//! `tofprobe flow [CONFIG]`: the main flow (`tofprobe_flow::flow`). Scene → bit-true
 //! model → RTL → golden vectors → Verilator co-simulation → a short report (spectrum at
 //! the bins, register widths, verdict, sizing summary) in the output directory. Installs
 //! nothing: a missing tool is named together with scripts/install-tools.sh.
@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tofprobe_study::flow::{FlowOptions, run_flow};
+use tofprobe_flow::flow::{FlowOptions, run_flow};
 
 use crate::error::CliError;
 
@@ -48,7 +48,7 @@ pub struct FlowArgs {
     #[arg(long)]
     pub recommended: bool,
     /// With --recommended: the largest tone error (µm, against the float DFT) accepted.
-    #[arg(long, requires = "recommended", default_value_t = tofprobe_study::options::DEFAULT_TARGET_ERROR_UM)]
+    #[arg(long, requires = "recommended", default_value_t = tofprobe_experiments::options::DEFAULT_TARGET_ERROR_UM)]
     pub target_error_um: f64,
     /// With --recommended: choose among these options only (repeatable; names as in
     /// `tofprobe size --options`; the baseline is always a candidate).
@@ -63,7 +63,7 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
     }
     let mut design = tofprobe_design::load(a.config.as_deref())?;
     let options = if a.recommended {
-        let size = tofprobe_study::sizing::SizeOptions {
+        let size = tofprobe_flow::sizing::SizeOptions {
             liberty: None,
             no_sky130: false,
             sky130_pdk: None,
@@ -72,15 +72,15 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
             sweep_widths: None,
             cache: None,
         };
-        let req = tofprobe_study::sizing::options_request(
+        let req = tofprobe_flow::sizing::options_request(
             &design,
             &size,
             a.only.clone(),
-            tofprobe_study::options::DEFAULT_SEEDS.to_vec(),
+            tofprobe_experiments::options::DEFAULT_SEEDS.to_vec(),
             a.target_error_um,
         )?;
-        let report = tofprobe_study::options::run(&design, &req)?;
-        design = tofprobe_study::options::recommended_design(&design, &report)?;
+        let report = tofprobe_experiments::options::run(&design, &req)?;
+        design = tofprobe_experiments::options::recommended_design(&design, &report)?;
         println!(
             "recommended: {} ({:.0} µm² on {}, tone error {:.3} µm ≤ {} µm)",
             report.recommendation.option,

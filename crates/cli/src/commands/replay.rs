@@ -1,12 +1,12 @@
 //! `tofprobe replay FILE [CONFIG] [--json]`: a real time-tagged record (PicoQuant PTU T2/T3,
-//! Becker & Hickl SPC) through the pixel (`tofprobe_study::replay`): the record's photon
+//! Becker & Hickl SPC) through the pixel (`tofprobe_experiments::replay`): the record's photon
 //! count and rates, the detected depth's mean and σ, and the bit-true spectrum beside its
 //! float twin, with the measured noise floor against the closed form the record implies.
 
 use std::path::PathBuf;
 
 use clap::Args;
-use tofprobe_study::replay::{ReplayOutcome, ReplayRequest, replay};
+use tofprobe_experiments::replay::{ReplayOutcome, ReplayRequest, replay};
 
 use crate::error::CliError;
 

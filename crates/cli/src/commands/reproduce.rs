@@ -15,8 +15,8 @@ use std::time::Instant;
 
 use clap::Args;
 use serde::Serialize;
-use tofprobe_study::paper::reproduce::reproduce;
-use tofprobe_study::paper::{self, Row, table2};
+use tofprobe_experiments::paper::reproduce::reproduce;
+use tofprobe_experiments::paper::{self, Row, table2};
 
 use crate::error::CliError;
 

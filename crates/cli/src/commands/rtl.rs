@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use tofprobe_design::RtlOverrides;
-use tofprobe_study::rtl::{CoreSimPaths, render_design};
+use tofprobe_flow::rtl::{CoreSimPaths, render_design};
 
 use crate::error::CliError;
 

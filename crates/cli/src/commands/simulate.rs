@@ -3,7 +3,7 @@
 //! depth, run time), then run one frame through the bit-true pixel (transaction model) and
 //! print its spectrum at the configured bins (amplitude µm, phase, the noise estimate);
 //! `--svg` plots that spectrum. On a Haar pixel the frame's registers become the transient
-//! analysis instead (`tofprobe_study::transients`): coefficients, per-scale thresholds at a
+//! analysis instead (`tofprobe_experiments::transients`): coefficients, per-scale thresholds at a
 //! stated false-alarm rate, events; `--json` carries the scalogram and the events, `--svg`
 //! draws the scalogram.
 
@@ -18,8 +18,8 @@ use tofprobe_pixel::spectrum::BitTrueSpectrum;
 use tofprobe_scene::{FillCounts, PhotonSource};
 
 use tofprobe_design::ResolvedDesign;
-use tofprobe_study::spectrum::{run_spectrum, setup, write_svg};
-use tofprobe_study::transients::{HaarAnalysis, bit_true_haar};
+use tofprobe_experiments::spectrum::{run_spectrum, setup, write_svg};
+use tofprobe_experiments::transients::{HaarAnalysis, bit_true_haar};
 
 use crate::error::CliError;
 
@@ -207,7 +207,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         None
     };
     if let (Some(path), Some(h)) = (&args.svg, &haar) {
-        tofprobe_report::scalogram::write_scalogram_svg(
+        tofprobe_experiments::scalogram::write_scalogram_svg(
             &h.analysis.scalogram,
             &format!("bit-true Haar scalogram: {}", design.origin),
             Some(&h.analysis.events),

@@ -7,12 +7,12 @@ use std::path::PathBuf;
 
 use clap::Args;
 use serde::Serialize;
-use tofprobe_report::report::SizeReport;
-use tofprobe_report::{markdown, plot};
-use tofprobe_study::options::OptionsReport;
-use tofprobe_study::options::markdown::render as options_markdown;
-use tofprobe_study::options::plot::front_svg;
-use tofprobe_study::sizing::{SizeOptions, options_request, size_report};
+use tofprobe_eda::size_report::SizeReport;
+use tofprobe_eda::{markdown, plot};
+use tofprobe_experiments::options::OptionsReport;
+use tofprobe_experiments::options::markdown::render as options_markdown;
+use tofprobe_experiments::options::plot::front_svg;
+use tofprobe_flow::sizing::{SizeOptions, options_request, size_report};
 
 use crate::error::CliError;
 
@@ -64,10 +64,10 @@ pub struct SizeArgs {
     pub only: Vec<String>,
     /// With --options: the largest tone error (µm, worst seed, against the float DFT) the
     /// recommendation accepts.
-    #[arg(long, requires = "options", default_value_t = tofprobe_study::options::DEFAULT_TARGET_ERROR_UM)]
+    #[arg(long, requires = "options", default_value_t = tofprobe_experiments::options::DEFAULT_TARGET_ERROR_UM)]
     pub target_error_um: f64,
     /// With --options: seeds of the accuracy measurement (comma-separated).
-    #[arg(long, value_delimiter = ',', requires = "options", default_values_t = tofprobe_study::options::DEFAULT_SEEDS)]
+    #[arg(long, value_delimiter = ',', requires = "options", default_values_t = tofprobe_experiments::options::DEFAULT_SEEDS)]
     pub seeds: Vec<u64>,
 }
 
@@ -96,14 +96,14 @@ pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
             a.target_error_um,
         )?;
         // Before minutes of synthesis: an unknown option or target fails now.
-        tofprobe_study::options::check(&design, &req)?;
+        tofprobe_experiments::options::check(&design, &req)?;
         Some(req)
     } else {
         None
     };
     let size = size_report(&design, &options)?;
     let options = match &req {
-        Some(req) => Some(tofprobe_study::options::run(&design, req)?),
+        Some(req) => Some(tofprobe_experiments::options::run(&design, req)?),
         None => None,
     };
     Ok(FullReport { size, options })

@@ -3,7 +3,7 @@
 //! per simulated second and scored against the float DFT and the scene's truth (a Haar
 //! pixel: float Haar, bit-true, cycle-accurate, Verilator, scored by the coefficient error
 //! against the float Haar and the event time error, `tradeoff::haar`); with
-//! `--knobs` the bit-true knob sweep ([`tofprobe_study::tradeoff::knobs::DEFAULT_SWEEP`]) and with
+//! `--knobs` the bit-true knob sweep ([`tofprobe_experiments::tradeoff::knobs::DEFAULT_SWEEP`]) and with
 //! `--skips` the skipped-stage speedups, both on a frame of at most `--sweep-pulses` and
 //! timed as the median of `--reps` runs. Markdown tables on stdout (or one JSON object),
 //! and with `--out` the tables (`tradeoff.md`) and the Pareto plot (`pareto.svg`),
@@ -14,10 +14,10 @@ use std::path::PathBuf;
 use clap::Args;
 use serde::Serialize;
 
-use tofprobe_study::tradeoff::haar::{self, HaarSceneResult, measure_haar};
-use tofprobe_study::tradeoff::knobs::{self, DEFAULT_SWEEP, KnobSweep};
-use tofprobe_study::tradeoff::skips::{self, SkipReport, measure_skips};
-use tofprobe_study::tradeoff::{SceneResult, markdown, measure, plot::pareto_svg_text};
+use tofprobe_experiments::tradeoff::haar::{self, HaarSceneResult, measure_haar};
+use tofprobe_experiments::tradeoff::knobs::{self, DEFAULT_SWEEP, KnobSweep};
+use tofprobe_experiments::tradeoff::skips::{self, SkipReport, measure_skips};
+use tofprobe_experiments::tradeoff::{SceneResult, markdown, measure, plot::pareto_svg_text};
 
 use crate::error::CliError;
 

@@ -56,7 +56,8 @@ pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
         trace_window: None,
         directed: None,
     };
-    let (g, w) = golden_run(&p, &stim, &rom, &o).map_err(tofprobe_study::StudyError::from)?;
+    let (g, w) =
+        golden_run(&p, &stim, &rom, &o).map_err(tofprobe_experiments::ExperimentError::from)?;
     let m = write_vectors(&a.out, &p, &stim, &rom, &g, w, &o)?;
     println!(
         "vectors: {} frames, {} pulses, {} cycles, {} trace events, {} digest windows, hash {} -> {}; {note}",

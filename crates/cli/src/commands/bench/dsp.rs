@@ -12,7 +12,7 @@ use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::dft::amplitude_spectrum;
 
 use crate::error::CliError;
-use tofprobe_study::paper::table2;
+use tofprobe_experiments::paper::table2;
 
 /// Arguments of `tofprobe bench dsp`.
 #[derive(Debug, Args)]

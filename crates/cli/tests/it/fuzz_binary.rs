@@ -1,0 +1,278 @@
+//! Mutated configurations through the binary (docs/reliability.md): a sample of the
+//! property test that crates/design/tests/mutations.rs runs through the library (600
+//! cases), here 40 cases through `config`, `simulate` and `rtl` as a user runs them. Each
+//! run exits 0 or 2 within a time limit, prints no panic, and a refusal names a key of the
+//! document together with the value given (or, for a cross-field refusal, another key of
+//! the document by its dotted path). Deterministic: a fixed seed walks the same cases.
+//! `TOFPROBE_BINARY_MUTATIONS=N` runs N cases.
+
+use crate::common;
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::{default_text, edit};
+
+/// SplitMix64 (as in the library's test: the case list must not depend on a crate).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn pick<'a, T>(&mut self, v: &'a [T]) -> &'a T {
+        &v[(self.next() % v.len() as u64) as usize]
+    }
+}
+
+/// The keys mutated, by table (`motion` = `scene.motion[0]`).
+const KEYS: &[(&str, &[&str])] = &[
+    (
+        "sensor",
+        &[
+            "laser_rate_hz",
+            "jitter_ps",
+            "tdc_lsb_ps",
+            "window_start_ps",
+            "window_length_ps",
+            "signal_rate",
+            "background_rate",
+        ],
+    ),
+    ("scene", &["depth_mm"]),
+    ("acquisition", &["duration_s", "pulses", "seed"]),
+    (
+        "pixel",
+        &[
+            "mode",
+            "bins",
+            "adders",
+            "cycles_per_pulse",
+            "shift",
+            "frac_bits",
+            "tdc_bits",
+            "width",
+            "frame_pulses",
+            "rom_depth",
+        ],
+    ),
+    (
+        "probe",
+        &[
+            "order",
+            "osr",
+            "h_inf",
+            "window",
+            "amplitude",
+            "rom_mode",
+            "rom_depth",
+        ],
+    ),
+    (
+        "motion",
+        &["kind", "amplitude_mm", "frequency_hz", "phase_deg"],
+    ),
+];
+
+/// TOML literals a mutation writes: zero, signs, extremes, non-finite values, wrong types.
+const VALUES: &[&str] = &[
+    "0",
+    "-1",
+    "1",
+    "2",
+    "3",
+    "16",
+    "64",
+    "1e5",
+    "4294967296",
+    "9223372036854775807",
+    "0.0",
+    "-0.0",
+    "0.5",
+    "0.999",
+    "1.5",
+    "7.99",
+    "1e-300",
+    "5e-324",
+    "1e300",
+    "inf",
+    "-inf",
+    "nan",
+    "60.0",
+    "\"x\"",
+    "\"auto\"",
+    "true",
+    "[]",
+    "\"haar\"",
+    "\"windowed\"",
+    "\"periodic\"",
+];
+
+/// The short windowed frame (N = 4096, B = 4; fast through `simulate`) with one to three
+/// keys set from [`VALUES`]; the text and the mutations (key, literal).
+fn mutate(rng: &mut Rng) -> (String, Vec<(String, String)>) {
+    let base = edit(
+        default_text(),
+        &[
+            ("duration_s = 1.0 ", "pulses = 4096 #"),
+            ("rom_mode = \"periodic\"", "rom_mode = \"windowed\""),
+            ("bins = 16 ", "bins = 4 "),
+            ("cycles_per_pulse = 16 ", "cycles_per_pulse = 4 "),
+        ],
+    );
+    let mut doc: toml::Table = toml::from_str(&base).unwrap();
+    let mut muts = Vec::new();
+    for _ in 0..1 + rng.next() % 3 {
+        let (table, keys) = rng.pick(KEYS);
+        let key = rng.pick(keys).to_string();
+        let lit = rng.pick(VALUES).to_string();
+        let value = toml::from_str::<toml::Table>(&format!("v = {lit}"))
+            .unwrap()
+            .remove("v")
+            .unwrap();
+        let target = if *table == "motion" {
+            let scene = doc.get_mut("scene").unwrap().as_table_mut().unwrap();
+            scene.get_mut("motion").unwrap().as_array_mut().unwrap()[0]
+                .as_table_mut()
+                .unwrap()
+        } else {
+            doc.entry(table.to_string())
+                .or_insert_with(|| toml::Value::Table(Default::default()))
+                .as_table_mut()
+                .unwrap()
+        };
+        target.insert(key.clone(), value);
+        muts.push((key, lit));
+    }
+    (toml::to_string(&doc).unwrap(), muts)
+}
+
+/// The forms a value may take in a message (as written, or as Rust prints the number).
+fn value_forms(lit: &str) -> Vec<String> {
+    let mut f = vec![lit.trim_matches('"').to_string()];
+    if let Ok(x) = lit.parse::<f64>() {
+        f.extend([
+            format!("{x}"),
+            format!("{x:?}"),
+            format!("{x:e}"),
+            tofprobe_io::text::number(x),
+        ]);
+    }
+    if lit == "nan" {
+        f.push("NaN".into());
+    }
+    f
+}
+
+/// `section.key` of every key of `doc` (`scene.motion[i].key` for the motions).
+fn dotted_paths(doc: &toml::Table) -> Vec<String> {
+    let mut v = Vec::new();
+    for (section, body) in doc {
+        for (key, value) in body.as_table().into_iter().flatten() {
+            if let Some(list) = value.as_array().filter(|_| key == "motion") {
+                for (i, m) in list.iter().enumerate() {
+                    for k in m.as_table().into_iter().flatten().map(|(k, _)| k) {
+                        v.push(format!("scene.motion[{i}].{k}"));
+                    }
+                }
+            }
+            v.push(format!("{section}.{key}"));
+        }
+    }
+    v
+}
+
+/// Runs the binary with a time limit; (exit code, stderr). A run past the limit is killed
+/// and reported as a hang.
+fn run(args: &[&str], cfg: &Path, limit: Duration) -> Result<(Option<i32>, String), String> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .args(args)
+        .arg(cfg)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(format!("{args:?} still running after {limit:?}"));
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    let mut err = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    Ok((status.code(), err))
+}
+
+#[test]
+fn mutated_configurations_through_the_binary_exit_0_or_2_and_name_their_field() {
+    let cases: usize = std::env::var("TOFPROBE_BINARY_MUTATIONS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(40);
+    let tmp = tempfile::tempdir().unwrap();
+    let mut rng = Rng(0x0b1a_2026_1119);
+    let (mut runs, mut accepted, mut refused) = (0, 0, 0);
+    let mut failures = Vec::new();
+    for case in 0..cases {
+        let (text, muts) = mutate(&mut rng);
+        let cfg = tmp.path().join(format!("m{case}.toml"));
+        std::fs::write(&cfg, &text).unwrap();
+        let doc: toml::Table = toml::from_str(&text).unwrap();
+        let out = tmp.path().join(format!("rtl{case}"));
+        let rtl = ["rtl", "--out", out.to_str().unwrap()];
+        for args in [&["config"][..], &["simulate"][..], &rtl[..]] {
+            runs += 1;
+            let (code, err) = match run(args, &cfg, Duration::from_secs(60)) {
+                Ok(r) => r,
+                Err(hang) => {
+                    failures.push(format!("case {case} {muts:?}: {hang}"));
+                    continue;
+                }
+            };
+            if err.contains("panicked") || !matches!(code, Some(0 | 2)) {
+                failures.push(format!(
+                    "case {case} {args:?} {muts:?}: exit {code:?}: {err}"
+                ));
+                continue;
+            }
+            if code == Some(0) {
+                accepted += 1;
+                continue;
+            }
+            refused += 1;
+            let named = muts.iter().any(|(key, lit)| {
+                err.contains(key.as_str())
+                    && (err.contains("exactly one of")
+                        || value_forms(lit).iter().any(|f| {
+                            err.contains(&tofprobe_io::text::clip(f, 60)[..f.len().min(57)])
+                        }))
+            }) || dotted_paths(&doc).iter().any(|p| err.contains(p.as_str()));
+            if !named {
+                failures.push(format!(
+                    "case {case} {args:?} {muts:?}: names no field: {err}"
+                ));
+            }
+        }
+    }
+    eprintln!(
+        "binary mutations: {cases} cases, {runs} runs: {accepted} exit 0, {refused} exit 2 naming their field, {} failures",
+        failures.len()
+    );
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

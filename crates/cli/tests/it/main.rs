@@ -1,0 +1,32 @@
+//! The integration tests of `tofprobe-cli`, linked into one binary (a binary per file
+//! cost a link each: most of a cold CI run's build time). Run one module with
+//! `cargo test --release -p tofprobe-cli --test it MODULE::`.
+
+mod adders_auto;
+mod bench_fullband;
+mod bit_true;
+mod cli;
+mod committed;
+mod common;
+mod core;
+mod cosim_directed;
+mod cosim_exact;
+mod exit_codes;
+mod extremes;
+mod finite_json;
+mod flow;
+mod fuzz_binary;
+mod haar;
+mod junit;
+mod options;
+mod prefilter_rounding;
+mod probe_convention;
+mod register_file;
+mod register_frac_bits;
+mod reliability;
+mod replay;
+mod reproduce;
+mod resolution;
+mod signals;
+mod size;
+mod tradeoff;

@@ -1,0 +1,240 @@
+//! Formal equivalence of a mapped netlist and its RTL, with yosys's equivalence passes
+//! (`equiv_make`, `equiv_simple -seq`, `equiv_induct`, `equiv_status -assert`).
+//!
+//! Gold: the RTL through yosys's coarse synthesis (`synth -flatten -run begin:fine`: proc,
+//! const-flop removal, width reduction), so its registers have the names and widths the
+//! netlist's flops carry (`equiv_make` pairs registers by name; a register the netlist
+//! narrowed — `held`'s constant sign bit — would otherwise stay unpaired and break the
+//! induction). What is proven is therefore the fine half of synthesis: techmap, ABC's
+//! mapping, buffering and sizing, and the flop mapping — everything that turns words
+//! into cells. Gate: the netlist with the cells' functions read from the liberty
+//! (`read_liberty` without `-lib`: `function` and `ff` groups become logic and flops).
+//! Both sides get `async2sync; dffunmap` (plain flops: `equiv_simple -seq` steps
+//! through `$dff` only). `equiv_induct` then proves every register and output pair by
+//! one-step induction: all pairs equal at t ⇒ equal at t + 1.
+//!
+//! A clock-gated register file (`register_file = "clock_gated"`): yosys's model steps every
+//! flop at every step whatever drives its clock, so a gated register's update is proven
+//! through the signals its clock is made of, which both sides name alike and `equiv_make`
+//! pairs: each gate's latched enable (`cg_<r>.en_l`, a latch on both sides) and gated clock
+//! (`gclk_<r>`), besides the flops' D logic. A gate on the wrong enable fails as an
+//! unproven `cg_<r>.en_l` pair. An integrated clock-gating cell is read as the behaviour its
+//! liberty declares (`latch_posedge`: latch open while CLK is low, AND with CLK), so the
+//! proof covers the netlist's wiring of the cells, not the cells' transistors.
+
+use crate::error::{EdaError, Result};
+use crate::fsutil::write_atomic;
+use crate::tools::{Tool, tail};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// What to compare.
+#[derive(Debug, Clone)]
+pub struct EquivSpec {
+    /// The RTL sources (the gold side).
+    pub rtl: Vec<PathBuf>,
+    /// The module both sides implement.
+    pub top: String,
+    /// Verilog parameter overrides of the RTL (as the netlist was synthesised with).
+    pub params: Vec<(String, i64)>,
+    /// The mapped netlist (`write_verilog -noattr`).
+    pub netlist: PathBuf,
+    /// The liberty whose cells the netlist instantiates (their functions).
+    pub liberty: PathBuf,
+}
+
+/// A proven equivalence.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Equivalence {
+    /// `$equiv` points (paired signal bits: registers and outputs).
+    pub points: u64,
+    /// All of them, proven.
+    pub proven: u64,
+    /// Wall time of yosys (s).
+    pub seconds: f64,
+    /// The yosys log.
+    pub log: PathBuf,
+}
+
+/// The yosys script comparing `spec`.
+pub fn equiv_script(spec: &EquivSpec) -> String {
+    equiv_script_with(spec, None)
+}
+
+/// [`equiv_script`], with `icg_models` (a clock-gated register file's integrated clock
+/// gates as Verilog, [`crate::clock_gate::icg_models`]) read on the gate side: a liberty
+/// describes those cells by a `statetable`, which `read_liberty` cannot turn into logic.
+pub fn equiv_script_with(spec: &EquivSpec, icg_models: Option<&Path>) -> String {
+    let top = &spec.top;
+    let mut s = String::new();
+    for src in &spec.rtl {
+        s += &format!("read_verilog -sv {}\n", src.display());
+    }
+    if !spec.params.is_empty() {
+        s += "chparam";
+        for (k, v) in &spec.params {
+            s += &format!(" -set {k} {v}");
+        }
+        s += &format!(" {top}\n");
+    }
+    s += &format!(
+        "synth -top {top} -flatten -run begin:fine\n\
+         async2sync\n\
+         dffunmap\n\
+         memory_map\n\
+         opt_clean\n\
+         rename {top} gold\n\
+         design -stash gold\n\
+         read_liberty -ignore_miss_func {lib}\n\
+         {icg}read_verilog {net}\n\
+         prep -top {top} -flatten\n\
+         async2sync\n\
+         dffunmap\n\
+         rename {top} gate\n\
+         design -stash gate\n\
+         design -copy-from gold -as gold gold\n\
+         design -copy-from gate -as gate gate\n\
+         equiv_make gold gate equiv\n\
+         hierarchy -top equiv\n\
+         equiv_simple -seq 2\n\
+         equiv_induct -seq 1\n\
+         equiv_status -assert\n",
+        lib = spec.liberty.display(),
+        net = spec.netlist.display(),
+        icg = icg_models.map_or(String::new(), |m| format!(
+            "read_verilog -overwrite {}\n",
+            m.display()
+        )),
+    );
+    s
+}
+
+/// Parses `equiv_status`: (points, unproven, first unproven pair).
+pub fn parse_status(log: &str) -> Option<(u64, u64, String)> {
+    let pos = log.rfind("Executing EQUIV_STATUS pass")?;
+    let text = &log[pos..];
+    let points = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("Found") && l.contains("$equiv cells"))
+        .and_then(|l| l.split_whitespace().nth(1)?.parse().ok())?;
+    // "Of those cells P are proven and U are unproven."
+    let unproven = text
+        .lines()
+        .find(|l| l.contains("are proven and"))
+        .and_then(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            let i = w.iter().position(|x| *x == "and")?;
+            w.get(i + 1)?.parse().ok()
+        })
+        .unwrap_or(0);
+    let first = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("Unproven $equiv "))
+        .and_then(|l| l.split_once(": "))
+        .map(|(_, pair)| pair.trim().to_string())
+        .unwrap_or_default();
+    Some((points, unproven, first))
+}
+
+/// Proves `spec`'s netlist equivalent to its RTL; `work` holds the script and the log.
+/// An unproven pair is [`EdaError::NotEquivalent`], naming the netlist and the first
+/// pair (`\\y[3]_gold [5] \\y[3]_gate [5]`: register 3, bit 5).
+pub fn check_equivalence(spec: &EquivSpec, work: &Path) -> Result<Equivalence> {
+    let yosys = Tool::Yosys.locate()?;
+    for src in &spec.rtl {
+        if !src.is_file() {
+            return Err(EdaError::RtlMissing { path: src.clone() });
+        }
+    }
+    if !spec.netlist.is_file() {
+        return Err(EdaError::RtlMissing {
+            path: spec.netlist.clone(),
+        });
+    }
+    let lib = crate::liberty::Liberty::load(&spec.liberty)?;
+    let netlist = std::fs::read_to_string(&spec.netlist)
+        .map_err(|e| EdaError::io("reading", &spec.netlist, e))?;
+    let models = crate::clock_gate::icg_models(&lib, &netlist);
+    let models_path = work.join("icg_models.v");
+    if let Some(m) = &models {
+        write_atomic(&models_path, m.as_bytes())?;
+    }
+    let script = work.join("equiv.ys");
+    write_atomic(
+        &script,
+        equiv_script_with(spec, models.as_ref().map(|_| models_path.as_path())).as_bytes(),
+    )?;
+    let log_path = work.join("equiv.log");
+    let start = std::time::Instant::now();
+    let out = Command::new(&yosys)
+        .arg("-q")
+        .arg("-l")
+        .arg(&log_path)
+        .arg(&script)
+        .output()
+        .map_err(|e| EdaError::io("running", &yosys, e))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let log = std::fs::read_to_string(&log_path).unwrap_or_default();
+    match parse_status(&log) {
+        Some((points, 0, _)) if out.status.success() => Ok(Equivalence {
+            points,
+            proven: points,
+            seconds,
+            log: log_path,
+        }),
+        Some((points, unproven, first)) if unproven > 0 => Err(EdaError::NotEquivalent(Box::new(
+            crate::error::EquivFailure {
+                netlist: spec.netlist.clone(),
+                top: spec.top.clone(),
+                unproven,
+                total: points,
+                first,
+                log_tail: tail(&log, 8),
+            },
+        ))),
+        _ => Err(EdaError::ToolFailed {
+            tool: "yosys (equivalence)",
+            status: out
+                .status
+                .code()
+                .map_or("killed by a signal".into(), |c| c.to_string()),
+            log_tail: tail(
+                &format!("{log}{}", String::from_utf8_lossy(&out.stderr)),
+                15,
+            ),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn status_is_parsed_from_the_last_pass() {
+        let log = "17. Executing EQUIV_STATUS pass.\nFound 35 $equiv cells in equiv:\n  Of those cells 24 are proven and 11 are unproven.\n  Unproven $equiv $auto$equiv_make.cc:274:find_same_wires$441: \\x_gold [6] \\x_gate [6]\n";
+        assert_eq!(
+            parse_status(log),
+            Some((35, 11, "\\x_gold [6] \\x_gate [6]".into()))
+        );
+        let ok = "Executing EQUIV_STATUS pass.\nFound 39 $equiv cells in equiv:\n  Of those cells 39 are proven and 0 are unproven.\n  Equivalence successfully proven!\n";
+        assert_eq!(parse_status(ok), Some((39, 0, String::new())));
+        assert_eq!(parse_status("nothing"), None);
+    }
+
+    #[test]
+    fn script_compares_coarse_gold_with_the_liberty_cells() {
+        let s = equiv_script(&EquivSpec {
+            rtl: vec!["p.v".into()],
+            top: "pix".into(),
+            params: vec![("B".into(), 2)],
+            netlist: "n.v".into(),
+            liberty: "c.lib".into(),
+        });
+        assert!(s.contains("chparam -set B 2 pix"));
+        assert!(s.contains("synth -top pix -flatten -run begin:fine"));
+        assert!(s.contains("read_liberty -ignore_miss_func c.lib\nread_verilog n.v"));
+        assert!(s.ends_with("equiv_status -assert\n"));
+    }
+}

@@ -1,0 +1,392 @@
+//! One chart description for every reproduce figure (lines, markers, mean ± sd error bars,
+//! labelled vertical marks and text notes such as the paper's printed values), rendered to
+//! SVG text by plotters on linear or logarithmic axes. Rendering never writes a file: the
+//! reproduction stages every figure into one output set (`reproduce`), whole or absent.
+
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{AsRangedCoord, Ranged, ValueFormatter};
+use plotters::prelude::*;
+
+use crate::ExperimentError;
+
+/// A named series of (x, y) points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+impl Series {
+    pub fn new(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            name: name.into(),
+            points,
+        }
+    }
+}
+
+/// A named set of (x, mean, sd) points drawn as a marker with a ±sd bar.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ErrorSeries {
+    pub name: String,
+    pub points: Vec<(f64, f64, f64)>,
+}
+
+/// One figure: everything drawn, and the file it is staged as.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Chart {
+    /// File name inside the output directory (a plain name).
+    pub file: String,
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub x_log: bool,
+    pub y_log: bool,
+    /// Drawn as lines.
+    pub lines: Vec<Series>,
+    /// Drawn as markers (e.g. the paper's printed values).
+    pub points: Vec<Series>,
+    pub error_bars: Vec<ErrorSeries>,
+    /// Labelled vertical lines (band edges, 3 dB points).
+    pub marks: Vec<(String, f64)>,
+    /// Text lines printed under the chart (the paper's values, the measured ones).
+    pub notes: Vec<String>,
+    /// Corner of the legend (the one the data leaves empty).
+    pub legend: Legend,
+}
+
+/// Where the legend box goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Legend {
+    #[default]
+    LowerLeft,
+    LowerRight,
+    UpperLeft,
+    UpperRight,
+}
+
+impl Legend {
+    fn position(self) -> SeriesLabelPosition {
+        match self {
+            Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
+            Legend::LowerRight => SeriesLabelPosition::LowerRight,
+            Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+            Legend::UpperRight => SeriesLabelPosition::UpperRight,
+        }
+    }
+}
+
+/// Distinct colours (the Tableau 10 set), in drawing order.
+const COLOURS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(23, 190, 207),
+    RGBColor(127, 127, 127),
+];
+
+/// A short tick label: 3 significant digits, trailing zeros dropped, exponent form only
+/// outside 1e-3..1e6.
+fn tick(v: &f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e6).contains(&a) {
+        return format!("{v:.0e}");
+    }
+    let digits = if a == 0.0 {
+        0
+    } else {
+        (2 - a.log10().floor() as i32).max(0) as usize
+    };
+    let s = format!("{v:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Height of the chart proper and of one note line (pixels).
+const CHART_H: u32 = 600;
+const LINE_H: u32 = 18;
+
+fn plot_err(file: &str, e: impl std::fmt::Display) -> ExperimentError {
+    ExperimentError::Plot {
+        path: file.to_string(),
+        message: e.to_string(),
+    }
+}
+
+impl Chart {
+    /// Every number the chart would draw, with where it comes from (for the finite check).
+    fn values(&self) -> impl Iterator<Item = (&str, f64)> {
+        let xy = |s: &'_ Series| {
+            s.points
+                .iter()
+                .flat_map(|&(x, y)| [x, y])
+                .collect::<Vec<_>>()
+        };
+        self.lines
+            .iter()
+            .chain(&self.points)
+            .flat_map(move |s| xy(s).into_iter().map(move |v| (s.name.as_str(), v)))
+            .chain(self.error_bars.iter().flat_map(|s| {
+                s.points
+                    .iter()
+                    .flat_map(|&(x, m, d)| [x, m, d])
+                    .map(move |v| (s.name.as_str(), v))
+            }))
+            .chain(self.marks.iter().map(|(n, v)| (n.as_str(), *v)))
+    }
+
+    /// The data range of one axis over every drawn element (positive values only on a
+    /// log axis), padded.
+    fn range(&self, x_axis: bool) -> Result<(f64, f64), ExperimentError> {
+        let log = if x_axis { self.x_log } else { self.y_log };
+        let mut v: Vec<f64> = Vec::new();
+        for s in self.lines.iter().chain(&self.points) {
+            v.extend(s.points.iter().map(|&(x, y)| if x_axis { x } else { y }));
+        }
+        for s in &self.error_bars {
+            for &(x, m, d) in &s.points {
+                if x_axis {
+                    v.push(x);
+                } else {
+                    v.extend([m - d, m + d]);
+                }
+            }
+        }
+        if x_axis {
+            v.extend(self.marks.iter().map(|m| m.1));
+        }
+        let v: Vec<f64> = v.into_iter().filter(|&a| !log || a > 0.0).collect();
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if !(lo.is_finite() && hi.is_finite()) || lo > hi {
+            return Err(plot_err(&self.file, "no data to plot on an axis"));
+        }
+        Ok(if log {
+            let (lo, hi) = if lo == hi {
+                (lo / 2.0, hi * 2.0)
+            } else {
+                (lo, hi)
+            };
+            (lo / 1.25, hi * 1.6)
+        } else {
+            let pad = if hi > lo { 0.06 * (hi - lo) } else { 1.0 };
+            (lo - pad, hi + pad)
+        })
+    }
+
+    /// Renders the chart as SVG text. Refuses a NaN or infinite value (naming its series):
+    /// no output carries one.
+    pub fn render(&self) -> Result<String, ExperimentError> {
+        if let Some((name, v)) = self.values().find(|(_, v)| !v.is_finite()) {
+            return Err(plot_err(
+                &self.file,
+                format!("series `{name}` holds {v}: every plotted value must be finite"),
+            ));
+        }
+        let (x0, x1) = self.range(true)?;
+        let (y0, y1) = self.range(false)?;
+        let mut svg = String::new();
+        {
+            let h = CHART_H + LINE_H * self.notes.len() as u32 + 8;
+            let root = SVGBackend::with_string(&mut svg, (960, h)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| plot_err(&self.file, e))?;
+            let (upper, lower) = root.split_vertically(CHART_H);
+            match (self.x_log, self.y_log) {
+                (false, false) => self.draw(&upper, x0..x1, y0..y1),
+                (true, false) => self.draw(&upper, (x0..x1).log_scale(), y0..y1),
+                (false, true) => self.draw(&upper, x0..x1, (y0..y1).log_scale()),
+                (true, true) => self.draw(&upper, (x0..x1).log_scale(), (y0..y1).log_scale()),
+            }?;
+            for (i, note) in self.notes.iter().enumerate() {
+                lower
+                    .draw(&Text::new(
+                        note.clone(),
+                        (80, (LINE_H * i as u32) as i32),
+                        ("sans-serif", 14).into_font().color(&BLACK),
+                    ))
+                    .map_err(|e| plot_err(&self.file, e))?;
+            }
+            root.present().map_err(|e| plot_err(&self.file, e))?;
+        }
+        Ok(svg)
+    }
+
+    fn draw<'a, X, Y>(
+        &self,
+        root: &DrawingArea<SVGBackend<'a>, Shift>,
+        xr: X,
+        yr: Y,
+    ) -> Result<(), ExperimentError>
+    where
+        X: AsRangedCoord<Value = f64>,
+        Y: AsRangedCoord<Value = f64>,
+        X::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        let e = |e: &dyn std::fmt::Display| plot_err(&self.file, e);
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, ("sans-serif", 19))
+            .margin(14)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d(xr, yr)
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .x_desc(self.x_label.as_str())
+            .y_desc(self.y_label.as_str())
+            .draw()
+            .map_err(|x| e(&x))?;
+        let (y_lo, y_hi) = {
+            let r = chart.y_range();
+            (r.start, r.end)
+        };
+        let mut colour = 0usize;
+        let mut next = || {
+            colour += 1;
+            COLOURS[(colour - 1) % COLOURS.len()].to_rgba()
+        };
+        for s in &self.lines {
+            let c = next();
+            chart
+                .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
+                .map_err(|x| e(&x))?
+                .label(s.name.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c));
+        }
+        for s in &self.error_bars {
+            let c = next();
+            // A marker at the mean and a bar from mean − sd to mean + sd (clipped to the
+            // axis on a log scale, where mean − sd may be ≤ 0).
+            let bar = |&(x, m, d): &(f64, f64, f64)| {
+                let lo = if self.y_log { (m - d).max(y_lo) } else { m - d };
+                PathElement::new(vec![(x, lo), (x, m + d)], c.stroke_width(2))
+            };
+            chart
+                .draw_series(s.points.iter().map(bar))
+                .map_err(|x| e(&x))?;
+            chart
+                .draw_series(
+                    s.points
+                        .iter()
+                        .map(|&(x, m, _)| Circle::new((x, m), 4, c.filled())),
+                )
+                .map_err(|x| e(&x))?
+                .label(s.name.as_str())
+                .legend(move |(x, y)| Circle::new((x + 8, y), 4, c.filled()));
+        }
+        for s in &self.points {
+            let c = next();
+            chart
+                .draw_series(
+                    s.points
+                        .iter()
+                        .map(|&p| Cross::new(p, 6, c.stroke_width(2))),
+                )
+                .map_err(|x| e(&x))?
+                .label(s.name.as_str())
+                .legend(move |(x, y)| Cross::new((x + 8, y), 5, c.stroke_width(2)));
+        }
+        for (i, (label, x)) in self.marks.iter().enumerate() {
+            let c = BLACK.mix(0.6);
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(*x, y_lo), (*x, y_hi)],
+                    c.stroke_width(1),
+                )))
+                .map_err(|x| e(&x))?;
+            // Labels stacked down from the top so that close marks do not overprint.
+            let (px, py) = chart.backend_coord(&(*x, y_hi));
+            root.draw(&Text::new(
+                label.clone(),
+                (px + 4, py + 6 + 17 * i as i32),
+                ("sans-serif", 13).into_font().color(&BLACK),
+            ))
+            .map_err(|x| e(&x))?;
+        }
+        chart
+            .configure_series_labels()
+            .position(self.legend.position())
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|x| e(&x))?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn chart() -> Chart {
+        Chart {
+            file: "t.svg".into(),
+            title: "T: a test".into(),
+            x_label: "x (Hz)".into(),
+            y_label: "y (µm)".into(),
+            x_log: true,
+            y_log: true,
+            lines: vec![Series::new("closed form", vec![(1.0, 1.0), (10.0, 10.0)])],
+            points: vec![Series::new("paper", vec![(2.0, 2.5)])],
+            error_bars: vec![ErrorSeries {
+                name: "mean ± sd".into(),
+                points: vec![(3.0, 3.0, 0.5)],
+            }],
+            marks: vec![("edge 5 Hz".into(), 5.0)],
+            notes: vec!["paper: 2.5 µm".into()],
+            legend: Legend::UpperRight,
+        }
+    }
+
+    #[test]
+    fn ticks_are_short() {
+        assert_eq!(tick(&0.300_000_000_000_004), "0.3");
+        assert_eq!(tick(&1000.0), "1000");
+        assert_eq!(tick(&156.25), "156");
+        assert_eq!(tick(&1e7), "1e7");
+        assert_eq!(tick(&0.0), "0");
+        assert_eq!(tick(&-20.0), "-20");
+    }
+
+    /// Every element reaches the SVG as text; a NaN anywhere is refused with its series.
+    #[test]
+    fn renders_text_and_refuses_non_finite() {
+        let svg = chart().render().unwrap();
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        for t in [
+            "T: a test",
+            "x (Hz)",
+            "closed form",
+            "paper: 2.5 µm",
+            "edge 5 Hz",
+        ] {
+            assert!(svg.contains(t), "{t}");
+        }
+        for (x_log, y_log) in [(false, false), (true, false), (false, true)] {
+            let c = Chart {
+                x_log,
+                y_log,
+                ..chart()
+            };
+            assert!(c.render().is_ok());
+        }
+        let mut bad = chart();
+        bad.error_bars[0].points[0].2 = f64::NAN;
+        let err = bad.render().unwrap_err().to_string();
+        assert!(err.contains("mean ± sd") && err.contains("NaN"), "{err}");
+        let empty = Chart {
+            file: "e.svg".into(),
+            ..Chart::default()
+        };
+        assert!(empty.render().is_err());
+    }
+}

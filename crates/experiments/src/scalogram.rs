@@ -1,0 +1,262 @@
+//! The Haar scalogram as an SVG heat map and as JSON.
+//!
+//! The heat map: time across (ms), scale down (u = 0, the whole frame, on top; U at the
+//! bottom), each coefficient a rectangle over its wavelet's support, so a coarse
+//! coefficient covers the 2^(U−u) finest cells below it. A diverging colour scale (blue
+//! for w < 0, a depth increase; white at 0; red for w > 0, a depth decrease), symmetric
+//! about 0 at ±max|w|, with a colour bar in mm. The row labels give the scale and its
+//! wavelet duration T/2^u. Events, when given, outline their peak coefficient in black.
+//!
+//! The JSON form is the [`ScalogramDocument`]: the scalogram (N, U, f_s and each
+//! coefficient's u, v, value_mm, start_s, end_s) and, if given, the events.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+use serde::Serialize;
+use tofprobe_dsp::haar::{EventReport, Scalogram};
+
+use tofprobe_eda::error::{EdaError, Result};
+
+/// Diverging blue–white–red for x in [−1, 1].
+pub fn diverging(x: f64) -> RGBColor {
+    let x = if x.is_finite() {
+        x.clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    // White to (178, 24, 43) for x > 0, white to (33, 102, 172) for x < 0 (ColorBrewer
+    // RdBu ends): linear in each half keeps 0 white and the sign readable.
+    let (r, g, b) = if x >= 0.0 {
+        (178.0, 24.0, 43.0)
+    } else {
+        (33.0, 102.0, 172.0)
+    };
+    let a = x.abs();
+    let mix = |c: f64| (255.0 + (c - 255.0) * a).round() as u8;
+    RGBColor(mix(r), mix(g), mix(b))
+}
+
+fn check(s: &Scalogram) -> std::result::Result<f64, String> {
+    if s.coefficients.is_empty() {
+        return Err("the scalogram has no coefficients".into());
+    }
+    if let Some(c) = s
+        .coefficients
+        .iter()
+        .find(|c| !(c.value_mm.is_finite() && c.start_s.is_finite() && c.end_s.is_finite()))
+    {
+        return Err(format!(
+            "coefficient ({}, {}) is not finite: {} mm over {}..{} s",
+            c.u, c.v, c.value_mm, c.start_s, c.end_s
+        ));
+    }
+    let vmax = s
+        .coefficients
+        .iter()
+        .map(|c| c.value_mm.abs())
+        .fold(0.0, f64::max);
+    Ok(if vmax > 0.0 { vmax } else { 1.0 })
+}
+
+/// Renders the scalogram (and optionally its events) as SVG text.
+pub fn scalogram_svg(
+    s: &Scalogram,
+    title: &str,
+    events: Option<&EventReport>,
+) -> std::result::Result<String, String> {
+    let vmax = check(s)?;
+    let u_max = s.scales;
+    let t_ms = s.duration_s() * 1e3;
+    let e = |e: &dyn std::fmt::Display| e.to_string();
+    let mut svg = String::new();
+    {
+        let root =
+            SVGBackend::with_string(&mut svg, (1000, 80 + 50 * (u_max + 1))).into_drawing_area();
+        root.fill(&WHITE).map_err(|x| e(&x))?;
+        let (main, bar) = root.split_horizontally(880);
+        // Row u spans y ∈ [U − u − ½, U − u + ½]: integer ticks fall on the row centres.
+        let y_top = f64::from(u_max) + 0.5;
+        let mut chart = ChartBuilder::on(&main)
+            .caption(title, ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(130)
+            .build_cartesian_2d(0.0..t_ms, -0.5..y_top)
+            .map_err(|x| e(&x))?;
+        let row_label = move |y: &f64| {
+            let k = y.round();
+            if (y - k).abs() > 1e-6 || k < 0.0 || k > f64::from(u_max) {
+                return String::new();
+            }
+            let u = u_max - k as u32;
+            let d = t_ms / (1u64 << u) as f64;
+            format!("u = {u} ({d:.3} ms)")
+        };
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("time (ms)")
+            .y_desc("scale (wavelet duration)")
+            .y_labels(u_max as usize + 2)
+            .y_label_formatter(&row_label)
+            .draw()
+            .map_err(|x| e(&x))?;
+        let row = |u: u32| f64::from(u_max - u);
+        chart
+            .draw_series(s.coefficients.iter().map(|c| {
+                let y = row(c.u);
+                Rectangle::new(
+                    [(c.start_s * 1e3, y - 0.5), (c.end_s * 1e3, y + 0.5)],
+                    diverging(c.value_mm / vmax).filled(),
+                )
+            }))
+            .map_err(|x| e(&x))?;
+        if let Some(ev) = events {
+            chart
+                .draw_series(ev.events.iter().map(|v| {
+                    let c = &v.peak;
+                    let y = row(c.u);
+                    Rectangle::new(
+                        [(c.start_s * 1e3, y - 0.5), (c.end_s * 1e3, y + 0.5)],
+                        BLACK.stroke_width(2),
+                    )
+                }))
+                .map_err(|x| e(&x))?;
+        }
+        // Colour bar: 100 strips from −max|w| to +max|w|.
+        let mut cb = ChartBuilder::on(&bar)
+            .margin_top(40)
+            .margin_bottom(50)
+            .margin_right(10)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0.0..1.0, -vmax..vmax)
+            .map_err(|x| e(&x))?;
+        cb.configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_desc("w (mm)")
+            .y_labels(7)
+            .y_label_formatter(&|y: &f64| format!("{y:+.3}"))
+            .draw()
+            .map_err(|x| e(&x))?;
+        let strips = 100;
+        cb.draw_series((0..strips).map(|i| {
+            let lo = -vmax + 2.0 * vmax * i as f64 / strips as f64;
+            let hi = -vmax + 2.0 * vmax * (i + 1) as f64 / strips as f64;
+            Rectangle::new(
+                [(0.0, lo), (1.0, hi)],
+                diverging(0.5 * (lo + hi) / vmax).filled(),
+            )
+        }))
+        .map_err(|x| e(&x))?;
+        root.present().map_err(|x| e(&x))?;
+    }
+    Ok(svg)
+}
+
+/// Writes the scalogram SVG to `path` atomically.
+pub fn write_scalogram_svg(
+    s: &Scalogram,
+    title: &str,
+    events: Option<&EventReport>,
+    path: &Path,
+) -> Result<()> {
+    let svg = scalogram_svg(s, title, events).map_err(|reason| EdaError::Plot {
+        path: path.to_path_buf(),
+        reason,
+    })?;
+    tofprobe_eda::fsutil::write_atomic(path, svg.as_bytes())
+}
+
+/// The JSON document of a scalogram and its events.
+#[derive(Debug, Clone, Serialize)]
+pub struct ScalogramDocument<'a> {
+    pub scalogram: &'a Scalogram,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub events: Option<&'a EventReport>,
+}
+
+/// The scalogram (and events) as pretty JSON; refuses non-finite values (JSON has none).
+pub fn scalogram_json(s: &Scalogram, events: Option<&EventReport>) -> Result<String> {
+    check(s).map_err(|reason| EdaError::OutOfRange {
+        field: "scalogram",
+        value: reason,
+        allowed: "finite coefficients and times".into(),
+    })?;
+    serde_json::to_string_pretty(&ScalogramDocument {
+        scalogram: s,
+        events,
+    })
+    .map_err(|source| EdaError::Json {
+        what: "the Haar scalogram".into(),
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tofprobe_dsp::haar::{HaarNoise, Thresholds, detect_events};
+
+    fn step() -> (Scalogram, EventReport) {
+        let n = 1024;
+        let x: Vec<f64> = (0..n).map(|i| if i >= 300 { 2.0 } else { 0.0 }).collect();
+        let s = Scalogram::from_depths_mm(&x, 5, 1e7).unwrap();
+        let t = Thresholds::new(&HaarNoise::new(0.05, 1.0).unwrap(), n, 5, 0.01).unwrap();
+        let ev = detect_events(&s, &t).unwrap();
+        (s, ev)
+    }
+
+    /// One rectangle per coefficient (63) plus 100 colour-bar strips plus one event
+    /// outline; the row labels name scale and duration; no NaN reaches the file.
+    #[test]
+    fn svg_has_every_coefficient_and_the_colour_bar() {
+        let (s, ev) = step();
+        let svg = scalogram_svg(&s, "step", Some(&ev)).unwrap();
+        assert!(svg.starts_with("<svg"));
+        let rects = svg.matches("<rect").count();
+        // + the background fill of the root.
+        assert!(rects > 63 + 100, "{rects} rects");
+        assert!(svg.contains("u = 5 (0.003 ms)"), "row label");
+        assert!(svg.contains("time (ms)") && svg.contains("w (mm)"));
+        assert!(!svg.contains("NaN"));
+        // The deepest colours are the extremes: w(5,9) = −0.75 is not the max; the max
+        // |w| is at a coarser scale; its colour is the full blue end.
+        assert!(
+            svg.contains("#2166AC") || svg.contains("#2166ac"),
+            "full blue present"
+        );
+        let mut bad = s.clone();
+        bad.coefficients[3].value_mm = f64::NAN;
+        assert!(scalogram_svg(&bad, "bad", None).is_err());
+        assert!(scalogram_json(&bad, None).is_err());
+    }
+
+    #[test]
+    fn colour_scale_is_diverging() {
+        assert_eq!(diverging(0.0), RGBColor(255, 255, 255));
+        assert_eq!(diverging(1.0), RGBColor(178, 24, 43));
+        assert_eq!(diverging(-1.0), RGBColor(33, 102, 172));
+        assert_eq!(diverging(f64::NAN), RGBColor(255, 255, 255));
+        assert_eq!(diverging(7.0), diverging(1.0));
+    }
+
+    /// The JSON round-trips: coefficients with u, v, value_mm, start_s, end_s, and the
+    /// events with their times and rates.
+    #[test]
+    fn json_round_trips() {
+        let (s, ev) = step();
+        let j = scalogram_json(&s, Some(&ev)).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&j).unwrap();
+        let back: Scalogram = serde_json::from_value(v["scalogram"].clone()).unwrap();
+        assert_eq!(back, s);
+        let c = &v["scalogram"]["coefficients"][0];
+        for k in ["u", "v", "value_mm", "start_s", "end_s"] {
+            assert!(c.get(k).is_some(), "{k}");
+        }
+        let evs: EventReport = serde_json::from_value(v["events"].clone()).unwrap();
+        assert_eq!(evs, ev);
+        assert_eq!(v["events"]["events"][0]["change"], "increase");
+    }
+}

@@ -1,0 +1,382 @@
+//! The speed/accuracy trade (issue 8): one configuration measured at every fidelity level
+//! on the same photon record — closed form, float full DFT, float selected-bin DFT, float
+//! ΣΔ probing, bit-true transaction model, cycle-accurate model (shortened frame,
+//! extrapolated) — each with its wall time per simulated second and its accuracy: the
+//! tone amplitude and the noise floor (mean amplitude over the noise bins) against the
+//! float full DFT and against the scene's true amplitude.
+
+pub mod haar;
+pub mod knobs;
+pub mod overrides;
+pub mod plot;
+pub mod skips;
+pub mod timing;
+
+use std::time::Instant;
+
+use serde::Serialize;
+use tofprobe_dsp::bins::SelectedBins;
+use tofprobe_dsp::closed_form::{
+    FirstArrival, MixtureParams, first_arrival, hold_response_sq, mixture_gain,
+    noise_floor_hold_mm, noise_floor_mm,
+};
+use tofprobe_dsp::dft::amplitude_spectrum;
+use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_detections};
+use tofprobe_pixel::autobins::choose_bins;
+use tofprobe_pixel::bench::bench_cycle;
+use tofprobe_pixel::spectrum::bit_true_spectrum;
+
+use tofprobe_design::{DesignError, ResolvedDesign};
+
+use crate::error::ExperimentError;
+use crate::records::{detection_record, held_record};
+use crate::spectrum::{BitTrueSetup, setup};
+
+/// Pulses of the shortened frame the cycle-accurate model is timed on.
+pub const CYCLE_FRAME: u64 = 1 << 14;
+
+/// One fidelity level's measurement.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct LevelResult {
+    /// Level name.
+    pub level: String,
+    /// Wall seconds per simulated second of sensor time (f_s pulses).
+    pub seconds_per_sim_second: f64,
+    /// True when the time was measured on a shortened frame and scaled up.
+    pub extrapolated: bool,
+    /// Tone amplitude read, µm (`None` for a scene without an in-band tone).
+    pub amplitude_um: Option<f64>,
+    /// Noise floor: mean amplitude over the noise bins, µm.
+    pub noise_um: f64,
+    /// |amplitude − float DFT amplitude|, µm.
+    pub amplitude_err_vs_dft_um: Option<f64>,
+    /// |amplitude − true amplitude|, µm.
+    pub amplitude_err_vs_true_um: Option<f64>,
+    /// Noise floor relative to the float DFT's, minus 1.
+    pub noise_rel_err_vs_dft: f64,
+}
+
+/// All levels of one configuration.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SceneResult {
+    /// Where the configuration came from.
+    pub origin: String,
+    /// Pulses N.
+    pub pulses: u64,
+    /// True amplitude of the scene's strongest in-band tone, µm.
+    pub true_amplitude_um: Option<f64>,
+    /// One row per level.
+    pub levels: Vec<LevelResult>,
+}
+
+/// The levels' raw readings before scoring: (name, wall s, extrapolated, tone µm, noise µm).
+type Reading = (&'static str, f64, bool, Option<f64>, f64);
+
+/// Measures every level on `design` (Fourier pixel; the float levels use its ROM's bins);
+/// with `verilator`, also the Verilator RTL on a shortened frame (builds the harness).
+pub fn measure(design: &ResolvedDesign, verilator: bool) -> Result<SceneResult, ExperimentError> {
+    let su: BitTrueSetup = setup(design)?;
+    measure_setup(design, &su, verilator)
+}
+
+/// [`measure`] with the ROM already generated (`su` from [`setup`] on the same `design`),
+/// so a caller that also times the bit-true model on its own generates the ROM once.
+pub fn measure_setup(
+    design: &ResolvedDesign,
+    su: &BitTrueSetup,
+    verilator: bool,
+) -> Result<SceneResult, ExperimentError> {
+    let (config, origin) = (&design.document, design.origin.as_str());
+    let scene_err = |source| ExperimentError::from(DesignError::scene(origin, source));
+    let source = config.photon_source().map_err(scene_err)?;
+    let n = su.params.frame_pulses;
+    let fs = config.sensor.laser_rate_hz;
+    let sim_seconds = n as f64 / fs;
+    let lsb_mm = config.sensor.tdc_lsb_mm();
+    let ctx = &design.context;
+    let choice = choose_bins(
+        &ctx.tones,
+        fs,
+        su.params.rom_depth as u64,
+        config.probe.osr,
+        Some(su.params.bins),
+    )
+    .map_err(|source| ExperimentError::from(DesignError::pixel(origin, source)))?;
+    let tone_bin = choice.tones.first().copied();
+    let true_amp = tone_bin.and_then(|k| {
+        ctx.tones
+            .iter()
+            .filter(|(f, _)| (f * su.params.rom_depth as f64 / fs).round() as u64 == k)
+            .map(|(_, a)| a.abs() * 1000.0)
+            .reduce(f64::max)
+    });
+    let noise_idx: Vec<usize> = (0..su.rom.bins.len())
+        .filter(|&i| Some(su.rom.bin_indices[i]) != tone_bin)
+        .collect();
+    let tone_idx = tone_bin.and_then(|k| su.rom.bin_indices.iter().position(|&b| b == k));
+    let score = |amps: &[f64]| -> (Option<f64>, f64) {
+        let noise = if noise_idx.is_empty() {
+            0.0
+        } else {
+            noise_idx.iter().map(|&i| amps[i]).sum::<f64>() / noise_idx.len() as f64
+        };
+        (tone_idx.map(|i| amps[i]), noise)
+    };
+    let mut readings: Vec<Reading> = Vec::new();
+
+    // The detections (mm) and the held depth record, as the pixel sees them: the one
+    // float front end's hold, nothing before the first detection.
+    let t0 = Instant::now();
+    let detections = detection_record(&source, n);
+    let depths = held_record(&source, &detections, 0.0)?;
+    let record_s = t0.elapsed().as_secs_f64();
+
+    // Closed form: eq. 12 with the window's N_eff and the 1NN hold, on the first-arrival
+    // mixture of signal and background (dsp::closed_form): its variance plus a²/12 for the
+    // noise, its valid rate ρ_v (a detection of either kind in the window) for the hold, and
+    // the gain ∂μ/∂t_s by which its mean follows the signal for the tone (pile-up: with
+    // background the first arrival follows a motion only when the signal photon came first).
+    // Without background this is σ² = σ_I² + a²/12, ρ_v = ρ_s and gain 1. The hold's noise
+    // factor F(ρ_v, ω) is averaged over the noise bins; the tone is scaled by g·|H(ρ_v, ω)|.
+    let t = Instant::now();
+    // The ROM's window (rectangular in periodic mode), so every level weighs alike.
+    let window = su.rom.window;
+    let mixture = MixtureParams {
+        signal_rate: config.sensor.signal_rate,
+        background_rate: config.sensor.background_rate,
+        signal_depth_mm: config.scene.depth_mm - config.sensor.window_start_mm(),
+        jitter_mm: config.sensor.jitter_mm(),
+        window_mm: config.sensor.window_end_mm() - config.sensor.window_start_mm(),
+    };
+    let dsp_err = |source| ExperimentError::from(DesignError::probe(origin, source));
+    // A scene without photons has no mixture: no detections, so the closed form reads 0.
+    let arrival = if mixture.signal_rate + mixture.background_rate > 0.0 {
+        first_arrival(&mixture).map_err(dsp_err)?
+    } else {
+        FirstArrival {
+            valid_rate: 0.0,
+            mean_mm: mixture.signal_depth_mm,
+            variance_mm2: mixture.jitter_mm * mixture.jitter_mm,
+            signal_fraction: 0.0,
+        }
+    };
+    let sigma = (arrival.variance_mm2 + lsb_mm * lsb_mm / 12.0).sqrt();
+    let rho = arrival.valid_rate.min(1.0);
+    let n_eff = n as f64 * window.effective_length_factor();
+    let omega = |i: usize| 2.0 * std::f64::consts::PI * su.rom.bins[i] / fs;
+    let cf_noise = if noise_idx.is_empty() {
+        noise_floor_mm(sigma, n_eff) * 1000.0
+    } else {
+        noise_idx
+            .iter()
+            .map(|&i| noise_floor_hold_mm(sigma, rho, omega(i), n_eff) * 1000.0)
+            .sum::<f64>()
+            / noise_idx.len() as f64
+    };
+    let gain = if config.sensor.background_rate > 0.0 {
+        mixture_gain(&mixture).map_err(dsp_err)?
+    } else {
+        1.0
+    };
+    let cf_amp = true_amp.map(|a| {
+        let w = tone_idx.map(omega).unwrap_or(0.0);
+        a * gain * hold_response_sq(rho, w).sqrt()
+    });
+    readings.push((
+        "closed form",
+        t.elapsed().as_secs_f64(),
+        false,
+        cf_amp,
+        cf_noise,
+    ));
+
+    // Float full DFT (rustfft over the whole record).
+    let t = Instant::now();
+    let spec = amplitude_spectrum(&depths, window)
+        .map_err(|source| ExperimentError::from(DesignError::probe(origin, source)))?;
+    // ROM bin k is f = k·f_s/L; in the N-point DFT that is k·N/L (equal in windowed mode,
+    // the nearest bin in periodic mode when L does not divide N).
+    let dft_bins = dft_bins(&su.rom.bin_indices, n, su.params.rom_depth);
+    let amps: Vec<f64> = dft_bins
+        .iter()
+        .map(|&k| spec.get(k).copied().unwrap_or(0.0) * 1000.0)
+        .collect();
+    let (a, nz) = score(&amps);
+    readings.push((
+        "float full DFT",
+        record_s + t.elapsed().as_secs_f64(),
+        false,
+        a,
+        nz,
+    ));
+    drop(spec);
+
+    // Float selected-bin DFT (streamed, only the B bins).
+    let t = Instant::now();
+    let bins = dft_bins;
+    let mut sel = SelectedBins::new(n, &bins, window).map_err(dsp_err)?;
+    for chunk in depths.chunks(1 << 16) {
+        sel.push(chunk).map_err(dsp_err)?;
+    }
+    let amps: Vec<f64> = sel
+        .amplitudes()
+        .map_err(dsp_err)?
+        .iter()
+        .map(|a| a * 1000.0)
+        .collect();
+    let (a, nz) = score(&amps);
+    readings.push((
+        "float selected-bin DFT",
+        record_s + t.elapsed().as_secs_f64(),
+        false,
+        a,
+        nz,
+    ));
+
+    // Float ΣΔ probing: the pixel's float twin (same ROM, the front end's hold, priming
+    // and prefilter α = 2^−S on the same detections).
+    let t = Instant::now();
+    let alpha = 1.0 / f64::from(1u32 << su.params.shift);
+    let zoom = f64::from(su.params.zoom);
+    let twin = detections
+        .iter()
+        .map(|c| c.map(|c| (f64::from(c) - zoom) * lsb_mm));
+    let sums = probe_detections(&su.rom, twin, Some(alpha));
+    let amps = amplitudes_um(&normalise(&su.rom, &sums, n, Some(alpha)));
+    let (a, nz) = score(&amps);
+    readings.push((
+        "float ΣΔ probing",
+        record_s + t.elapsed().as_secs_f64(),
+        false,
+        a,
+        nz,
+    ));
+    drop(depths);
+    drop(detections);
+
+    // Bit-true transaction model (streams the photon source itself).
+    let t = Instant::now();
+    let bt = bit_true_spectrum(&su.params, &su.rom, &source, lsb_mm)
+        .map_err(|source| ExperimentError::from(DesignError::pixel(origin, source)))?;
+    let amps: Vec<f64> = bt.bins.iter().map(|b| b.amplitude_um).collect();
+    let (a, nz) = score(&amps);
+    readings.push((
+        "bit-true transaction",
+        t.elapsed().as_secs_f64(),
+        false,
+        a,
+        nz,
+    ));
+
+    // Cycle-accurate model: timed on a shortened frame (same registers, schedule and
+    // C cycles per pulse) and scaled to N; its registers equal the transaction model's
+    // after every pulse (crates/pixel/tests/equivalence.rs), so its accuracy is the
+    // transaction model's.
+    let mut short = su.params.clone();
+    short.frame_pulses = CYCLE_FRAME.min(n);
+    short.rom_depth = short.rom_depth.min(short.frame_pulses as usize);
+    let rom = tofprobe_pixel::bench::synthetic_rom(short.rom_depth, short.registers());
+    let cb = bench_cycle(&short, &rom, 1)
+        .map_err(|source| ExperimentError::from(DesignError::pixel(origin, source)))?;
+    let per_pulse = cb.seconds / short.frame_pulses as f64;
+    readings.push(("cycle-accurate", per_pulse * n as f64, true, a, nz));
+
+    // Verilator RTL: the generated RTL co-simulated against the cycle model on a shortened
+    // frame of the scene's own detections; the bare harness time (no checking) scaled to
+    // N. A passing co-simulation is bit-exact, so its accuracy is the model's.
+    if verilator {
+        let mut rtl = short.clone();
+        rtl.rom_depth = rtl.rom_depth.min(rtl.frame_pulses as usize);
+        let mut stim = vec![None; short.frame_pulses as usize];
+        source.fill_counted(0, &mut stim);
+        let work =
+            std::env::temp_dir().join(format!("tofprobe-tradeoff-rtl-{}", std::process::id()));
+        let mut o = tofprobe_cosim::CosimOptions::new(&work);
+        o.frames = 1;
+        o.measure_bare = true;
+        o.profile = tofprobe_cosim::BuildProfile::Speed;
+        o.stimulus = Some(stim);
+        // A scratch directory: removed after the run, and by an interrupt during it
+        // (tofprobe_io::live).
+        let live = tofprobe_io::live::register(tofprobe_io::live::Kind::Temporary, &work);
+        let rep = tofprobe_cosim::cosim(&rtl, &o);
+        let _ = std::fs::remove_dir_all(&work);
+        drop(live);
+        let rep = rep?;
+        if !rep.pass {
+            return Err(ExperimentError::Output {
+                path: work,
+                message: "Verilator co-simulation mismatched the model; run `tofprobe cosim`"
+                    .into(),
+            });
+        }
+        let secs = rep.bare_seconds.unwrap_or(rep.verilator_seconds);
+        let per_pulse = secs / rep.pulses.max(1) as f64;
+        readings.push(("Verilator RTL", per_pulse * n as f64, true, a, nz));
+    }
+
+    let dft = readings[1];
+    let levels = readings
+        .iter()
+        .map(|&(name, secs, extrapolated, amp, noise)| LevelResult {
+            level: name.to_string(),
+            seconds_per_sim_second: secs / sim_seconds,
+            extrapolated,
+            amplitude_um: amp,
+            noise_um: noise,
+            amplitude_err_vs_dft_um: amp.zip(dft.3).map(|(x, d)| (x - d).abs()),
+            amplitude_err_vs_true_um: amp.zip(true_amp).map(|(x, t)| (x - t).abs()),
+            noise_rel_err_vs_dft: if dft.4 > 0.0 {
+                noise / dft.4 - 1.0
+            } else {
+                0.0
+            },
+        })
+        .collect();
+    Ok(SceneResult {
+        origin: origin.to_string(),
+        pulses: n,
+        true_amplitude_um: true_amp,
+        levels,
+    })
+}
+
+/// The ROM's bins k·f_s/L as indices of the N-point DFT (equal in windowed mode, the
+/// nearest bin in periodic mode when L does not divide N).
+pub fn dft_bins(rom_bins: &[u64], n: u64, rom_depth: usize) -> Vec<usize> {
+    rom_bins
+        .iter()
+        .map(|&k| (k as f64 * n as f64 / rom_depth as f64).round() as usize)
+        .collect()
+}
+
+/// The Markdown table of one scene.
+pub fn markdown(r: &SceneResult) -> String {
+    let mut s = format!(
+        "### {} (N = {}, true amplitude {})\n\n| level | wall s per simulated s | amplitude µm | err vs DFT µm | err vs true µm | noise µm | noise vs DFT |\n|---|---|---|---|---|---|---|\n",
+        r.origin,
+        r.pulses,
+        r.true_amplitude_um
+            .map(|a| format!("{a:.2} µm"))
+            .unwrap_or_else(|| "–".into())
+    );
+    let f = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "–".into());
+    for l in &r.levels {
+        s.push_str(&format!(
+            "| {}{} | {:.3e} | {} | {} | {} | {:.3} | {:+.1}% |\n",
+            l.level,
+            if l.extrapolated {
+                " (extrapolated)"
+            } else {
+                ""
+            },
+            l.seconds_per_sim_second,
+            f(l.amplitude_um),
+            f(l.amplitude_err_vs_dft_um),
+            f(l.amplitude_err_vs_true_um),
+            l.noise_um,
+            l.noise_rel_err_vs_dft * 100.0
+        ));
+    }
+    s
+}

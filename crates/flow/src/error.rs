@@ -1,0 +1,89 @@
+//! `FlowError`: every way the hardware flow fails (the design, an experiment it reports on,
+//! a tool, an output file). Messages name what to change or install.
+
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+/// The one error type of the flow crate.
+#[derive(Debug, Error)]
+pub enum FlowError {
+    /// The configuration does not resolve (the message names the key and a valid value).
+    #[error(transparent)]
+    Design(Box<tofprobe_design::DesignError>),
+    /// An experiment the flow reports on failed (spectrum, transients, options).
+    #[error(transparent)]
+    Experiment(Box<tofprobe_experiments::ExperimentError>),
+    /// A float reference refused its input.
+    #[error(transparent)]
+    Dsp(#[from] tofprobe_dsp::DspError),
+    /// The scene or sensor model refused its input.
+    #[error(transparent)]
+    Scene(#[from] tofprobe_scene::SceneError),
+    /// The bit-true pixel refused its parameters.
+    #[error(transparent)]
+    Pixel(#[from] tofprobe_pixel::PixelError),
+    /// A file cannot be written.
+    #[error("cannot write `{path}`: {source}")]
+    Io {
+        /// The output path.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// An output file cannot be written.
+    #[error("cannot write `{path}`: {message}")]
+    Output {
+        /// The output path.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// An option out of range.
+    #[error("--{option} = {value} is out of range: allowed {allowed}")]
+    Option {
+        /// The option's name without dashes.
+        option: String,
+        /// The value given.
+        value: String,
+        /// The allowed range.
+        allowed: String,
+    },
+    /// A sizing report or sign-off step failed (tool or liberty missing, synthesis error, …).
+    #[error("{0}")]
+    Eda(#[from] tofprobe_eda::EdaError),
+    /// RTL generation or vector writing failed.
+    #[error("{0}")]
+    Rtl(#[from] tofprobe_rtlgen::RtlError),
+    /// Co-simulation failed to run (a tool missing: the message names the install script).
+    #[error("{0}")]
+    Cosim(#[from] tofprobe_cosim::CosimError),
+}
+
+impl FlowError {
+    /// An option out of range.
+    pub fn option(option: &str, value: impl ToString, allowed: &str) -> Self {
+        FlowError::Option {
+            option: option.to_string(),
+            value: value.to_string(),
+            allowed: allowed.to_string(),
+        }
+    }
+}
+
+// Boxed: the design and experiment errors carry other crates' errors inline, and every flow
+// function returns this type (clippy::result_large_err).
+impl From<tofprobe_design::DesignError> for FlowError {
+    fn from(e: tofprobe_design::DesignError) -> Self {
+        FlowError::Design(Box::new(e))
+    }
+}
+
+impl From<tofprobe_experiments::ExperimentError> for FlowError {
+    fn from(e: tofprobe_experiments::ExperimentError) -> Self {
+        match e {
+            tofprobe_experiments::ExperimentError::Design(d) => FlowError::Design(d),
+            other => FlowError::Experiment(Box::new(other)),
+        }
+    }
+}

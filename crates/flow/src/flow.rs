@@ -1,0 +1,545 @@
+//! The main flow (`tofprobe flow`). Scene → bit-true model → RTL → golden vectors →
+//! Verilator co-simulation → a short report (spectrum at the bins, register widths,
+//! verdict, sizing summary; a Haar pixel's transient analysis and `scalogram.svg`) in the
+//! output directory. Installs nothing: a missing tool is
+//! named together with scripts/install-tools.sh.
+//!
+//! The ROM is the configuration's ΣΔ probe ROM (`probe_rom`); its bins come from the scene
+//! (`autobins`) for the frame actually simulated. The default short frame is whole periods
+//! of a periodic ROM ([`periodic_short_frame`]: the default's 60,000 = 3 × 20,000), and for
+//! a windowed ROM is chosen so that the scene's strongest in-band tone sits exactly on a
+//! bin (see [`short_frame`]): a windowed readout off a bin loses up to the window's
+//! scalloping (≈ 12 % for Blackman at half a bin), which would hide whether the chain
+//! reads the right amplitude.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use tofprobe_cosim::{CosimOptions, cosim};
+use tofprobe_design::rom_policy::{RtlOverrides, rtl_rom};
+use tofprobe_design::{ResolvedDesign, rtl_params};
+use tofprobe_dsp::sd::{amplitudes_um, normalise, prefilter_response};
+use tofprobe_pixel::Mode;
+use tofprobe_pixel::fixed::sign_extend as sext;
+use tofprobe_rtlgen::write::write_atomic;
+
+use crate::error::FlowError;
+use crate::sizing::{SizeOptions, size_report};
+
+/// What the flow runs on a design.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowOptions {
+    /// Output directory (RTL, vectors, report.md).
+    pub out: PathBuf,
+    /// Pulses per frame N (default: a short frame of at most [`SHORT_FRAME`] pulses on
+    /// which the scene's strongest tone sits on a bin; the design's own N with
+    /// `full_frame`).
+    pub frame_pulses: Option<u64>,
+    /// Use the design's frame length.
+    pub full_frame: bool,
+    /// Frames (1..=100).
+    pub frames: u64,
+    /// Skip the sizing summary.
+    pub no_size: bool,
+    /// Include the sky130 area-only mapping in the sizing summary.
+    pub sky130: bool,
+    /// Sign off the co-simulated RTL: synthesis, gate-level replay of the same vectors and
+    /// equivalence on every library found ([`crate::signoff`]); short frames only.
+    pub signoff: bool,
+    /// The options study that chose this design (`flow --recommended`): the report opens
+    /// with the recommendation and carries the options table.
+    pub options: Option<tofprobe_experiments::options::OptionsReport>,
+}
+
+/// What the flow found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowOutcome {
+    /// Whether the co-simulation (and, when asked, every library's sign-off) passed.
+    pub pass: bool,
+    /// Pulses per frame simulated.
+    pub frame_pulses: u64,
+    /// Cycles co-simulated.
+    pub cycles: u64,
+    /// Mismatching cycles.
+    pub mismatches: u64,
+    /// Wall time of the flow (s).
+    pub seconds: f64,
+    /// One line on the readout (the strongest bin, or the Haar coefficients).
+    pub headline: String,
+    /// The sizing summary line (or why it is missing).
+    pub size_line: String,
+    /// The report written.
+    pub report: PathBuf,
+    /// The sign-off per library (empty without `signoff`).
+    pub signoff: Vec<crate::signoff::SignoffLine>,
+}
+
+/// Longest default short frame of the flow.
+pub const SHORT_FRAME: u64 = 65_536;
+
+/// The flow's default frame: the longest N in [SHORT_FRAME/2, SHORT_FRAME] for which the
+/// strongest tone below `band_hz` is a whole number of cycles per frame (f·N/f_s an integer,
+/// so a windowed ROM of depth N has a bin on it), else SHORT_FRAME. The default's 4.5 kHz
+/// at 10 MHz gives N = 60 000, bin 27.
+pub fn short_frame(tones: &[(f64, f64)], sample_rate_hz: f64, band_hz: f64) -> u64 {
+    let strongest = tones
+        .iter()
+        .filter(|(f, a)| *f > 0.0 && *f < band_hz && a.is_finite())
+        .max_by(|x, y| x.1.abs().total_cmp(&y.1.abs()));
+    let Some(&(f, _)) = strongest else {
+        return SHORT_FRAME;
+    };
+    (SHORT_FRAME / 2..=SHORT_FRAME)
+        .rev()
+        .find(|&n| {
+            let k = f * n as f64 / sample_rate_hz;
+            // Relative tolerance: k is a few hundred at most, f and f_s are exact decimals.
+            (k - k.round()).abs() < 1e-9 * k.max(1.0) && k.round() >= 1.0
+        })
+        .unwrap_or(SHORT_FRAME)
+}
+
+/// The flow's default frame for a periodic ROM of depth L: the most whole periods that fit
+/// in [`SHORT_FRAME`], at least one (the default's L = 20,000 gives 60,000).
+pub fn periodic_short_frame(l: u64) -> u64 {
+    (SHORT_FRAME / l.max(1)).max(1) * l.max(1)
+}
+
+/// Runs the flow on `design` and writes its report into `a.out`.
+pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome, FlowError> {
+    if a.frames == 0 || a.frames > 100 {
+        return Err(FlowError::option("frames", a.frames, "1..=100"));
+    }
+    // Before minutes of co-simulation, not after: a hand-written report.md stays.
+    refuse_foreign_report(&a.out.join("report.md"))?;
+    let t_start = std::time::Instant::now();
+    let config = &design.document;
+    let fs = config.sensor.laser_rate_hz;
+    let n_override = if a.full_frame {
+        a.frame_pulses
+    } else {
+        let band = fs / (2.0 * config.probe.osr);
+        // Haar frames must be a power of two and have no bins to align.
+        let haar = design.pixel.mode == tofprobe_pixel::Mode::Haar;
+        let probe = &config.probe;
+        let periodic = probe.rom_mode == tofprobe_dsp::sd::RomMode::Periodic;
+        Some(if haar {
+            a.frame_pulses.unwrap_or(SHORT_FRAME)
+        } else if periodic {
+            // The bins are already on the ROM's grid: whole periods, as many as fit.
+            a.frame_pulses
+                .unwrap_or_else(|| periodic_short_frame(probe.rom_depth as u64))
+        } else {
+            a.frame_pulses
+                .unwrap_or_else(|| short_frame(design.tones(), fs, band))
+        })
+    };
+    let overrides = RtlOverrides {
+        frame_pulses: n_override,
+        rom_depth: None,
+    };
+    let mut p = rtl_params(design, &overrides)?;
+    let rom = rtl_rom(design, &mut p)?;
+    if a.signoff {
+        // Before the co-simulation: a trace too long for gate level is refused at once.
+        crate::signoff::check_length(&p, a.frames)?;
+    }
+    // Scene → TDC stream.
+    let source = design.photon_source()?;
+    let mut stim = vec![None; (a.frames * p.frame_pulses) as usize];
+    source.fill(0, &mut stim);
+    let mut o = CosimOptions::new(&a.out);
+    o.frames = a.frames;
+    o.seed = config.acquisition.seed;
+    o.stimulus = Some(stim);
+    o.rom = Some(rom.words.clone());
+    if a.frames * p.frame_pulses * p.cycles_per_pulse as u64 > 2_000_000 {
+        o.digest_pulses = 1024;
+        o.profile = tofprobe_cosim::BuildProfile::Speed;
+    }
+    let r = cosim(&p, &o)?;
+    let lsb_mm = config.sensor.tdc_lsb_mm();
+    let mut md = String::new();
+    let _ = writeln!(md, "{REPORT_TITLE}\n");
+    let _ = writeln!(
+        md,
+        "Configuration: {} (hash {}), {:?} mode, N = {} pulses/frame, {} frame(s), L = {}.\n\nROM: {}.\n",
+        tofprobe_io::text::sanitize(&design.origin),
+        tofprobe_rtlgen::config_hash(&p),
+        p.mode,
+        p.frame_pulses,
+        a.frames,
+        p.rom_depth,
+        rom.note
+    );
+    if let Some(o) = &a.options {
+        let _ = writeln!(
+            md,
+            "## Recommended architecture\n\nThis pixel is the option `{}` that `tofprobe size --options` recommends (target: tone error ≤ {} µm against the float DFT; the table below).\n",
+            o.recommendation.option, o.target_error_um
+        );
+    }
+    let _ = writeln!(md, "## Verdict\n");
+    let _ = writeln!(
+        md,
+        "Co-simulation (Verilator vs the pixel crate's cycle model): **{}**, {} cycles, {} mismatches, Verilator {:.2} s, model {:.2} s.{}\n",
+        if r.pass { "PASS" } else { "FAIL" },
+        r.cycles,
+        r.outcome.mismatches,
+        r.verilator_seconds,
+        r.model_seconds,
+        r.first
+            .as_ref()
+            .map(|m| format!(
+                " First mismatch: cycle {} pulse {} {} expected {} actual {}.",
+                m.cycle, m.pulse, m.signal, m.expected, m.actual
+            ))
+            .unwrap_or_default()
+    );
+    let _ = writeln!(md, "## Register widths\n");
+    let _ = writeln!(
+        md,
+        "{} registers x W = {} bits ({} bits of readout per frame); operand {} bits (T = {}, F = {}{}); TDC LSB {:.4} mm.\n",
+        p.registers(),
+        p.width,
+        p.registers() as u64 * u64::from(p.width),
+        p.operand_bits(),
+        p.tdc_bits,
+        p.effective_frac_bits(),
+        // G only where it differs from F, so the default's report reads as before.
+        if p.register_frac_bits() < p.effective_frac_bits() {
+            format!(", G = {}", p.register_frac_bits())
+        } else {
+            String::new()
+        },
+        lsb_mm
+    );
+    let mut headline = String::new();
+    if let Some(f) = r.readouts.first() {
+        if p.mode == Mode::Fourier {
+            headline = spectrum(&mut md, &p, f, rom.sd.as_ref(), lsb_mm);
+        } else {
+            headline =
+                tofprobe_experiments::transients::flow_section(&mut md, design, &p, f, &a.out)?;
+        }
+    }
+    let size_line = if a.no_size {
+        "sizing skipped (--no-size)".to_string()
+    } else {
+        let sa = SizeOptions {
+            liberty: None,
+            no_sky130: !a.sky130,
+            sky130_pdk: None,
+            node_nm: 40.0,
+            // The configured point only: the B/W sweeps are `tofprobe size`'s job.
+            sweep_bins: Some(vec![p.bins as u64]),
+            sweep_widths: Some(vec![p.width]),
+            cache: None,
+        };
+        match size_report(design, &sa) {
+            Ok(s) => tofprobe_eda::markdown::summary(&s),
+            // Non-fatal: the flow's verdict is the co-simulation; say what is missing.
+            Err(e) => format!(
+                "sizing not available ({e}); run scripts/install-tools.sh, or pass --no-size"
+            ),
+        }
+    };
+    let _ = writeln!(
+        md,
+        "## Sizing\n\n{size_line}{}\n",
+        if a.sky130 {
+            ""
+        } else {
+            " (sky130 skipped; --sky130 includes it)"
+        }
+    );
+    if let Some(o) = &a.options {
+        md += &tofprobe_experiments::options::markdown::render(o);
+        md += "\n";
+    }
+    let mut signoff = Vec::new();
+    if a.signoff {
+        let _ = writeln!(md, "## Sign-off\n");
+        if r.pass {
+            signoff = crate::signoff::sign_off_all(
+                &p,
+                fs,
+                &r.rtl_dir,
+                &r.vectors_dir,
+                &a.out.join("signoff"),
+            )?;
+            for l in &signoff {
+                let _ = writeln!(md, "- {}", l.text);
+            }
+            let _ = writeln!(md);
+        } else {
+            let _ = writeln!(md, "Not run: the co-simulation failed.\n");
+        }
+    }
+    let seconds = t_start.elapsed().as_secs_f64();
+    let _ = writeln!(md, "Flow time: {seconds:.1} s.");
+    let path = a.out.join("report.md");
+    refuse_foreign_report(&path)?;
+    write_atomic(&path, md.as_bytes())?;
+    Ok(FlowOutcome {
+        pass: r.pass && signoff.iter().all(|l| l.pass()),
+        frame_pulses: p.frame_pulses,
+        cycles: r.cycles,
+        mismatches: r.outcome.mismatches,
+        seconds,
+        headline,
+        size_line,
+        report: path,
+        signoff,
+    })
+}
+
+/// First line of every flow report: a `report.md` that does not start with it was written by
+/// someone else and is never replaced.
+const REPORT_TITLE: &str = "# tofprobe flow report";
+
+/// Refuses to replace a `report.md` that the flow did not write.
+fn refuse_foreign_report(path: &std::path::Path) -> Result<(), FlowError> {
+    match std::fs::read(path) {
+        Ok(bytes) if !bytes.starts_with(REPORT_TITLE.as_bytes()) => {
+            Err(tofprobe_rtlgen::RtlError::Foreign {
+                path: path.to_path_buf(),
+            }
+            .into())
+        }
+        _ => Ok(()),
+    }
+}
+
+/// One probed bin of a readout, normalised.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BinReading {
+    /// Raw sums in TDC codes (the register words / 2^F).
+    pub i: f64,
+    pub q: f64,
+    /// |H_pre(f_k)| of the prefilter at the bin.
+    pub prefilter_gain: f64,
+    /// Amplitude in µm and phase in degrees.
+    pub amplitude_um: f64,
+    pub phase_deg: f64,
+}
+
+/// Normalises a Fourier readout `f` (raw W-bit words, register 2k = I, 2k+1 = Q) read with
+/// the ΣΔ ROM `rom`: (I − jQ) · 2/N / (G · A_p · H_pre(f_k)) in codes, times the LSB.
+pub fn normalised_bins(
+    p: &tofprobe_pixel::PixelParams,
+    f: &[u64],
+    rom: &tofprobe_dsp::sd::ProbeRom,
+    lsb_mm: f64,
+) -> Vec<BinReading> {
+    let frac = f64::from(1u32 << p.register_frac_bits());
+    let sums: Vec<(f64, f64)> = (0..p.bins.min(rom.bins.len()))
+        .map(|k| {
+            (
+                sext(f[2 * k], p.width) as f64 / frac,
+                sext(f[2 * k + 1], p.width) as f64 / frac,
+            )
+        })
+        .collect();
+    let alpha = 1.0 / f64::from(1u32 << p.shift);
+    let phasors = normalise(rom, &sums, p.frame_pulses, Some(alpha));
+    // normalise works in the sums' unit (TDC codes); µm = codes · LSB (mm) · 1000.
+    let amps = amplitudes_um(&phasors);
+    sums.iter()
+        .zip(&phasors)
+        .zip(amps)
+        .zip(&rom.bins)
+        .map(|(((&(i, q), y), a), &hz)| {
+            let amp = a * lsb_mm;
+            let ph = y.arg().to_degrees();
+            BinReading {
+                i,
+                q,
+                prefilter_gain: prefilter_response(alpha, hz / rom.sample_rate_hz).norm(),
+                amplitude_um: if amp.is_finite() { amp } else { 0.0 },
+                phase_deg: if ph.is_finite() { ph } else { 0.0 },
+            }
+        })
+        .collect()
+}
+
+/// Writes the spectrum table of a Fourier readout `f` (raw W-bit words) into `md`: with the
+/// ΣΔ ROM, normalised to µm ([`normalised_bins`]); with the sign probe, raw. Returns a
+/// one-line headline (the strongest bin).
+fn spectrum(
+    md: &mut String,
+    p: &tofprobe_pixel::PixelParams,
+    f: &[u64],
+    sd: Option<&tofprobe_dsp::sd::ProbeRom>,
+    lsb_mm: f64,
+) -> String {
+    let Some(rom) = sd else {
+        let frac = f64::from(1u32 << p.register_frac_bits());
+        let _ = writeln!(
+            md,
+            "## Spectrum at the bins (frame 0, sign-of-cosine probes: unnormalised)\n"
+        );
+        let _ = writeln!(md, "| bin | I (codes) | Q (codes) |\n|---|---|---|");
+        for k in 0..p.bins {
+            let i = sext(f[2 * k], p.width) as f64 / frac;
+            let q = sext(f[2 * k + 1], p.width) as f64 / frac;
+            let _ = writeln!(md, "| {k} | {i} | {q} |");
+        }
+        let _ = writeln!(md);
+        return "sign-probe ROM: spectrum not normalised".into();
+    };
+    let bins = normalised_bins(p, f, rom, lsb_mm);
+    let _ = writeln!(
+        md,
+        "## Spectrum at the bins (frame 0, ΣΔ ROM)\n\nAmplitude = |I − jQ| · 2/N / (G · A_p · |H_pre(f_k)|) · LSB, with N = {}, G = {:.4} ({} window), A_p = {}, α = 2^-{}, LSB = {:.4} mm. I and Q in TDC codes.\n",
+        p.frame_pulses,
+        rom.coherent_gain,
+        rom.window.name(),
+        rom.amplitude,
+        p.shift,
+        lsb_mm
+    );
+    let _ = writeln!(
+        md,
+        "| reg pair | k | f (Hz) | I | Q | abs(H_pre) | amplitude (µm) | phase (deg) |\n|---|---|---|---|---|---|---|---|"
+    );
+    let mut best = (0usize, f64::MIN);
+    for (b, r) in bins.iter().enumerate() {
+        if r.amplitude_um > best.1 {
+            best = (b, r.amplitude_um);
+        }
+        let _ = writeln!(
+            md,
+            "| {b} | {} | {:.1} | {:.3} | {:.3} | {:.4} | {:.2} | {:.1} |",
+            rom.bin_indices[b],
+            rom.bins[b],
+            r.i,
+            r.q,
+            r.prefilter_gain,
+            r.amplitude_um,
+            r.phase_deg
+        );
+    }
+    let _ = writeln!(md);
+    // Noise estimate: the median of the other bins (autobins' noise bins keep clear of the
+    // tones' main lobes, so they read the floor: photon jitter and ΣΔ noise over N pulses).
+    let mut rest: Vec<f64> = bins.iter().skip(1).map(|r| r.amplitude_um).collect();
+    rest.sort_by(f64::total_cmp);
+    let floor = rest.get(rest.len() / 2).copied().unwrap_or(0.0);
+    let _ = writeln!(
+        md,
+        "Noise estimate (median of bins 1..): {floor:.2} µm; it falls as 1/√N (a short frame reads a 100 µm tone only to ± this).\n"
+    );
+    match bins.first() {
+        Some(r) => format!(
+            "bin 0 ({:.1} Hz) reads {:.2} µm, noise estimate {floor:.2} µm; strongest bin {:.1} Hz",
+            rom.bins[0], r.amplitude_um, rom.bins[best.0]
+        ),
+        None => "no bins".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tofprobe_dsp::sd::{ProbeConfig, ProbeDesign, ProbeRom};
+    use tofprobe_pixel::PixelParams;
+
+    #[test]
+    fn periodic_short_frame_is_whole_periods() {
+        assert_eq!(periodic_short_frame(20_000), 60_000);
+        assert_eq!(periodic_short_frame(65_536), 65_536);
+        assert_eq!(periodic_short_frame(100_000), 100_000);
+        assert_eq!(periodic_short_frame(7), 65_534);
+    }
+
+    #[test]
+    fn short_frame_puts_the_strongest_tone_on_a_bin() {
+        // 4.5 kHz at 10 MHz: f·N/f_s = 9N/20000 is an integer iff 20000 | N; the largest
+        // such N ≤ 65536 is 60000 (bin 27), whatever the weaker tones are.
+        let tones = [(4500.0, 0.1), (7000.0, 0.01)];
+        assert_eq!(short_frame(&tones, 10e6, 156_250.0), 60_000);
+        // No tone, or the only tone out of band: the plain short frame.
+        assert_eq!(short_frame(&[], 10e6, 156_250.0), SHORT_FRAME);
+        assert_eq!(short_frame(&[(2e5, 0.1)], 10e6, 156_250.0), SHORT_FRAME);
+        // 1 kHz at 10 MHz: 10000 | N, so 60000 again; 2^16 itself when f = f_s/2^10.
+        assert_eq!(short_frame(&[(1000.0, 0.1)], 10e6, 156_250.0), 60_000);
+        assert_eq!(
+            short_frame(&[(10e6 / 1024.0, 0.1)], 10e6, 156_250.0),
+            SHORT_FRAME
+        );
+    }
+
+    /// The flow's normalisation against a naive float pixel: a 3-code cosine through the
+    /// prefilter x[n] = x[n−1] + α(d[n−1] − x[n−1]), summed with the ROM's ±1 bits into
+    /// W-bit words with F fraction bits, must read back 3 codes · LSB at its bin and ≈ 0 at
+    /// another. Tolerance 1 %: the ΣΔ probe reads A_p to < 0.5 % (crates/dsp probe tests),
+    /// the word rounding is 2^−F/N relative, and Blackman leakage from bin 100 to bin 40
+    /// is below −90 dB.
+    #[test]
+    fn readout_normalises_to_the_tone_amplitude() {
+        let n = 8192usize;
+        let cfg = ProbeConfig::default();
+        let design = ProbeDesign::new(&cfg, 40.0 / n as f64).unwrap();
+        let rom = ProbeRom::generate(&design, 10e6, n as u64, &[40, 100]).unwrap();
+        let p = PixelParams {
+            bins: 2,
+            frame_pulses: n as u64,
+            rom_depth: n,
+            frac_bits: 8,
+            shift: 5,
+            width: 40,
+            ..PixelParams::default()
+        };
+        let alpha = 1.0 / 32.0;
+        let (amp, phase) = (3.0, 0.3f64);
+        let d: Vec<f64> = (0..n)
+            .map(|i| amp * (2.0 * std::f64::consts::PI * 40.0 * i as f64 / n as f64 + phase).cos())
+            .collect();
+        let mut x = d[0];
+        let mut sums = [0.0f64; 4];
+        for i in 1..n {
+            x += alpha * (d[i - 1] - x);
+            for (r, s) in sums.iter_mut().enumerate() {
+                *s += if rom.image.bit(i, r) { x } else { -x };
+            }
+        }
+        let words = |frac: f64| -> Vec<u64> {
+            sums.iter()
+                .map(|s| ((s * frac).round() as i64 as u64) & ((1u64 << 40) - 1))
+                .collect()
+        };
+        let lsb_mm = 0.75;
+        let b = normalised_bins(&p, &words(256.0), &rom, lsb_mm);
+        let want_um = amp * lsb_mm * 1000.0;
+        // Registers keeping G = 2 of the F = 8 fraction bits count in 2^−2 codes: the same
+        // sums as G-bit words must read back the same amplitude (the word rounding, 2^−2/N
+        // relative, is far below the 1 %), and read as F-bit words they would be 2^6 low.
+        let pg = PixelParams {
+            register_frac_bits: Some(2),
+            ..p.clone()
+        };
+        let bg = normalised_bins(&pg, &words(4.0), &rom, lsb_mm);
+        assert!(
+            (bg[0].amplitude_um / want_um - 1.0).abs() < 0.01,
+            "G = 2: {} vs {want_um}",
+            bg[0].amplitude_um
+        );
+        let wrong = normalised_bins(&p, &words(4.0), &rom, lsb_mm);
+        assert!(wrong[0].amplitude_um < 0.02 * want_um);
+        assert!(
+            (b[0].amplitude_um / want_um - 1.0).abs() < 0.01,
+            "{} vs {want_um}",
+            b[0].amplitude_um
+        );
+        assert!(b[1].amplitude_um < 0.01 * want_um, "{}", b[1].amplitude_um);
+        // The prefilter's delay and gain are divided out: the phase is the tone's.
+        assert!(
+            (b[0].phase_deg - phase.to_degrees()).abs() < 1.0,
+            "{}",
+            b[0].phase_deg
+        );
+        let h = prefilter_response(alpha, 40.0 / n as f64).norm();
+        assert!((b[0].prefilter_gain - h).abs() < 1e-12);
+    }
+}
