@@ -1,31 +1,63 @@
 //! `adders = "auto"`: the fewest shared adders whose pixel meets the laser rate on a liberty,
-//! decided from measured timing, as part of the one resolution.
+//! decided from measured timing, as a step of its own after the (pure) resolution.
+//!
+//! [`crate::resolve`] never runs a tool: with `adders = "auto"` it leaves the choice open
+//! ([`AdderStatus::Open`]) and resolves the pixel with a provisional A (the bit-true
+//! registers do not depend on A or C, only the schedule does). The commands that build
+//! hardware resolve with a timing oracle ([`AdderTiming`], implemented with yosys and OpenSTA
+//! in `tofprobe-flow`, cached by the RTL's hash), and [`choose`] decides here, in pure code.
 //!
 //! A pixel with A adders needs K = ⌈P/A⌉ slots per pulse for its P operations, so it runs
 //! at the slowest clock K·f_laser with C = K cycles per pulse. More adders for the same K
-//! only cost area, so the candidates are the A where K changes, fewest first. Each
-//! candidate's pixel is rendered, synthesised with the delay-driven script for its clock
-//! and timed with OpenSTA (`tofprobe_eda::analysis`, cached by the RTL's hash, as the
-//! size report's points are); the first whose slack keeps [`MARGIN_PERCENT`] of the
-//! period wins. Typically two syntheses: A = 1 (P cycles: too fast a clock) and A = 2.
+//! only cost area, so the candidates are the A where K changes, fewest first; the first
+//! whose slack keeps the oracle's margin (10 % of the period) wins. The search is bounded
+//! before any synthesis: a candidate whose clock exceeds [`SKIP_FACTOR`] × the fastest
+//! f_max measured on the liberty (the oracle's cache, then this search's own trials) cannot
+//! meet it — the pixel's critical path is one adder and its operand mux whatever A is, so
+//! f_max changes by a few per cent with A (303 vs 302 MHz for A = 1, 2 on osu018), not
+//! twofold — and is skipped without synthesis; and at most [`MAX_ADDER_TRIALS`] candidates
+//! are synthesised.
 
-use std::path::{Path, PathBuf};
-
-use serde::Serialize;
-use tofprobe_eda::analysis::analyse_point;
-use tofprobe_eda::corners::{CornerTiming, MARGIN_PERCENT};
-use tofprobe_eda::fsutil::synth_cache_dir;
-use tofprobe_eda::generated::GeneratedPixel;
-use tofprobe_eda::liberty::Liberty;
-use tofprobe_eda::pdk::Sky130Pdk;
-use tofprobe_eda::signoff::OSU018_LIBERTY;
+use serde::{Deserialize, Serialize};
 use tofprobe_pixel::config::Choice;
 use tofprobe_pixel::{PixelConfig, PixelContext, PixelError, PixelParams};
 
 use crate::error::DesignError;
 
-/// One candidate: A adders at C = ⌈P/A⌉ cycles per pulse, timed.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// Candidates synthesised at most by one choice.
+pub const MAX_ADDER_TRIALS: usize = 4;
+
+/// A candidate whose clock exceeds this multiple of the fastest f_max measured on the
+/// liberty is skipped unsynthesised (see the module documentation).
+pub const SKIP_FACTOR: f64 = 2.0;
+
+/// What the oracle measured of one candidate pixel at its clock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CandidateTiming {
+    /// Measured f_max (MHz).
+    pub f_max_mhz: f64,
+    /// Slack as a percentage of the clock period.
+    pub slack_percent: f64,
+    /// Whether the slack keeps the oracle's margin.
+    pub meets: bool,
+}
+
+/// Measures a candidate pixel's timing on one liberty (synthesis + static timing in
+/// `tofprobe-flow`; a closed-form model in tests).
+pub trait AdderTiming {
+    /// The liberty's file name, for notes and errors.
+    fn liberty_name(&self) -> String;
+    /// The slack margin required, as a percentage of the period.
+    fn margin_percent(&self) -> f64;
+    /// The fastest f_max measured on this liberty before (any pixel), if known: a bound
+    /// that lets [`choose`] skip hopeless candidates without synthesis.
+    fn fastest_known_f_max_mhz(&self) -> Option<f64>;
+    /// Times `candidate` at `clock_mhz`; the error text says what failed.
+    fn time(&self, candidate: &PixelParams, clock_mhz: f64) -> Result<CandidateTiming, String>;
+}
+
+/// One candidate: A adders at C = ⌈P/A⌉ cycles per pulse, timed or skipped.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AdderTrial {
     /// A.
     pub adders: usize,
@@ -33,115 +65,142 @@ pub struct AdderTrial {
     pub cycles_per_pulse: usize,
     /// C·f_laser (MHz).
     pub clock_mhz: f64,
-    /// Measured f_max (MHz).
-    pub f_max_mhz: f64,
-    /// Slack as a percentage of the clock period.
-    pub slack_percent: f64,
-    /// slack ≥ [`MARGIN_PERCENT`] %.
+    /// Measured f_max (MHz); `None` when skipped without synthesis.
+    pub f_max_mhz: Option<f64>,
+    /// Slack as a percentage of the clock period (`None` when skipped).
+    pub slack_percent: Option<f64>,
+    /// slack ≥ the margin.
     pub meets: bool,
 }
 
 /// What `adders = "auto"` chose, and the evidence.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AdderChoice {
     /// The chosen A.
     pub adders: usize,
     /// Its C = ⌈P/A⌉.
     pub cycles_per_pulse: usize,
-    /// The liberty timed on.
-    pub liberty: PathBuf,
+    /// The liberty timed on (file name).
+    pub liberty: String,
     /// The slack margin required (% of the period).
     pub margin_percent: f64,
-    /// Every candidate timed, fewest adders first; the last is the chosen one.
+    /// Every candidate considered, fewest adders first; the last is the chosen one.
     pub trials: Vec<AdderTrial>,
+}
+
+/// How a design's A was set.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum AdderStatus {
+    /// `pixel.adders` is a number.
+    Explicit,
+    /// `adders = "auto"`, not yet timed: the pixel carries a provisional A (the model's
+    /// results do not depend on it); the hardware commands decide it.
+    Open {
+        /// The provisional A the pixel was resolved with.
+        provisional: usize,
+    },
+    /// `adders = "auto"`, decided from measured timing.
+    Chosen(AdderChoice),
+}
+
+impl AdderStatus {
+    /// The choice, once made.
+    pub fn choice(&self) -> Option<&AdderChoice> {
+        match self {
+            AdderStatus::Chosen(c) => Some(c),
+            _ => None,
+        }
+    }
+}
+
+/// The note every command prints for an open choice.
+pub fn open_note(provisional: usize) -> String {
+    format!(
+        "adders = \"auto\": open — the hardware commands (rtl, vectors, cosim, flow, size, \
+         tradeoff, layout, or `config --time-adders`) choose A from measured timing; the \
+         model's registers do not depend on A (provisional A = {provisional})"
+    )
 }
 
 impl AdderChoice {
     /// The note every command prints.
     pub fn note(&self) -> String {
-        let lib = self.liberty.file_name().map_or_else(
-            || self.liberty.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
         let chosen = self.trials.last().expect("a choice has its trial");
         let mut s = format!(
-            "adders = \"auto\": A = {}, C = {} ({:.1} MHz) on {lib}: f_max {:.1} MHz, {:.1} % slack (margin {:.0} %)",
+            "adders = \"auto\": A = {}, C = {} ({:.1} MHz) on {}: f_max {:.1} MHz, {:.1} % slack (margin {:.0} %)",
             self.adders,
             self.cycles_per_pulse,
             chosen.clock_mhz,
-            chosen.f_max_mhz,
-            chosen.slack_percent,
+            self.liberty,
+            chosen.f_max_mhz.unwrap_or(f64::NAN),
+            chosen.slack_percent.unwrap_or(f64::NAN),
             self.margin_percent
         );
         for t in &self.trials[..self.trials.len() - 1] {
-            s += &format!(
-                "; A = {} would need {:.1} MHz (C = {}), f_max {:.1} MHz",
-                t.adders, t.clock_mhz, t.cycles_per_pulse, t.f_max_mhz
-            );
+            match t.f_max_mhz {
+                Some(f) => {
+                    s += &format!(
+                        "; A = {} would need {:.1} MHz (C = {}), f_max {f:.1} MHz",
+                        t.adders, t.clock_mhz, t.cycles_per_pulse
+                    )
+                }
+                None => {
+                    s += &format!(
+                        "; A = {} would need {:.1} MHz (C = {}), skipped: over {SKIP_FACTOR}× the fastest f_max measured",
+                        t.adders, t.clock_mhz, t.cycles_per_pulse
+                    )
+                }
+            }
         }
         s
     }
 }
 
-fn key_error(value: &str, reason: impl ToString) -> PixelError {
-    PixelError::invalid(
-        "timing_liberty",
-        format!("\"{value}\""),
-        reason,
-        "\"osu018\", \"sky130\" or the path of a liberty with timing",
-    )
+/// The pixel of `px` with A adders at C cycles per pulse.
+fn with(
+    px: &PixelConfig,
+    ctx: &PixelContext,
+    a: usize,
+    c: usize,
+) -> Result<PixelParams, PixelError> {
+    let mut p = px.clone();
+    p.adders = Choice::Value(a);
+    p.cycles_per_pulse = c;
+    p.resolve(ctx)
 }
 
-/// The liberty `pixel.timing_liberty` names (see [`PixelConfig::timing_liberty`]).
-fn liberty(name: Option<&str>, cache: &Path) -> Result<Liberty, PixelError> {
-    let path = match name.unwrap_or("osu018") {
-        "osu018" => PathBuf::from(OSU018_LIBERTY),
-        "sky130" => {
-            let pdk = Sky130Pdk::discover(None)
-                .map_err(|e| key_error("sky130", e))?
-                .ok_or_else(|| {
-                    key_error(
-                        "sky130",
-                        "no timed sky130_fd_sc_hd PDK found ($TOFPROBE_SKY130_PDK, ../shared/pdk/sky130_fd_sc_hd)",
-                    )
-                })?;
-            pdk.typical(cache).map_err(|e| key_error("sky130", e))?
-        }
-        path => PathBuf::from(path),
+/// The provisional A of an open choice: the default's 2 adders (one per lane) when that
+/// schedule fits, else the fewest that fit in the longest schedule.
+pub fn provisional(px: &PixelConfig, ctx: &PixelContext) -> Result<(usize, usize), PixelError> {
+    let ops = with(px, ctx, 1, tofprobe_pixel::params::MAX_CYCLES_PER_PULSE)?.ops_per_pulse();
+    let max_c = tofprobe_pixel::params::MAX_CYCLES_PER_PULSE;
+    let a = if ops.div_ceil(2) <= max_c {
+        2.min(ops.max(1))
+    } else {
+        ops.div_ceil(max_c)
     };
-    let shown = name.unwrap_or("osu018");
-    let lib = Liberty::load(&path).map_err(|e| key_error(shown, e))?;
-    if !lib.has_timing {
-        return Err(key_error(
-            shown,
-            format!(
-                "{} has no timing groups: f_max cannot be measured on it",
-                path.display()
-            ),
-        ));
-    }
-    Ok(lib)
+    Ok((a, ops.div_ceil(a).max(1)))
 }
 
-/// Chooses A (and C) for `px`, whose `adders` is `"auto"`. Errors are `[pixel]` errors of
-/// `origin` naming `adders` or `timing_liberty`.
+/// Chooses A (and C) for `px`, whose `adders` is `"auto"`, with `timing` measuring the
+/// candidates. Errors are `[pixel]` errors of `origin` naming `adders`.
 pub fn choose(
     px: &PixelConfig,
     ctx: &PixelContext,
     origin: &str,
+    timing: &dyn AdderTiming,
 ) -> Result<AdderChoice, DesignError> {
     let err = |e| DesignError::pixel(origin, e);
-    let cache = synth_cache_dir(None);
-    let lib = liberty(px.timing_liberty.as_deref(), &cache).map_err(err)?;
     // P from the pixel with one adder and as many cycles as its operations need at most.
-    let with = |a: usize, c: usize| -> Result<PixelParams, DesignError> {
-        let mut p = px.clone();
-        p.adders = Choice::Value(a);
-        p.cycles_per_pulse = c;
-        p.resolve(ctx).map_err(err)
-    };
-    let ops = with(1, tofprobe_pixel::params::MAX_CYCLES_PER_PULSE)?.ops_per_pulse();
-    let mut trials = Vec::new();
+    let ops = with(px, ctx, 1, tofprobe_pixel::params::MAX_CYCLES_PER_PULSE)
+        .map_err(err)?
+        .ops_per_pulse();
+    let liberty = timing.liberty_name();
+    let margin = timing.margin_percent();
+    let mut bound = timing.fastest_known_f_max_mhz();
+    let mut trials: Vec<AdderTrial> = Vec::new();
+    let mut timed = 0;
+    let mut capped = false;
     let mut last_k = 0;
     for a in 1..=ops {
         let k = ops.div_ceil(a);
@@ -149,22 +208,24 @@ pub fn choose(
             continue;
         }
         last_k = k;
-        let params = with(a, k)?;
         let clock_mhz = k as f64 * ctx.laser_rate_hz / 1e6;
-        let provider = GeneratedPixel {
-            base: params.clone(),
-        };
-        let point = analyse_point(
-            &provider,
-            params.bins as u64,
-            params.width,
-            &lib,
-            true,
-            "clk",
-            &cache,
-            Some(1e6 / clock_mhz),
-        )
-        .map_err(|e| {
+        if bound.is_some_and(|b| clock_mhz > SKIP_FACTOR * b) {
+            trials.push(AdderTrial {
+                adders: a,
+                cycles_per_pulse: k,
+                clock_mhz,
+                f_max_mhz: None,
+                slack_percent: None,
+                meets: false,
+            });
+            continue;
+        }
+        if timed == MAX_ADDER_TRIALS {
+            capped = true;
+            break;
+        }
+        let params = with(px, ctx, a, k).map_err(err)?;
+        let t = timing.time(&params, clock_mhz).map_err(|e| {
             err(PixelError::invalid(
                 "adders",
                 "\"auto\"",
@@ -172,52 +233,168 @@ pub fn choose(
                 "an explicit number of adders",
             ))
         })?;
-        let timing = point.timing.expect("a liberty with timing is timed");
-        // The size report's verdict, so `size` and `adders = "auto"` judge slack alike.
-        let verdict = CornerTiming::new(
-            &lib.name,
-            "typical",
-            &lib.path,
-            &timing,
-            clock_mhz,
-            ctx.laser_rate_hz,
-        );
-        let trial = AdderTrial {
+        timed += 1;
+        bound = Some(bound.map_or(t.f_max_mhz, |b| b.max(t.f_max_mhz)));
+        trials.push(AdderTrial {
             adders: a,
             cycles_per_pulse: k,
             clock_mhz,
-            f_max_mhz: timing.f_max_mhz,
-            slack_percent: verdict.slack_percent,
-            meets: verdict.meets_margin,
-        };
-        let meets = trial.meets;
-        trials.push(trial);
-        if meets {
+            f_max_mhz: Some(t.f_max_mhz),
+            slack_percent: Some(t.slack_percent),
+            meets: t.meets,
+        });
+        if t.meets {
             return Ok(AdderChoice {
                 adders: a,
                 cycles_per_pulse: k,
-                liberty: lib.path.clone(),
-                margin_percent: MARGIN_PERCENT,
+                liberty,
+                margin_percent: margin,
                 trials,
             });
         }
     }
+    let skipped = trials.iter().filter(|t| t.f_max_mhz.is_none()).count();
     let best = trials
         .iter()
-        .max_by(|x, y| x.slack_percent.total_cmp(&y.slack_percent))
-        .expect("P ≥ 1 gives a candidate");
+        .filter(|t| t.slack_percent.is_some())
+        .max_by(|x, y| {
+            x.slack_percent
+                .unwrap_or(f64::MIN)
+                .total_cmp(&y.slack_percent.unwrap_or(f64::MIN))
+        });
+    let closest = match best {
+        Some(b) => format!(
+            "closest A = {} at {:.1} MHz (C = {}), f_max {:.1} MHz, {:.1} % slack",
+            b.adders,
+            b.clock_mhz,
+            b.cycles_per_pulse,
+            b.f_max_mhz.unwrap_or(f64::NAN),
+            b.slack_percent.unwrap_or(f64::NAN)
+        ),
+        None => "no candidate was timed".to_string(),
+    };
+    let how = match (capped, skipped) {
+        (true, _) => format!(
+            "; the search stopped after {MAX_ADDER_TRIALS} syntheses (A > {} not tried)",
+            trials.last().map_or(0, |t| t.adders)
+        ),
+        (false, 0) => String::new(),
+        (false, n) => format!(
+            "; {n} candidate(s) skipped unsynthesised: even C = 1 needs {:.1} MHz, over {SKIP_FACTOR}× the fastest f_max measured ({:.1} MHz)",
+            ctx.laser_rate_hz / 1e6,
+            bound.unwrap_or(f64::NAN)
+        ),
+    };
     Err(err(PixelError::invalid(
         "adders",
         "\"auto\"",
         format!(
-            "no number of adders meets the laser rate on {} with {MARGIN_PERCENT:.0} % slack: closest A = {} at {:.1} MHz (C = {}), f_max {:.1} MHz, {:.1} % slack",
-            lib.path.display(),
-            best.adders,
-            best.clock_mhz,
-            best.cycles_per_pulse,
-            best.f_max_mhz,
-            best.slack_percent
+            "no number of adders meets the laser rate on {liberty} with {margin:.0} % slack: {closest}{how}"
         ),
         "a slower laser (sensor.laser_rate_hz), a faster liberty, or an explicit A",
     )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cell::Cell;
+
+    /// A liberty on which every pixel's f_max is `f_max` MHz, counting syntheses.
+    struct Flat {
+        f_max: f64,
+        known: Option<f64>,
+        calls: Cell<usize>,
+    }
+
+    impl AdderTiming for Flat {
+        fn liberty_name(&self) -> String {
+            "flat.lib".into()
+        }
+        fn margin_percent(&self) -> f64 {
+            10.0
+        }
+        fn fastest_known_f_max_mhz(&self) -> Option<f64> {
+            self.known
+        }
+        fn time(&self, _: &PixelParams, clock_mhz: f64) -> Result<CandidateTiming, String> {
+            self.calls.set(self.calls.get() + 1);
+            let slack_percent = (1.0 - clock_mhz / self.f_max) * 100.0;
+            Ok(CandidateTiming {
+                f_max_mhz: self.f_max,
+                slack_percent,
+                meets: slack_percent >= 10.0,
+            })
+        }
+    }
+
+    fn default_pixel() -> (PixelConfig, PixelContext) {
+        let d = crate::Document::from_toml_str(crate::DEFAULT_TOML, "t").unwrap();
+        (d.pixel.clone(), d.pixel_context())
+    }
+
+    /// The default (P = 32 at 10 MHz) on a 300 MHz liberty: A = 1 needs 320 MHz and fails,
+    /// A = 2 needs 160 MHz and meets: two syntheses, as the closed form says.
+    #[test]
+    fn fewest_adders_whose_clock_keeps_the_margin() {
+        let (px, ctx) = default_pixel();
+        let t = Flat {
+            f_max: 300.0,
+            known: None,
+            calls: Cell::new(0),
+        };
+        let c = choose(&px, &ctx, "t", &t).unwrap();
+        assert_eq!((c.adders, c.cycles_per_pulse), (2, 16));
+        assert_eq!(t.calls.get(), 2);
+        assert!(
+            c.note().contains("A = 1 would need 320.0 MHz"),
+            "{}",
+            c.note()
+        );
+    }
+
+    /// A laser no adder count can serve is refused after one synthesis (every other
+    /// candidate needs more than twice the f_max it measured), and with a known bound from
+    /// the cache before any synthesis.
+    #[test]
+    fn hopeless_lasers_are_refused_without_walking_every_candidate() {
+        let (px, mut ctx) = default_pixel();
+        ctx.laser_rate_hz = 2e9;
+        let t = Flat {
+            f_max: 300.0,
+            known: None,
+            calls: Cell::new(0),
+        };
+        let e = choose(&px, &ctx, "t", &t).unwrap_err().to_string();
+        assert_eq!(t.calls.get(), 1, "{e}");
+        assert!(
+            e.contains("adders") && e.contains("skipped unsynthesised"),
+            "{e}"
+        );
+        let cached = Flat {
+            f_max: 300.0,
+            known: Some(300.0),
+            calls: Cell::new(0),
+        };
+        assert!(choose(&px, &ctx, "t", &cached).is_err());
+        assert_eq!(cached.calls.get(), 0);
+    }
+
+    /// A liberty slower than the bound predicts stops after MAX_ADDER_TRIALS syntheses.
+    #[test]
+    fn the_search_is_capped() {
+        let (px, mut ctx) = default_pixel();
+        // 1 MHz laser, f_max 4 MHz: C = 3 would keep 10 % slack (3 ≤ 3.6), but A = 1
+        // (C = 32) is timed first, C = 16 and 11 are skipped (over 2 × 4 MHz), and C = 8,
+        // 7 and 6 use up the four syntheses before C = 5.
+        ctx.laser_rate_hz = 1e6;
+        let t = Flat {
+            f_max: 4.0,
+            known: None,
+            calls: Cell::new(0),
+        };
+        let e = choose(&px, &ctx, "t", &t).unwrap_err().to_string();
+        assert_eq!(t.calls.get(), MAX_ADDER_TRIALS, "{e}");
+        assert!(e.contains("stopped after"), "{e}");
+    }
 }

@@ -14,10 +14,10 @@ pub mod resolve;
 pub mod rom_policy;
 pub mod schema;
 
-pub use adders::AdderChoice;
+pub use adders::{AdderChoice, AdderStatus, AdderTiming, CandidateTiming};
 pub use analysis_mode::ModeDecision;
 pub use document::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, SIZING_SIGMAS, read_text};
 pub use error::DesignError;
 pub use probe_cache::ProbeCache;
-pub use resolve::{ResolvedDesign, load, resolve, resolve_with};
+pub use resolve::{ResolvedDesign, load, resolve, resolve_timed, resolve_with};
 pub use rom_policy::{RtlOverrides, RtlRom, rtl_params};

@@ -10,6 +10,7 @@ use tofprobe_dsp::sd::{ProbeDesign, ProbeRom, RomMode};
 use tofprobe_pixel::{Mode, PixelContext, PixelError, PixelParams};
 use tofprobe_scene::{PhotonSource, Scene};
 
+use crate::adders::{AdderStatus, AdderTiming};
 use crate::analysis_mode::{ModeDecision, check_haar, decide_mode};
 use crate::bins::bin_indices;
 use crate::document::Document;
@@ -40,8 +41,8 @@ pub struct ResolvedDesign {
     /// Notes every command prints: a mixed scene under `mode = "auto"`, a `[probe]` a Haar
     /// pixel ignores, transients outside the Haar frame.
     pub notes: Vec<String>,
-    /// What `adders = "auto"` chose and the timing behind it (`None`: A was explicit).
-    pub adders: Option<crate::adders::AdderChoice>,
+    /// How A was set: explicit, `"auto"` still open (no tool ran), or chosen from timing.
+    pub adders: AdderStatus,
 }
 
 /// Reads `path` (or the embedded default) and resolves it.
@@ -50,7 +51,8 @@ pub fn load(path: Option<&Path>) -> Result<ResolvedDesign, DesignError> {
     resolve(document, &origin)
 }
 
-/// Resolves a document; `origin` names it in every error.
+/// Resolves a document; `origin` names it in every error. Pure: no tool runs
+/// (`adders = "auto"` stays open, see [`crate::adders`]).
 pub fn resolve(document: Document, origin: &str) -> Result<ResolvedDesign, DesignError> {
     resolve_with(document, origin, &mut ProbeCache::default())
 }
@@ -61,6 +63,17 @@ pub fn resolve_with(
     document: Document,
     origin: &str,
     cache: &mut ProbeCache,
+) -> Result<ResolvedDesign, DesignError> {
+    resolve_timed(document, origin, cache, None)
+}
+
+/// The one resolution, with `adders = "auto"` decided by `timing` when one is given (the
+/// hardware commands pass `tofprobe-flow`'s synthesis oracle) and left open otherwise.
+pub fn resolve_timed(
+    document: Document,
+    origin: &str,
+    cache: &mut ProbeCache,
+    timing: Option<&dyn AdderTiming>,
 ) -> Result<ResolvedDesign, DesignError> {
     let scene_err = |e| DesignError::scene(origin, e);
     let probe_err = |e| DesignError::probe(origin, e);
@@ -144,16 +157,29 @@ pub fn resolve_with(
             ));
         }
     }
-    // `adders = "auto"`: A and C from measured timing (crate::adders), then the pixel
-    // resolves with them like any explicit value.
+    // `adders = "auto"`: A and C from measured timing when an oracle is given
+    // (crate::adders), else a provisional A, open; then the pixel resolves with them like any
+    // explicit value.
     let adders = if matches!(px.adders, tofprobe_pixel::config::Choice::Auto(_)) {
-        let choice = crate::adders::choose(&px, &context, origin)?;
-        px.adders = tofprobe_pixel::config::Choice::Value(choice.adders);
-        px.cycles_per_pulse = choice.cycles_per_pulse;
-        notes.push(choice.note());
-        Some(choice)
+        let (status, a, c) = match timing {
+            Some(t) => {
+                let choice = crate::adders::choose(&px, &context, origin, t)?;
+                notes.push(choice.note());
+                let (a, c) = (choice.adders, choice.cycles_per_pulse);
+                (AdderStatus::Chosen(choice), a, c)
+            }
+            None => {
+                let (a, c) = crate::adders::provisional(&px, &context)
+                    .map_err(|e| pixel_err(derived_from(e, d)))?;
+                notes.push(crate::adders::open_note(a));
+                (AdderStatus::Open { provisional: a }, a, c)
+            }
+        };
+        px.adders = tofprobe_pixel::config::Choice::Value(a);
+        px.cycles_per_pulse = c;
+        status
     } else {
-        None
+        AdderStatus::Explicit
     };
     let pixel = px
         .resolve(&context)
@@ -221,6 +247,18 @@ fn derived_from(e: PixelError, d: &Document) -> PixelError {
 }
 
 impl ResolvedDesign {
+    /// The document with a decided `adders = "auto"` written out as the chosen A and C, so
+    /// a variant re-resolved from it (an architecture option, a knob) keeps the measured
+    /// choice instead of reopening it; the document as written otherwise.
+    pub fn document_with_decided_adders(&self) -> Document {
+        let mut d = self.document.clone();
+        if let AdderStatus::Chosen(c) = &self.adders {
+            d.pixel.adders = tofprobe_pixel::config::Choice::Value(c.adders);
+            d.pixel.cycles_per_pulse = c.cycles_per_pulse;
+        }
+        d
+    }
+
     /// The number of pulses N of the acquisition.
     pub fn pulses(&self) -> u64 {
         self.document.pulses()

@@ -5,6 +5,7 @@
 //! measurements it reports on (spectrum, transients, options) come from
 //! `tofprobe-experiments`; the EDA tools are driven by `tofprobe-eda` and `tofprobe-cosim`.
 
+pub mod adders;
 pub mod error;
 pub mod flow;
 pub mod rtl;

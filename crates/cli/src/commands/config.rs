@@ -1,5 +1,7 @@
 //! `tofprobe config`: print the embedded default configuration, or check a file (the
 //! analysis mode, and why when `pixel.mode = "auto"` picked it, and the resolution's notes).
+//! The check is the pure resolution: no tool runs unless `--time-adders` asks for the
+//! `adders = "auto"` choice.
 
 use std::path::PathBuf;
 
@@ -15,6 +17,10 @@ pub struct ConfigArgs {
     /// Print the embedded default configuration (TOML) and exit.
     #[arg(long)]
     print_default: bool,
+    /// Decide `adders = "auto"` now (synthesis and static timing, cached) instead of leaving
+    /// it to the hardware commands: checking a configuration runs no tool otherwise.
+    #[arg(long)]
+    time_adders: bool,
     /// A configuration file to validate (without it: the embedded default).
     config: Option<PathBuf>,
 }
@@ -26,7 +32,11 @@ pub fn run(args: &ConfigArgs) -> Result<(), CliError> {
         print!("{DEFAULT_TOML}");
         return Ok(());
     }
-    let design = tofprobe_design::load(args.config.as_deref())?;
+    let design = if args.time_adders {
+        tofprobe_flow::adders::load(args.config.as_deref())?
+    } else {
+        tofprobe_design::load(args.config.as_deref())?
+    };
     let c = &design.document;
     println!(
         "{}: ok ({} pulses at {} Hz, {} TDC codes of {} ps = {} bits, jitter {} mm)",

@@ -61,7 +61,7 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
     if a.frames == 0 || a.frames > 100 {
         return Err(CliError::option("frames", a.frames.to_string(), "1..=100"));
     }
-    let mut design = tofprobe_design::load(a.config.as_deref())?;
+    let mut design = tofprobe_flow::adders::load(a.config.as_deref())?;
     let options = if a.recommended {
         let size = tofprobe_flow::sizing::SizeOptions {
             liberty: None,

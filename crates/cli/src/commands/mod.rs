@@ -56,7 +56,7 @@ pub fn simulated_design(
     if frames == 0 || frames > 1000 {
         return Err(CliError::option("frames", frames, "1..=1000"));
     }
-    let design = tofprobe_design::load(config)?;
+    let design = tofprobe_flow::adders::load(config)?;
     let p = tofprobe_design::rtl_params(&design, overrides)?;
     Ok((design, p))
 }

@@ -91,7 +91,7 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     let mut skip_reports = Vec::new();
     let mut tables = Vec::new();
     for p in paths {
-        let design = tofprobe_design::load(p)?;
+        let design = tofprobe_flow::adders::load(p)?;
         if design.pixel.mode == tofprobe_pixel::Mode::Haar {
             let h = measure_haar(&design, args.verilator)?;
             tables.push(haar::markdown(&h));

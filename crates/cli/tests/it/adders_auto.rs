@@ -64,7 +64,15 @@ fn fewest_adders_that_meet_the_laser_rate() {
     let dir = scratch("fast");
     let cfg = config(&dir, "fast.toml", 2, "100e6", "");
     let cfg = cfg.to_str().unwrap();
+    // `config` alone is the pure resolution: the choice stays open, no tool runs.
     let out = run(&dir, &["config", cfg]);
+    let t = text(&out);
+    assert!(
+        out.status.success() && t.contains("adders = \"auto\": open"),
+        "{t}"
+    );
+    assert!(!dir.join("cache").exists(), "config synthesised: {t}");
+    let out = run(&dir, &["config", "--time-adders", cfg]);
     let t = text(&out);
     assert!(out.status.success(), "{t}");
     let note = t
@@ -104,8 +112,10 @@ fn fewest_adders_that_meet_the_laser_rate() {
 }
 
 /// A 1 GHz laser: even one operation per cycle (A = P, C = 1) needs 1 GHz, beyond osu018;
-/// the refusal names the key, the closest A and its slack, and what would work. A liberty
-/// key naming nothing usable is refused naming `timing_liberty`.
+/// the refusal names the key, the closest A and its slack, and what would work — after one
+/// synthesis: A = 1 (2 GHz) measures f_max ≈ 340 MHz, and A = 2 (1 GHz) is more than twice
+/// that, so it is skipped unsynthesised. A liberty key naming nothing usable is refused
+/// naming `timing_liberty`.
 #[test]
 fn impossible_rates_and_untimed_liberties_are_refused() {
     if !have_tools(&["yosys", "sta"]) {
@@ -113,13 +123,14 @@ fn impossible_rates_and_untimed_liberties_are_refused() {
     }
     let dir = scratch("refused");
     let cfg = config(&dir, "ghz.toml", 1, "1e9", "");
-    let out = run(&dir, &["config", cfg.to_str().unwrap()]);
+    let out = run(&dir, &["config", "--time-adders", cfg.to_str().unwrap()]);
     let t = text(&out);
     assert_eq!(out.status.code(), Some(2), "{t}");
     for part in [
         "pixel.adders",
         "\"auto\"",
-        "closest A = 2 at 1000.0 MHz (C = 1)",
+        "closest A = 1 at 2000.0 MHz (C = 2)",
+        "1 candidate(s) skipped unsynthesised: even C = 1 needs 1000.0 MHz",
         "sensor.laser_rate_hz",
     ] {
         assert!(t.contains(part), "`{part}` missing: {t}");
@@ -147,7 +158,7 @@ fn impossible_rates_and_untimed_liberties_are_refused() {
             "10e6",
             &format!("timing_liberty = {value:?}"),
         );
-        let out = run(&dir, &["config", cfg.to_str().unwrap()]);
+        let out = run(&dir, &["config", "--time-adders", cfg.to_str().unwrap()]);
         let t = text(&out);
         assert_eq!(out.status.code(), Some(2), "{t}");
         assert!(
@@ -155,4 +166,44 @@ fn impossible_rates_and_untimed_liberties_are_refused() {
             "{t}"
         );
     }
+}
+
+/// The resolution is pure: `config` on an `adders = "auto"` document runs no EDA tool —
+/// with a PATH that holds no yosys and no sta it resolves at once and says the choice is
+/// open — and so does `simulate` (the registers do not depend on A). The hardware command
+/// `rtl` is where the choice is made, so it needs the tools and names the missing one.
+#[test]
+fn checking_an_auto_design_runs_no_tool() {
+    let dir = scratch("pure");
+    let cfg = config(&dir, "pure.toml", 2, "100e6", "");
+    let empty = dir.join("no-tools");
+    std::fs::create_dir_all(&empty).unwrap();
+    let bare = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+            .args(args)
+            .env("PATH", &empty)
+            .env("TOFPROBE_CACHE", dir.join("cache"))
+            .output()
+            .expect("run tofprobe")
+    };
+    let t0 = std::time::Instant::now();
+    let out = bare(&["config", cfg.to_str().unwrap()]);
+    let t = text(&out);
+    assert!(out.status.success(), "{t}");
+    assert!(t.contains("adders = \"auto\": open"), "{t}");
+    // A synthesis takes seconds; the pure resolution of this small design well under one.
+    assert!(t0.elapsed().as_secs_f64() < 5.0, "{:?}", t0.elapsed());
+    assert!(!dir.join("cache").exists(), "a tool ran: {t}");
+    let out = bare(&["simulate", cfg.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let out = bare(&[
+        "rtl",
+        cfg.to_str().unwrap(),
+        "--out",
+        dir.join("rtl").to_str().unwrap(),
+    ]);
+    let t = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{t}");
+    assert!(t.contains("yosys"), "{t}");
+    assert!(!dir.join("rtl").exists(), "{t}");
 }

@@ -7,13 +7,7 @@ use tofprobe_pixel::{Mode, PixelParams};
 /// True when the tools exist; otherwise prints a loud SKIP line (CI installs them via
 /// scripts/test.sh, so there the tests always run).
 pub fn tools_or_skip(tools: &[&'static str], test: &str) -> bool {
-    for t in tools {
-        if let Err(e) = tofprobe_cosim::tools::require(t) {
-            eprintln!("\n*** SKIPPED {test}: {e} ***\n");
-            return false;
-        }
-    }
-    true
+    tofprobe_testkit::tools::have(tools, test)
 }
 
 /// A fresh work directory under the cargo target dir.

@@ -150,7 +150,8 @@ pub fn run(
         .map(|p| Liberty::load(p))
         .collect::<Result<Vec<_>, _>>()?;
     let laser = design.sensor().laser_rate_hz;
-    let accuracies = accuracy::measure(&design.document, &design.origin, &options, &req.seeds);
+    let base = design.document_with_decided_adders();
+    let accuracies = accuracy::measure(&base, &design.origin, &options, &req.seeds);
     let mut rows = Vec::new();
     for (option, acc) in options.into_iter().zip(accuracies) {
         let acc = acc?;
@@ -245,7 +246,7 @@ pub fn recommended_design(
         design.origin, report.recommendation.option
     );
     crate::tradeoff::overrides::with_overrides(
-        &design.document,
+        &design.document_with_decided_adders(),
         &origin,
         &ov,
         &mut tofprobe_design::ProbeCache::default(),

@@ -14,11 +14,7 @@ use tofprobe_rtlgen::write::write_generated;
 use tofprobe_rtlgen::{DEFAULT_MODULE_PREFIX, module_names};
 
 fn have(tool: &str) -> bool {
-    let ok = Command::new(tool).arg("-V").output().is_ok();
-    if !ok {
-        eprintln!("\n*** SKIPPED: `{tool}` is not installed: run scripts/install-tools.sh ***\n");
-    }
-    ok
+    tofprobe_testkit::tools::have(&[tool], "tofprobe-rtlgen gates")
 }
 
 fn configs() -> Vec<(&'static str, PixelParams)> {

@@ -1,6 +1,6 @@
 //! Runs `scripts/tttr-crosscheck.sh`: our decoder against ptufile and phconvert's SPC
 //! algorithm on the real files (a cached venv; the first run installs from PyPI). Skipped,
-//! with a message, only when python3 is missing.
+//! with a message, only when python3 is missing, and never under CI (tofprobe_testkit::tools).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -15,8 +15,7 @@ fn dump_binary() -> PathBuf {
 
 #[test]
 fn decoder_agrees_with_ptufile_and_phconvert() {
-    if Command::new("python3").arg("--version").output().is_err() {
-        println!("SKIPPED: python3 not found; the cross-check with ptufile did not run");
+    if !tofprobe_testkit::tools::have(&["python3"], "the cross-check with ptufile") {
         return;
     }
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");

@@ -19,16 +19,7 @@ pub fn tofprobe(args: &[&str]) -> Output {
 /// Whether every one of `tools` is installed; the first missing one is named on stderr
 /// (the EDA tests skip without them).
 pub fn have_tools(tools: &[&'static str]) -> bool {
-    match tools
-        .iter()
-        .find(|t| tofprobe_cosim::tools::require(t).is_err())
-    {
-        None => true,
-        Some(t) => {
-            eprintln!("\n*** SKIPPED: {t} not installed (scripts/install-tools.sh) ***\n");
-            false
-        }
-    }
+    tofprobe_testkit::tools::have(tools, "tofprobe-cli test")
 }
 
 /// The JSON object a `--json` command printed on its last stdout line (panics with both
