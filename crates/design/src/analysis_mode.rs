@@ -20,7 +20,7 @@ pub const AUTO_HAAR_SCALES: u32 = 6;
 
 /// How the mode was decided: the choice of `mode = "auto"` (why, and a note for a mixed
 /// scene), or `None` when the document names the mode.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct ModeDecision {
     /// The mode the pixel runs in.
     pub mode: Mode,

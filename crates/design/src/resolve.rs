@@ -20,8 +20,10 @@ use crate::probe_cache::ProbeCache;
 /// Longest frame a windowed ROM (L = N) may span: 2^24 pulses (1.68 s at 10 MHz).
 pub const MAX_WINDOWED_FRAME: u64 = 1 << 24;
 
-/// A configuration resolved once: everything a command needs, already validated.
-#[derive(Debug, Clone)]
+/// A configuration resolved once: everything a command needs, already validated. It
+/// serialises (serde; [`ResolvedDesign::to_json`]), so a worker process receives the design
+/// instead of resolving it again (no stability sweep: the probe design carries its limit).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ResolvedDesign {
     /// The file path, or [`crate::DEFAULT_ORIGIN`].
     pub origin: String,
@@ -262,6 +264,22 @@ impl ResolvedDesign {
     /// The number of pulses N of the acquisition.
     pub fn pulses(&self) -> u64 {
         self.document.pulses()
+    }
+
+    /// The design as JSON (floats round-trip exactly: serde_json's `float_roundtrip`).
+    pub fn to_json(&self) -> Result<String, DesignError> {
+        serde_json::to_string(self).map_err(|e| DesignError::Toml {
+            origin: self.origin.clone(),
+            message: format!("the resolved design does not serialise: {e}"),
+        })
+    }
+
+    /// A design sent as [`Self::to_json`]; errors name what does not fit.
+    pub fn from_json(text: &str) -> Result<ResolvedDesign, DesignError> {
+        serde_json::from_str(text).map_err(|e| DesignError::Toml {
+            origin: "<serialised design>".to_string(),
+            message: e.to_string(),
+        })
     }
 
     /// The sensor.

@@ -9,13 +9,50 @@ use crate::error::DspError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// A bit-packed probe ROM: `depth` entries of `registers` bits.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// A bit-packed probe ROM: `depth` entries of `registers` bits. Serialised as its fields;
+/// a deserialised image whose words do not fit its depth and registers is refused.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "RomImageFields")]
 pub struct RomImage {
     depth: usize,
     registers: usize,
     words_per_entry: usize,
     data: Vec<u64>,
+}
+
+/// [`RomImage`]'s fields as serialised, checked before they become an image.
+#[derive(Deserialize)]
+struct RomImageFields {
+    depth: usize,
+    registers: usize,
+    words_per_entry: usize,
+    data: Vec<u64>,
+}
+
+impl TryFrom<RomImageFields> for RomImage {
+    type Error = String;
+
+    fn try_from(f: RomImageFields) -> Result<Self, String> {
+        let words = f.registers.div_ceil(64).max(1);
+        if f.words_per_entry != words || f.depth.checked_mul(words) != Some(f.data.len()) {
+            return Err(format!(
+                "a ROM image of {} entries × {} registers needs {} words per entry and {} words, \
+                 not {} and {}",
+                f.depth,
+                f.registers,
+                words,
+                f.depth.saturating_mul(words),
+                f.words_per_entry,
+                f.data.len()
+            ));
+        }
+        Ok(RomImage {
+            depth: f.depth,
+            registers: f.registers,
+            words_per_entry: f.words_per_entry,
+            data: f.data,
+        })
+    }
 }
 
 impl RomImage {

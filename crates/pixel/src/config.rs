@@ -122,7 +122,7 @@ pub const DEFAULT_OSR: f64 = 32.0;
 
 /// What the rest of the configuration tells the pixel: the sensor's window and rate, the
 /// acquisition length and, if known, the codes the depth can take.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PixelContext {
     /// TDC codes in the timing window (the sensor's `tdc_codes()`).
     pub tdc_codes: u32,

@@ -4,3 +4,4 @@
 
 mod mutations;
 mod resolve;
+mod serde_roundtrip;

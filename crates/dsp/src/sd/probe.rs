@@ -48,8 +48,11 @@ pub const MAX_PERIODS: usize = 8;
 pub const WRAP_CANDIDATES: usize = 1 << 16;
 
 /// A designed probe set: the modulator and its measured amplitude limit, reusable for
-/// many ROMs (the stability sweep is the expensive part of the design).
-#[derive(Debug, Clone)]
+/// many ROMs (the stability sweep is the expensive part of the design). It serialises as
+/// its configuration and measured limit; deserialising designs the modulator again
+/// (deterministic and fast) but skips the stability sweep, and re-checks the amplitude.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(into = "ProbeDesignRecord", try_from = "ProbeDesignRecord")]
 pub struct ProbeDesign {
     pub config: ProbeConfig,
     pub modulator: Modulator,
@@ -57,6 +60,33 @@ pub struct ProbeDesign {
     pub max_stable_amplitude: f64,
     /// Normalised frequency of that measurement.
     pub limit_f_norm: f64,
+}
+
+/// What a [`ProbeDesign`] serialises to: the configuration and the measured limit.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct ProbeDesignRecord {
+    config: ProbeConfig,
+    max_stable_amplitude: f64,
+    limit_f_norm: f64,
+}
+
+impl From<ProbeDesign> for ProbeDesignRecord {
+    fn from(d: ProbeDesign) -> Self {
+        ProbeDesignRecord {
+            config: d.config,
+            max_stable_amplitude: d.max_stable_amplitude,
+            limit_f_norm: d.limit_f_norm,
+        }
+    }
+}
+
+impl TryFrom<ProbeDesignRecord> for ProbeDesign {
+    type Error = String;
+
+    fn try_from(r: ProbeDesignRecord) -> Result<Self, String> {
+        ProbeDesign::with_known_limit(&r.config, r.max_stable_amplitude, r.limit_f_norm)
+            .map_err(|e| e.to_string())
+    }
 }
 
 impl ProbeDesign {
@@ -144,8 +174,9 @@ impl ProbeDesign {
     }
 }
 
-/// The chip's probe ROM plus everything a readout needs to be normalised.
-#[derive(Debug, Clone, PartialEq)]
+/// The chip's probe ROM plus everything a readout needs to be normalised. It serialises
+/// (serde), so a worker process can receive a ROM instead of building it again.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ProbeRom {
     pub image: RomImage,
     /// Bin index k of each probed bin (f_k = k·f_s/L).
