@@ -7,10 +7,34 @@ use tofprobe_pixel::autobins::{band_limit, choose_bins};
 
 use crate::document::Document;
 
+/// THE band rule, checked here for every caller (the resolution's OSR and ROM-depth checks
+/// and the RTL's ROM policy): the ΣΔ band f_s/(2·OSR) must hold `bins` ROM bins
+/// (k = 1 .. band edge, exclusive) at depth L; the refusal is one phrase they all print.
+pub fn band_check(depth: u64, osr: f64, bins: usize) -> Result<(), String> {
+    let limit = band_limit(depth, osr);
+    if limit < bins as u64 + 1 {
+        return Err(format!(
+            "the ΣΔ band f_s/(2·OSR) holds {} bin(s) at L = {depth} and OSR = {osr}, fewer than B = {bins}",
+            limit.saturating_sub(1)
+        ));
+    }
+    Ok(())
+}
+
 /// The ROM bin indices of `doc` for B = `bins` bins and ROM depth L = `depth`. A band
 /// f_s/(2·OSR) too narrow for B bins at L is refused naming `rom_depth`, with the
 /// shallowest L that holds them.
 pub fn bin_indices(doc: &Document, bins: usize, depth: u64) -> Result<Vec<u64>, PixelError> {
+    bin_indices_in(doc, &doc.pixel_context(), bins, depth)
+}
+
+/// [`bin_indices`] with the document's pixel context already built (the resolution's).
+pub fn bin_indices_in(
+    doc: &Document,
+    ctx: &tofprobe_pixel::PixelContext,
+    bins: usize,
+    depth: u64,
+) -> Result<Vec<u64>, PixelError> {
     let fs = doc.sensor.laser_rate_hz;
     if !doc.pixel.frequencies_hz.is_empty() {
         return Ok(doc
@@ -21,19 +45,16 @@ pub fn bin_indices(doc: &Document, bins: usize, depth: u64) -> Result<Vec<u64>, 
             .collect());
     }
     let osr = doc.probe.osr;
-    let limit = band_limit(depth, osr);
-    if limit < bins as u64 + 1 {
+    if let Err(why) = band_check(depth, osr, bins) {
         return Err(PixelError::invalid(
             "rom_depth",
             depth,
             format!(
-                "the ΣΔ band f_s/(2·OSR) holds {} bin(s) at L = {depth} and OSR = {osr}, fewer than bins = {bins} (L is pixel.rom_depth, else probe.rom_depth in periodic mode, N in windowed mode)",
-                limit.saturating_sub(1)
+                "{why} (L is pixel.rom_depth, else probe.rom_depth in periodic mode, N in windowed mode)"
             ),
             min_depth(bins, osr),
         ));
     }
-    let ctx = doc.pixel_context();
     Ok(choose_bins(&ctx.tones, fs, depth, osr, Some(bins))?.all())
 }
 

@@ -12,7 +12,7 @@ use tofprobe_scene::{PhotonSource, Scene};
 
 use crate::adders::{AdderStatus, AdderTiming};
 use crate::analysis_mode::{ModeDecision, check_haar, decide_mode};
-use crate::bins::bin_indices;
+use crate::bins::bin_indices_in;
 use crate::document::Document;
 use crate::error::DesignError;
 use crate::probe_cache::ProbeCache;
@@ -145,13 +145,13 @@ pub fn resolve_timed(
     // (it used to be reported against `pixel.bins` or `pixel.rom_depth`).
     if mode.mode == Mode::Fourier && d.pixel.frequencies_hz.is_empty() {
         let l = px.rom_depth.unwrap_or(probe_depth) as u64;
-        if tofprobe_pixel::autobins::band_limit(l, d.probe.osr) < 2 {
+        if let Err(why) = crate::bins::band_check(l, d.probe.osr, 1) {
             return Err(probe_err(
                 tofprobe_dsp::DspError::out_of_range(
                     "probe.osr",
                     tofprobe_io::text::number(d.probe.osr),
                     format!(
-                        "osr < L/2 = {}: the ΣΔ band f_s/(2·OSR) must hold at least the ROM's first bin f_s/L (L = {l})",
+                        "osr < L/2 = {}: {why}; the band must hold at least the ROM's first bin f_s/L",
                         l as f64 / 2.0
                     ),
                 )
@@ -188,7 +188,8 @@ pub fn resolve_timed(
         .map_err(|e| pixel_err(derived_from(e, d)))?;
 
     let (bins, probe_design) = if pixel.mode == Mode::Fourier {
-        let bins = bin_indices(d, pixel.bins, pixel.rom_depth as u64).map_err(pixel_err)?;
+        let bins =
+            bin_indices_in(d, &context, pixel.bins, pixel.rom_depth as u64).map_err(pixel_err)?;
         // The modulator's stability limit is lowest towards DC: check at the lowest bin.
         let lowest = bins.iter().copied().min().unwrap_or(1).max(1);
         let f_norm = lowest as f64 / pixel.rom_depth as f64;

@@ -13,11 +13,10 @@
 //! testbench/README.md.
 
 use tofprobe_dsp::sd::{ProbeDesign, ProbeRom, RomMode};
-use tofprobe_pixel::autobins::band_limit;
 use tofprobe_pixel::{Mode, PixelParams};
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 
-use crate::bins::bin_indices;
+use crate::bins::bin_indices_in;
 use crate::error::DesignError;
 use crate::resolve::ResolvedDesign;
 
@@ -134,24 +133,23 @@ pub fn rtl_rom(design: &ResolvedDesign, p: &mut PixelParams) -> Result<RtlRom, D
         });
     }
     let depth = config.probe.depth(p.frame_pulses);
-    let limit = band_limit(depth as u64, config.probe.osr);
     let reason = if depth > MAX_SD_ROM_DEPTH {
         Some(format!(
             "a {} ΣΔ ROM of depth {depth} exceeds {MAX_SD_ROM_DEPTH} entries",
             config.probe.rom_mode.name()
         ))
-    } else if depth < 16 || (limit as usize) <= p.bins {
+    } else if depth < 16 {
         Some(format!(
-            "the ΣΔ band f_s/(2·OSR) holds {} bin(s) at L = {depth}, fewer than B = {}",
-            limit.saturating_sub(1),
-            p.bins
+            "a ΣΔ ROM of {depth} entries is too short to probe (fewer than 16)"
         ))
     } else {
-        None
+        crate::bins::band_check(depth as u64, config.probe.osr, p.bins).err()
     };
     let bins = match reason {
         Some(r) => Err(r),
-        None => bin_indices(config, p.bins, depth as u64).map_err(|e| e.to_string()),
+        None => {
+            bin_indices_in(config, &design.context, p.bins, depth as u64).map_err(|e| e.to_string())
+        }
     };
     let bins = match bins {
         Ok(b) => b,

@@ -18,7 +18,6 @@ use std::path::PathBuf;
 use tofprobe_cosim::{CosimOptions, cosim};
 use tofprobe_design::rom_policy::{RtlOverrides, rtl_rom};
 use tofprobe_design::{ResolvedDesign, rtl_params};
-use tofprobe_dsp::sd::{amplitudes_um, normalise, prefilter_response};
 use tofprobe_pixel::Mode;
 use tofprobe_pixel::fixed::sign_extend as sext;
 use tofprobe_rtlgen::write::write_atomic;
@@ -311,60 +310,9 @@ fn refuse_foreign_report(path: &std::path::Path) -> Result<(), FlowError> {
     }
 }
 
-/// One probed bin of a readout, normalised.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BinReading {
-    /// Raw sums in TDC codes (the register words / 2^F).
-    pub i: f64,
-    pub q: f64,
-    /// |H_pre(f_k)| of the prefilter at the bin.
-    pub prefilter_gain: f64,
-    /// Amplitude in µm and phase in degrees.
-    pub amplitude_um: f64,
-    pub phase_deg: f64,
-}
-
-/// Normalises a Fourier readout `f` (raw W-bit words, register 2k = I, 2k+1 = Q) read with
-/// the ΣΔ ROM `rom`: (I − jQ) · 2/N / (G · A_p · H_pre(f_k)) in codes, times the LSB.
-pub fn normalised_bins(
-    p: &tofprobe_pixel::PixelParams,
-    f: &[u64],
-    rom: &tofprobe_dsp::sd::ProbeRom,
-    lsb_mm: f64,
-) -> Vec<BinReading> {
-    let frac = f64::from(1u32 << p.register_frac_bits());
-    let sums: Vec<(f64, f64)> = (0..p.bins.min(rom.bins.len()))
-        .map(|k| {
-            (
-                sext(f[2 * k], p.width) as f64 / frac,
-                sext(f[2 * k + 1], p.width) as f64 / frac,
-            )
-        })
-        .collect();
-    let alpha = 1.0 / f64::from(1u32 << p.shift);
-    let phasors = normalise(rom, &sums, p.frame_pulses, Some(alpha));
-    // normalise works in the sums' unit (TDC codes); µm = codes · LSB (mm) · 1000.
-    let amps = amplitudes_um(&phasors);
-    sums.iter()
-        .zip(&phasors)
-        .zip(amps)
-        .zip(&rom.bins)
-        .map(|(((&(i, q), y), a), &hz)| {
-            let amp = a * lsb_mm;
-            let ph = y.arg().to_degrees();
-            BinReading {
-                i,
-                q,
-                prefilter_gain: prefilter_response(alpha, hz / rom.sample_rate_hz).norm(),
-                amplitude_um: if amp.is_finite() { amp } else { 0.0 },
-                phase_deg: if ph.is_finite() { ph } else { 0.0 },
-            }
-        })
-        .collect()
-}
-
 /// Writes the spectrum table of a Fourier readout `f` (raw W-bit words) into `md`: with the
-/// ΣΔ ROM, normalised to µm ([`normalised_bins`]); with the sign probe, raw. Returns a
+/// ΣΔ ROM, normalised to µm (`tofprobe_pixel::spectrum::phasors`, the one readout → phasor
+/// function); with the sign probe, raw. Returns a
 /// one-line headline (the strongest bin).
 fn spectrum(
     md: &mut String,
@@ -388,7 +336,20 @@ fn spectrum(
         let _ = writeln!(md);
         return "sign-probe ROM: spectrum not normalised".into();
     };
-    let bins = normalised_bins(p, f, rom, lsb_mm);
+    let words: Vec<i64> = f.iter().map(|&w| sext(w, p.width)).collect();
+    let bins = match tofprobe_pixel::spectrum::phasors(p, rom, &words, p.frame_pulses, lsb_mm) {
+        Ok(b) => b,
+        Err(e) => {
+            let _ = writeln!(
+                md,
+                "## Spectrum at the bins
+
+not normalised: {e}
+"
+            );
+            return format!("spectrum not normalised: {e}");
+        }
+    };
     let _ = writeln!(
         md,
         "## Spectrum at the bins (frame 0, ΣΔ ROM)\n\nAmplitude = |I − jQ| · 2/N / (G · A_p · |H_pre(f_k)|) · LSB, with N = {}, G = {:.4} ({} window), A_p = {}, α = 2^-{}, LSB = {:.4} mm. I and Q in TDC codes.\n",
@@ -413,8 +374,8 @@ fn spectrum(
             "| {b} | {} | {:.1} | {:.3} | {:.3} | {:.4} | {:.2} | {:.1} |",
             rom.bin_indices[b],
             rom.bins[b],
-            r.i,
-            r.q,
+            r.i_codes,
+            r.q_codes,
             r.prefilter_gain,
             r.amplitude_um,
             r.phase_deg
@@ -442,8 +403,6 @@ fn spectrum(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tofprobe_dsp::sd::{ProbeConfig, ProbeDesign, ProbeRom};
-    use tofprobe_pixel::PixelParams;
 
     #[test]
     fn periodic_short_frame_is_whole_periods() {
@@ -468,78 +427,5 @@ mod tests {
             short_frame(&[(10e6 / 1024.0, 0.1)], 10e6, 156_250.0),
             SHORT_FRAME
         );
-    }
-
-    /// The flow's normalisation against a naive float pixel: a 3-code cosine through the
-    /// prefilter x[n] = x[n−1] + α(d[n−1] − x[n−1]), summed with the ROM's ±1 bits into
-    /// W-bit words with F fraction bits, must read back 3 codes · LSB at its bin and ≈ 0 at
-    /// another. Tolerance 1 %: the ΣΔ probe reads A_p to < 0.5 % (crates/dsp probe tests),
-    /// the word rounding is 2^−F/N relative, and Blackman leakage from bin 100 to bin 40
-    /// is below −90 dB.
-    #[test]
-    fn readout_normalises_to_the_tone_amplitude() {
-        let n = 8192usize;
-        let cfg = ProbeConfig::default();
-        let design = ProbeDesign::new(&cfg, 40.0 / n as f64).unwrap();
-        let rom = ProbeRom::generate(&design, 10e6, n as u64, &[40, 100]).unwrap();
-        let p = PixelParams {
-            bins: 2,
-            frame_pulses: n as u64,
-            rom_depth: n,
-            frac_bits: 8,
-            shift: 5,
-            width: 40,
-            ..PixelParams::default()
-        };
-        let alpha = 1.0 / 32.0;
-        let (amp, phase) = (3.0, 0.3f64);
-        let d: Vec<f64> = (0..n)
-            .map(|i| amp * (2.0 * std::f64::consts::PI * 40.0 * i as f64 / n as f64 + phase).cos())
-            .collect();
-        let mut x = d[0];
-        let mut sums = [0.0f64; 4];
-        for i in 1..n {
-            x += alpha * (d[i - 1] - x);
-            for (r, s) in sums.iter_mut().enumerate() {
-                *s += if rom.image.bit(i, r) { x } else { -x };
-            }
-        }
-        let words = |frac: f64| -> Vec<u64> {
-            sums.iter()
-                .map(|s| ((s * frac).round() as i64 as u64) & ((1u64 << 40) - 1))
-                .collect()
-        };
-        let lsb_mm = 0.75;
-        let b = normalised_bins(&p, &words(256.0), &rom, lsb_mm);
-        let want_um = amp * lsb_mm * 1000.0;
-        // Registers keeping G = 2 of the F = 8 fraction bits count in 2^−2 codes: the same
-        // sums as G-bit words must read back the same amplitude (the word rounding, 2^−2/N
-        // relative, is far below the 1 %), and read as F-bit words they would be 2^6 low.
-        let pg = PixelParams {
-            register_frac_bits: Some(2),
-            ..p.clone()
-        };
-        let bg = normalised_bins(&pg, &words(4.0), &rom, lsb_mm);
-        assert!(
-            (bg[0].amplitude_um / want_um - 1.0).abs() < 0.01,
-            "G = 2: {} vs {want_um}",
-            bg[0].amplitude_um
-        );
-        let wrong = normalised_bins(&p, &words(4.0), &rom, lsb_mm);
-        assert!(wrong[0].amplitude_um < 0.02 * want_um);
-        assert!(
-            (b[0].amplitude_um / want_um - 1.0).abs() < 0.01,
-            "{} vs {want_um}",
-            b[0].amplitude_um
-        );
-        assert!(b[1].amplitude_um < 0.01 * want_um, "{}", b[1].amplitude_um);
-        // The prefilter's delay and gain are divided out: the phase is the tone's.
-        assert!(
-            (b[0].phase_deg - phase.to_degrees()).abs() < 1.0,
-            "{}",
-            b[0].phase_deg
-        );
-        let h = prefilter_response(alpha, 40.0 / n as f64).norm();
-        assert!((b[0].prefilter_gain - h).abs() < 1e-12);
     }
 }

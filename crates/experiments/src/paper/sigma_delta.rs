@@ -189,11 +189,8 @@ pub fn bit_true(
         tm.run(chunk, Some(&setup.rom.image), (i as u64) << 16)?;
     }
     let words = tm.readout().words;
+    let bit_sums = tofprobe_pixel::spectrum::register_sums(&p, &words);
     let scale = f64::from(1u32 << p.register_frac_bits());
-    let bit_sums: Vec<(f64, f64)> = words
-        .chunks(2)
-        .map(|c| (c[0] as f64 / scale, c[1] as f64 / scale))
-        .collect();
     let phasors = setup.phasors(&bit_sums, Some(alpha()));
 
     // The float reference under the pixel's rules on the same detections.
