@@ -1,12 +1,14 @@
 //! The configuration document and its ONE resolution: [`Document`] (the TOML file or the
 //! embedded default) → [`resolve`] → [`ResolvedDesign`] (scene, sensor, pixel parameters
 //! and widths, Fourier bins, the stability-checked ΣΔ probe design). Every `tofprobe`
-//! command starts from a `ResolvedDesign`. Also the bin chooser ([`bins`]) and the chip
-//! ROM policy of the RTL commands ([`rom_policy`]).
+//! command starts from a `ResolvedDesign`. Also the bin chooser ([`bins`]), the chip the RTL
+//! commands build ([`chip`]: array shape, the broadcast probe ROM by the ROM policy
+//! [`rom_policy`], the sequencer) and `adders = "auto"`'s pure choice ([`adders`]).
 
 pub mod adders;
 pub mod analysis_mode;
 pub mod bins;
+pub mod chip;
 pub mod document;
 pub mod error;
 pub mod probe_cache;
@@ -16,6 +18,7 @@ pub mod schema;
 
 pub use adders::{AdderChoice, AdderStatus, AdderTiming, CandidateTiming};
 pub use analysis_mode::ModeDecision;
+pub use chip::{Chip, RomPurpose, SequencerKind};
 pub use document::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, SIZING_SIGMAS, read_text};
 pub use error::DesignError;
 pub use probe_cache::ProbeCache;

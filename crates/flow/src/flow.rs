@@ -16,8 +16,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use tofprobe_cosim::{CosimOptions, cosim};
-use tofprobe_design::rom_policy::{RtlOverrides, rtl_rom};
-use tofprobe_design::{ResolvedDesign, rtl_params};
+use tofprobe_design::rom_policy::RtlOverrides;
+use tofprobe_design::{Chip, ResolvedDesign, RomPurpose};
 use tofprobe_pixel::Mode;
 use tofprobe_pixel::fixed::sign_extend as sext;
 use tofprobe_rtlgen::write::write_atomic;
@@ -137,8 +137,8 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
         frame_pulses: n_override,
         rom_depth: None,
     };
-    let mut p = rtl_params(design, &overrides)?;
-    let rom = rtl_rom(design, &mut p)?;
+    let chip = Chip::of(design, &overrides, RomPurpose::Configured)?;
+    let (p, rom) = (chip.pixel, chip.rom);
     if a.signoff {
         // Before the co-simulation: a trace too long for gate level is refused at once.
         crate::signoff::check_length(&p, a.frames)?;

@@ -1,12 +1,12 @@
-//! The chip's RTL for a resolved design (`tofprobe rtl`): the generator's parameters and
-//! chip ROM from the design's ROM policy (`tofprobe_design::rom_policy`), rendered and
+//! The chip's RTL for a resolved design (`tofprobe rtl`): the design's chip
+//! (`tofprobe_design::Chip`: the pixel as simulated, the ROM the policy renders), rendered and
 //! written atomically with the ΣΔ ROM's TOML manifest beside its hex and the FuseSoC core
 //! (`tofprobe_rtlgen::core`) that packages them.
 
 use std::path::{Path, PathBuf};
 
-use tofprobe_design::rom_policy::{RtlOverrides, chip_rom};
-use tofprobe_design::{ResolvedDesign, rtl_params};
+use tofprobe_design::rom_policy::RtlOverrides;
+use tofprobe_design::{Chip, ResolvedDesign, RomPurpose};
 use tofprobe_dsp::sd::ProbeRom;
 use tofprobe_pixel::PixelParams;
 use tofprobe_rtlgen::core::{CoreSim, relative_path, render_core};
@@ -58,8 +58,8 @@ pub fn render_design(
     sim: Option<&CoreSimPaths>,
 ) -> Result<RenderedRtl, FlowError> {
     let sim = sim.map(|s| s.relative_to(out)).transpose()?;
-    let mut p = rtl_params(design, o)?;
-    let rom = chip_rom(design, o, &mut p)?;
+    let chip = Chip::of(design, o, RomPurpose::Rendered)?;
+    let (p, rom) = (chip.pixel, chip.rom);
     let files = render_to(
         &p,
         &rom.words,

@@ -9,7 +9,7 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 use tofprobe_cosim::{BuildProfile, CosimOptions, CosimReport, Simulator, cosim};
 use tofprobe_design::RtlOverrides;
-use tofprobe_design::rom_policy::{chip_rom, simulation_rom};
+use tofprobe_design::{Chip, RomPurpose};
 use tofprobe_pixel::{DirectedOptions, PixelParams};
 
 use crate::error::CliError;
@@ -209,22 +209,25 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
     if let Some(n) = a.random {
         return run_random(a, n);
     }
-    let (design, mut p) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
-    let mut rom_note = "sign-of-cosine probe ROM (--rom-depth given)".to_string();
-    let mut sd_rom = None;
-    if a.rtl.is_some() {
-        // The ROM `tofprobe rtl` renders for this configuration: the image in DIR must be it.
-        let r = chip_rom(&design, &overrides, &mut p)?;
-        rom_note = format!(
+    let (design, _) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
+    // With --rtl, the chip `tofprobe rtl` renders for this configuration (the image in DIR
+    // must be its ROM); else the chip the simulating commands replay.
+    let purpose = if a.rtl.is_some() {
+        RomPurpose::Rendered
+    } else {
+        RomPurpose::Replayed
+    };
+    let chip = Chip::of(&design, &overrides, purpose)?;
+    let p = chip.pixel;
+    let rom_note = if a.rtl.is_some() {
+        format!(
             "ROM of --rtl checked against the configuration's: {}",
-            r.note
-        );
-        sd_rom = Some(r.words);
-    } else if a.rom_depth.is_none() {
-        let r = simulation_rom(&design, &overrides, &mut p)?;
-        rom_note = r.note;
-        sd_rom = Some(r.words);
-    }
+            chip.rom.note
+        )
+    } else {
+        chip.rom.note
+    };
+    let sd_rom = Some(chip.rom.words);
     let mut o = options(&p, a);
     o.rom = sd_rom;
     let r = cosim(&p, &o)?;

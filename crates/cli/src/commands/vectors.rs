@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use tofprobe_design::RtlOverrides;
-use tofprobe_design::rom_policy::simulation_rom;
+use tofprobe_design::{Chip, RomPurpose};
 use tofprobe_rtlgen::stimulus::random_stimulus;
 use tofprobe_rtlgen::vectors::golden_run;
 use tofprobe_rtlgen::vectors::{VectorOptions, write_vectors};
@@ -45,9 +45,9 @@ pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
     };
-    let (design, mut p) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
-    let chip = simulation_rom(&design, &overrides, &mut p)?;
-    let (rom, note) = (chip.words, chip.note);
+    let (design, _) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
+    let chip = Chip::of(&design, &overrides, RomPurpose::Replayed)?;
+    let (p, rom, note) = (chip.pixel, chip.rom.words, chip.rom.note);
     let stim = random_stimulus(&p, a.frames * p.frame_pulses, a.seed);
     let o = VectorOptions {
         frames: a.frames,

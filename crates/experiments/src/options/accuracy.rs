@@ -10,8 +10,9 @@ use tofprobe_design::{Document, ProbeCache, ResolvedDesign};
 
 use super::catalogue::ArchOption;
 use crate::error::ExperimentError;
+use crate::level::Level;
 use crate::spectrum::setup;
-use crate::tradeoff::measure_setup;
+use crate::tradeoff::measure_levels;
 use crate::tradeoff::overrides::with_overrides;
 
 /// The tone error over the seeds (µm).
@@ -113,11 +114,10 @@ fn one(
     let label = format!("{origin} with option {} (seed {seed})", o.name);
     let design = with_overrides(config, &label, &ov, cache)?;
     let su = setup(&design)?;
-    let r = measure_setup(&design, &su, false)?;
+    // Only the level it compares (the float full DFT it is scored against runs too).
+    let r = measure_levels(&design, &su, &[Level::BitTrue])?;
     let err = r
-        .levels
-        .iter()
-        .find(|l| l.level == "bit-true transaction")
+        .level(Level::BitTrue)
         .and_then(|l| l.amplitude_err_vs_dft_um)
         .ok_or_else(|| {
             ExperimentError::option(

@@ -155,17 +155,21 @@ impl RowRecord<'_> {
     }
 }
 
-/// A column of the table: a name and a function from a row's record to a measurement
-/// (`None`: the column does not apply to this row).
+/// A column of the table: a name, the fidelity level it measures at and a function from a
+/// row's record to a measurement (`None`: the column does not apply to this row).
 #[derive(Debug, Clone, Copy)]
 pub struct Column {
     pub name: &'static str,
+    /// The level of the registry ([`crate::level`]) this column reads.
+    pub level: crate::level::Level,
     pub measure: fn(&RowRecord<'_>) -> Result<Option<Measurement>, ExperimentError>,
 }
 
 /// Column names.
 pub const DFT: &str = "DFT";
 pub const SD: &str = "ΣΔ";
+/// The float ΣΔ level read without dividing the prefilter's gain out (the paper's point
+/// that the correction is needed).
 pub const SD_RAW: &str = "ΣΔ no prefilter";
 pub const BIT_TRUE: &str = "bit-true";
 
@@ -173,18 +177,22 @@ pub const BIT_TRUE: &str = "bit-true";
 pub const COLUMNS: &[Column] = &[
     Column {
         name: DFT,
+        level: crate::level::Level::FullDft,
         measure: dft_column,
     },
     Column {
         name: SD,
+        level: crate::level::Level::FloatSd,
         measure: sd_column,
     },
     Column {
         name: SD_RAW,
+        level: crate::level::Level::FloatSd,
         measure: sd_raw_column,
     },
     Column {
         name: BIT_TRUE,
+        level: crate::level::Level::BitTrue,
         measure: bit_true_column,
     },
 ];

@@ -22,6 +22,7 @@ use tofprobe_pixel::{CycleModel, PixelError, PixelParams, ReadoutCollector, Sequ
 
 use super::CYCLE_FRAME;
 use crate::error::ExperimentError;
+use crate::level::Level;
 use crate::records::{detection_record, held_record};
 use crate::transients::{
     HaarAnalysis, analyse_registers, analyse_scalogram, bit_true_registers, haar_params,
@@ -141,14 +142,14 @@ pub fn measure_haar(
     // Its events under the pixel's thresholds (same noise model, same N and U).
     let reference: HaarAnalysis = analyse_scalogram(design, float_s)?;
     let float_centres = centres(&reference.events);
-    let score = |name: &str,
+    let score = |level: Level,
                  secs: Option<f64>,
                  extrapolated: bool,
                  a: Option<&HaarAnalysis>,
                  note: String| {
         let c = a.map(|a| centres(&a.events));
         HaarLevel {
-            level: name.to_string(),
+            level: level.name().to_string(),
             seconds_per_sim_second: secs.map(|s| s / sim_seconds),
             extrapolated,
             coefficient_err_mm: a.map(|a| max_abs_diff(&a.scalogram, &reference.scalogram)),
@@ -160,72 +161,84 @@ pub fn measure_haar(
             note,
         }
     };
-    let mut levels = vec![score(
-        "float Haar",
-        Some(float_secs),
-        false,
-        Some(&reference),
-        "f64 Haar of the held record (mm); the reference".into(),
-    )];
 
-    // Bit-true transaction model, streaming the photon source itself (the same record).
+    // The Haar ladder of the level registry, cheapest first. The bit-true transaction
+    // model streams the photon source itself (the same record); the bit-exact levels
+    // after it are checked against its registers.
     let (regs, bt_secs) = bit_true_registers(&p, &source, n).map_err(px_err)?;
     let bt = analyse_registers(design, &regs, n)?;
-    levels.push(score(
-        "bit-true transaction",
-        Some(bt_secs),
-        false,
-        Some(&bt),
-        "integer registers, normalised".into(),
-    ));
-
-    // Cycle-accurate model: the whole frame if short enough, else a shortened one.
-    let short_n = if n <= CYCLE_FULL_MAX {
-        n
-    } else {
-        CYCLE_FRAME.min(n)
-    };
-    let mut short = p.clone();
-    short.frame_pulses = short_n;
-    let stim = &detections[..short_n as usize];
-    let t = Instant::now();
-    let cregs = cycle_registers(&short, stim).map_err(px_err)?;
-    let c_secs = t.elapsed().as_secs_f64() * n as f64 / short_n as f64;
-    if short_n == n {
-        let ca = analyse_registers(design, &cregs, n)?;
-        let same = if cregs == regs {
-            "equal to"
-        } else {
-            "DIFFERENT from"
-        };
-        levels.push(score(
-            "cycle-accurate",
-            Some(c_secs),
-            false,
-            Some(&ca),
-            format!("its readout, {same} the transaction model's registers"),
-        ));
-    } else {
-        let mut tm = tofprobe_pixel::TransactionModel::new(&short).map_err(px_err)?;
-        tm.run(stim, None, 0).map_err(px_err)?;
-        if tm.readout().words != cregs {
-            return Err(px_err(PixelError::mismatch(
-                "cycle-accurate Haar registers",
-                "different",
-                "the transaction model's on the same frame",
-            )));
+    let mut levels = Vec::new();
+    for level in Level::haar_ladder(verilator) {
+        match level {
+            Level::FloatHaar => levels.push(score(
+                level,
+                Some(float_secs),
+                false,
+                Some(&reference),
+                "f64 Haar of the held record (mm); the reference".into(),
+            )),
+            Level::BitTrue => levels.push(score(
+                level,
+                Some(bt_secs),
+                false,
+                Some(&bt),
+                "integer registers, normalised".into(),
+            )),
+            Level::Cycle => {
+                // The whole frame if short enough, else a shortened one.
+                let short_n = if n <= CYCLE_FULL_MAX {
+                    n
+                } else {
+                    CYCLE_FRAME.min(n)
+                };
+                let mut short = p.clone();
+                short.frame_pulses = short_n;
+                let stim = &detections[..short_n as usize];
+                let t = Instant::now();
+                let cregs = cycle_registers(&short, stim).map_err(px_err)?;
+                let c_secs = t.elapsed().as_secs_f64() * n as f64 / short_n as f64;
+                if short_n == n {
+                    let ca = analyse_registers(design, &cregs, n)?;
+                    let same = if cregs == regs {
+                        "equal to"
+                    } else {
+                        "DIFFERENT from"
+                    };
+                    levels.push(score(
+                        level,
+                        Some(c_secs),
+                        false,
+                        Some(&ca),
+                        format!("its readout, {same} the transaction model's registers"),
+                    ));
+                } else {
+                    let mut tm = tofprobe_pixel::TransactionModel::new(&short).map_err(px_err)?;
+                    tm.run(stim, None, 0).map_err(px_err)?;
+                    if tm.readout().words != cregs {
+                        return Err(px_err(PixelError::mismatch(
+                            "cycle-accurate Haar registers",
+                            "different",
+                            "the transaction model's on the same frame",
+                        )));
+                    }
+                    levels.push(score(
+                        level,
+                        Some(c_secs),
+                        true,
+                        Some(&bt),
+                        format!("timed on {short_n} pulses, bit-exact with the transaction model there; scored as it"),
+                    ));
+                }
+            }
+            Level::Rtl => levels.push(verilator_level(&p, &detections, n, &bt, &score)),
+            other => {
+                return Err(ExperimentError::option(
+                    "level",
+                    other.name(),
+                    "a level of the Haar ladder",
+                ));
+            }
         }
-        levels.push(score(
-            "cycle-accurate",
-            Some(c_secs),
-            true,
-            Some(&bt),
-            format!("timed on {short_n} pulses, bit-exact with the transaction model there; scored as it"),
-        ));
-    }
-
-    if verilator {
-        levels.push(verilator_level(&p, &detections, n, &bt, &score));
     }
     Ok(HaarSceneResult {
         origin: origin.to_string(),
@@ -237,7 +250,7 @@ pub fn measure_haar(
 }
 
 /// Builds a level's row: (name, wall s, extrapolated, its analysis, note).
-type Scorer<'a> = dyn Fn(&str, Option<f64>, bool, Option<&HaarAnalysis>, String) -> HaarLevel + 'a;
+type Scorer<'a> = dyn Fn(Level, Option<f64>, bool, Option<&HaarAnalysis>, String) -> HaarLevel + 'a;
 
 /// The Verilator RTL on a shortened frame; a harness refusal (e.g. more than 64
 /// registers) is a row saying why, not a failed ladder.
@@ -266,7 +279,7 @@ fn verilator_level(
             let secs = rep.bare_seconds.unwrap_or(rep.verilator_seconds);
             let per_pulse = secs / rep.pulses.max(1) as f64;
             score(
-                "Verilator RTL",
+                Level::Rtl,
                 Some(per_pulse * n as f64),
                 true,
                 Some(bt),
@@ -277,7 +290,7 @@ fn verilator_level(
             )
         }
         Ok(rep) => score(
-            "Verilator RTL",
+            Level::Rtl,
             None,
             true,
             None,
@@ -286,7 +299,7 @@ fn verilator_level(
                 rep.outcome.mismatches
             ),
         ),
-        Err(e) => score("Verilator RTL", None, true, None, format!("not run: {e}")),
+        Err(e) => score(Level::Rtl, None, true, None, format!("not run: {e}")),
     }
 }
 

@@ -13,8 +13,9 @@ use tofprobe_design::{DesignError, Document, ProbeCache, ResolvedDesign};
 
 use super::overrides::{shortened, with_overrides};
 use super::timing::median_seconds;
-use super::{LevelResult, measure_setup};
+use super::{LevelResult, measure_levels};
 use crate::error::ExperimentError;
+use crate::level::Level;
 use crate::spectrum::setup;
 
 /// One knob setting: the knob's name, the value shown, and the TOML keys it sets. A value
@@ -278,19 +279,23 @@ fn measure_row(
     row.width_bits = Some(su.params.width);
     row.bins = Some(su.params.bins);
     row.rom_depth_entries = Some(su.params.rom_depth);
-    let r = measure_setup(&design, &su, false)?;
-    let level = |name: &str| -> Result<&LevelResult, ExperimentError> {
-        r.levels.iter().find(|l| l.level == name).ok_or_else(|| {
+    let r = measure_levels(
+        &design,
+        &su,
+        &[Level::ClosedForm, Level::FullDft, Level::BitTrue],
+    )?;
+    let level = |level: Level| -> Result<&LevelResult, ExperimentError> {
+        r.level(level).ok_or_else(|| {
             DesignError::Toml {
                 origin: label.clone(),
-                message: format!("level {name} missing from the measurement"),
+                message: format!("level {level} missing from the measurement"),
             }
             .into()
         })
     };
-    let cf = level("closed form")?;
-    let dft = level("float full DFT")?;
-    let bt = level("bit-true transaction")?;
+    let cf = level(Level::ClosedForm)?;
+    let dft = level(Level::FullDft)?;
+    let bt = level(Level::BitTrue)?;
     row.amplitude_um = bt.amplitude_um;
     row.noise_um = Some(bt.noise_um);
     row.float_dft_amplitude_um = dft.amplitude_um;

@@ -27,8 +27,10 @@ use tofprobe_pixel::bench::bench_cycle;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
 
 use tofprobe_design::{DesignError, ResolvedDesign};
+use tofprobe_scene::PhotonSource;
 
 use crate::error::ExperimentError;
+use crate::level::Level;
 use crate::records::{detection_record, held_record};
 use crate::spectrum::{BitTrueSetup, setup};
 
@@ -56,6 +58,13 @@ pub struct LevelResult {
     pub noise_rel_err_vs_dft: f64,
 }
 
+impl SceneResult {
+    /// The row of `level`, if it was measured.
+    pub fn level(&self, level: Level) -> Option<&LevelResult> {
+        self.levels.iter().find(|l| l.level == level.name())
+    }
+}
+
 /// All levels of one configuration.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct SceneResult {
@@ -69,11 +78,22 @@ pub struct SceneResult {
     pub levels: Vec<LevelResult>,
 }
 
-/// The levels' raw readings before scoring: (name, wall s, extrapolated, tone µm, noise µm).
-type Reading = (&'static str, f64, bool, Option<f64>, f64);
+/// One level's raw reading before scoring.
+#[derive(Debug, Clone, Copy)]
+struct Reading {
+    level: Level,
+    /// Wall seconds for the frame (measured, or scaled up from a shortened frame).
+    seconds: f64,
+    extrapolated: bool,
+    /// Tone amplitude, µm.
+    amplitude: Option<f64>,
+    /// Mean amplitude over the noise bins, µm.
+    noise: f64,
+}
 
-/// Measures every level on `design` (Fourier pixel; the float levels use its ROM's bins);
-/// with `verilator`, also the Verilator RTL on a shortened frame (builds the harness).
+/// Measures every level of the Fourier ladder on `design` (Fourier pixel; the float
+/// levels use its ROM's bins); with `verilator`, also the Verilator RTL on a shortened
+/// frame (builds the harness).
 pub fn measure(design: &ResolvedDesign, verilator: bool) -> Result<SceneResult, ExperimentError> {
     let su: BitTrueSetup = setup(design)?;
     measure_setup(design, &su, verilator)
@@ -86,209 +106,345 @@ pub fn measure_setup(
     su: &BitTrueSetup,
     verilator: bool,
 ) -> Result<SceneResult, ExperimentError> {
-    let (config, origin) = (&design.document, design.origin.as_str());
-    let scene_err = |source| ExperimentError::from(DesignError::scene(origin, source));
-    let source = config.photon_source().map_err(scene_err)?;
-    let n = su.params.frame_pulses;
-    let fs = config.sensor.laser_rate_hz;
-    let sim_seconds = n as f64 / fs;
-    let lsb_mm = config.sensor.tdc_lsb_mm();
-    let ctx = &design.context;
-    let choice = choose_bins(
-        &ctx.tones,
-        fs,
-        su.params.rom_depth as u64,
-        config.probe.osr,
-        Some(su.params.bins),
-    )
-    .map_err(|source| ExperimentError::from(DesignError::pixel(origin, source)))?;
-    let tone_bin = choice.tones.first().copied();
-    let true_amp = tone_bin.and_then(|k| {
-        ctx.tones
-            .iter()
-            .filter(|(f, _)| (f * su.params.rom_depth as f64 / fs).round() as u64 == k)
-            .map(|(_, a)| a.abs() * 1000.0)
-            .reduce(f64::max)
-    });
-    let noise_idx: Vec<usize> = (0..su.rom.bins.len())
-        .filter(|&i| Some(su.rom.bin_indices[i]) != tone_bin)
+    measure_levels(design, su, &Level::fourier_ladder(verilator))
+}
+
+/// The chosen Fourier `levels` of `design`, in the order given, each timed and scored
+/// against the float full DFT (run for the scoring when it is not among them, but not
+/// reported) and the scene's true amplitude. Only what the levels need is computed: the
+/// held record for the float levels, the bit-true spectrum for the bit-exact ones.
+pub fn measure_levels(
+    design: &ResolvedDesign,
+    su: &BitTrueSetup,
+    levels: &[Level],
+) -> Result<SceneResult, ExperimentError> {
+    if let Some(l) = levels.iter().find(|l| !l.info().fourier) {
+        return Err(ExperimentError::option(
+            "level",
+            l.name(),
+            "a level of the Fourier ladder (tradeoff::haar measures the Haar one)",
+        ));
+    }
+    let mut ladder = Ladder::new(design, su)?;
+    let dft = ladder.reading(Level::FullDft)?;
+    let mut readings = Vec::with_capacity(levels.len());
+    for &level in levels {
+        readings.push(ladder.reading(level)?);
+    }
+    let sim_seconds = ladder.n as f64 / ladder.fs;
+    let true_amp = ladder.true_amp;
+    let levels = readings
+        .iter()
+        .map(|r| LevelResult {
+            level: r.level.name().to_string(),
+            seconds_per_sim_second: r.seconds / sim_seconds,
+            extrapolated: r.extrapolated,
+            amplitude_um: r.amplitude,
+            noise_um: r.noise,
+            amplitude_err_vs_dft_um: r.amplitude.zip(dft.amplitude).map(|(x, d)| (x - d).abs()),
+            amplitude_err_vs_true_um: r.amplitude.zip(true_amp).map(|(x, t)| (x - t).abs()),
+            noise_rel_err_vs_dft: if dft.noise > 0.0 {
+                r.noise / dft.noise - 1.0
+            } else {
+                0.0
+            },
+        })
         .collect();
-    let tone_idx = tone_bin.and_then(|k| su.rom.bin_indices.iter().position(|&b| b == k));
-    let score = |amps: &[f64]| -> (Option<f64>, f64) {
-        let noise = if noise_idx.is_empty() {
+    Ok(SceneResult {
+        origin: design.origin.clone(),
+        pulses: ladder.n,
+        true_amplitude_um: true_amp,
+        levels,
+    })
+}
+
+/// The shared state of one ladder: the scene, the scoring bins and, once a level needs
+/// them, the detection record, the held record and the bit-true spectrum.
+struct Ladder<'a> {
+    design: &'a ResolvedDesign,
+    su: &'a BitTrueSetup,
+    source: PhotonSource,
+    n: u64,
+    fs: f64,
+    lsb_mm: f64,
+    true_amp: Option<f64>,
+    tone_idx: Option<usize>,
+    noise_idx: Vec<usize>,
+    /// (detections, held depths, seconds to build them).
+    record: Option<(Vec<Option<u32>>, Vec<f64>, f64)>,
+    done: Vec<Reading>,
+}
+
+impl<'a> Ladder<'a> {
+    fn new(design: &'a ResolvedDesign, su: &'a BitTrueSetup) -> Result<Self, ExperimentError> {
+        let (config, origin) = (&design.document, design.origin.as_str());
+        let scene_err = |source| ExperimentError::from(DesignError::scene(origin, source));
+        let source = config.photon_source().map_err(scene_err)?;
+        let n = su.params.frame_pulses;
+        let fs = config.sensor.laser_rate_hz;
+        let ctx = &design.context;
+        let choice = choose_bins(
+            &ctx.tones,
+            fs,
+            su.params.rom_depth as u64,
+            config.probe.osr,
+            Some(su.params.bins),
+        )
+        .map_err(|source| ExperimentError::from(DesignError::pixel(origin, source)))?;
+        let tone_bin = choice.tones.first().copied();
+        let true_amp = tone_bin.and_then(|k| {
+            ctx.tones
+                .iter()
+                .filter(|(f, _)| (f * su.params.rom_depth as f64 / fs).round() as u64 == k)
+                .map(|(_, a)| a.abs() * 1000.0)
+                .reduce(f64::max)
+        });
+        let noise_idx: Vec<usize> = (0..su.rom.bins.len())
+            .filter(|&i| Some(su.rom.bin_indices[i]) != tone_bin)
+            .collect();
+        let tone_idx = tone_bin.and_then(|k| su.rom.bin_indices.iter().position(|&b| b == k));
+        Ok(Ladder {
+            design,
+            su,
+            source,
+            n,
+            fs,
+            lsb_mm: config.sensor.tdc_lsb_mm(),
+            true_amp,
+            tone_idx,
+            noise_idx,
+            record: None,
+            done: Vec::new(),
+        })
+    }
+
+    fn origin(&self) -> &str {
+        &self.design.origin
+    }
+
+    fn dsp_err(&self) -> impl Fn(tofprobe_dsp::DspError) -> ExperimentError + '_ {
+        move |source| ExperimentError::from(DesignError::probe(self.origin(), source))
+    }
+
+    /// (tone amplitude, mean noise amplitude) of per-bin amplitudes in µm.
+    fn score(&self, amps: &[f64]) -> (Option<f64>, f64) {
+        let noise = if self.noise_idx.is_empty() {
             0.0
         } else {
-            noise_idx.iter().map(|&i| amps[i]).sum::<f64>() / noise_idx.len() as f64
+            self.noise_idx.iter().map(|&i| amps[i]).sum::<f64>() / self.noise_idx.len() as f64
         };
-        (tone_idx.map(|i| amps[i]), noise)
-    };
-    let mut readings: Vec<Reading> = Vec::new();
-
-    // The detections (mm) and the held depth record, as the pixel sees them: the one
-    // float front end's hold, nothing before the first detection.
-    let t0 = Instant::now();
-    let detections = detection_record(&source, n);
-    let depths = held_record(&source, &detections, 0.0)?;
-    let record_s = t0.elapsed().as_secs_f64();
-
-    // Closed form: eq. 12 with the window's N_eff and the 1NN hold, on the first-arrival
-    // mixture of signal and background (dsp::closed_form): its variance plus a²/12 for the
-    // noise, its valid rate ρ_v (a detection of either kind in the window) for the hold, and
-    // the gain ∂μ/∂t_s by which its mean follows the signal for the tone (pile-up: with
-    // background the first arrival follows a motion only when the signal photon came first).
-    // Without background this is σ² = σ_I² + a²/12, ρ_v = ρ_s and gain 1. The hold's noise
-    // factor F(ρ_v, ω) is averaged over the noise bins; the tone is scaled by g·|H(ρ_v, ω)|.
-    let t = Instant::now();
-    // The ROM's window (rectangular in periodic mode), so every level weighs alike.
-    let window = su.rom.window;
-    let mixture = MixtureParams {
-        signal_rate: config.sensor.signal_rate,
-        background_rate: config.sensor.background_rate,
-        signal_depth_mm: config.scene.depth_mm - config.sensor.window_start_mm(),
-        jitter_mm: config.sensor.jitter_mm(),
-        window_mm: config.sensor.window_end_mm() - config.sensor.window_start_mm(),
-    };
-    let dsp_err = |source| ExperimentError::from(DesignError::probe(origin, source));
-    // A scene without photons has no mixture: no detections, so the closed form reads 0.
-    let arrival = if mixture.signal_rate + mixture.background_rate > 0.0 {
-        first_arrival(&mixture).map_err(dsp_err)?
-    } else {
-        FirstArrival {
-            valid_rate: 0.0,
-            mean_mm: mixture.signal_depth_mm,
-            variance_mm2: mixture.jitter_mm * mixture.jitter_mm,
-            signal_fraction: 0.0,
-        }
-    };
-    let sigma = (arrival.variance_mm2 + lsb_mm * lsb_mm / 12.0).sqrt();
-    let rho = arrival.valid_rate.min(1.0);
-    let n_eff = n as f64 * window.effective_length_factor();
-    let omega = |i: usize| 2.0 * std::f64::consts::PI * su.rom.bins[i] / fs;
-    let cf_noise = if noise_idx.is_empty() {
-        noise_floor_mm(sigma, n_eff) * 1000.0
-    } else {
-        noise_idx
-            .iter()
-            .map(|&i| noise_floor_hold_mm(sigma, rho, omega(i), n_eff) * 1000.0)
-            .sum::<f64>()
-            / noise_idx.len() as f64
-    };
-    let gain = if config.sensor.background_rate > 0.0 {
-        mixture_gain(&mixture).map_err(dsp_err)?
-    } else {
-        1.0
-    };
-    let cf_amp = true_amp.map(|a| {
-        let w = tone_idx.map(omega).unwrap_or(0.0);
-        a * gain * hold_response_sq(rho, w).sqrt()
-    });
-    readings.push((
-        "closed form",
-        t.elapsed().as_secs_f64(),
-        false,
-        cf_amp,
-        cf_noise,
-    ));
-
-    // Float full DFT (rustfft over the whole record).
-    let t = Instant::now();
-    let spec = amplitude_spectrum(&depths, window)
-        .map_err(|source| ExperimentError::from(DesignError::probe(origin, source)))?;
-    // ROM bin k is f = k·f_s/L; in the N-point DFT that is k·N/L (equal in windowed mode,
-    // the nearest bin in periodic mode when L does not divide N).
-    let dft_bins = dft_bins(&su.rom.bin_indices, n, su.params.rom_depth);
-    let amps: Vec<f64> = dft_bins
-        .iter()
-        .map(|&k| spec.get(k).copied().unwrap_or(0.0) * 1000.0)
-        .collect();
-    let (a, nz) = score(&amps);
-    readings.push((
-        "float full DFT",
-        record_s + t.elapsed().as_secs_f64(),
-        false,
-        a,
-        nz,
-    ));
-    drop(spec);
-
-    // Float selected-bin DFT (streamed, only the B bins).
-    let t = Instant::now();
-    let bins = dft_bins;
-    let mut sel = SelectedBins::new(n, &bins, window).map_err(dsp_err)?;
-    for chunk in depths.chunks(1 << 16) {
-        sel.push(chunk).map_err(dsp_err)?;
+        (self.tone_idx.map(|i| amps[i]), noise)
     }
-    let amps: Vec<f64> = sel
-        .amplitudes()
-        .map_err(dsp_err)?
-        .iter()
-        .map(|a| a * 1000.0)
-        .collect();
-    let (a, nz) = score(&amps);
-    readings.push((
-        "float selected-bin DFT",
-        record_s + t.elapsed().as_secs_f64(),
-        false,
-        a,
-        nz,
-    ));
 
-    // Float ΣΔ probing: the pixel's float twin (same ROM, the front end's hold, priming
-    // and prefilter α = 2^−S on the same detections).
-    let t = Instant::now();
-    let alpha = 1.0 / f64::from(1u32 << su.params.shift);
-    let zoom = f64::from(su.params.zoom);
-    let twin = detections
-        .iter()
-        .map(|c| c.map(|c| (f64::from(c) - zoom) * lsb_mm));
-    let sums = probe_detections(&su.rom, twin, Some(alpha));
-    let amps = amplitudes_um(&normalise(&su.rom, &sums, n, Some(alpha)));
-    let (a, nz) = score(&amps);
-    readings.push((
-        "float ΣΔ probing",
-        record_s + t.elapsed().as_secs_f64(),
-        false,
-        a,
-        nz,
-    ));
-    drop(depths);
-    drop(detections);
+    /// The detections (codes) and the held depth record (mm), as the pixel sees them: the
+    /// one float front end's hold, nothing before the first detection; built once.
+    fn ensure_record(&mut self) -> Result<(), ExperimentError> {
+        if self.record.is_none() {
+            let t0 = Instant::now();
+            let detections = detection_record(&self.source, self.n);
+            let depths = held_record(&self.source, &detections, 0.0)?;
+            self.record = Some((detections, depths, t0.elapsed().as_secs_f64()));
+        }
+        Ok(())
+    }
 
-    // Bit-true transaction model (streams the photon source itself).
-    let t = Instant::now();
-    let bt = bit_true_spectrum(&su.params, &su.rom, &source, lsb_mm)
-        .map_err(|source| ExperimentError::from(DesignError::pixel(origin, source)))?;
-    let amps: Vec<f64> = bt.bins.iter().map(|b| b.amplitude_um).collect();
-    let (a, nz) = score(&amps);
-    readings.push((
-        "bit-true transaction",
-        t.elapsed().as_secs_f64(),
-        false,
-        a,
-        nz,
-    ));
+    /// The reading of `level` (measured once per ladder).
+    fn reading(&mut self, level: Level) -> Result<Reading, ExperimentError> {
+        if let Some(r) = self.done.iter().find(|r| r.level == level) {
+            return Ok(*r);
+        }
+        let r = self.measure_level(level)?;
+        self.done.push(r);
+        Ok(r)
+    }
 
-    // Cycle-accurate model: timed on a shortened frame (same registers, schedule and
-    // C cycles per pulse) and scaled to N; its registers equal the transaction model's
-    // after every pulse (crates/pixel/tests/equivalence.rs), so its accuracy is the
-    // transaction model's.
-    let mut short = su.params.clone();
-    short.frame_pulses = CYCLE_FRAME.min(n);
-    short.rom_depth = short.rom_depth.min(short.frame_pulses as usize);
-    let rom = tofprobe_pixel::bench::synthetic_rom(short.rom_depth, short.registers());
-    let cb = bench_cycle(&short, &rom, 1)
-        .map_err(|source| ExperimentError::from(DesignError::pixel(origin, source)))?;
-    let per_pulse = cb.seconds / short.frame_pulses as f64;
-    readings.push(("cycle-accurate", per_pulse * n as f64, true, a, nz));
+    fn measure_level(&mut self, level: Level) -> Result<Reading, ExperimentError> {
+        let reading = |seconds, extrapolated, (amplitude, noise): (Option<f64>, f64)| Reading {
+            level,
+            seconds,
+            extrapolated,
+            amplitude,
+            noise,
+        };
+        let window = self.su.rom.window;
+        match level {
+            Level::ClosedForm => {
+                let t = Instant::now();
+                let score = self.closed_form()?;
+                Ok(reading(t.elapsed().as_secs_f64(), false, score))
+            }
+            Level::FullDft => {
+                self.ensure_record()?;
+                let (_, depths, record_s) = self.record.as_ref().expect("built");
+                let record_s = *record_s;
+                let t = Instant::now();
+                let spec = amplitude_spectrum(depths, window).map_err(|source| {
+                    ExperimentError::from(DesignError::probe(&self.design.origin, source))
+                })?;
+                // ROM bin k is f = k·f_s/L; in the N-point DFT that is k·N/L (equal in
+                // windowed mode, the nearest bin in periodic mode when L does not divide N).
+                let amps: Vec<f64> =
+                    dft_bins(&self.su.rom.bin_indices, self.n, self.su.params.rom_depth)
+                        .iter()
+                        .map(|&k| spec.get(k).copied().unwrap_or(0.0) * 1000.0)
+                        .collect();
+                let secs = record_s + t.elapsed().as_secs_f64();
+                Ok(reading(secs, false, self.score(&amps)))
+            }
+            Level::SelectedDft => {
+                self.ensure_record()?;
+                let (_, depths, record_s) = self.record.as_ref().expect("built");
+                let record_s = *record_s;
+                let t = Instant::now();
+                let bins = dft_bins(&self.su.rom.bin_indices, self.n, self.su.params.rom_depth);
+                let dsp_err =
+                    |source| ExperimentError::from(DesignError::probe(&self.design.origin, source));
+                let mut sel = SelectedBins::new(self.n, &bins, window).map_err(dsp_err)?;
+                for chunk in depths.chunks(1 << 16) {
+                    sel.push(chunk).map_err(dsp_err)?;
+                }
+                let amps: Vec<f64> = sel
+                    .amplitudes()
+                    .map_err(dsp_err)?
+                    .iter()
+                    .map(|a| a * 1000.0)
+                    .collect();
+                let secs = record_s + t.elapsed().as_secs_f64();
+                Ok(reading(secs, false, self.score(&amps)))
+            }
+            Level::FloatSd => {
+                // The pixel's float twin: same ROM, the front end's hold, priming and
+                // prefilter α = 2^−S on the same detections.
+                self.ensure_record()?;
+                let (detections, _, record_s) = self.record.as_ref().expect("built");
+                let record_s = *record_s;
+                let t = Instant::now();
+                let p = &self.su.params;
+                let alpha = 1.0 / f64::from(1u32 << p.shift);
+                let zoom = f64::from(p.zoom);
+                let lsb_mm = self.lsb_mm;
+                let twin = detections
+                    .iter()
+                    .map(|c| c.map(|c| (f64::from(c) - zoom) * lsb_mm));
+                let sums = probe_detections(&self.su.rom, twin, Some(alpha));
+                let amps = amplitudes_um(&normalise(&self.su.rom, &sums, self.n, Some(alpha)));
+                let secs = record_s + t.elapsed().as_secs_f64();
+                Ok(reading(secs, false, self.score(&amps)))
+            }
+            Level::BitTrue => {
+                // The bit-true transaction model streams the photon source itself.
+                let t = Instant::now();
+                let bt =
+                    bit_true_spectrum(&self.su.params, &self.su.rom, &self.source, self.lsb_mm)
+                        .map_err(|source| {
+                            ExperimentError::from(DesignError::pixel(&self.design.origin, source))
+                        })?;
+                let amps: Vec<f64> = bt.bins.iter().map(|b| b.amplitude_um).collect();
+                Ok(reading(t.elapsed().as_secs_f64(), false, self.score(&amps)))
+            }
+            Level::Cycle => {
+                // Timed on a shortened frame (same registers, schedule and C cycles per
+                // pulse) and scaled to N; its registers equal the transaction model's
+                // after every pulse (crates/pixel/tests/it/equivalence.rs), so its
+                // accuracy is the transaction model's.
+                let bt = self.reading(Level::BitTrue)?;
+                let short = self.short_frame();
+                let rom = tofprobe_pixel::bench::synthetic_rom(short.rom_depth, short.registers());
+                let cb = bench_cycle(&short, &rom, 1).map_err(|source| {
+                    ExperimentError::from(DesignError::pixel(&self.design.origin, source))
+                })?;
+                let per_pulse = cb.seconds / short.frame_pulses as f64;
+                Ok(reading(
+                    per_pulse * self.n as f64,
+                    true,
+                    (bt.amplitude, bt.noise),
+                ))
+            }
+            Level::Rtl => {
+                let bt = self.reading(Level::BitTrue)?;
+                let secs = self.verilator_seconds()?;
+                Ok(reading(secs, true, (bt.amplitude, bt.noise)))
+            }
+            Level::FloatHaar => Err(ExperimentError::option(
+                "level",
+                level.name(),
+                "a level of the Fourier ladder",
+            )),
+        }
+    }
 
-    // Verilator RTL: the generated RTL co-simulated against the cycle model on a shortened
-    // frame of the scene's own detections; the bare harness time (no checking) scaled to
-    // N. A passing co-simulation is bit-exact, so its accuracy is the model's.
-    if verilator {
-        let mut rtl = short.clone();
-        rtl.rom_depth = rtl.rom_depth.min(rtl.frame_pulses as usize);
+    /// The shortened frame the cycle-accurate and RTL levels are timed on.
+    fn short_frame(&self) -> tofprobe_pixel::PixelParams {
+        let mut short = self.su.params.clone();
+        short.frame_pulses = CYCLE_FRAME.min(self.n);
+        short.rom_depth = short.rom_depth.min(short.frame_pulses as usize);
+        short
+    }
+
+    /// Closed form: eq. 12 with the window's N_eff and the 1NN hold, on the first-arrival
+    /// mixture of signal and background (dsp::closed_form): its variance plus a²/12 for
+    /// the noise, its valid rate ρ_v (a detection of either kind in the window) for the
+    /// hold, and the gain ∂μ/∂t_s by which its mean follows the signal for the tone
+    /// (pile-up: with background the first arrival follows a motion only when the signal
+    /// photon came first). Without background this is σ² = σ_I² + a²/12, ρ_v = ρ_s and
+    /// gain 1. The hold's noise factor F(ρ_v, ω) is averaged over the noise bins; the tone
+    /// is scaled by g·|H(ρ_v, ω)|.
+    fn closed_form(&self) -> Result<(Option<f64>, f64), ExperimentError> {
+        let config = &self.design.document;
+        // The ROM's window (rectangular in periodic mode), so every level weighs alike.
+        let window = self.su.rom.window;
+        let mixture = MixtureParams {
+            signal_rate: config.sensor.signal_rate,
+            background_rate: config.sensor.background_rate,
+            signal_depth_mm: config.scene.depth_mm - config.sensor.window_start_mm(),
+            jitter_mm: config.sensor.jitter_mm(),
+            window_mm: config.sensor.window_end_mm() - config.sensor.window_start_mm(),
+        };
+        let dsp_err = self.dsp_err();
+        // A scene without photons has no mixture: no detections, so the closed form reads 0.
+        let arrival = if mixture.signal_rate + mixture.background_rate > 0.0 {
+            first_arrival(&mixture).map_err(&dsp_err)?
+        } else {
+            FirstArrival {
+                valid_rate: 0.0,
+                mean_mm: mixture.signal_depth_mm,
+                variance_mm2: mixture.jitter_mm * mixture.jitter_mm,
+                signal_fraction: 0.0,
+            }
+        };
+        let lsb_mm = self.lsb_mm;
+        let sigma = (arrival.variance_mm2 + lsb_mm * lsb_mm / 12.0).sqrt();
+        let rho = arrival.valid_rate.min(1.0);
+        let n_eff = self.n as f64 * window.effective_length_factor();
+        let omega = |i: usize| 2.0 * std::f64::consts::PI * self.su.rom.bins[i] / self.fs;
+        let cf_noise = if self.noise_idx.is_empty() {
+            noise_floor_mm(sigma, n_eff) * 1000.0
+        } else {
+            self.noise_idx
+                .iter()
+                .map(|&i| noise_floor_hold_mm(sigma, rho, omega(i), n_eff) * 1000.0)
+                .sum::<f64>()
+                / self.noise_idx.len() as f64
+        };
+        let gain = if config.sensor.background_rate > 0.0 {
+            mixture_gain(&mixture).map_err(&dsp_err)?
+        } else {
+            1.0
+        };
+        let cf_amp = self.true_amp.map(|a| {
+            let w = self.tone_idx.map(omega).unwrap_or(0.0);
+            a * gain * hold_response_sq(rho, w).sqrt()
+        });
+        Ok((cf_amp, cf_noise))
+    }
+
+    /// The generated RTL co-simulated against the cycle model on a shortened frame of the
+    /// scene's own detections; the bare harness time (no checking) scaled to N. A passing
+    /// co-simulation is bit-exact, so its accuracy is the model's.
+    fn verilator_seconds(&self) -> Result<f64, ExperimentError> {
+        let short = self.short_frame();
         let mut stim = vec![None; short.frame_pulses as usize];
-        source.fill_counted(0, &mut stim);
+        self.source.fill_counted(0, &mut stim);
         let work =
             std::env::temp_dir().join(format!("tofprobe-tradeoff-rtl-{}", std::process::id()));
         let mut o = tofprobe_cosim::CosimOptions::new(&work);
@@ -299,7 +455,7 @@ pub fn measure_setup(
         // A scratch directory: removed after the run, and by an interrupt during it
         // (tofprobe_io::live).
         let live = tofprobe_io::live::register(tofprobe_io::live::Kind::Temporary, &work);
-        let rep = tofprobe_cosim::cosim(&rtl, &o);
+        let rep = tofprobe_cosim::cosim(&short, &o);
         let _ = std::fs::remove_dir_all(&work);
         drop(live);
         let rep = rep?;
@@ -312,33 +468,8 @@ pub fn measure_setup(
         }
         let secs = rep.bare_seconds.unwrap_or(rep.verilator_seconds);
         let per_pulse = secs / rep.pulses.max(1) as f64;
-        readings.push(("Verilator RTL", per_pulse * n as f64, true, a, nz));
+        Ok(per_pulse * self.n as f64)
     }
-
-    let dft = readings[1];
-    let levels = readings
-        .iter()
-        .map(|&(name, secs, extrapolated, amp, noise)| LevelResult {
-            level: name.to_string(),
-            seconds_per_sim_second: secs / sim_seconds,
-            extrapolated,
-            amplitude_um: amp,
-            noise_um: noise,
-            amplitude_err_vs_dft_um: amp.zip(dft.3).map(|(x, d)| (x - d).abs()),
-            amplitude_err_vs_true_um: amp.zip(true_amp).map(|(x, t)| (x - t).abs()),
-            noise_rel_err_vs_dft: if dft.4 > 0.0 {
-                noise / dft.4 - 1.0
-            } else {
-                0.0
-            },
-        })
-        .collect();
-    Ok(SceneResult {
-        origin: origin.to_string(),
-        pulses: n,
-        true_amplitude_um: true_amp,
-        levels,
-    })
 }
 
 /// The ROM's bins k·f_s/L as indices of the N-point DFT (equal in windowed mode, the
