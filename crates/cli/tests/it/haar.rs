@@ -320,15 +320,9 @@ fn flow_on_a_haar_frame_reports_the_events_and_the_scalogram() {
 /// missed; this test judges the Haar rows only.)
 #[test]
 fn reproduce_shows_fig3_and_fig12() {
-    let dir = scratch("reproduce");
-    let o = tofprobe(&[
-        "reproduce",
-        "--quick",
-        "--json",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    assert!(matches!(o.status.code(), Some(0 | 1)), "{}", stderr(&o));
+    // The one shared run of this test binary (reproduce.rs reads it too).
+    let (o, dir) = common::reproduce_quick();
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{}", stderr(o));
     let v: Value = serde_json::from_slice(&o.stdout).expect("json");
     let rows = v["rows"].as_array().expect("rows");
     let haar: Vec<&Value> = rows
@@ -350,5 +344,4 @@ fn reproduce_shows_fig3_and_fig12() {
         .expect("fig3 compression");
     assert_eq!(fig3["paper"].as_f64(), Some(787.0));
     assert!(dir.join("fig3_scalogram.svg").is_file() && dir.join("fig12_scalogram.svg").is_file());
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -11,18 +11,10 @@ use common::tofprobe;
 
 #[test]
 fn quick_json_rows_carry_seeds_bands_and_z_scores() {
-    let dir = std::env::temp_dir().join(format!("tofprobe-reproduce-{}", std::process::id()));
-    let out = tofprobe(&[
-        "reproduce",
-        "--quick",
-        "--json",
-        "--out",
-        dir.to_str().expect("utf-8 path"),
-    ]);
+    // The one shared run of this test binary (haar.rs reads it too).
+    let (out, dir) = common::reproduce_quick();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
-    let figures = check_figures(&dir, &v);
-    let _ = std::fs::remove_dir_all(&dir);
-    figures.unwrap_or_else(|e| panic!("{e}"));
+    check_figures(dir, &v).unwrap_or_else(|e| panic!("{e}"));
     // Every figure finite; nulls only where a row has no reference (docs/reliability.md).
     common::finite::assert_finite("reproduce --quick --json", &v);
     assert!(

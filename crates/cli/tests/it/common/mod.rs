@@ -8,6 +8,25 @@ pub mod finite;
 use std::path::Path;
 use std::process::{Command, Output};
 
+/// `tofprobe reproduce --quick --json --out DIR`, run once per test binary and shared by the
+/// tests that read it (≈ 25 s each time): its output and the figures' directory.
+pub fn reproduce_quick() -> &'static (Output, std::path::PathBuf) {
+    static RUN: std::sync::OnceLock<(Output, std::path::PathBuf)> = std::sync::OnceLock::new();
+    RUN.get_or_init(|| {
+        let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!("reproduce-quick-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let out = tofprobe(&[
+            "reproduce",
+            "--quick",
+            "--json",
+            "--out",
+            dir.to_str().expect("utf-8 path"),
+        ]);
+        (out, dir)
+    })
+}
+
 /// Runs the built `tofprobe` with `args`.
 pub fn tofprobe(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_tofprobe"))
