@@ -1,5 +1,6 @@
-//! The integration tests of `tofprobe-experiments`, linked into one binary (a binary per file
-//! cost a link each: most of a cold CI run's build time). Run one module with
-//! `cargo test --release -p tofprobe-experiments --test it MODULE::`.
+//! The integration tests of `tofprobe-experiments`, linked into one binary: the library's
+//! entries tested through the library (the binary's tests in crates/cli test what users
+//! run). Run one module with `cargo test --release -p tofprobe-experiments --test it MODULE::`.
 
+mod levels;
 mod scalogram_figures;
