@@ -18,6 +18,9 @@ pub enum CliError {
     /// The hardware flow (RTL, vectors, co-simulation, sizing, sign-off) failed.
     #[error(transparent)]
     Flow(Box<tofprobe_flow::FlowError>),
+    /// `reproduce` could not run (not a missed row: that is the FAIL verdict).
+    #[error("reproduce: {0}")]
+    Reproduce(Box<tofprobe_experiments::ExperimentError>),
     /// JSON serialisation failed (should not happen for plain numbers).
     #[error("cannot serialise JSON output: {0}")]
     Json(#[from] serde_json::Error),
@@ -31,6 +34,11 @@ impl CliError {
             value: value.to_string(),
             allowed: allowed.to_string(),
         })
+    }
+
+    /// `reproduce`'s own failure, named as such.
+    pub fn reproduce(e: tofprobe_experiments::ExperimentError) -> Self {
+        CliError::Reproduce(Box::new(e))
     }
 
     /// An output file that cannot be written.

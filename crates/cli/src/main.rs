@@ -28,7 +28,8 @@ fn main() -> ExitCode {
         return stdout_failed(&e.to_string());
     }
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(commands::Verdict::Done) => ExitCode::SUCCESS,
+        Ok(commands::Verdict::Fail) => ExitCode::from(1),
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(2)

@@ -197,7 +197,7 @@ pub fn options(p: &PixelParams, a: &CosimArgs) -> CosimOptions {
 }
 
 /// Runs `tofprobe cosim`.
-pub fn run(a: &CosimArgs) -> Result<(), CliError> {
+pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
     let overrides = RtlOverrides {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
@@ -331,11 +331,7 @@ pub fn run(a: &CosimArgs) -> Result<(), CliError> {
     }
     let suite = tofprobe_cosim::junit::suite(&junit_name(a), &tofprobe_rtlgen::config_hash(&p), &r);
     write_junit(a, &[suite])?;
-    if r.pass {
-        Ok(())
-    } else {
-        std::process::exit(1)
-    }
+    Ok(super::Verdict::of(r.pass))
 }
 
 /// One line (or JSON object) of a soak.
@@ -354,7 +350,7 @@ struct SoakCase {
 
 /// `tofprobe cosim --random N --seed S`: N random valid configurations, each co-simulated
 /// over --frames frames; exits 1 if any fails.
-fn run_random(a: &CosimArgs, n: u64) -> Result<(), CliError> {
+fn run_random(a: &CosimArgs, n: u64) -> Result<super::Verdict, CliError> {
     if n == 0 || n > 100_000 {
         return Err(CliError::option("random", n, "1..=100000"));
     }
@@ -423,9 +419,5 @@ fn run_random(a: &CosimArgs, n: u64) -> Result<(), CliError> {
         t0.elapsed().as_secs_f64()
     );
     write_junit(a, &suites)?;
-    if failed == 0 {
-        Ok(())
-    } else {
-        std::process::exit(1)
-    }
+    Ok(super::Verdict::of(failed == 0))
 }

@@ -57,7 +57,7 @@ pub struct FlowArgs {
 }
 
 /// Runs `tofprobe flow`.
-pub fn run(a: &FlowArgs) -> Result<(), CliError> {
+pub fn run(a: &FlowArgs) -> Result<super::Verdict, CliError> {
     if a.frames == 0 || a.frames > 100 {
         return Err(CliError::option("frames", a.frames.to_string(), "1..=100"));
     }
@@ -120,9 +120,5 @@ pub fn run(a: &FlowArgs) -> Result<(), CliError> {
     for l in &o.signoff {
         println!("sign-off {}", l.text);
     }
-    if o.pass {
-        Ok(())
-    } else {
-        std::process::exit(1)
-    }
+    Ok(super::Verdict::of(o.pass))
 }

@@ -61,19 +61,38 @@ pub fn simulated_design(
     Ok((design, p))
 }
 
+/// What a command that ran to its end concludes (README "Exit codes"): `Fail` is a
+/// verdict command's FAIL (a co-simulation mismatch, a paper row missed, a failing flow),
+/// exit status 1 after its output; errors are `CliError`s (status 2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// Done; for a verdict command, PASS (exit status 0).
+    Done,
+    /// The verdict is FAIL (exit status 1).
+    Fail,
+}
+
+impl Verdict {
+    /// PASS when `pass`, else FAIL.
+    pub fn of(pass: bool) -> Verdict {
+        if pass { Verdict::Done } else { Verdict::Fail }
+    }
+}
+
 /// Runs one subcommand.
-pub fn run(command: Command) -> Result<(), CliError> {
+pub fn run(command: Command) -> Result<Verdict, CliError> {
+    let done = |r: Result<(), CliError>| r.map(|()| Verdict::Done);
     match command {
-        Command::Simulate(a) => simulate::run(&a),
-        Command::Config(a) => config::run(&a),
-        Command::Bench(a) => bench::run(a),
+        Command::Simulate(a) => done(simulate::run(&a)),
+        Command::Config(a) => done(config::run(&a)),
+        Command::Bench(a) => done(bench::run(a)),
         Command::Reproduce(a) => reproduce::run(&a),
-        Command::Replay(a) => replay::run(&a),
-        Command::Size(a) => size::run(&a),
-        Command::Rtl(a) => rtl::run(&a),
-        Command::Vectors(a) => vectors::run(&a),
+        Command::Replay(a) => done(replay::run(&a)),
+        Command::Size(a) => done(size::run(&a)),
+        Command::Rtl(a) => done(rtl::run(&a)),
+        Command::Vectors(a) => done(vectors::run(&a)),
         Command::Cosim(a) => cosim::run(&a),
         Command::Flow(a) => flow::run(&a),
-        Command::Tradeoff(a) => tradeoff::run(&a),
+        Command::Tradeoff(a) => done(tradeoff::run(&a)),
     }
 }

@@ -54,17 +54,11 @@ struct Report<'a> {
     pass: bool,
 }
 
-/// Runs the command. Internal failures print `error: reproduce: …` and exit 2; missed
-/// rows exit 1 after the table.
-pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
+/// Runs the command. Internal failures are `error: reproduce: …` (exit 2); missed rows
+/// are the FAIL verdict (exit 1) after the table.
+pub fn run(args: &ReproduceArgs) -> Result<super::Verdict, CliError> {
     let start = Instant::now();
-    let r = match reproduce(args.quick, &args.out) {
-        Ok(v) => v,
-        Err(e) => {
-            eprintln!("error: reproduce: {e}");
-            std::process::exit(2);
-        }
-    };
+    let r = reproduce(args.quick, &args.out).map_err(CliError::reproduce)?;
     let (rows, plots, n) = (r.rows, r.plots, r.table2_pulses);
     let seconds = start.elapsed().as_secs_f64();
     let failed = rows.iter().filter(|r| !r.pass).count();
@@ -118,8 +112,5 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
             r.band_seconds
         );
     }
-    if failed > 0 {
-        std::process::exit(1);
-    }
-    Ok(())
+    Ok(super::Verdict::of(failed == 0))
 }
