@@ -11,6 +11,7 @@ pub mod harness;
 pub mod icarus;
 pub mod junit;
 pub mod random;
+pub mod soak;
 pub mod tools;
 pub mod verilator;
 

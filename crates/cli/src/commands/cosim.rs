@@ -349,64 +349,57 @@ struct SoakCase {
 }
 
 /// `tofprobe cosim --random N --seed S`: N random valid configurations, each co-simulated
-/// over --frames frames; exits 1 if any fails.
+/// over --frames frames (`tofprobe_cosim::soak`); FAIL if any fails.
 fn run_random(a: &CosimArgs, n: u64) -> Result<super::Verdict, CliError> {
     if n == 0 || n > 100_000 {
         return Err(CliError::option("random", n, "1..=100000"));
     }
     let t0 = Instant::now();
-    let mut failed = 0u64;
-    let mut suites = Vec::new();
-    for i in 0..n {
-        let c = tofprobe_cosim::random::random_case(a.seed, i);
-        let mut o = CosimOptions::new(a.out.join(format!("random-{i}")));
-        o.frames = a.frames;
-        o.seed = c.seed;
-        o.simulator = a.simulator.into();
-        o.x_seed = a.x_seed;
-        o.vcd_on_mismatch = false;
-        let r = cosim(&c.params, &o)?;
-        if !r.pass {
-            failed += 1;
-        }
-        suites.push(tofprobe_cosim::junit::suite(
-            &format!("random-{i}"),
-            &tofprobe_rtlgen::config_hash(&c.params),
-            &r,
-        ));
+    let o = tofprobe_cosim::soak::SoakOptions {
+        seed: a.seed,
+        frames: a.frames,
+        simulator: a.simulator.into(),
+        x_seed: a.x_seed,
+        out: &a.out,
+    };
+    let mut printed: Result<(), CliError> = Ok(());
+    let report = tofprobe_cosim::soak::run(0..n, &o, |c| {
+        let p = &c.case.params;
         let line = SoakCase {
-            case: i,
-            pass: r.pass,
-            mode: format!("{:?}", c.params.mode),
-            registers: c.params.registers(),
-            width: c.params.width,
-            width_choice: format!("{:?}", c.width),
-            frame_pulses: c.params.frame_pulses,
-            seed: c.seed,
-            first_mismatch: r.first.as_ref().map(|m| {
-                format!(
-                    "cycle {} pulse {} {} expected {} actual {}",
-                    m.cycle, m.pulse, m.signal, m.expected, m.actual
-                )
-            }),
+            case: c.index,
+            pass: c.report.pass,
+            mode: format!("{:?}", p.mode),
+            registers: p.registers(),
+            width: p.width,
+            width_choice: format!("{:?}", c.case.width),
+            frame_pulses: p.frame_pulses,
+            seed: c.case.seed,
+            first_mismatch: c.first_mismatch(),
         };
         if a.json {
-            println!("{}", serde_json::to_string(&line)?);
+            match serde_json::to_string(&line) {
+                Ok(j) => println!("{j}"),
+                Err(e) => printed = Err(e.into()),
+            }
         } else {
             println!(
-                "case {i}: {} {:?} ({:?}, width {:?}) seed {}{}",
-                if r.pass { "PASS" } else { "FAIL" },
-                c.params,
-                c.params.mode,
-                c.width,
-                c.seed,
+                "case {}: {} {:?} ({:?}, width {:?}) seed {}{}",
+                c.index,
+                if c.report.pass { "PASS" } else { "FAIL" },
+                p,
+                p.mode,
+                c.case.width,
+                c.case.seed,
                 line.first_mismatch
                     .as_ref()
                     .map(|m| format!(": {m}"))
                     .unwrap_or_default()
             );
         }
-    }
+        Ok(())
+    })?;
+    printed?;
+    let (failed, suites) = (report.failed, report.suites);
     println!(
         "cosim soak: {} of {n} configuration(s) passed ({}, --seed {}, {} frame(s) each) in {:.1} s",
         n - failed,
