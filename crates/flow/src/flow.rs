@@ -104,6 +104,37 @@ pub fn periodic_short_frame(l: u64) -> u64 {
     (SHORT_FRAME / l.max(1)).max(1) * l.max(1)
 }
 
+/// `flow --recommended`: the architecture options of `design` measured (accuracy over the
+/// default seeds, synthesis and timing on osu018 and the sky130 PDK when found, the
+/// synthesis cache of `tofprobe size`), the recommendation for `target_error_um` among
+/// `only` (all when empty), and the pixel it recommends — `design` with the option's
+/// `[pixel]` keys, `adders = "auto"` decided again for it.
+pub fn recommended(
+    design: &ResolvedDesign,
+    only: Vec<String>,
+    target_error_um: f64,
+) -> Result<(ResolvedDesign, tofprobe_experiments::options::OptionsReport), FlowError> {
+    let size = SizeOptions {
+        liberty: None,
+        no_sky130: false,
+        sky130_pdk: None,
+        node_nm: 40.0,
+        sweep_bins: None,
+        sweep_widths: None,
+        cache: None,
+    };
+    let req = crate::sizing::options_request(
+        design,
+        &size,
+        only,
+        tofprobe_experiments::options::DEFAULT_SEEDS.to_vec(),
+        target_error_um,
+    )?;
+    let report = tofprobe_experiments::options::run(design, &req)?;
+    let chosen = tofprobe_experiments::options::recommended_design(design, &report)?;
+    Ok((crate::adders::decide(chosen)?, report))
+}
+
 /// Runs the flow on `design` and writes its report into `a.out`.
 pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome, FlowError> {
     if a.frames == 0 || a.frames > 100 {

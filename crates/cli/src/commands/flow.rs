@@ -63,24 +63,9 @@ pub fn run(a: &FlowArgs) -> Result<super::Verdict, CliError> {
     }
     let mut design = tofprobe_flow::adders::load(a.config.as_deref())?;
     let options = if a.recommended {
-        let size = tofprobe_flow::sizing::SizeOptions {
-            liberty: None,
-            no_sky130: false,
-            sky130_pdk: None,
-            node_nm: 40.0,
-            sweep_bins: None,
-            sweep_widths: None,
-            cache: None,
-        };
-        let req = tofprobe_flow::sizing::options_request(
-            &design,
-            &size,
-            a.only.clone(),
-            tofprobe_experiments::options::DEFAULT_SEEDS.to_vec(),
-            a.target_error_um,
-        )?;
-        let report = tofprobe_experiments::options::run(&design, &req)?;
-        design = tofprobe_experiments::options::recommended_design(&design, &report)?;
+        let (chosen, report) =
+            tofprobe_flow::flow::recommended(&design, a.only.clone(), a.target_error_um)?;
+        design = chosen;
         println!(
             "recommended: {} ({:.0} µm² on {}, tone error {:.3} µm ≤ {} µm)",
             report.recommendation.option,
