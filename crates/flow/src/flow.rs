@@ -367,7 +367,12 @@ fn spectrum(
         let _ = writeln!(md);
         return "sign-probe ROM: spectrum not normalised".into();
     };
-    let words: Vec<i64> = f.iter().map(|&w| sext(w, p.width)).collect();
+    // The frame's register words (the readout ends with the status word).
+    let words: Vec<i64> = f
+        .iter()
+        .take(2 * p.bins)
+        .map(|&w| sext(w, p.width))
+        .collect();
     let bins = match tofprobe_pixel::spectrum::phasors(p, rom, &words, p.frame_pulses, lsb_mm) {
         Ok(b) => b,
         Err(e) => {
