@@ -23,32 +23,6 @@ pub enum FlowError {
     /// The bit-true pixel refused its parameters.
     #[error(transparent)]
     Pixel(#[from] tofprobe_pixel::PixelError),
-    /// A file cannot be written.
-    #[error("cannot write `{path}`: {source}")]
-    Io {
-        /// The output path.
-        path: String,
-        /// The I/O error.
-        source: std::io::Error,
-    },
-    /// An output file cannot be written.
-    #[error("cannot write `{path}`: {message}")]
-    Output {
-        /// The output path.
-        path: PathBuf,
-        /// Why.
-        message: String,
-    },
-    /// An option out of range.
-    #[error("--{option} = {value} is out of range: allowed {allowed}")]
-    Option {
-        /// The option's name without dashes.
-        option: String,
-        /// The value given.
-        value: String,
-        /// The allowed range.
-        allowed: String,
-    },
     /// A sizing report or sign-off step failed (tool or liberty missing, synthesis error, …).
     #[error("{0}")]
     Eda(#[from] tofprobe_eda::EdaError),
@@ -61,13 +35,14 @@ pub enum FlowError {
 }
 
 impl FlowError {
-    /// An option out of range.
+    /// An option out of range (the same error, and message, as an experiment's).
     pub fn option(option: &str, value: impl ToString, allowed: &str) -> Self {
-        FlowError::Option {
-            option: option.to_string(),
-            value: value.to_string(),
-            allowed: allowed.to_string(),
-        }
+        tofprobe_experiments::ExperimentError::option(option, value, allowed).into()
+    }
+
+    /// An output that cannot be written.
+    pub fn output(path: PathBuf, message: String) -> Self {
+        tofprobe_experiments::ExperimentError::Output { path, message }.into()
     }
 }
 

@@ -37,10 +37,8 @@ pub struct CoreSimPaths {
 impl CoreSimPaths {
     /// The paths relative to the core's directory `out`, as the core records them.
     pub fn relative_to(&self, out: &Path) -> Result<CoreSim, FlowError> {
-        let cwd = std::env::current_dir().map_err(|e| FlowError::Output {
-            path: PathBuf::from("."),
-            message: e.to_string(),
-        })?;
+        let cwd = std::env::current_dir()
+            .map_err(|e| FlowError::output(PathBuf::from("."), e.to_string()))?;
         Ok(CoreSim {
             vectors_dir: relative_path(&cwd, out, &self.vectors_dir),
             testbench: relative_path(&cwd, out, &self.testbench),

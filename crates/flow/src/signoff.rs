@@ -42,16 +42,16 @@ pub fn check_length(p: &PixelParams, frames: u64) -> Result<(), FlowError> {
     let per_frame = p.frame_pulses * p.cycles_per_pulse as u64 + p.registers() as u64 + 2;
     let cycles = frames.saturating_mul(per_frame) + 3;
     if cycles > MAX_SIGNOFF_CYCLES {
-        return Err(FlowError::Option {
-            option: "signoff".into(),
-            value: format!(
+        return Err(FlowError::option(
+            "signoff",
+            format!(
                 "a {cycles}-cycle trace (N = {}, {frames} frame(s))",
                 p.frame_pulses
             ),
-            allowed: format!(
+            &format!(
                 "at most {MAX_SIGNOFF_CYCLES} cycles of gate-level simulation: a short frame, e.g. --frame-pulses 64 --frames 2"
             ),
-        });
+        ));
     }
     Ok(())
 }
@@ -68,10 +68,7 @@ pub fn sign_off_all(
     // The simulator runs in the RTL directory ($readmemh finds the ROM image there), so
     // every path it is given must not depend on the caller's working directory.
     let abs = |d: &Path| {
-        std::path::absolute(d).map_err(|e| FlowError::Io {
-            path: d.display().to_string(),
-            source: e,
-        })
+        std::path::absolute(d).map_err(|e| FlowError::output(d.to_path_buf(), e.to_string()))
     };
     let (rtl_dir, vec_dir, work) = (&abs(rtl_dir)?, &abs(vec_dir)?, &abs(work)?);
     let mut libraries = vec![SignoffLibrary::osu018()];
