@@ -73,6 +73,26 @@ impl From<tofprobe_flow::FlowError> for CliError {
     }
 }
 
+impl From<tofprobe_bench::BenchError> for CliError {
+    fn from(e: tofprobe_bench::BenchError) -> Self {
+        use tofprobe_bench::BenchError as B;
+        match e {
+            B::Design(d) => CliError::Design(d),
+            B::Option {
+                option,
+                value,
+                allowed,
+            } => CliError::option(option, value, allowed),
+            B::Output { path, message } => CliError::output(path, message),
+            B::Internal { bench, message } => CliError::option(
+                format!("bench {bench}"),
+                message,
+                "an internal computation that succeeds",
+            ),
+        }
+    }
+}
+
 // Boxed: the design error names the file, key and value inline (clippy::result_large_err).
 impl From<tofprobe_design::DesignError> for CliError {
     fn from(e: tofprobe_design::DesignError) -> Self {

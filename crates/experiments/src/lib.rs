@@ -14,6 +14,7 @@ pub mod paper;
 pub mod records;
 pub mod replay;
 pub mod scalogram;
+pub mod simulation;
 pub mod spectrum;
 pub mod tradeoff;
 pub mod transients;

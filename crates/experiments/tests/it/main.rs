@@ -4,3 +4,4 @@
 
 mod levels;
 mod scalogram_figures;
+mod simulation;

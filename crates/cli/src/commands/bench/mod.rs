@@ -3,8 +3,6 @@
 
 pub mod dsp;
 pub mod fullband;
-mod fullband_svg;
-mod lane_rates;
 pub mod pixel;
 pub mod scene;
 pub mod sd;

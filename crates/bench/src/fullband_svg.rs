@@ -6,14 +6,14 @@ use std::path::Path;
 use plotters::prelude::*;
 use tofprobe_dsp::sd::fullband_spectrum::BandSpectrum;
 
-use crate::error::CliError;
+use crate::BenchError;
 
-fn err(e: impl std::fmt::Display) -> CliError {
-    CliError::option("bench fullband --svg", e.to_string(), "a plot that renders")
+fn err(e: impl std::fmt::Display) -> BenchError {
+    BenchError::internal("fullband --svg", e)
 }
 
 /// Writes the plot atomically.
-pub fn write(path: &Path, s: &BandSpectrum, origin: &str) -> Result<(), CliError> {
+pub(crate) fn write(path: &Path, s: &BandSpectrum, origin: &str) -> Result<(), BenchError> {
     let um = |v: Vec<f64>| -> Vec<(f64, f64)> {
         s.frequencies_hz
             .iter()
@@ -68,6 +68,8 @@ pub fn write(path: &Path, s: &BandSpectrum, origin: &str) -> Result<(), CliError
             .map_err(err)?;
         root.present().map_err(err)?;
     }
-    tofprobe_io::write_atomic(path, text.as_bytes())
-        .map_err(|e| CliError::output(path.to_path_buf(), e.to_string()))
+    tofprobe_io::write_atomic(path, text.as_bytes()).map_err(|e| BenchError::Output {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
 }

@@ -1,4 +1,4 @@
-//! The lane speed runs `bench sd` and `bench fullband` print: the full-band prober's
+//! The lane speed runs of the `sd` and `fullband` benchmarks: the full-band prober's
 //! modulator steps per second on one thread (f64 and f32 lanes, on this CPU's instruction
 //! path and on the x86-64 baseline, whose sums must agree bit for bit) and the scalar
 //! reference loop's, measured in the same run so their ratio holds on a busy machine.
@@ -8,8 +8,11 @@ use std::time::Instant;
 use tofprobe_dsp::sd::fullband_check::naive_sums;
 use tofprobe_dsp::sd::{FullBandProber, KernelPath, LanePrecision, ProbeDesign};
 
-use super::sd::err;
-use crate::error::CliError;
+use crate::BenchError;
+
+fn err(e: impl std::fmt::Display) -> BenchError {
+    BenchError::internal("lane rates", e)
+}
 
 /// Samples of the full-band speed runs (64 bins) and of the scalar reference (1 bin).
 const N_FULLBAND: u64 = 1 << 20;
@@ -17,7 +20,7 @@ const N_FULLBAND: u64 = 1 << 20;
 /// Modulator steps/s on one thread: the scalar reference, and the full-band prober's f64
 /// and f32 lanes on this CPU's path and on the baseline.
 #[derive(Debug)]
-pub(crate) struct FullBandRates {
+pub struct FullBandRates {
     pub scalar: f64,
     pub path: KernelPath,
     /// [f64, f32] on `path`.
@@ -27,13 +30,13 @@ pub(crate) struct FullBandRates {
 }
 
 /// The depth record of the speed runs: a slow sine on 30 mm.
-pub(crate) fn speed_record(n: u64) -> Vec<f64> {
+pub fn speed_record(n: u64) -> Vec<f64> {
     (0..n).map(|n| 30.0 + (n as f64 * 0.001).sin()).collect()
 }
 
 /// The scalar reference (`Modulator::run` and direct accumulation, one bin's I and Q)
 /// over `x`, on the calling thread: modulator steps per second.
-pub(crate) fn scalar_reference_rate(design: &ProbeDesign, x: &[f64]) -> Result<f64, CliError> {
+pub fn scalar_reference_rate(design: &ProbeDesign, x: &[f64]) -> Result<f64, BenchError> {
     let frame = x.len() as u64;
     let bin = (frame as f64 / (4.0 * design.config.osr)) as u64;
     let t0 = Instant::now();
@@ -43,7 +46,7 @@ pub(crate) fn scalar_reference_rate(design: &ProbeDesign, x: &[f64]) -> Result<f
     Ok(rate)
 }
 
-pub(crate) fn fullband_rates(design: &ProbeDesign) -> Result<FullBandRates, CliError> {
+pub fn fullband_rates(design: &ProbeDesign) -> Result<FullBandRates, BenchError> {
     let x = speed_record(N_FULLBAND);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -51,7 +54,7 @@ pub(crate) fn fullband_rates(design: &ProbeDesign) -> Result<FullBandRates, CliE
         .map_err(err)?;
     let scalar = scalar_reference_rate(design, &x)?;
     let bins: Vec<u64> = (1..=64).map(|i| 70 * i).collect();
-    let run = |p: LanePrecision, path: KernelPath| -> Result<(f64, Vec<(f64, f64)>), CliError> {
+    let run = |p: LanePrecision, path: KernelPath| -> Result<(f64, Vec<(f64, f64)>), BenchError> {
         let t0 = Instant::now();
         let mut prober =
             FullBandProber::on_path(design, N_FULLBAND, &bins, p, path).map_err(err)?;

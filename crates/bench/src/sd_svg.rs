@@ -1,0 +1,60 @@
+//! The SVG of `bench sd --svg`: the output spectrum of a 50 kHz probe (the paper's
+//! Fig. 2: the noise shaping).
+
+use std::path::Path;
+
+use plotters::prelude::*;
+use tofprobe_dsp::sd::Modulator;
+use tofprobe_dsp::sd::quality::ToneSpectrum;
+
+use crate::BenchError;
+use crate::sd::{FS_HZ, err};
+
+/// The output spectrum of a 50 kHz, amplitude-0.5 probe (2^16 samples, Hann), dB vs
+/// log frequency, with the band edge f_s/(2·OSR) marked.
+pub(crate) fn write(m: &Modulator, path: &Path) -> Result<(), BenchError> {
+    let n = 1usize << 16;
+    let tone = (50_000.0 / FS_HZ * n as f64).round() as usize;
+    let sp = ToneSpectrum::measure(m, 0.5, tone, n).map_err(err)?;
+    let pts: Vec<(f64, f64)> = sp
+        .power
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, p)| (k as f64 * FS_HZ / n as f64, 10.0 * p.max(1e-20).log10()))
+        .collect();
+    let band = FS_HZ / (2.0 * m.osr);
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, (900, 500)).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                "Output spectrum of a 50 kHz probe (order 3, OSR 32, H_inf 1.5)",
+                ("sans-serif", 18),
+            )
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d((150.0f64..5e6).log_scale(), -160.0f64..0.0)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("frequency (Hz)")
+            .y_desc("power per bin (dB re full-scale sine)")
+            .draw()
+            .map_err(err)?;
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), &BLUE))
+            .map_err(err)?;
+        chart
+            .draw_series(LineSeries::new(vec![(band, -160.0), (band, 0.0)], &RED))
+            .map_err(err)?
+            .label("f_s / (2 OSR) = 156 kHz");
+        root.present().map_err(err)?;
+    }
+    tofprobe_dsp::rom::write_atomic(path, text.as_bytes()).map_err(|e| BenchError::Output {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
