@@ -73,6 +73,16 @@ impl From<tofprobe_flow::FlowError> for CliError {
     }
 }
 
+impl From<tofprobe_array::ArrayError> for CliError {
+    fn from(e: tofprobe_array::ArrayError) -> Self {
+        match e {
+            tofprobe_array::ArrayError::Design(d) => CliError::Design(d),
+            tofprobe_array::ArrayError::Output { path, message } => CliError::output(path, message),
+            other => CliError::option("array", other.to_string(), "an array the model can run"),
+        }
+    }
+}
+
 impl From<tofprobe_bench::BenchError> for CliError {
     fn from(e: tofprobe_bench::BenchError) -> Self {
         use tofprobe_bench::BenchError as B;

@@ -42,6 +42,9 @@ pub struct Document {
     /// `[probe]`: the ΣΔ probe design (order, OSR, H_inf, window, amplitude, ROM mode).
     #[serde(default)]
     pub probe: tofprobe_dsp::sd::ProbeConfig,
+    /// `[array]`: R × C pixels on the scene plane (absent: the single pixel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub array: Option<crate::array::ArrayConfig>,
 }
 
 impl Document {

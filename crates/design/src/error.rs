@@ -76,12 +76,29 @@ pub enum DesignError {
         /// What is wrong (names the nearest powers of two or the largest U).
         source: Box<tofprobe_dsp::DspError>,
     },
+    /// The `[array]` section (shape, mapping, rate maps) is invalid, or the command does
+    /// not run arrays.
+    #[error("in configuration `{origin}`: {message}")]
+    Array {
+        /// The file name, or `<embedded default>`.
+        origin: Box<str>,
+        /// The field, the value, the allowed range and a value that works.
+        message: String,
+    },
     /// The generator refuses the parameters of the chip ROM policy.
     #[error("{0}")]
     Rtl(#[from] tofprobe_rtlgen::RtlError),
 }
 
 impl DesignError {
+    /// An `[array]` error of the document `origin`.
+    pub fn array(origin: &str, message: impl Into<String>) -> Self {
+        DesignError::Array {
+            origin: origin.into(),
+            message: message.into(),
+        }
+    }
+
     /// A `[pixel]` error of the document `origin`.
     pub fn pixel(origin: &str, source: tofprobe_pixel::PixelError) -> Self {
         DesignError::Pixel {

@@ -7,17 +7,20 @@
 
 pub mod adders;
 pub mod analysis_mode;
+pub mod array;
 pub mod bins;
 pub mod chip;
 pub mod document;
 pub mod error;
 pub mod probe_cache;
+mod rate_image;
 pub mod resolve;
 pub mod rom_policy;
 pub mod schema;
 
 pub use adders::{AdderChoice, AdderStatus, AdderTiming, CandidateTiming};
 pub use analysis_mode::ModeDecision;
+pub use array::{ArrayConfig, RateMap, SensorArray, pixel_seed};
 pub use chip::{Chip, RomPurpose, SequencerKind};
 pub use document::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, SIZING_SIGMAS, read_text};
 pub use error::DesignError;

@@ -45,6 +45,10 @@ pub struct ResolvedDesign {
     pub notes: Vec<String>,
     /// How A was set: explicit, `"auto"` still open (no tool ran), or chosen from timing.
     pub adders: AdderStatus,
+    /// `[array]` resolved: the shape, the mapping onto the scene plane and the per-pixel
+    /// rate maps; `None` for the single pixel.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub array: Option<crate::array::SensorArray>,
 }
 
 /// Reads `path` (or the embedded default) and resolves it.
@@ -86,7 +90,14 @@ pub fn resolve_timed(
     d.acquisition
         .validate(d.sensor.laser_rate_hz)
         .map_err(scene_err)?;
-    PhotonSource::new(&d.sensor, &scene, d.acquisition.seed).map_err(scene_err)?;
+    match &d.array {
+        // An array checks the scene over the whole plane (its spatial motions' bounds);
+        // each pixel's own scene is a point of it.
+        Some(_) => tofprobe_scene::check_scene(&d.sensor, &scene).map_err(scene_err)?,
+        None => {
+            PhotonSource::new(&d.sensor, &scene, d.acquisition.seed).map_err(scene_err)?;
+        }
+    }
     d.probe.validate().map_err(probe_err)?;
     let frame = d.pixel.frame_pulses.unwrap_or(d.pulses());
     d.probe.check_frame(frame).map_err(probe_err)?;
@@ -198,6 +209,17 @@ pub fn resolve_timed(
     } else {
         (Vec::new(), None)
     };
+    let array = match &d.array {
+        Some(a) => Some(crate::array::resolve_array(
+            a,
+            &d.sensor,
+            pixel.registers(),
+            pixel.bins,
+            pixel.frame_pulses,
+            origin,
+        )?),
+        None => None,
+    };
     Ok(ResolvedDesign {
         origin: origin.to_string(),
         document,
@@ -208,6 +230,7 @@ pub fn resolve_timed(
         mode,
         notes,
         adders,
+        array,
     })
 }
 
@@ -291,6 +314,52 @@ impl ResolvedDesign {
     /// The scene's tones (frequency Hz, amplitude mm).
     pub fn tones(&self) -> &[(f64, f64)] {
         &self.context.tones
+    }
+
+    /// The photon source of pixel (r, c) of the array: the sensor with that pixel's ρ_s and
+    /// ρ_b, the scene at its centre on the plane, and its own seed
+    /// ([`crate::array::pixel_seed`]). Refused for a single-pixel design or a pixel outside.
+    pub fn pixel_source(&self, r: usize, c: usize) -> Result<PhotonSource, DesignError> {
+        let Some(a) = &self.array else {
+            return Err(DesignError::array(
+                &self.origin,
+                "the design has no [array]: its one pixel is `photon_source()`",
+            ));
+        };
+        if r >= a.rows || c >= a.cols {
+            return Err(DesignError::array(
+                &self.origin,
+                format!(
+                    "pixel ({r}, {c}) is outside the {} × {} array",
+                    a.rows, a.cols
+                ),
+            ));
+        }
+        let mut sensor = self.document.sensor.clone();
+        sensor.signal_rate = a.signal_rate[r * a.cols + c];
+        sensor.background_rate = a.background_rate[r * a.cols + c];
+        let scene =
+            Scene::new(&self.document.scene).map_err(|e| DesignError::scene(&self.origin, e))?;
+        let (x, y) = a.centre_mm(r, c);
+        let seed = crate::array::pixel_seed(self.document.acquisition.seed, r, c);
+        PhotonSource::new(&sensor, &scene.at_point(x, y), seed)
+            .map_err(|e| DesignError::scene(&self.origin, e))
+    }
+
+    /// Refuses an array design for a command that runs one pixel (`command` names it, and
+    /// the message says what runs arrays).
+    pub fn single_pixel(&self, command: &str) -> Result<(), DesignError> {
+        match &self.array {
+            None => Ok(()),
+            Some(a) => Err(DesignError::array(
+                &self.origin,
+                format!(
+                    "`{command}` runs one pixel, and [array] makes this a {} × {} sensor: \
+                     `tofprobe simulate CONFIG --out DIR` runs the array (remove [array] to {command} its pixel)",
+                    a.rows, a.cols
+                ),
+            )),
+        }
     }
 
     /// The photon source of the design (validated by the resolution).

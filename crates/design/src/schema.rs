@@ -62,6 +62,9 @@ fn kind(table: &str, key: &str) -> Option<Kind> {
         ("probe", "window" | "rom_mode" | "convention") => Text,
         ("motion", "kind") => Text,
         ("motion", "depths_mm") => Numbers,
+        ("motion", "m" | "n" | "blades") => Integer,
+        ("array", "rows" | "cols") => Integer,
+        ("array", "pitch_um" | "mm_per_pixel" | "field_of_view_deg" | "distance_mm") => Number,
         ("motion", _) => Number,
         _ => return None,
     })

@@ -22,20 +22,9 @@ pub struct ModeChoice {
     pub note: Option<String>,
 }
 
-fn kind(m: &MotionConfig) -> &'static str {
-    match m {
-        MotionConfig::Sine { .. } => "sine",
-        MotionConfig::Square { .. } => "square",
-        MotionConfig::Disk { .. } => "disk",
-        MotionConfig::Step { .. } => "step",
-        MotionConfig::Ramp { .. } => "ramp",
-        MotionConfig::Impulse { .. } => "impulse",
-    }
-}
-
 fn listed(ms: &[(usize, &MotionConfig)]) -> String {
     ms.iter()
-        .map(|(i, m)| format!("scene.motion[{i}] ({})", kind(m)))
+        .map(|(i, m)| format!("scene.motion[{i}] ({})", m.kind()))
         .collect::<Vec<_>>()
         .join(", ")
 }
@@ -45,11 +34,12 @@ fn listed(ms: &[(usize, &MotionConfig)]) -> String {
 /// measured, the transients raise the floor) with a note naming the transients and
 /// `mode = "haar"` to localise them.
 pub fn mode_for_scene(scene: &SceneConfig) -> ModeChoice {
-    let (periodic, transient): (Vec<_>, Vec<_>) = scene
-        .motions
-        .iter()
-        .enumerate()
-        .partition(|(_, m)| crate::haar::checks::transient_span_s(m).is_none());
+    let (periodic, transient): (Vec<_>, Vec<_>) =
+        scene.motions.iter().enumerate().partition(|(_, m)| {
+            // A sweeping edge is a step at each pixel (its time depends on the pixel).
+            crate::haar::checks::transient_span_s(m).is_none()
+                && !matches!(m, MotionConfig::Edge { .. })
+        });
     match (periodic.is_empty(), transient.is_empty()) {
         (true, true) => ModeChoice {
             mode: AnalysisMode::Fourier,

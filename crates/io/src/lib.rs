@@ -10,6 +10,7 @@
 
 mod atomic;
 pub mod live;
+pub mod npy;
 mod set;
 pub mod stale;
 pub mod text;

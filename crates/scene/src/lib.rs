@@ -11,6 +11,7 @@ mod motion;
 mod scene;
 mod sensor;
 mod source;
+pub mod spatial;
 pub mod splitmix;
 pub mod tttr;
 
@@ -19,7 +20,7 @@ pub use error::SceneError;
 pub use motion::MotionConfig;
 pub use scene::{Scene, SceneConfig};
 pub use sensor::SensorConfig;
-pub use source::{BLOCK_PULSES, FillCounts, PhotonSource};
+pub use source::{BLOCK_PULSES, FillCounts, PhotonSource, check_scene};
 pub use splitmix::SplitMix64;
 
 /// Depth per picosecond of time of flight, round trip: 1 ps ↔ 0.15 mm (c/2 = 0.15 mm/ps),

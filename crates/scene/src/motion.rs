@@ -1,16 +1,17 @@
 //! `[[scene.motion]]`: the motions that add to the static depth, as written in TOML
-//! (`kind = "sine" | "square" | "disk" | "step" | "ramp" | "impulse"`), and their checks.
+//! (`kind = "sine" | "square" | "disk" | "step" | "ramp" | "impulse"`, and the spatial
+//! `"plate_mode" | "rotor" | "edge"` of [`crate::spatial`]), and their checks.
 
 use serde::{Deserialize, Serialize};
 
 use crate::error::{SceneError, check_positive, check_range};
 
 /// Largest motion amplitude or height accepted (mm): far beyond any timing window.
-const MAX_MM: f64 = 1e6;
+pub(crate) const MAX_MM: f64 = 1e6;
 /// Largest frequency accepted (Hz); the sensor further bounds it by f_s/2.
-const MAX_HZ: f64 = 1e10;
+pub(crate) const MAX_HZ: f64 = 1e10;
 /// Largest time accepted for a start or duration (s).
-const MAX_S: f64 = 1e6;
+pub(crate) const MAX_S: f64 = 1e6;
 
 fn half() -> f64 {
     0.5
@@ -77,6 +78,80 @@ pub enum MotionConfig {
         width_s: f64,
         /// Height (mm).
         height_mm: f64,
+    },
+    /// The (m, n) mode of a simply supported rectangular plate of `length_x_mm` ×
+    /// `length_y_mm` whose corner is at (`x0_mm`, `y0_mm`) on the scene plane:
+    /// `amplitude_mm · sin(mπx'/Lx) · sin(nπy'/Ly) · sin(2π·frequency_hz·t + phase_deg)`
+    /// inside the plate, 0 outside. Several superpose into an operational deflection shape.
+    #[serde(rename = "plate_mode")]
+    PlateMode {
+        /// Mode index along x (≥ 1).
+        m: u32,
+        /// Mode index along y (≥ 1).
+        n: u32,
+        /// Plate size along x (mm).
+        length_x_mm: f64,
+        /// Plate size along y (mm).
+        length_y_mm: f64,
+        /// Peak amplitude of the mode shape (mm).
+        amplitude_mm: f64,
+        /// Frequency (Hz).
+        frequency_hz: f64,
+        /// Phase at t = 0 (degrees).
+        #[serde(default)]
+        phase_deg: f64,
+        /// Plate corner on the scene plane (mm).
+        #[serde(default)]
+        x0_mm: f64,
+        /// See `x0_mm`.
+        #[serde(default)]
+        y0_mm: f64,
+    },
+    /// A disk of `blades` blades rotating at `rpm` about (`centre_x_mm`, `centre_y_mm`):
+    /// between `hub_radius_mm` and `radius_mm` a pixel sees `blade_mm` where a blade covers
+    /// it (a fraction `blade_fraction` of each blade period) and 0 between blades: the
+    /// blade-pass frequency blades·rpm/60 and its harmonics.
+    Rotor {
+        /// Number of blades (≥ 1).
+        blades: u32,
+        /// Revolutions per minute.
+        rpm: f64,
+        /// Centre of rotation on the scene plane (mm).
+        centre_x_mm: f64,
+        /// See `centre_x_mm`.
+        centre_y_mm: f64,
+        /// Blade tip radius (mm).
+        radius_mm: f64,
+        /// Radius inside which the blades do not reach (mm).
+        #[serde(default)]
+        hub_radius_mm: f64,
+        /// Depth change where a blade is (mm; negative: the blade is closer).
+        blade_mm: f64,
+        /// Fraction of each blade period covered by the blade (0 < f < 1).
+        #[serde(default = "half")]
+        blade_fraction: f64,
+        /// Angle of the first blade at t = 0 (degrees).
+        #[serde(default)]
+        phase_deg: f64,
+    },
+    /// A depth step of `height_mm` whose front sweeps the plane at `velocity_mm_per_s` in
+    /// direction `direction_deg` (0: +x, along a row; 90: +y, down a column). At t = 0 the
+    /// front is `start_mm` along that direction from the origin; a pixel steps when the
+    /// front reaches its centre, over `width_mm` of front (0: an instantaneous step).
+    Edge {
+        /// Height of the step (mm).
+        height_mm: f64,
+        /// Speed of the front on the plane (mm/s).
+        velocity_mm_per_s: f64,
+        /// Direction of travel (degrees from +x towards +y).
+        #[serde(default)]
+        direction_deg: f64,
+        /// Front position along the direction at t = 0 (mm).
+        #[serde(default)]
+        start_mm: f64,
+        /// Width of the front (mm): the step is a ramp over width/velocity seconds.
+        #[serde(default)]
+        width_mm: f64,
     },
 }
 
@@ -151,17 +226,43 @@ impl MotionConfig {
                 check_positive(&f("width_s"), *width_s, MAX_S)?;
                 check_range(&f("height_mm"), *height_mm, -MAX_MM, MAX_MM)?;
             }
+            MotionConfig::PlateMode { .. }
+            | MotionConfig::Rotor { .. }
+            | MotionConfig::Edge { .. } => crate::spatial::validate(self, index)?,
         }
         Ok(())
+    }
+
+    /// The kind as written in TOML.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            MotionConfig::Sine { .. } => "sine",
+            MotionConfig::Square { .. } => "square",
+            MotionConfig::Disk { .. } => "disk",
+            MotionConfig::Step { .. } => "step",
+            MotionConfig::Ramp { .. } => "ramp",
+            MotionConfig::Impulse { .. } => "impulse",
+            MotionConfig::PlateMode { .. } => "plate_mode",
+            MotionConfig::Rotor { .. } => "rotor",
+            MotionConfig::Edge { .. } => "edge",
+        }
+    }
+
+    /// Whether the motion depends on position on the scene plane (it needs an array).
+    pub fn is_spatial(&self) -> bool {
+        matches!(
+            self,
+            MotionConfig::PlateMode { .. } | MotionConfig::Rotor { .. } | MotionConfig::Edge { .. }
+        )
     }
 
     /// The fundamental frequency of a sine or square wave (Hz): it must stay below the
     /// Nyquist rate f_s/2 of the pulse train, or the motion aliases.
     pub(crate) fn tone_hz(&self) -> Option<f64> {
         match self {
-            MotionConfig::Sine { frequency_hz, .. } | MotionConfig::Square { frequency_hz, .. } => {
-                Some(*frequency_hz)
-            }
+            MotionConfig::Sine { frequency_hz, .. }
+            | MotionConfig::Square { frequency_hz, .. }
+            | MotionConfig::PlateMode { frequency_hz, .. } => Some(*frequency_hz),
             _ => None,
         }
     }

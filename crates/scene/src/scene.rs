@@ -52,6 +52,30 @@ impl Scene {
         &self.motions
     }
 
+    /// Whether a motion depends on position (the scene needs an array to be sampled); the
+    /// first such motion's index and kind.
+    pub fn spatial_motion(&self) -> Option<(usize, &'static str)> {
+        self.motions
+            .iter()
+            .enumerate()
+            .find(|(_, m)| m.is_spatial())
+            .map(|(i, m)| (i, m.kind()))
+    }
+
+    /// The scene one point (x, y) mm of the plane sees: every spatial motion reduced to the
+    /// temporal motion (and static offset) at that point ([`crate::spatial::reduce`]),
+    /// temporal motions as they are.
+    pub fn at_point(&self, x_mm: f64, y_mm: f64) -> Scene {
+        let mut depth_mm = self.depth_mm;
+        let mut motions = Vec::with_capacity(self.motions.len());
+        for m in &self.motions {
+            let p = crate::spatial::reduce(m, x_mm, y_mm);
+            depth_mm += p.static_mm;
+            motions.extend(p.motion);
+        }
+        Scene { depth_mm, motions }
+    }
+
     /// δ(t) in mm at time `t_s` seconds.
     pub fn depth_mm(&self, t_s: f64) -> f64 {
         self.depth_mm + self.motions.iter().map(|m| motion_at(m, t_s)).sum::<f64>()
@@ -75,6 +99,7 @@ impl Scene {
                 | MotionConfig::Impulse { height_mm, .. } => {
                     (height_mm.min(0.0), height_mm.max(0.0))
                 }
+                spatial => crate::spatial::range_mm(spatial),
             };
             lo += a;
             hi += b;
@@ -107,7 +132,27 @@ impl Scene {
     /// are not periodic and have no tones. Tones at the same frequency are not merged.
     pub fn tones(&self) -> Vec<(f64, f64)> {
         let mut tones = Vec::new();
-        for m in &self.motions {
+        // A spatial motion's tones are those of its largest response: a plate mode at its
+        // antinode, a rotor at its blade tips; an edge has none.
+        let as_temporal: Vec<MotionConfig> = self
+            .motions
+            .iter()
+            .filter_map(|m| match m {
+                MotionConfig::PlateMode {
+                    amplitude_mm,
+                    frequency_hz,
+                    phase_deg,
+                    ..
+                } => Some(MotionConfig::Sine {
+                    amplitude_mm: *amplitude_mm,
+                    frequency_hz: *frequency_hz,
+                    phase_deg: *phase_deg,
+                }),
+                MotionConfig::Rotor { .. } => crate::spatial::rotor_disk(m),
+                other => Some(other.clone()),
+            })
+            .collect();
+        for m in &as_temporal {
             match m {
                 MotionConfig::Sine {
                     amplitude_mm,
@@ -166,6 +211,9 @@ impl Scene {
     /// t_n = n · period_s. Sines use a rotation recurrence anchored with an exact sin/cos at
     /// `first_pulse`, so the cost per pulse is a few multiplies; over one block of
     /// [`crate::BLOCK_PULSES`] its error stays below 1e-12 of the amplitude (see the tests).
+    ///
+    /// A spatial motion has no value without a position: it contributes 0 here (a photon
+    /// source refuses such a scene; an array samples `at_point`).
     pub fn fill_depths_mm(&self, first_pulse: u64, period_s: f64, out: &mut [f64]) {
         out.fill(self.depth_mm);
         for m in &self.motions {
@@ -254,6 +302,9 @@ fn motion_at(m: &MotionConfig, t: f64) -> f64 {
             } else {
                 0.0
             }
+        }
+        MotionConfig::PlateMode { .. } | MotionConfig::Rotor { .. } | MotionConfig::Edge { .. } => {
+            0.0
         }
     }
 }

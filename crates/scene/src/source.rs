@@ -83,8 +83,15 @@ impl PhotonSource {
         seed: u64,
     ) -> Result<PhotonSource, SceneError> {
         sensor.validate()?;
-        scene.check_nyquist(sensor.laser_rate_hz)?;
-        check_window(sensor, scene)?;
+        if let Some((i, kind)) = scene.spatial_motion() {
+            return Err(SceneError::out_of_range(
+                format!("scene.motion[{i}].kind"),
+                format!("\"{kind}\""),
+                "a motion that does not depend on position (sine, square, disk, step, ramp, \
+                 impulse), or an [array] section that places pixels on the scene plane",
+            ));
+        }
+        check_scene(sensor, scene)?;
         Ok(PhotonSource {
             scene: scene.clone(),
             seed,
@@ -288,6 +295,15 @@ impl PhotonSource {
         }
         counts
     }
+}
+
+/// Checks a sensor and a scene against each other without building a source: the
+/// sensor, the Nyquist rate of the scene's tones and the window against the scene's depth
+/// range (for a spatial scene, its bound over the whole plane).
+pub fn check_scene(sensor: &SensorConfig, scene: &Scene) -> Result<(), SceneError> {
+    sensor.validate()?;
+    scene.check_nyquist(sensor.laser_rate_hz)?;
+    check_window(sensor, scene)
 }
 
 /// The window must contain the scene's whole depth range, or the signal would be lost

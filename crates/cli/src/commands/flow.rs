@@ -62,6 +62,7 @@ pub fn run(a: &FlowArgs) -> Result<super::Verdict, CliError> {
         return Err(CliError::option("frames", a.frames.to_string(), "1..=100"));
     }
     let mut design = tofprobe_flow::adders::load(a.config.as_deref())?;
+    design.single_pixel("flow")?;
     let options = if a.recommended {
         let (chosen, report) =
             tofprobe_flow::flow::recommended(&design, a.only.clone(), a.target_error_um)?;

@@ -57,6 +57,7 @@ pub fn simulated_design(
         return Err(CliError::option("frames", frames, "1..=1000"));
     }
     let design = tofprobe_flow::adders::load(config)?;
+    design.single_pixel("vectors and cosim")?;
     let p = tofprobe_design::rtl_params(&design, overrides)?;
     Ok((design, p))
 }

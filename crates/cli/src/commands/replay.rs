@@ -46,7 +46,11 @@ pub fn run(a: &ReplayArgs) -> Result<(), CliError> {
         ));
     }
     let design = match &a.config {
-        Some(c) => Some(tofprobe_design::load(Some(c))?),
+        Some(c) => {
+            let d = tofprobe_design::load(Some(c))?;
+            d.single_pixel("replay")?;
+            Some(d)
+        }
         None => None,
     };
     let req = ReplayRequest {

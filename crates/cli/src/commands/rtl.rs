@@ -69,6 +69,7 @@ pub fn regen_command(a: &RtlArgs) -> String {
 /// Runs `tofprobe rtl`.
 pub fn run(a: &RtlArgs) -> Result<(), CliError> {
     let design = tofprobe_flow::adders::load(a.config.as_deref())?;
+    design.single_pixel("rtl")?;
     let overrides = RtlOverrides {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,

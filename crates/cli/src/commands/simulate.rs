@@ -28,11 +28,25 @@ pub struct SimulateArgs {
     /// Write an SVG plot of the bit-true spectrum (Haar: the scalogram) here (atomically).
     #[arg(long, value_name = "PATH")]
     svg: Option<PathBuf>,
+    /// An `[array]` configuration: write the array's set here (registers and maps as
+    /// .npy, heat maps, the deflection animation, the UFF file, summary.json last).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
 }
 
 /// Runs the command.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let design = tofprobe_design::load(args.config.as_deref())?;
+    if design.array.is_some() {
+        return run_array(args, &design);
+    }
+    if let Some(out) = &args.out {
+        return Err(CliError::option(
+            "out",
+            out.display(),
+            "an [array] configuration (a single pixel's output is stdout and --svg)",
+        ));
+    }
     // The progress bar appears on a terminal only once the run has taken a second.
     let on_terminal = !args.json && std::io::stderr().is_terminal();
     let bar = ProgressBar::with_draw_target(Some(design.pulses()), ProgressDrawTarget::hidden());
@@ -128,6 +142,63 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         } else {
             println!("spectrum plot      {}", p.display());
         }
+    }
+    Ok(())
+}
+
+/// `simulate` of an `[array]` configuration: the array's set into `--out`, the summary
+/// printed.
+fn run_array(
+    args: &SimulateArgs,
+    design: &tofprobe_design::ResolvedDesign,
+) -> Result<(), CliError> {
+    if let Some(svg) = &args.svg {
+        return Err(CliError::option(
+            "svg",
+            svg.display(),
+            "no --svg for an [array] configuration: its maps are written with --out DIR",
+        ));
+    }
+    let summary = match &args.out {
+        Some(dir) => tofprobe_array::output::run_and_write(design, dir)?,
+        None => tofprobe_array::output::simulate(design)?.2,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string(&summary)?);
+        return Ok(());
+    }
+    println!("configuration      {}", summary.configuration);
+    println!(
+        "array              {} × {} pixels, pitch {} um, {:.4} mm per pixel on the scene",
+        summary.rows, summary.cols, summary.pitch_um, summary.mm_per_pixel
+    );
+    println!(
+        "frame              {} pulses per pixel, {} mode, {:.1} detections per pixel",
+        summary.frame_pulses, summary.mode, summary.mean_detections_per_pixel
+    );
+    println!(
+        "array model        {:.3} s ({:.1} M pixel-pulses/s)",
+        summary.model_seconds,
+        summary.pixel_pulses_per_s / 1e6
+    );
+    if !summary.bins.is_empty() {
+        println!("  bin  frequency Hz  mean um    max um");
+        for b in &summary.bins {
+            println!(
+                "  {:>3} {:>13.2} {:>8.4} {:>9.4}",
+                b.index, b.frequency_hz, b.mean_amplitude_um, b.max_amplitude_um
+            );
+        }
+    }
+    if let (Some(b), Some(f)) = (summary.dominant_bin, summary.dominant_frequency_hz) {
+        println!("dominant bin       {b} ({f:.2} Hz)");
+    }
+    if let Some(dir) = &args.out {
+        println!(
+            "output set         {} ({} files)",
+            dir.display(),
+            summary.files.len()
+        );
     }
     Ok(())
 }

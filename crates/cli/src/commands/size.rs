@@ -86,6 +86,7 @@ pub struct FullReport {
 /// Builds the report for the arguments (no printing).
 pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
     let design = tofprobe_flow::adders::load(a.config.as_deref())?;
+    design.single_pixel("size")?;
     let options = size_options(a);
     let req = if a.options {
         let req = options_request(

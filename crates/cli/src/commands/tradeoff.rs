@@ -92,6 +92,7 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     let mut tables = Vec::new();
     for p in paths {
         let design = tofprobe_flow::adders::load(p)?;
+        design.single_pixel("tradeoff")?;
         if design.pixel.mode == tofprobe_pixel::Mode::Haar {
             let h = measure_haar(&design, args.verilator)?;
             tables.push(haar::markdown(&h));

@@ -3,6 +3,7 @@
 //! `cargo test --release -p tofprobe-cli --test it MODULE::`.
 
 mod adders_auto;
+mod array;
 mod bench_fullband;
 mod bench_sd;
 mod bit_true;

@@ -33,6 +33,7 @@ pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
         }
     }
     let design = tofprobe_design::load(args.config.as_deref())?;
+    design.single_pixel("bench pixel")?;
     let report = tofprobe_bench::pixel::measure(&design, args.pulses, args.cycle_pulses)?;
     if args.json {
         println!("{}", serde_json::to_string(&report)?);

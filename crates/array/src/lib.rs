@@ -1,0 +1,19 @@
+//! The sensor: an R × C array of the one pixel. [`model`] runs the pixel's datapath (the
+//! transaction driver of `tofprobe-pixel`, nothing of its own) on every pixel's own photon
+//! stream, in parallel on the caller's rayon pool, with memory linear in R·C·2B and
+//! independent of N; a tile of the array is a unit of work whose registers do not depend on
+//! the tiling, the threads or the process ([`model::run_tile`], [`model::merge`]).
+//! [`maps`] turns the registers into vibration maps (amplitude and phase per bin through
+//! `pixel::spectrum::phasors`, the dominant bin, the deflection shape, the modal assurance
+//! criterion), [`plot`] draws them, [`uff`] writes them for modal-analysis tools and
+//! [`output`] writes the whole set.
+
+mod error;
+pub mod maps;
+pub mod model;
+pub mod output;
+pub mod plot;
+pub mod uff;
+
+pub use error::ArrayError;
+pub use model::{ArrayFrame, Tile, run_array, run_tile};

@@ -1,0 +1,176 @@
+//! The array model: the one pixel datapath run on every pixel. Pixel (r, c) reads its own
+//! photon stream (`ResolvedDesign::pixel_source`: its rates, the scene at its centre, the
+//! seed of (seed, r, c)) through the transaction driver, streamed in chunks, with the
+//! chip's one probe ROM broadcast to all (Fourier) or the Haar signs of its counter. A
+//! tile is a rectangle of pixels run in parallel on the current rayon pool; tiles merge
+//! into the array byte for byte whatever the tiling, the threads or the process.
+
+use std::ops::Range;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use tofprobe_design::ResolvedDesign;
+use tofprobe_dsp::rom::RomImage;
+use tofprobe_pixel::transaction::TransactionModel;
+
+use crate::error::ArrayError;
+
+/// Pulses per streamed chunk of one pixel (64 k pulses: 512 kB of detections per thread).
+const CHUNK: usize = 1 << 16;
+
+/// The registers of a rectangle of pixels after one frame.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Tile {
+    pub rows: Range<usize>,
+    pub cols: Range<usize>,
+    /// Registers per pixel (2B Fourier, 2^(U+1) − 1 Haar).
+    pub registers_per_pixel: usize,
+    /// Row-major over the tile, `registers_per_pixel` words per pixel (sign-extended).
+    pub registers: Vec<i64>,
+    /// Detections of each pixel's frame, row-major over the tile.
+    pub detections: Vec<u64>,
+}
+
+/// The whole array's registers after one frame.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ArrayFrame {
+    pub rows: usize,
+    pub cols: usize,
+    pub registers_per_pixel: usize,
+    /// [R, C, registers] row-major.
+    pub registers: Vec<i64>,
+    /// [R, C] detections per pixel.
+    pub detections: Vec<u64>,
+}
+
+impl ArrayFrame {
+    /// Pixel (r, c)'s register words.
+    pub fn pixel(&self, r: usize, c: usize) -> &[i64] {
+        let k = self.registers_per_pixel;
+        let i = (r * self.cols + c) * k;
+        &self.registers[i..i + k]
+    }
+}
+
+/// One frame of pixel (r, c): its register words and its detections.
+pub fn run_pixel(
+    design: &ResolvedDesign,
+    rom: Option<&RomImage>,
+    r: usize,
+    c: usize,
+) -> Result<(Vec<i64>, u64), ArrayError> {
+    let source = design.pixel_source(r, c)?;
+    let err = |source| ArrayError::Pixel {
+        row: r,
+        col: c,
+        source,
+    };
+    let mut tm = TransactionModel::new(&design.pixel).map_err(err)?;
+    let mut result = Ok(());
+    let mut detections = 0u64;
+    source.for_each_chunk(design.pixel.frame_pulses, CHUNK, |first, chunk| {
+        if result.is_ok() {
+            detections += chunk.iter().filter(|d| d.is_some()).count() as u64;
+            result = tm.run(chunk, rom, first);
+        }
+    });
+    result.map_err(err)?;
+    Ok((tm.readout().words, detections))
+}
+
+/// The array shape of a design, or an error naming the missing `[array]`.
+fn shape(design: &ResolvedDesign) -> Result<(usize, usize), ArrayError> {
+    design
+        .array
+        .as_ref()
+        .map(|a| (a.rows, a.cols))
+        .ok_or_else(|| ArrayError::Shape(format!("`{}` has no [array] section", design.origin)))
+}
+
+/// Runs the pixels of rows × cols (within the array) in parallel on the current rayon
+/// pool. `rom` is the chip's probe ROM (Fourier; `None` in Haar mode).
+pub fn run_tile(
+    design: &ResolvedDesign,
+    rom: Option<&RomImage>,
+    rows: Range<usize>,
+    cols: Range<usize>,
+) -> Result<Tile, ArrayError> {
+    let (nr, nc) = shape(design)?;
+    if rows.start >= rows.end || cols.start >= cols.end || rows.end > nr || cols.end > nc {
+        return Err(ArrayError::Shape(format!(
+            "tile rows {rows:?} × cols {cols:?} is not a non-empty part of the {nr} × {nc} array"
+        )));
+    }
+    let w = cols.len();
+    let pixels: Vec<(Vec<i64>, u64)> = (0..rows.len() * w)
+        .into_par_iter()
+        .map(|i| run_pixel(design, rom, rows.start + i / w, cols.start + i % w))
+        .collect::<Result<_, _>>()?;
+    let registers_per_pixel = design.pixel.registers();
+    let mut registers = Vec::with_capacity(pixels.len() * registers_per_pixel);
+    let mut detections = Vec::with_capacity(pixels.len());
+    for (words, d) in pixels {
+        registers.extend(words);
+        detections.push(d);
+    }
+    Ok(Tile {
+        rows,
+        cols,
+        registers_per_pixel,
+        registers,
+        detections,
+    })
+}
+
+/// Merges tiles that cover the R × C array exactly once into the array's frame; refuses a
+/// gap or an overlap, naming the first pixel.
+pub fn merge(rows: usize, cols: usize, tiles: &[Tile]) -> Result<ArrayFrame, ArrayError> {
+    let k = tiles.first().map_or(0, |t| t.registers_per_pixel);
+    let mut registers = vec![0i64; rows * cols * k];
+    let mut detections = vec![0u64; rows * cols];
+    let mut seen = vec![false; rows * cols];
+    for t in tiles {
+        if t.registers_per_pixel != k || t.rows.end > rows || t.cols.end > cols {
+            return Err(ArrayError::Shape(format!(
+                "tile rows {:?} × cols {:?} does not fit the {rows} × {cols} array of {k} registers",
+                t.rows, t.cols
+            )));
+        }
+        let w = t.cols.len();
+        for (i, words) in t.registers.chunks_exact(k.max(1)).enumerate() {
+            let (r, c) = (t.rows.start + i / w, t.cols.start + i % w);
+            let p = r * cols + c;
+            if std::mem::replace(&mut seen[p], true) {
+                return Err(ArrayError::Shape(format!(
+                    "pixel ({r}, {c}) is in two tiles"
+                )));
+            }
+            registers[p * k..(p + 1) * k].copy_from_slice(words);
+            detections[p] = t.detections[i];
+        }
+    }
+    if let Some(p) = seen.iter().position(|s| !s) {
+        return Err(ArrayError::Shape(format!(
+            "pixel ({}, {}) is in no tile",
+            p / cols,
+            p % cols
+        )));
+    }
+    Ok(ArrayFrame {
+        rows,
+        cols,
+        registers_per_pixel: k,
+        registers,
+        detections,
+    })
+}
+
+/// Runs the whole array as one tile.
+pub fn run_array(
+    design: &ResolvedDesign,
+    rom: Option<&RomImage>,
+) -> Result<ArrayFrame, ArrayError> {
+    let (r, c) = shape(design)?;
+    let t = run_tile(design, rom, 0..r, 0..c)?;
+    merge(r, c, &[t])
+}

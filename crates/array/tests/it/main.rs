@@ -1,0 +1,6 @@
+//! The integration tests of `tofprobe-array`, one binary
+//! (`cargo test --release -p tofprobe-array --test it MODULE::`).
+
+mod common;
+mod determinism;
+mod validation;

@@ -1,0 +1,237 @@
+//! `tofprobe simulate CONFIG --out DIR` on `[array]` configurations, as users run it: the
+//! set is written whole (summary.json last, listing every file), the NPY arrays have the
+//! documented shapes and read back, the UFF file holds its data sets, `--json` carries the
+//! figures; bad arrays are refused naming the field with exit 2 and nothing written;
+//! commands that run one pixel refuse an array, naming what runs it.
+
+use std::path::Path;
+use std::process::Command;
+
+use tofprobe_io::npy;
+
+fn config(dir: &Path, name: &str, motions: &str, array: &str) -> std::path::PathBuf {
+    let text = include_str!("../../../../scenes/plate-mode.toml");
+    let head = text.split("[[scene.motion]]").next().unwrap();
+    let tail = &text[text.find("[acquisition]").unwrap()..];
+    let tail = tail.split("[array]").next().unwrap();
+    let tail = tail.replacen("pulses = 1000000", "pulses = 40000", 1);
+    let p = dir.join(name);
+    std::fs::write(&p, format!("{head}{motions}\n{tail}\n[array]\n{array}\n")).unwrap();
+    p
+}
+
+const PLATE: &str = "[[scene.motion]]\nkind = \"plate_mode\"\nm = 2\nn = 1\nlength_x_mm = 40.0\n\
+                     length_y_mm = 30.0\namplitude_mm = 1.0\nfrequency_hz = 1500.0\n";
+
+fn run(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn an_array_simulation_writes_its_whole_set() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = config(
+        tmp.path(),
+        "plate.toml",
+        PLATE,
+        "rows = 3\ncols = 4\npitch_um = 30.0\nmm_per_pixel = 10.0",
+    );
+    let out = tmp.path().join("out");
+    let o = run(&[
+        "simulate",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let on_disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary, on_disk, "stdout's summary is the set's");
+    let files: Vec<&str> = summary["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        files.last(),
+        Some(&"summary.json"),
+        "the completion file is last"
+    );
+    let mut listed: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    listed.sort();
+    let mut want: Vec<String> = files.iter().map(|s| s.to_string()).collect();
+    want.sort();
+    assert_eq!(listed, want, "exactly the listed files");
+    let regs = npy::from_bytes(&std::fs::read(out.join("registers.npy")).unwrap()).unwrap();
+    assert_eq!(regs.shape, vec![3, 4, 8], "[R, C, 2B]");
+    let amp = npy::from_bytes(&std::fs::read(out.join("amplitude_um.npy")).unwrap()).unwrap();
+    assert_eq!(amp.shape, vec![4, 3, 4], "[B, R, C]");
+    // The (2, 1) mode of a 40 × 30 mm plate seen by 10 mm pixels: columns 0 and 3 sit at
+    // x = 5 and 35 mm, |sin(2π·5/40)| = 0.71 of 1 mm × sin(π·15/30) = 1 in row 1.
+    let b = summary["dominant_bin"].as_u64().unwrap() as usize;
+    assert_eq!(summary["dominant_frequency_hz"], 1500.0);
+    let at = |r: usize, c: usize| amp.data[b * 12 + r * 4 + c];
+    // Noise ≈ 70 µm at 40,000 pulses (eq. 12): 3σ.
+    assert!((at(1, 0) - 707.0).abs() < 210.0, "{}", at(1, 0));
+    assert!((at(1, 3) - 707.0).abs() < 210.0, "{}", at(1, 3));
+    let uff = std::fs::read_to_string(out.join("vibration.uff")).unwrap();
+    let sets: Vec<&str> = uff
+        .lines()
+        .collect::<Vec<_>>()
+        .windows(2)
+        .filter(|w| w[0] == "    -1" && w[1].len() == 80)
+        .map(|w| w[1].trim())
+        .collect();
+    assert_eq!(sets, vec!["151", "164", "15", "55", "55", "55", "55"]);
+    assert!(
+        std::fs::read_to_string(out.join("deflection.svg"))
+            .unwrap()
+            .contains("<animate")
+    );
+}
+
+#[test]
+fn bad_arrays_are_refused_by_field_and_nothing_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let pgm = tmp.path().join("refl.pgm");
+    let mut img = b"P5\n3 3\n255\n".to_vec();
+    img.extend([128u8; 9]);
+    std::fs::write(&pgm, img).unwrap();
+    let ok_array = "rows = 4\ncols = 4\npitch_um = 30.0\nmm_per_pixel = 10.0";
+    let cases: Vec<(&str, String, String, &str)> = vec![
+        (
+            "rows 0",
+            PLATE.into(),
+            ok_array.replace("rows = 4", "rows = 0"),
+            "array.rows = 0",
+        ),
+        (
+            "too large",
+            PLATE.into(),
+            "rows = 4096\ncols = 4096\npitch_um = 30.0\nmm_per_pixel = 0.01".into(),
+            "GiB",
+        ),
+        (
+            "too long",
+            PLATE.into(),
+            "rows = 2048\ncols = 2048\npitch_um = 30.0\nmm_per_pixel = 0.01".into(),
+            "pixel-pulses",
+        ),
+        (
+            "image size",
+            PLATE.into(),
+            format!("{ok_array}\nsignal_map = {{ kind = \"image\", path = \"refl.pgm\" }}"),
+            "array.signal_map.path",
+        ),
+        (
+            "mode 0",
+            PLATE.replace("m = 2", "m = 0"),
+            ok_array.into(),
+            "scene.motion[0].m",
+        ),
+        (
+            "rotor centre",
+            "[[scene.motion]]\nkind = \"rotor\"\nblades = 2\nrpm = 600.0\ncentre_x_mm = 1e9\n\
+             centre_y_mm = 0.0\nradius_mm = 5.0\nblade_mm = -1.0\n"
+                .into(),
+            ok_array.into(),
+            "scene.motion[0].centre_x_mm",
+        ),
+        (
+            "no mapping",
+            PLATE.into(),
+            "rows = 4\ncols = 4\npitch_um = 30.0".into(),
+            "mm_per_pixel",
+        ),
+    ];
+    for (what, motions, array, field) in cases {
+        let cfg = config(tmp.path(), "bad.toml", &motions, &array);
+        if what == "too large" {
+            // 16 bins: 4096² pixels × (32 registers + 32 spectral values + 2 maps) × 8 bytes
+            // = 8.9 GB, above the 4 GiB cap.
+            let t = std::fs::read_to_string(&cfg).unwrap();
+            let t = t.replacen("bins = 4 ", "bins = 16 ", 1).replacen(
+                "cycles_per_pulse = 4 ",
+                "cycles_per_pulse = 16 ",
+                1,
+            );
+            std::fs::write(&cfg, t).unwrap();
+        }
+        if what == "too long" {
+            // 2048² pixels × 400,000 pulses = 1.7·10^12 pixel-pulses, above the 2^40 cap.
+            let t = std::fs::read_to_string(&cfg).unwrap();
+            std::fs::write(&cfg, t.replacen("pulses = 40000", "pulses = 400000", 1)).unwrap();
+        }
+        let out = tmp.path().join("never");
+        let o = run(&[
+            "simulate",
+            cfg.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{what}: {err}");
+        assert!(err.contains(field), "{what}: {err}");
+        assert!(!out.exists(), "{what}: nothing is written");
+    }
+    // The PGM of the right size is read as value / maxval.
+    let mut img = b"P5\n4 4\n255\n".to_vec();
+    img.extend([255u8; 16]);
+    std::fs::write(&pgm, img).unwrap();
+    let cfg = config(
+        tmp.path(),
+        "img.toml",
+        PLATE,
+        &format!(
+            "{ok_array}\nsignal_map = {{ kind = \"image\", path = \"refl.pgm\", scale = 0.5 }}"
+        ),
+    );
+    let o = run(&["simulate", cfg.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // ρ_s = 0.5: half the pulses detect (no background), ± 5σ of a binomial of 40,000.
+    let det = s["mean_detections_per_pixel"].as_f64().unwrap();
+    assert!((det - 20_000.0).abs() < 5.0 * 100.0 / 4.0, "{det}");
+}
+
+#[test]
+fn single_pixel_commands_refuse_an_array_and_spatial_motions_need_one() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = config(
+        tmp.path(),
+        "plate.toml",
+        PLATE,
+        "rows = 2\ncols = 2\npitch_um = 30.0\nmm_per_pixel = 10.0",
+    );
+    let c = cfg.to_str().unwrap();
+    for args in [
+        vec!["rtl", c, "--out", "never-rtl"],
+        vec!["tradeoff", c],
+        vec!["bench", "pixel", "--config", c, "--pulses", "4096"],
+    ] {
+        let o = run(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("simulate CONFIG --out DIR"), "{args:?}: {err}");
+    }
+    assert!(!Path::new("never-rtl").exists());
+    let text = std::fs::read_to_string(&cfg).unwrap();
+    let single = tmp.path().join("single.toml");
+    std::fs::write(&single, text.split("[array]").next().unwrap()).unwrap();
+    let o = run(&["simulate", single.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("scene.motion[0].kind") && err.contains("[array]"),
+        "{err}"
+    );
+}

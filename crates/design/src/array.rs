@@ -1,0 +1,309 @@
+//! `[array]`: the sensor as R × C pixels, all alike, on the scene plane. The section gives
+//! the shape, the pitch, how pixels map onto the plane (mm per pixel at the target, or a
+//! horizontal field of view and a distance) and per-pixel maps of the signal rate ρ_s
+//! (reflectivity) and the background ρ_b. [`SensorArray`] is its resolution: the mapping
+//! and both maps as R × C values, so a worker that receives a resolved design needs no map
+//! file. Pixel (r, c) sits at ((c + ½)·s, (r + ½)·s) mm, s the mm per pixel; its photon
+//! stream depends only on (seed, r, c) ([`pixel_seed`]). A document without `[array]` is
+//! the single pixel, unchanged.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::DesignError;
+
+/// Largest rows or columns.
+pub const MAX_SIDE: u32 = 4096;
+/// Most pixel-pulses an array frame may cost (R·C·N): 2^40 ≈ 1.1·10^12, a 256 × 256 array
+/// over a 1 s frame at 10 MHz and about three hours at the model's 10^8 pixel-pulses/s.
+pub const MAX_PIXEL_PULSES: u64 = 1 << 40;
+/// Largest memory an array's registers, spectra and maps may take (bytes): 4 GiB, a sixth
+/// of the 24 GiB machines the project runs on.
+pub const MAX_ARRAY_BYTES: u64 = 4 << 30;
+
+/// The `[array]` section as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArrayConfig {
+    /// Rows of pixels (y on the scene plane).
+    pub rows: u32,
+    /// Columns of pixels (x on the scene plane).
+    pub cols: u32,
+    /// Pixel pitch on the die (µm): the sensor's size, for the maps' axes and the layout.
+    pub pitch_um: f64,
+    /// Scene-plane size of one pixel at the target (mm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mm_per_pixel: Option<f64>,
+    /// Horizontal field of view across the columns (degrees), with `distance_mm`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub field_of_view_deg: Option<f64>,
+    /// Distance to the scene plane (mm), with `field_of_view_deg`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub distance_mm: Option<f64>,
+    /// Per-pixel ρ_s (default: `sensor.signal_rate` everywhere).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub signal_map: Option<RateMap>,
+    /// Per-pixel ρ_b (default: `sensor.background_rate` everywhere).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub background_map: Option<RateMap>,
+}
+
+/// Which way a gradient runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// Along a row: column 0 has `from`, the last column `to`.
+    #[default]
+    X,
+    /// Down a column: row 0 has `from`, the last row `to`.
+    Y,
+}
+
+/// A per-pixel map of a photon rate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum RateMap {
+    /// The same value everywhere.
+    Constant { value: f64 },
+    /// Linear from `from` to `to` across the array.
+    Gradient {
+        from: f64,
+        to: f64,
+        #[serde(default)]
+        axis: Axis,
+    },
+    /// An image of R × C: a binary PGM (8- or 16-bit; value / maxval) or a `.npy` of
+    /// R × C numbers, times `scale`. A relative path is relative to the configuration.
+    Image {
+        path: String,
+        #[serde(default = "one")]
+        scale: f64,
+    },
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// The resolved array.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SensorArray {
+    pub rows: usize,
+    pub cols: usize,
+    pub pitch_um: f64,
+    /// Scene-plane size of one pixel (mm).
+    pub mm_per_pixel: f64,
+    /// ρ_s of each pixel, row-major.
+    pub signal_rate: Vec<f64>,
+    /// ρ_b of each pixel, row-major.
+    pub background_rate: Vec<f64>,
+}
+
+impl SensorArray {
+    /// Pixels in the array.
+    pub fn pixels(&self) -> usize {
+        self.rows * self.cols
+    }
+
+    /// Centre of pixel (r, c) on the scene plane, (x, y) mm.
+    pub fn centre_mm(&self, r: usize, c: usize) -> (f64, f64) {
+        (
+            (c as f64 + 0.5) * self.mm_per_pixel,
+            (r as f64 + 0.5) * self.mm_per_pixel,
+        )
+    }
+
+    /// The bytes an array of `registers` words and `bins` spectral bins per pixel needs:
+    /// the registers (i64), amplitude and phase per bin (f64), and the two maps.
+    pub fn bytes_needed(rows: u64, cols: u64, registers: u64, bins: u64) -> u64 {
+        rows.saturating_mul(cols)
+            .saturating_mul(8 * (registers + 2 * bins + 2))
+    }
+}
+
+/// The stream seed of pixel (r, c): a bijective mix of (seed, r, c), so every pixel's
+/// photons depend on nothing else (not on the tiling, the threads or the process).
+pub fn pixel_seed(seed: u64, r: usize, c: usize) -> u64 {
+    use tofprobe_scene::splitmix::mix;
+    mix(mix(seed ^ 0xA22A_7E5E_ED00_0000) ^ ((r as u64) << 32 | c as u64))
+}
+
+/// Resolves `[array]`: checks the shape (and the memory it needs for `registers` words and
+/// `bins` bins per pixel), the mapping and the maps, with `sensor`'s rates as defaults.
+/// `origin` is the configuration's path (relative map paths are read beside it).
+pub fn resolve_array(
+    a: &ArrayConfig,
+    sensor: &tofprobe_scene::SensorConfig,
+    registers: usize,
+    bins: usize,
+    frame_pulses: u64,
+    origin: &str,
+) -> Result<SensorArray, DesignError> {
+    let err = |m: String| DesignError::array(origin, m);
+    for (name, v) in [("rows", a.rows), ("cols", a.cols)] {
+        if !(1..=MAX_SIDE).contains(&v) {
+            return Err(err(format!(
+                "array.{name} = {v} is out of range: allowed 1..={MAX_SIDE} (1 × 1 is one pixel)"
+            )));
+        }
+    }
+    let need =
+        SensorArray::bytes_needed(a.rows.into(), a.cols.into(), registers as u64, bins as u64);
+    if need > MAX_ARRAY_BYTES {
+        let per_pixel = 8 * (registers as u64 + 2 * bins as u64 + 2);
+        let side = ((MAX_ARRAY_BYTES / per_pixel) as f64).sqrt().floor() as u64;
+        return Err(err(format!(
+            "array.rows × array.cols = {} × {} needs {:.1} GiB for its registers ({registers} \
+             per pixel), spectra and maps: allowed at most {} GiB; {side} × {side} fits",
+            a.rows,
+            a.cols,
+            need as f64 / (1u64 << 30) as f64,
+            MAX_ARRAY_BYTES >> 30
+        )));
+    }
+    let work = u64::from(a.rows) * u64::from(a.cols) * frame_pulses;
+    if work > MAX_PIXEL_PULSES {
+        let n = MAX_PIXEL_PULSES / (u64::from(a.rows) * u64::from(a.cols));
+        return Err(err(format!(
+            "array.rows × array.cols × frame pulses = {} × {} × {frame_pulses} = {work:.3e} \
+             pixel-pulses: allowed at most 2^40 = {MAX_PIXEL_PULSES:.3e} per frame; \
+             acquisition.pulses (or pixel.frame_pulses) <= {n} fits this array",
+            a.rows, a.cols,
+        )));
+    }
+    if !(a.pitch_um.is_finite() && a.pitch_um > 0.0 && a.pitch_um <= 1e4) {
+        return Err(err(format!(
+            "array.pitch_um = {} is out of range: allowed 0 < pitch_um <= 10000 (e.g. 30)",
+            a.pitch_um
+        )));
+    }
+    let mm_per_pixel = match (a.mm_per_pixel, a.field_of_view_deg, a.distance_mm) {
+        (Some(s), None, None) => {
+            if !(s.is_finite() && s > 0.0 && s <= 1e4) {
+                return Err(err(format!(
+                    "array.mm_per_pixel = {s} is out of range: allowed 0 < mm_per_pixel <= 10000"
+                )));
+            }
+            s
+        }
+        (None, Some(fov), Some(d)) => {
+            if !(fov.is_finite() && fov > 0.0 && fov < 180.0) {
+                return Err(err(format!(
+                    "array.field_of_view_deg = {fov} is out of range: allowed 0 < fov < 180"
+                )));
+            }
+            if !(d.is_finite() && d > 0.0 && d <= 1e7) {
+                return Err(err(format!(
+                    "array.distance_mm = {d} is out of range: allowed 0 < distance_mm <= 1e7"
+                )));
+            }
+            2.0 * d * (fov.to_radians() / 2.0).tan() / f64::from(a.cols)
+        }
+        _ => {
+            return Err(err(
+                "[array] maps pixels onto the scene plane with either `mm_per_pixel` or both \
+                 `field_of_view_deg` and `distance_mm` (one of the two ways, not both)"
+                    .into(),
+            ));
+        }
+    };
+    let (rows, cols) = (a.rows as usize, a.cols as usize);
+    let base = config_dir(origin);
+    let signal_rate = rate_map(
+        a.signal_map.as_ref(),
+        "array.signal_map",
+        sensor.signal_rate,
+        rows,
+        cols,
+        &base,
+    )
+    .map_err(err)?;
+    let background_rate = rate_map(
+        a.background_map.as_ref(),
+        "array.background_map",
+        sensor.background_rate,
+        rows,
+        cols,
+        &base,
+    )
+    .map_err(err)?;
+    Ok(SensorArray {
+        rows,
+        cols,
+        pitch_um: a.pitch_um,
+        mm_per_pixel,
+        signal_rate,
+        background_rate,
+    })
+}
+
+/// The directory map paths are relative to.
+fn config_dir(origin: &str) -> PathBuf {
+    if origin == crate::DEFAULT_ORIGIN {
+        return PathBuf::from(".");
+    }
+    Path::new(origin)
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
+/// One map's R × C values, each a valid rate (ρ_s in [0, 1], ρ_b in [0, 20]).
+fn rate_map(
+    map: Option<&RateMap>,
+    field: &str,
+    default: f64,
+    rows: usize,
+    cols: usize,
+    base: &Path,
+) -> Result<Vec<f64>, String> {
+    let max = if field.contains("signal") { 1.0 } else { 20.0 };
+    let values = match map {
+        None => vec![default; rows * cols],
+        Some(RateMap::Constant { value }) => vec![*value; rows * cols],
+        Some(RateMap::Gradient { from, to, axis }) => (0..rows * cols)
+            .map(|i| {
+                let (r, c) = (i / cols, i % cols);
+                let (k, n) = match axis {
+                    Axis::X => (c, cols),
+                    Axis::Y => (r, rows),
+                };
+                let t = if n > 1 {
+                    k as f64 / (n - 1) as f64
+                } else {
+                    0.0
+                };
+                from + (to - from) * t
+            })
+            .collect(),
+        Some(RateMap::Image { path, scale }) => {
+            if !(scale.is_finite() && *scale >= 0.0) {
+                return Err(format!(
+                    "{field}.scale = {scale} is out of range: allowed >= 0 (1: the image as it is)"
+                ));
+            }
+            let p = base.join(path);
+            let img = crate::rate_image::read(&p, rows, cols)
+                .map_err(|m| format!("{field}.path = \"{path}\": {m}"))?;
+            img.into_iter().map(|v| v * scale).collect()
+        }
+    };
+    if let Some((i, v)) = values
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !(v.is_finite() && (0.0..=max).contains(*v)))
+    {
+        return Err(format!(
+            "{field} gives pixel ({}, {}) the rate {v}: allowed 0..={max} (a {} rate per pulse)",
+            i / cols,
+            i % cols,
+            if max == 1.0 {
+                "signal-photon probability; scale the map down"
+            } else {
+                "mean background"
+            }
+        ));
+    }
+    Ok(values)
+}
