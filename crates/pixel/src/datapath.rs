@@ -240,7 +240,10 @@ impl FourierStream {
                     STREAM_BLOCK
                 }
                 None => {
-                    codes.iter_mut().zip(tail_codes.clone()).for_each(|(c, t)| *c = t);
+                    codes
+                        .iter_mut()
+                        .zip(tail_codes.clone())
+                        .for_each(|(c, t)| *c = t);
                     tail.len()
                 }
             };
@@ -252,7 +255,14 @@ impl FourierStream {
                 // G = F (the default): the operand is x itself.
                 prefilter::<false>(&targets[..n], &mut ops[..n], none, shift, 0, &mut state);
             } else {
-                prefilter::<true>(&targets[..n], &mut ops[..n], none, shift, register_shift, &mut state);
+                prefilter::<true>(
+                    &targets[..n],
+                    &mut ops[..n],
+                    none,
+                    shift,
+                    register_shift,
+                    &mut state,
+                );
             }
             (target, x, u) = state;
             if n > 0 {

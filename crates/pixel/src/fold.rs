@@ -38,8 +38,7 @@ pub const MIN_SEGMENT: usize = 256;
 /// ⌈R/8⌉ byte tables, the fold into one phase sum and the phase sums into the byte tables
 /// once per frame). Haar has no ROM: never.
 pub fn fold_pays(params: &PixelParams) -> bool {
-    if params.mode != Mode::Fourier || params.rom_depth == 0 || params.rom_depth > MAX_FOLD_DEPTH
-    {
+    if params.mode != Mode::Fourier || params.rom_depth == 0 || params.rom_depth > MAX_FOLD_DEPTH {
         return false;
     }
     let n = u128::from(params.frame_pulses);

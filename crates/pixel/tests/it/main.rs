@@ -6,6 +6,7 @@ mod common;
 mod directed;
 mod equivalence;
 mod float_sd;
+mod fold;
 mod haar;
 mod numerics;
 mod refusal;
