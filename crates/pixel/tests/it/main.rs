@@ -11,4 +11,5 @@ mod haar;
 mod numerics;
 mod refusal;
 mod register_frac_bits;
+mod sequencer;
 mod sizing;
