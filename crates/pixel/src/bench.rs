@@ -191,6 +191,11 @@ pub struct CycleBench {
     pub seconds: f64,
     /// Edges per second.
     pub cycles_per_s: f64,
+    /// CPU time of the run on its thread, seconds (Linux; `None` elsewhere): the work "on
+    /// one core" that wall time inflates on a shared machine.
+    pub cpu_seconds: Option<f64>,
+    /// Edges per second of CPU time (`None` where it is not measured).
+    pub cpu_cycles_per_s: Option<f64>,
 }
 
 /// Times the cycle model under the reference sequencer for `frames` frames.
@@ -204,6 +209,7 @@ pub fn bench_cycle(
     let seq = Sequencer::new(params, &stimuli, Some(rom))?;
     let mut cm = CycleModel::new(params)?;
     let cycles = seq.total_cycles();
+    let c0 = thread_cpu_seconds();
     let t0 = Instant::now();
     let mut sink = 0u64;
     for pins in seq {
@@ -211,10 +217,13 @@ pub fn bench_cycle(
         sink = sink.wrapping_add(o.rd_data);
     }
     let seconds = t0.elapsed().as_secs_f64().max(1e-9);
+    let cpu_seconds = c0.zip(thread_cpu_seconds()).map(|(a, b)| b - a);
     std::hint::black_box(sink);
     Ok(CycleBench {
         cycles,
         seconds,
         cycles_per_s: cycles as f64 / seconds,
+        cpu_seconds,
+        cpu_cycles_per_s: cpu_seconds.map(|c| cycles as f64 / c.max(1e-9)),
     })
 }
