@@ -7,7 +7,7 @@
 //! [`CycleModel::writes`].
 //!
 //! The accumulate is pipelined (the contract's "Pipeline"): each adder's register operand,
-//! register and sign are read one edge ahead ([`CycleModel::read_ahead`], after the edge's
+//! register and sign are read one edge ahead (`CycleModel::read_ahead`, after the edge's
 //! writes, which is the forward), and the write edge adds to that operand.
 //!
 //! The arithmetic is the one [`Datapath`]'s, the slot order the one [`Schedule`]'s. The

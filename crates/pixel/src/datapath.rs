@@ -192,7 +192,7 @@ const NO_CODE: u32 = u32::MAX;
 /// the drivers, crates/pixel/tests/it/fold.rs), in another grouping.
 ///
 /// - The detections are decoded to their T-bit codes a block at a time without a branch
-///   (whether a pulse has one is the scene's coin flip; see [`decode`]).
+///   (whether a pulse has one is the scene's coin flip; see `decode`).
 /// - The hold is a select of the rounded target t = ((tdc − Z) << F) + r (t of the pulse,
 ///   or the held one), and the prefilter x ← x + ((t − x) >>> S) is carried as the
 ///   distance u = t − x: with s = u >>> S, x ← x + s and u ← u + (t' − t) − s, t' the
