@@ -1,6 +1,8 @@
 //! Speed of the two fidelities (issue point 8), measured by `tofprobe bench pixel`: the
-//! transaction model's pulses per second at B = 16 with the ROM read for every pulse, and
-//! the cycle model's clock edges per second under the reference sequencer.
+//! transaction model's pulses per second at B = 16 with the ROM read for every pulse, the
+//! folded driver's on the same frame (issue 28; [`bench_fold`], checked bit-identical to
+//! the transaction driver's readout), and the cycle model's clock edges per second under
+//! the reference sequencer.
 
 use std::time::Instant;
 
@@ -8,6 +10,7 @@ use tofprobe_dsp::RomImage;
 
 use crate::cycle::CycleModel;
 use crate::error::PixelError;
+use crate::fold::FoldModel;
 use crate::params::PixelParams;
 use crate::sequencer::Sequencer;
 use crate::transaction::TransactionModel;
@@ -108,6 +111,77 @@ pub fn bench_transaction(
     })
 }
 
+/// Result of the folded-driver benchmark ([`bench_fold`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FoldBench {
+    /// Pulses run.
+    pub pulses: u64,
+    /// Wall time of the frame (run and readout), seconds.
+    pub seconds: f64,
+    /// CPU time of the frame on its thread, seconds (Linux; `None` elsewhere).
+    pub cpu_seconds: Option<f64>,
+    /// Pulses per second (wall time).
+    pub pulses_per_s: f64,
+    /// Real-time factor at `laser_rate_hz` (wall time).
+    pub realtime_factor: f64,
+    /// Real-time factor on the thread's CPU time (`None` where it is not measured).
+    pub cpu_realtime_factor: Option<f64>,
+}
+
+impl FoldBench {
+    /// How many times faster than the transaction driver on the same frame: the ratio of
+    /// CPU times where both were measured, else of wall times.
+    pub fn speedup_over(&self, transaction: &TransactionBench) -> f64 {
+        match (transaction.cpu_seconds, self.cpu_seconds) {
+            (Some(t), Some(f)) => t / f.max(1e-9),
+            _ => transaction.seconds / self.seconds.max(1e-9),
+        }
+    }
+}
+
+/// Times one frame of `pulses` through the folded driver ([`FoldModel`], streamed in the
+/// same chunks as [`bench_transaction`], readout included) on the same stimuli, then
+/// checks its readout against [`TransactionModel::run`]'s (untimed): a mismatch is an
+/// error. `rom` must have the depth L = `params.rom_depth`.
+pub fn bench_fold(
+    params: &PixelParams,
+    pulses: usize,
+    rom: &RomImage,
+    laser_rate_hz: f64,
+) -> Result<FoldBench, PixelError> {
+    let stimuli = synthetic_stimuli(pulses, 80);
+    let mut fm = FoldModel::new(params, rom)?;
+    let c0 = thread_cpu_seconds();
+    let t0 = Instant::now();
+    for (i, chunk) in stimuli.chunks(1 << 16).enumerate() {
+        fm.run(chunk, (i << 16) as u64);
+    }
+    let folded = fm.readout();
+    let seconds = t0.elapsed().as_secs_f64().max(1e-9);
+    let cpu_seconds = c0.zip(thread_cpu_seconds()).map(|(a, b)| b - a);
+
+    let mut tm = TransactionModel::new(params)?;
+    for (i, chunk) in stimuli.chunks(1 << 16).enumerate() {
+        tm.run(chunk, Some(rom), (i << 16) as u64)?;
+    }
+    if tm.readout() != folded {
+        return Err(PixelError::mismatch(
+            "benchmark readouts of the folded and transaction drivers",
+            "different",
+            "identical",
+        ));
+    }
+    let simulated = pulses as f64 / laser_rate_hz;
+    Ok(FoldBench {
+        pulses: pulses as u64,
+        seconds,
+        cpu_seconds,
+        pulses_per_s: pulses as f64 / seconds,
+        realtime_factor: simulated / seconds,
+        cpu_realtime_factor: cpu_seconds.map(|c| simulated / c.max(1e-9)),
+    })
+}
+
 /// Result of the cycle-model benchmark.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CycleBench {
@@ -117,6 +191,11 @@ pub struct CycleBench {
     pub seconds: f64,
     /// Edges per second.
     pub cycles_per_s: f64,
+    /// CPU time of the run on its thread, seconds (Linux; `None` elsewhere): the work "on
+    /// one core" that wall time inflates on a shared machine.
+    pub cpu_seconds: Option<f64>,
+    /// Edges per second of CPU time (`None` where it is not measured).
+    pub cpu_cycles_per_s: Option<f64>,
 }
 
 /// Times the cycle model under the reference sequencer for `frames` frames.
@@ -130,6 +209,7 @@ pub fn bench_cycle(
     let seq = Sequencer::new(params, &stimuli, Some(rom))?;
     let mut cm = CycleModel::new(params)?;
     let cycles = seq.total_cycles();
+    let c0 = thread_cpu_seconds();
     let t0 = Instant::now();
     let mut sink = 0u64;
     for pins in seq {
@@ -137,10 +217,13 @@ pub fn bench_cycle(
         sink = sink.wrapping_add(o.rd_data);
     }
     let seconds = t0.elapsed().as_secs_f64().max(1e-9);
+    let cpu_seconds = c0.zip(thread_cpu_seconds()).map(|(a, b)| b - a);
     std::hint::black_box(sink);
     Ok(CycleBench {
         cycles,
         seconds,
         cycles_per_s: cycles as f64 / seconds,
+        cpu_seconds,
+        cpu_cycles_per_s: cpu_seconds.map(|c| cycles as f64 / c.max(1e-9)),
     })
 }

@@ -7,7 +7,7 @@
 //! [`CycleModel::writes`].
 //!
 //! The accumulate is pipelined (the contract's "Pipeline"): each adder's register operand,
-//! register and sign are read one edge ahead ([`CycleModel::read_ahead`], after the edge's
+//! register and sign are read one edge ahead (`CycleModel::read_ahead`, after the edge's
 //! writes, which is the forward), and the write edge adds to that operand.
 //!
 //! The arithmetic is the one [`Datapath`]'s, the slot order the one [`Schedule`]'s. The
@@ -84,8 +84,12 @@ pub struct CycleModel {
     rd_active: bool,
     rd_ptr: usize,
     y: Vec<i64>,
-    /// Read-ahead stage: per adder of the next slot, (register, add, `yin`).
+    /// Read-ahead stage: per adder of the next slot, (register, add, `yin`); the first
+    /// `pre_len` entries are valid.
     pre: Vec<(usize, bool, i64)>,
+    pre_len: usize,
+    /// All-ones in the low W bits (the raw word of a register).
+    raw_mask: u64,
     // Registered outputs.
     rd_valid: bool,
     rd_index: u32,
@@ -135,7 +139,9 @@ impl CycleModel {
             rd_active: false,
             rd_ptr: 0,
             y: vec![0; r],
-            pre: Vec::with_capacity(params.adders),
+            pre: vec![(0, false, 0); params.adders],
+            pre_len: 0,
+            raw_mask: mask(params.width),
             rd_valid: false,
             rd_index: 0,
             rd_data: 0,
@@ -224,7 +230,27 @@ impl CycleModel {
 
     /// One clock cycle: returns the outputs as seen during the cycle, then applies the
     /// rising edge with inputs `pins`.
+    ///
+    /// A pixel without a fault runs a copy of the edge compiled without the fault hooks
+    /// (`FAULTY = false`), so they cost nothing when off.
+    #[inline]
     pub fn step(&mut self, pins: &PinsIn) -> PinsOut {
+        if self.fault.is_none() {
+            self.edge::<false>(pins)
+        } else {
+            self.edge::<true>(pins)
+        }
+    }
+
+    /// Whether the model carries fault `f` (always false in the fault-free copy).
+    #[inline(always)]
+    fn has<const FAULTY: bool>(&self, f: Fault) -> bool {
+        FAULTY && self.fault == Some(f)
+    }
+
+    /// [`CycleModel::step`], with (`FAULTY`) or without the fault hooks.
+    #[inline(always)]
+    fn edge<const FAULTY: bool>(&mut self, pins: &PinsIn) -> PinsOut {
         let out = self.outputs();
         self.writes.clear();
         self.cycle += 1;
@@ -233,26 +259,26 @@ impl CycleModel {
             self.reset();
             return out;
         }
-        let w = self.p.width;
         let free = self.free();
         let haar_room = self.p.mode == Mode::Fourier
             || self.pcount < self.p.frame_pulses
-            || self.fault == Some(Fault::HaarFrameLimit);
+            || self.has::<FAULTY>(Fault::HaarFrameLimit);
         let take_readout = pins.readout && free;
         let take_pulse = pins.pulse && free && !pins.readout && haar_room;
         let refuse_pulse = pins.pulse && !take_pulse;
 
-        if self.fault == Some(Fault::MissingForward) {
+        if self.has::<FAULTY>(Fault::MissingForward) {
             self.stale.clone_from(&self.y);
         }
         // Accumulate one slot with the old op/acc_en: register, sign and register operand
         // were read ahead at the last edge; the datapath adds.
         if self.active {
             if self.acc_en {
-                for i in 0..self.pre.len() {
+                let fault = if FAULTY { self.fault } else { None };
+                for i in 0..self.pre_len {
                     let (reg, add, yin) = self.pre[i];
-                    let v = self.dp.accumulate(yin, self.op, add, self.fault);
-                    self.write(reg, v);
+                    let v = self.dp.accumulate(yin, self.op, add, fault);
+                    self.write::<FAULTY>(reg, v);
                 }
             }
             if self.slot == self.k - 1 {
@@ -265,49 +291,56 @@ impl CycleModel {
         let mut refused_next = self.refused;
         let status_edge = self.rd_active && self.rd_ptr == self.r;
         if self.rd_active {
-            if self.rd_ptr < self.r {
-                self.rd_data = to_raw(self.y[self.rd_ptr], w);
-                self.rd_index = self.rd_ptr as u32;
-                self.rd_valid = true;
-                self.write(self.rd_ptr, 0);
-                self.rd_ptr += 1;
-            } else {
-                // StatusWord: the RTL's word multiplexer, whose default arm (index R) is 0.
-                self.rd_data = if self.fault == Some(Fault::StatusWord) {
-                    0
-                } else {
-                    self.refused & mask(w)
-                };
-                self.rd_index = self.r as u32;
-                self.rd_valid = true;
-                refused_next = 0;
-                self.pcount = 0;
-                self.rd_active = false;
-            }
+            self.readout_edge::<FAULTY>(&mut refused_next);
         } else {
             self.rd_valid = false;
         }
         // RefusedCounter: only the status edge's `refused ← 0 or 1` remains.
-        let counts = self.fault != Some(Fault::RefusedCounter) || status_edge;
+        let counts = !self.has::<FAULTY>(Fault::RefusedCounter) || status_edge;
         if refuse_pulse && counts {
             refused_next = (refused_next + 1).min(self.p.refused_max());
         }
         self.refused = refused_next;
 
         if take_pulse {
-            self.accept(pins);
+            self.accept::<FAULTY>(pins);
         }
         if take_readout {
             self.rd_active = true;
             self.rd_ptr = 0;
         }
         if self.active {
-            self.read_ahead();
+            self.read_ahead::<FAULTY>();
         }
-        if self.fault == Some(Fault::ScheduleLate) {
+        if self.has::<FAULTY>(Fault::ScheduleLate) {
             self.apply_late();
         }
         out
+    }
+
+    /// One edge of the readout: the next register word out (and cleared), or the status
+    /// word, which ends the readout.
+    #[inline(always)]
+    fn readout_edge<const FAULTY: bool>(&mut self, refused_next: &mut u64) {
+        if self.rd_ptr < self.r {
+            self.rd_data = self.y[self.rd_ptr] as u64 & self.raw_mask;
+            self.rd_index = self.rd_ptr as u32;
+            self.rd_valid = true;
+            self.write::<FAULTY>(self.rd_ptr, 0);
+            self.rd_ptr += 1;
+        } else {
+            // StatusWord: the RTL's word multiplexer, whose default arm (index R) is 0.
+            self.rd_data = if self.has::<FAULTY>(Fault::StatusWord) {
+                0
+            } else {
+                self.refused & self.raw_mask
+            };
+            self.rd_index = self.r as u32;
+            self.rd_valid = true;
+            *refused_next = 0;
+            self.pcount = 0;
+            self.rd_active = false;
+        }
     }
 
     /// The read stage of the pipeline, for the slot the next edge performs: the schedule
@@ -315,32 +348,34 @@ impl CycleModel {
     /// edge), and the register is read after this edge's writes: the forward of a K = 1
     /// pulse's write to the next pulse's read of the same register.
     #[inline(always)]
-    fn read_ahead(&mut self) {
-        self.pre.clear();
+    fn read_ahead<const FAULTY: bool>(&mut self) {
+        let mut len = 0;
         for i in 0..self.p.adders {
             let Some(operation) = self.schedule.at(self.slot, i) else {
                 break;
             };
             let (reg, add) = operation.target(self.n_lat, self.log2_n, &self.bits);
-            let yin = if self.fault == Some(Fault::MissingForward) {
+            let yin = if self.has::<FAULTY>(Fault::MissingForward) {
                 self.stale[reg]
             } else {
                 self.y[reg]
             };
-            self.pre.push((reg, add, yin));
+            self.pre[i] = (reg, add, yin);
+            len += 1;
         }
+        self.pre_len = len;
     }
 
     /// A register write of this edge (a trace event).
     #[inline(always)]
-    fn write(&mut self, reg: usize, v: i64) {
-        if self.fault.is_some() {
+    fn write<const FAULTY: bool>(&mut self, reg: usize, v: i64) {
+        if FAULTY {
             return self.write_faulty(reg, v);
         }
         self.y[reg] = v;
         self.writes.push(RegWrite {
             register: reg as u32,
-            value: to_raw(v, self.p.width),
+            value: v as u64 & self.raw_mask,
         });
     }
 
@@ -377,8 +412,10 @@ impl CycleModel {
 
     /// The state changes at the edge that accepts a pulse: the datapath's zoom, hold and
     /// prefilter select the operand; the ROM word or pulse index is latched for the slots.
-    fn accept(&mut self, pins: &PinsIn) {
-        let operand = self.dp.pulse(pins.valid, pins.tdc, self.fault);
+    #[inline(always)]
+    fn accept<const FAULTY: bool>(&mut self, pins: &PinsIn) {
+        let fault = if FAULTY { self.fault } else { None };
+        let operand = self.dp.pulse(pins.valid, pins.tdc, fault);
         self.acc_en = operand.is_some();
         if let Some(op) = operand {
             self.op = op;

@@ -5,6 +5,9 @@
 //! - [`params`]: the validated parameters ([`PixelParams`]) and their derived sizes;
 //! - [`config`]: the `[pixel]` TOML section ([`PixelConfig`]) and its validation;
 //! - [`datapath`]: the one datapath (zoom, hold, prefilter, accumulate) both models drive;
+//! - [`fold`]: the folded driver of a Fourier frame (phase sums of the periodic ROM), and
+//!   [`driver`]: [`FrameDriver`], which runs it when it pays and the transaction driver
+//!   otherwise;
 //! - [`schedule`]: the adder schedule, which register each adder touches in which slot;
 //! - [`fault`]: deliberate faults the cycle model carries for the mutation tests;
 //! - [`fixed`]: the fixed-width arithmetic of the datapath;
@@ -19,9 +22,11 @@ pub mod config;
 pub mod cycle;
 pub mod datapath;
 pub mod directed;
+pub mod driver;
 pub mod error;
 pub mod fault;
 pub mod fixed;
+pub mod fold;
 pub mod params;
 pub mod readout;
 pub mod schedule;
@@ -41,8 +46,10 @@ pub use config::{PixelConfig, PixelContext};
 pub use cycle::{CycleModel, PinsIn, PinsOut, RegWrite};
 pub use datapath::Datapath;
 pub use directed::{DirectedOptions, Program, directed_program};
+pub use driver::FrameDriver;
 pub use error::PixelError;
 pub use fault::Fault;
+pub use fold::{FoldModel, fold_pays};
 pub use params::{Mode, PixelParams, RegisterFile, Rounding};
 pub use readout::{Readout, ReadoutCollector};
 pub use schedule::{Operation, Schedule};

@@ -56,6 +56,24 @@ pub struct Sequencer<'a> {
     rom_depth: u64,
     /// The directed schedule, when this is not the reference sequencer.
     program: Option<Program>,
+    /// Where [`Iterator::next`] is in the reference sequence, kept by counting instead of
+    /// dividing the cycle index (what [`Sequencer::phase`] does for any cycle).
+    at: Position,
+}
+
+/// The reference sequence's counters at the iterator's cycle (after the reset cycles).
+#[derive(Debug, Clone, Copy, Default)]
+struct Position {
+    /// Cycle within the frame.
+    within: u64,
+    /// Cycle within the pulse (`within` mod C, while pulses are presented).
+    sub: u64,
+    /// Pulse within the frame (`within` / C).
+    pulse: u64,
+    /// ROM address of that pulse (`pulse` mod L).
+    address: u64,
+    /// Global index of the frame's first pulse (frame · N).
+    first: u64,
 }
 
 /// Presents no detection for pulses beyond the stimuli (the status cycle's pulse).
@@ -94,6 +112,7 @@ impl<'a> Sequencer<'a> {
             cycle: 0,
             rom_depth: params.rom_depth.max(1) as u64,
             program: None,
+            at: Position::default(),
         })
     }
 
@@ -124,6 +143,7 @@ impl<'a> Sequencer<'a> {
             cycle: 0,
             rom_depth: params.rom_depth.max(1) as u64,
             program: Some(program),
+            at: Position::default(),
         })
     }
 
@@ -266,8 +286,53 @@ impl<'a> Iterator for Sequencer<'a> {
         if self.cycle >= self.total {
             return None;
         }
-        let pins = self.pins(self.cycle);
+        if self.program.is_some() || self.cycle < RESET_CYCLES {
+            let pins = self.pins(self.cycle);
+            self.cycle += 1;
+            return Some(pins);
+        }
+        // The reference sequence by counting: the same pins as `pins(cycle)` (tested).
+        let at = &mut self.at;
+        let pulses = self.n * self.c;
+        let pins = if at.within < pulses {
+            if at.sub == 0 {
+                let det = detection(self.stimuli, at.first + at.pulse);
+                PinsIn {
+                    pulse: true,
+                    valid: det.is_some(),
+                    tdc: det.unwrap_or(0),
+                    rom_word: self
+                        .rom
+                        .map(|rom| rom.entry(at.address as usize))
+                        .unwrap_or(&[]),
+                    ..PinsIn::default()
+                }
+            } else {
+                PinsIn::default()
+            }
+        } else {
+            PinsIn {
+                readout: at.within == pulses,
+                ..PinsIn::default()
+            }
+        };
         self.cycle += 1;
+        at.within += 1;
+        at.sub += 1;
+        if at.sub == self.c {
+            at.sub = 0;
+            at.pulse += 1;
+            at.address += 1;
+            if at.address == self.rom_depth {
+                at.address = 0;
+            }
+        }
+        if at.within == self.frame_cycles {
+            *at = Position {
+                first: at.first + self.n,
+                ..Position::default()
+            };
+        }
         Some(pins)
     }
 

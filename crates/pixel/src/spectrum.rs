@@ -8,10 +8,10 @@
 use tofprobe_dsp::sd::{ProbeRom, normalise, prefilter_response};
 use tofprobe_scene::PhotonSource;
 
+use crate::driver::FrameDriver;
 use crate::error::PixelError;
 use crate::params::{Mode, PixelParams};
 use crate::readout::Readout;
-use crate::transaction::TransactionModel;
 
 /// Pulses per chunk streamed from the photon source.
 const CHUNK: usize = 1 << 16;
@@ -144,7 +144,8 @@ pub fn spectrum_from_readout(
 }
 
 /// Runs one frame of N = `params.frame_pulses` pulses of `source` through the transaction
-/// model (streamed, never holding the record) and returns its spectrum. For `tofprobe
+/// level ([`FrameDriver`]: the folded driver when it pays; streamed, never holding the
+/// record) and returns its spectrum. For `tofprobe
 /// simulate`: `lsb_mm` is the sensor's `tdc_lsb_mm()`.
 pub fn bit_true_spectrum(
     params: &PixelParams,
@@ -152,11 +153,11 @@ pub fn bit_true_spectrum(
     source: &PhotonSource,
     lsb_mm: f64,
 ) -> Result<BitTrueSpectrum, PixelError> {
-    let mut tm = TransactionModel::new(params)?;
+    let mut tm = FrameDriver::new(params, Some(&rom.image))?;
     let mut result = Ok(());
     source.for_each_chunk(params.frame_pulses, CHUNK, |first, chunk| {
         if result.is_ok() {
-            result = tm.run(chunk, Some(&rom.image), first);
+            result = tm.run(chunk, first);
         }
     });
     result?;

@@ -212,32 +212,7 @@ impl TransactionModel {
         }
         tables.truncate(nbytes);
         self.pcount += detections.len() as u64;
-        // Distribute: the pulses whose ROM byte j had value v added ±(their x sum) to the
-        // eight registers of that byte, with the sign of each bit of v.
-        let w = self.params.width;
-        for (j, table) in tables.iter_mut().enumerate() {
-            for (v, cell) in table.iter_mut().enumerate() {
-                let h = std::mem::take(cell);
-                if h == 0 {
-                    continue;
-                }
-                for b in 0..8 {
-                    let reg = 8 * j + b;
-                    if reg >= r {
-                        break;
-                    }
-                    let s = if (v >> b) & 1 == 1 {
-                        h
-                    } else {
-                        h.wrapping_neg()
-                    };
-                    self.regs[reg] = self.regs[reg].wrapping_add(s);
-                }
-            }
-        }
-        for y in &mut self.regs {
-            *y = wrap(*y, w);
-        }
+        distribute(&mut tables, &mut self.regs, self.params.width);
         self.tables = tables;
         Ok(())
     }
@@ -266,6 +241,37 @@ impl TransactionModel {
             out.push(self.readout());
         }
         Ok(out)
+    }
+}
+
+/// Adds the byte tables into the registers and wraps them to `width` bits, emptying the
+/// tables: the pulses whose ROM byte j had value v added ±(their x sum) to the eight
+/// registers of that byte, with the sign of each bit of v. Shared by [`TransactionModel::run`]
+/// and the folded driver ([`crate::fold`]).
+pub(crate) fn distribute(tables: &mut [[i64; 256]], regs: &mut [i64], width: u32) {
+    let r = regs.len();
+    for (j, table) in tables.iter_mut().enumerate() {
+        for (v, cell) in table.iter_mut().enumerate() {
+            let h = std::mem::take(cell);
+            if h == 0 {
+                continue;
+            }
+            for b in 0..8 {
+                let reg = 8 * j + b;
+                if reg >= r {
+                    break;
+                }
+                let s = if (v >> b) & 1 == 1 {
+                    h
+                } else {
+                    h.wrapping_neg()
+                };
+                regs[reg] = regs[reg].wrapping_add(s);
+            }
+        }
+    }
+    for y in regs.iter_mut() {
+        *y = wrap(*y, width);
     }
 }
 
