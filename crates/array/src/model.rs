@@ -1,6 +1,7 @@
 //! The array model: the one pixel datapath run on every pixel. Pixel (r, c) reads its own
 //! photon stream (`ResolvedDesign::pixel_source`: its rates, the scene at its centre, the
-//! seed of (seed, r, c)) through the transaction driver, streamed in chunks, with the
+//! seed of (seed, r, c)) through the pixel's `FrameDriver` (the folded driver of a
+//! periodic ROM, or the transaction driver), streamed in chunks, with the
 //! chip's one probe ROM broadcast to all (Fourier) or the Haar signs of its counter. A
 //! tile is a rectangle of pixels run in parallel on the current rayon pool; tiles merge
 //! into the array byte for byte whatever the tiling, the threads or the process.
@@ -11,7 +12,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use tofprobe_design::ResolvedDesign;
 use tofprobe_dsp::rom::RomImage;
-use tofprobe_pixel::transaction::TransactionModel;
+use tofprobe_pixel::FrameDriver;
 
 use crate::error::ArrayError;
 
@@ -65,13 +66,15 @@ pub fn run_pixel(
         col: c,
         source,
     };
-    let mut tm = TransactionModel::new(&design.pixel).map_err(err)?;
+    // The folded driver when it pays (periodic ROM, Fourier), the transaction driver
+    // otherwise: bit-identical registers either way.
+    let mut tm = FrameDriver::new(&design.pixel, rom).map_err(err)?;
     let mut result = Ok(());
     let mut detections = 0u64;
     source.for_each_chunk(design.pixel.frame_pulses, CHUNK, |first, chunk| {
         if result.is_ok() {
             detections += chunk.iter().filter(|d| d.is_some()).count() as u64;
-            result = tm.run(chunk, rom, first);
+            result = tm.run(chunk, first);
         }
     });
     result.map_err(err)?;

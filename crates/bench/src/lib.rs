@@ -8,6 +8,7 @@
 //! is the thread count reported): a host that must not oversubscribe its cores installs
 //! its own pool around the call.
 
+pub mod array;
 pub mod cpu;
 pub mod dsp;
 mod error;

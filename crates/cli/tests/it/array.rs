@@ -235,3 +235,34 @@ fn single_pixel_commands_refuse_an_array_and_spatial_motions_need_one() {
         "{err}"
     );
 }
+
+/// `tofprobe bench array --json`, short: the rates are there, finite and consistent (the
+/// pixel-pulses are R·C·N), the Monte Carlo alone is measured in the same run, and the
+/// peak memory is far below the R·C·2B bound's scale (a 4 × 4 array: well under 1 GB).
+#[test]
+fn bench_array_prints_its_rates() {
+    let o = run(&[
+        "bench",
+        "array",
+        "--rows",
+        "4",
+        "--cols",
+        "4",
+        "--pulses",
+        "40000,80000",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let runs = r["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    for (run, n) in runs.iter().zip([40_000.0, 80_000.0]) {
+        assert_eq!(run["pixel_pulses"].as_f64().unwrap(), 16.0 * n);
+        let rate = run["pixel_pulses_per_s"].as_f64().unwrap();
+        let secs = run["seconds"].as_f64().unwrap();
+        assert!((rate * secs / (16.0 * n) - 1.0).abs() < 1e-9);
+        assert!(run["monte_carlo_pulses_per_cpu_s"].as_f64().unwrap() > 1e6);
+        assert!(run["peak_memory_bytes"].as_f64().unwrap() < 1e9);
+    }
+    assert!(r["projected_64x64_1e7_seconds"].as_f64().unwrap() > 0.0);
+}

@@ -1,6 +1,7 @@
 //! `tofprobe bench <target> [--json]`: speed measurements, one file per target. To add a
 //! target, add a variant to [`BenchTarget`] and a line to [`run`].
 
+pub mod array;
 pub mod dsp;
 pub mod fullband;
 pub mod pixel;
@@ -21,6 +22,9 @@ pub struct BenchArgs {
 /// What to benchmark.
 #[derive(Debug, Subcommand)]
 pub enum BenchTarget {
+    /// The array model: pixel-pulses/s of a 64 × 64 array at N = 10^6 and 10^7 on all
+    /// cores beside the single-pixel Monte Carlo alone, and peak memory.
+    Array(array::ArrayBenchArgs),
     /// Photon/TDC Monte Carlo throughput (pulses/s, one thread) at (ρ_s, ρ_b) = (1, 0) and
     /// (0.3, 0.3).
     Scene(scene::SceneBenchArgs),
@@ -41,6 +45,7 @@ pub enum BenchTarget {
 /// Runs one benchmark.
 pub fn run(args: BenchArgs) -> Result<(), CliError> {
     match args.target {
+        BenchTarget::Array(a) => array::run(&a),
         BenchTarget::Scene(a) => scene::run(&a),
         BenchTarget::Dsp(a) => dsp::run(&a),
         BenchTarget::Pixel(a) => pixel::run(&a),

@@ -66,6 +66,22 @@ fn print_text(r: &PixelReport) {
         r.pulse_by_pulse_seconds
     );
     println!(
+        "folded driver      {:.4} s = {:.1} M pulses/s, {:.1}x real time{}; {:.2}x the transaction driver (L = {}, {})",
+        r.fold_seconds,
+        r.fold_pulses_per_s / 1e6,
+        r.fold_realtime_factor,
+        r.fold_cpu_realtime_factor
+            .map(|f| format!(" ({f:.1}x on CPU time)"))
+            .unwrap_or_default(),
+        r.fold_speedup_vs_transaction,
+        r.rom_depth,
+        if r.fold_chosen {
+            "chosen for this frame"
+        } else {
+            "not chosen: the transaction driver runs"
+        }
+    );
+    println!(
         "cycle model        {} cycles in {:.4} s = {:.1} M cycles/s ({:.3}x real time at {} cycles/pulse)",
         r.cycle_cycles,
         r.cycle_seconds,

@@ -1,0 +1,74 @@
+//! `tofprobe bench array [CONFIG] [--rows 64] [--cols 64] [--pulses 1000000,10000000]
+//! [--json]`: the array model's speed (`tofprobe_bench::array` measures; this prints).
+
+use std::path::PathBuf;
+
+use clap::Args;
+use tofprobe_bench::array::ArrayReport;
+
+use crate::error::CliError;
+
+/// Arguments of `tofprobe bench array`.
+#[derive(Debug, Args)]
+pub struct ArrayBenchArgs {
+    /// Configuration whose pixel, sensor and scene each array pixel gets (default: the
+    /// embedded default); its own `[array]` maps are kept, the shape is `--rows × --cols`.
+    config: Option<PathBuf>,
+    /// Rows of the timed array.
+    #[arg(long, default_value_t = 64)]
+    rows: u32,
+    /// Columns of the timed array.
+    #[arg(long, default_value_t = 64)]
+    cols: u32,
+    /// Frame lengths to time, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1000000,10000000")]
+    pulses: Vec<u64>,
+    /// Print one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs the benchmark.
+pub fn run(args: &ArrayBenchArgs) -> Result<(), CliError> {
+    let base = tofprobe_design::load(args.config.as_deref())?;
+    let report = tofprobe_bench::array::measure(&base, args.rows, args.cols, &args.pulses)?;
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print_text(&report);
+    }
+    Ok(())
+}
+
+fn print_text(r: &ArrayReport) {
+    println!(
+        "array model, {} × {} pixels of {} on {} threads",
+        r.rows, r.cols, r.configuration, r.threads
+    );
+    for run in &r.runs {
+        println!(
+            "N = {:>9}: {:.2} s, {:.1} M pixel-pulses/s{}; Monte Carlo alone {:.1} M pulses/CPU-s (model share {:.0} %)",
+            run.pulses,
+            run.seconds,
+            run.pixel_pulses_per_s / 1e6,
+            run.pixel_pulses_per_cpu_s
+                .map(|c| format!(" ({:.1} M per CPU-s)", c / 1e6))
+                .unwrap_or_default(),
+            run.monte_carlo_pulses_per_cpu_s / 1e6,
+            100.0 * run.model_share
+        );
+        if let Some(s) = run.seconds_on_2_idle_cores {
+            println!("  64 × 64 at this N on 2 idle cores: {s:.1} s");
+        }
+        if let Some(m) = run.peak_memory_bytes {
+            println!("  peak memory {:.1} MB", m as f64 / 1e6);
+        }
+    }
+    println!(
+        "target: 64 × 64, N = 10^7 in <= {:.0} s on 2 cores: projected {} s, {}",
+        r.target_seconds,
+        r.projected_64x64_1e7_seconds
+            .map_or("?".to_string(), |s| format!("{s:.0}")),
+        if r.pass { "pass" } else { "FAIL" }
+    );
+}
