@@ -1,37 +1,53 @@
 //! Events: the coefficients that stand out of the noise, grouped into transients with a
-//! time, a duration scale, a sign and a ramp-rate estimate.
+//! time, a sign, a measured height, duration and mean rate, and the paper's ramp-rate
+//! estimator.
 //!
-//! # Grouping rule
+//! # Grouping rule: one transition, one event
 //! 1. A coefficient is *significant* when |w| > z·sd(w) ([`super::Thresholds`]).
 //! 2. A significant coefficient with no significant descendant (a finer wavelet inside its
 //!    support) is a *leaf*: the transient's finest significant localisation. Leaves never
 //!    overlap.
-//! 3. Leaves whose supports touch or overlap form one event, whatever their signs (a brief
-//!    impulse is a rise and a fall in neighbouring wavelets).
-//! 4. A significant non-leaf coefficient joins the event of the leaves below it when they
+//! 3. Leaves whose supports touch, or lie less than two finest wavelets apart, form one
+//!    event, whatever their signs (a brief impulse is a rise and a fall in neighbouring
+//!    wavelets). Two finest wavelets of steady depth between two transitions is the
+//!    resolution at which they are told apart.
+//! 4. Consecutive groups further apart are one event when the depth moves across the gap
+//!    between them: the mean depth of the gap's second half minus its first, from the
+//!    coefficients across scales (the inverse transform, [`super::profile`]), exceeds the
+//!    same z·sd. A slow ramp whose finest coefficients sit near the threshold leaves gaps
+//!    in its leaves, but its depth keeps moving through them (the coarser coefficients
+//!    carry it); two transitions with steady depth between them stay two.
+//! 5. A significant non-leaf coefficient joins the event of the leaves below it when they
 //!    all belong to one event (the same transient seen at a coarser scale); when the
 //!    leaves below it belong to several events it is listed as *spanning* (a coarse view of
 //!    several transients) and joins none.
 //!
-//! An event's time is the span of its leaves ([start, end), centre the midpoint); its
-//! *peak* is its largest |w|, whose scale u′ is the duration scale (wavelets of
-//! T_u′ = T/2^u′) and whose sign gives the direction: w > 0 is a depth *decrease* (the
-//! paper's convention, the first half deeper than the second).
+//! An event's time is the span of its leaves and gaps ([start, end), centre the midpoint);
+//! its *peak* is its largest |w|, whose sign gives the direction: w > 0 is a depth
+//! *decrease* (the paper's convention, the first half deeper than the second).
 //!
-//! # Ramp rate (paper Suppl. S5)
-//! A linear ramp δ(t) = r·t across a whole wavelet gives w = −r·T_u/4, so the rate is
-//! estimated as r̂ = −4·w_{u′,v′}/T_u′. This crate keeps ONE convention: `rate_m_per_s`
-//! is dδ/dt, positive when the depth increases (the target recedes); the paper's
-//! 4·w/(T/2^u′) is its negative. A transient shorter than the wavelet is averaged over it:
-//! a ramp of height h and duration D centred in a wavelet of duration T_u gives
-//! |r̂| = (2h/T_u)·(1 − D/(2T_u)), not h/D ([`super::paper`] shows both).
+//! # Measured height, duration and mean rate ([`super::profile`])
+//! The height is the mean depth after the event minus before it; the duration is
+//! measured at the finest scale's resolution and the mean rate is height / duration. An
+//! event whose duration is not resolved (below one finest wavelet) is a *step*: it gets an
+//! upper bound on its duration and a lower bound on |rate| instead. One convention:
+//! every rate is dδ/dt, positive when the depth increases (the target recedes).
+//!
+//! # The paper's ramp rate (Suppl. S5)
+//! A linear ramp δ(t) = r·t across a whole wavelet gives w = −r·T_u/4, so the paper
+//! estimates the rate as r̂ = −4·w_{u′,v′}/T_u′ at the peak (`paper_rate_m_per_s`, the
+//! negative of the paper's 4·w/(T/2^u′) in this crate's sign). A transient shorter than
+//! the wavelet is averaged over it: a ramp of height h and duration D centred in a wavelet
+//! of duration T_u gives |r̂| = (2h/T_u)·(1 − D/(2T_u)), not h/D ([`super::paper`] shows
+//! both); `peak_wavelet_longer_than_event` says when that is so.
 
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
 use super::analysis::{Coefficient, Scalogram};
 use super::noise::Thresholds;
-use super::{register_count, register_index, support};
+use super::profile::{Profile, Shape};
+use super::{register_count, register_index};
 use crate::error::DspError;
 
 /// Which way the depth moved over an event's peak wavelet.
@@ -61,8 +77,27 @@ pub struct Event {
     pub wavelet_duration_s: f64,
     /// Sign of the peak.
     pub change: DepthChange,
-    /// Ramp-rate estimate dδ/dt = −4·w/T_u′ (m/s; positive = depth increases).
-    pub rate_m_per_s: f64,
+    /// The paper's ramp-rate estimator at the peak, dδ/dt = −4·w/T_u′ (m/s; positive =
+    /// depth increases): the transition averaged over the peak's wavelet, the event's rate
+    /// only for a ramp covering that whole wavelet.
+    pub paper_rate_m_per_s: f64,
+    /// The peak's wavelet is longer than the event (its measured duration, or one finest
+    /// wavelet for a step): the paper's rate is then not the event's.
+    pub peak_wavelet_longer_than_event: bool,
+    /// What the depth profile resolves ([`Shape`]).
+    pub shape: Shape,
+    /// Measured height: mean depth after minus before (mm; absent at the frame's edge).
+    pub height_mm: Option<f64>,
+    /// Its sd under the noise model (mm).
+    pub height_sd_mm: Option<f64>,
+    /// Measured duration of a resolved transition (s; `shape` = ramp).
+    pub duration_s: Option<f64>,
+    /// Measured mean rate dδ/dt = height / duration (m/s; `shape` = ramp).
+    pub mean_rate_m_per_s: Option<f64>,
+    /// A step's duration is below this: one finest wavelet (s; `shape` = step).
+    pub duration_upper_bound_s: Option<f64>,
+    /// A step's |dδ/dt| is above this: |height| / one finest wavelet (m/s; `shape` = step).
+    pub abs_rate_lower_bound_m_per_s: Option<f64>,
     /// Finest and coarsest scale among the event's coefficients.
     pub finest_scale: u32,
     pub coarsest_scale: u32,
@@ -71,10 +106,33 @@ pub struct Event {
 }
 
 impl Event {
-    /// One line of text (times in ms).
+    /// One line of text (times in ms): where, which way, the measured transition (which
+    /// estimator each figure is), and the paper's estimator.
     pub fn text_line(&self) -> String {
+        let measured = match self.shape {
+            Shape::Ramp => format!(
+                "ramp: height {:+.3} ± {:.3} mm over {:.3} ms, measured mean rate dδ/dt = height/duration = {:+.3} m/s",
+                self.height_mm.unwrap_or(f64::NAN),
+                self.height_sd_mm.unwrap_or(f64::NAN),
+                self.duration_s.unwrap_or(f64::NAN) * 1e3,
+                self.mean_rate_m_per_s.unwrap_or(f64::NAN),
+            ),
+            Shape::Step => format!(
+                "step-like (no finite duration resolved): height {:+.3} ± {:.3} mm, duration < {:.3} ms, |dδ/dt| > {:.3} m/s",
+                self.height_mm.unwrap_or(f64::NAN),
+                self.height_sd_mm.unwrap_or(f64::NAN),
+                self.duration_upper_bound_s.unwrap_or(f64::NAN) * 1e3,
+                self.abs_rate_lower_bound_m_per_s.unwrap_or(f64::NAN),
+            ),
+            Shape::Excursion => format!(
+                "excursion: no significant net height ({:+.3} ± {:.3} mm), no rate",
+                self.height_mm.unwrap_or(f64::NAN),
+                self.height_sd_mm.unwrap_or(f64::NAN),
+            ),
+            Shape::Edge => "at the frame's edge: height, duration and rate not measured".into(),
+        };
         format!(
-            "{:.3} ms ({:.3}–{:.3} ms): depth {}, peak w({},{}) = {:+.4} mm ({:.1} sd) at scale {} ({:.3} ms wavelets, scales {}..{}), rate dδ/dt = {:+.3} m/s",
+            "{:.3} ms ({:.3}–{:.3} ms): depth {}; {measured}; peak w({},{}) = {:+.4} mm ({:.1} sd) at scale {} ({:.3} ms wavelets, scales {}..{}), paper's estimator −4w/T_u = {:+.3} m/s{}",
             self.centre_s * 1e3,
             self.start_s * 1e3,
             self.end_s * 1e3,
@@ -90,7 +148,12 @@ impl Event {
             self.wavelet_duration_s * 1e3,
             self.coarsest_scale,
             self.finest_scale,
-            self.rate_m_per_s,
+            self.paper_rate_m_per_s,
+            if self.peak_wavelet_longer_than_event {
+                " (averaged over a wavelet longer than the event: not its rate)"
+            } else {
+                ""
+            },
         )
     }
 }
@@ -161,19 +224,21 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
             below[register_index(u, v)] = sig[a] || sig[b] || below[a] || below[b];
         }
     }
+    let profile = Profile::new(s, &t.sd_mm, n);
+    // Supports in profile cells (half finest wavelets).
     let span = |r: usize| {
         let c = &s.coefficients[r];
-        let (st, _, e) = support(n, c.u, c.v);
-        (st, e)
+        profile.cells_of(c.u, c.v)
     };
     let mut leaves: Vec<usize> = (0..k).filter(|&r| sig[r] && !below[r]).collect();
     leaves.sort_by_key(|&r| span(r).0);
-    // Groups of touching leaves: (first sample, end sample, registers).
+    // Groups of leaves (first cell, end cell, registers): touching leaves (rule 3), and
+    // groups whose gap the depth moves across (rule 4).
     let mut groups: Vec<(usize, usize, Vec<usize>)> = Vec::new();
     for &r in &leaves {
         let (st, e) = span(r);
         match groups.last_mut() {
-            Some(g) if st <= g.1 => {
+            Some(g) if st <= g.1 + 2 || profile.moves_across(g.1, st, t.z) => {
                 g.1 = g.1.max(e);
                 g.2.push(r);
             }
@@ -200,10 +265,12 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
             _ => spanning.push((s.coefficients[r].u, s.coefficients[r].v)),
         }
     }
-    let fs = s.laser_rate_hz;
-    let events = groups
-        .into_iter()
-        .map(|(st, e, mut regs)| {
+    let events = (0..groups.len())
+        .map(|i| {
+            let (st, e) = (groups[i].0, groups[i].1);
+            let prev_end = if i == 0 { 0 } else { groups[i - 1].1 };
+            let next_start = groups.get(i + 1).map_or(profile.len(), |g| g.0);
+            let mut regs = groups[i].2.clone();
             regs.sort_unstable();
             let peak_r = regs
                 .iter()
@@ -218,10 +285,17 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
                 .unwrap_or(regs[0]);
             let peak = s.coefficients[peak_r];
             let d = peak.duration_s();
+            let m = profile.measure(st, e, prev_end, next_start, t.z);
+            let longer = match m.shape {
+                Shape::Ramp => m.duration_s.is_some_and(|x| d > x),
+                // Shorter than one finest wavelet, the shortest there is.
+                Shape::Step => true,
+                Shape::Excursion | Shape::Edge => d > profile.time_s(e) - profile.time_s(st),
+            };
             Event {
-                start_s: st as f64 / fs,
-                end_s: e as f64 / fs,
-                centre_s: 0.5 * (st + e) as f64 / fs,
+                start_s: profile.time_s(st),
+                end_s: profile.time_s(e),
+                centre_s: 0.5 * (profile.time_s(st) + profile.time_s(e)),
                 peak,
                 peak_z: peak.value_mm.abs() / t.sd_mm[peak_r],
                 wavelet_duration_s: d,
@@ -230,7 +304,15 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
                 } else {
                     DepthChange::Increase
                 },
-                rate_m_per_s: -4.0 * peak.value_mm / d * 1e-3,
+                paper_rate_m_per_s: -4.0 * peak.value_mm / d * 1e-3,
+                peak_wavelet_longer_than_event: longer,
+                shape: m.shape,
+                height_mm: m.height_mm,
+                height_sd_mm: m.height_sd_mm,
+                duration_s: m.duration_s,
+                mean_rate_m_per_s: m.mean_rate_m_per_s,
+                duration_upper_bound_s: m.duration_upper_bound_s,
+                abs_rate_lower_bound_m_per_s: m.abs_rate_lower_bound_m_per_s,
                 finest_scale: regs.iter().map(|&r| s.coefficients[r].u).max().unwrap_or(0),
                 coarsest_scale: regs.iter().map(|&r| s.coefficients[r].u).min().unwrap_or(0),
                 coefficients: regs
@@ -273,7 +355,7 @@ mod tests {
         // Finest wavelets are 32 samples: 300 lies in v = 9 (288..320).
         assert_eq!((e.start_s, e.end_s), (288e-7, 320e-7));
         assert_eq!(e.change, DepthChange::Increase);
-        assert!(e.peak.value_mm < 0.0 && e.rate_m_per_s > 0.0);
+        assert!(e.peak.value_mm < 0.0 && e.paper_rate_m_per_s > 0.0);
         assert_eq!((e.coarsest_scale, e.finest_scale), (0, 5));
         assert_eq!(e.coefficients.len(), 6);
         assert!(r.spanning.is_empty());
@@ -311,7 +393,7 @@ mod tests {
         let r = detect_events(&s, &t).unwrap();
         for e in &r.events {
             assert!(
-                (e.rate_m_per_s / rate - 1.0).abs() < 1e-9,
+                (e.paper_rate_m_per_s / rate - 1.0).abs() < 1e-9,
                 "{}",
                 e.text_line()
             );

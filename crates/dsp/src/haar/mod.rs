@@ -28,10 +28,12 @@ pub mod events;
 pub mod montecarlo;
 pub mod noise;
 pub mod paper;
+pub mod profile;
 
 pub use analysis::{Coefficient, Scalogram, held_codes};
 pub use events::{Event, EventReport, detect_events};
 pub use noise::{HaarNoise, Thresholds, inverse_normal_cdf};
+pub use profile::Shape;
 
 use crate::error::DspError;
 

@@ -391,7 +391,7 @@ pub fn fig12(seed: u64) -> Result<TransientFigure, DspError> {
         .events
         .iter()
         .find(|e| e.start_s <= centre && centre < e.end_s)
-        .map(|e| e.rate_m_per_s)
+        .map(|e| e.paper_rate_m_per_s)
         .unwrap_or(f64::NAN);
     // Tolerance of the rate: 5 sd of 4·w/T_5 (sd(w) from the noise model).
     let sd_w5 = t.sd_mm[big.register()];

@@ -1,0 +1,228 @@
+//! The depth profile behind the coefficients, and what it measures about an event: whether
+//! the depth moves across a gap between two groups of significant wavelets, and an event's
+//! height, duration and mean rate.
+//!
+//! # The profile
+//! The 2^(U+1) half-wavelets of the finest scale are the profile's *cells* (duration
+//! τ = T/2^(U+1)). With w = (mean of the first half − mean of the second)/2, a cell's mean
+//! depth relative to the frame's mean is x_c = Σ_u ±w_{u,v(c)} (+ in the first half of the
+//! wavelet holding c, − in the second): the inverse Haar transform, exact for equal halves
+//! (N divisible by 2^(U+1), always so for the pixel's power-of-two frames; otherwise the
+//! halves differ by at most one sample). Every statistic below is linear in the
+//! coefficients, Σ_c b_c x_c = Σ_i a_i w_i, so its sd is √(Σ a_i² sd(w_i)²) under the
+//! noise model's independent coefficients ([`super::Thresholds`]).
+//!
+//! # Height, duration, mean rate
+//! An event spanning cells [S, E) has a level before it, L0 = the mean over up to E − S
+//! cells before S (not reaching the previous event), and after it, L1 likewise; its height
+//! is h = L1 − L0 (mm, positive when the depth increases), from the coarse structure of the
+//! coefficients (a difference of window means). The depth steps between the consecutive
+//! levels L0, x_S, …, x_{E−1}, L1 are a distribution of mass p_j = Δ_j/h (Σp = 1) over the
+//! cell boundaries t_j; its variance is that of the transition's dδ/dt convolved with the
+//! cells' box of width τ, so a linear ramp of duration D gives 12·var = D² + τ², and the
+//! duration is D̂ = √(12·var − τ²) at the resolution of the finest scale. A transition is
+//! *resolved* when D̂ ≥ T_U (one finest wavelet = 2τ: a step inside one cell gives at most
+//! √2·τ); then its mean rate is h/D̂. Otherwise it is *step-like*: its duration is below
+//! one finest wavelet and |rate| above |h|/T_U, and only those bounds are given.
+
+use serde::{Deserialize, Serialize};
+
+use super::analysis::Scalogram;
+use super::support;
+
+/// The cell profile of one scalogram with its noise model.
+pub(crate) struct Profile<'a> {
+    sd_mm: &'a [f64],
+    scales: u32,
+    /// x_c − x̄ per cell (mm).
+    cells: Vec<f64>,
+    /// Cell boundaries (samples), cells + 1 of them.
+    edges: Vec<usize>,
+    fs: f64,
+}
+
+/// What the profile says about an event's transition.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Shape {
+    /// A finite duration is resolved: duration and mean rate are measured.
+    Ramp,
+    /// No finite duration resolved (shorter than one finest wavelet): only an upper bound
+    /// on the duration and a lower bound on |rate|.
+    Step,
+    /// The depth returns: no significant net height (an impulse, a there-and-back).
+    Excursion,
+    /// The event touches the frame's edge: no level on one side, no height.
+    Edge,
+}
+
+/// The measured transition of one event (module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Measured {
+    pub shape: Shape,
+    pub height_mm: Option<f64>,
+    pub height_sd_mm: Option<f64>,
+    pub duration_s: Option<f64>,
+    pub mean_rate_m_per_s: Option<f64>,
+    pub duration_upper_bound_s: Option<f64>,
+    pub abs_rate_lower_bound_m_per_s: Option<f64>,
+}
+
+impl<'a> Profile<'a> {
+    pub(crate) fn new(s: &Scalogram, sd_mm: &'a [f64], n: usize) -> Profile<'a> {
+        let nc = 1usize << (s.scales + 1);
+        let mut cells = vec![0.0; nc];
+        for c in &s.coefficients {
+            let per = nc >> c.u;
+            let st = c.v * per;
+            for (k, x) in cells[st..st + per].iter_mut().enumerate() {
+                *x += if k < per / 2 { c.value_mm } else { -c.value_mm };
+            }
+        }
+        let mut edges = Vec::with_capacity(nc + 1);
+        for v in 0..(1usize << s.scales) {
+            let (a, m, _) = support(n, s.scales, v);
+            edges.push(a);
+            edges.push(m);
+        }
+        edges.push(n);
+        Profile {
+            sd_mm,
+            scales: s.scales,
+            cells,
+            edges,
+            fs: s.laser_rate_hz,
+        }
+    }
+
+    /// Number of cells, 2^(U+1).
+    pub(crate) fn len(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// Time of cell boundary j (s).
+    pub(crate) fn time_s(&self, j: usize) -> f64 {
+        self.edges[j] as f64 / self.fs
+    }
+
+    /// Cells of wavelet (u, v): [first, end).
+    pub(crate) fn cells_of(&self, u: u32, v: usize) -> (usize, usize) {
+        let per = self.len() >> u;
+        (v * per, (v + 1) * per)
+    }
+
+    /// Σ_c b_c x_c and its sd (module doc).
+    fn linear(&self, b: &[f64]) -> (f64, f64) {
+        let value = b.iter().zip(&self.cells).map(|(b, x)| b * x).sum();
+        let mut prefix = Vec::with_capacity(b.len() + 1);
+        prefix.push(0.0);
+        for &x in b {
+            prefix.push(prefix.last().copied().unwrap_or(0.0) + x);
+        }
+        let mut var = 0.0;
+        let mut r = 0;
+        for u in 0..=self.scales {
+            for v in 0..(1usize << u) {
+                let (a, e) = self.cells_of(u, v);
+                let m = (a + e) / 2;
+                let coef = (prefix[m] - prefix[a]) - (prefix[e] - prefix[m]);
+                var += (coef * self.sd_mm[r]).powi(2);
+                r += 1;
+            }
+        }
+        (value, var.sqrt())
+    }
+
+    /// Mean of cells [a, b) as weights.
+    fn window(&self, a: usize, b: usize) -> Vec<f64> {
+        let mut w = vec![0.0; self.len()];
+        let k = (b - a) as f64;
+        for x in &mut w[a..b] {
+            *x = 1.0 / k;
+        }
+        w
+    }
+
+    /// Whether the depth moves across the gap of cells [a, b): the mean of its second half
+    /// minus that of its first exceeds z sd. `false` for gaps under 4 cells (two finest
+    /// wavelets), where the gap's only statistic is a coefficient already found not
+    /// significant.
+    pub(crate) fn moves_across(&self, a: usize, b: usize, z: f64) -> bool {
+        if b < a + 4 {
+            return false;
+        }
+        let h = (b - a) / 2;
+        let mut w = vec![0.0; self.len()];
+        for x in &mut w[a..a + h] {
+            *x = -1.0 / h as f64;
+        }
+        for x in &mut w[b - h..b] {
+            *x = 1.0 / h as f64;
+        }
+        let (d, sd) = self.linear(&w);
+        d.abs() > z * sd
+    }
+
+    /// The transition of the event over cells [s, e), with free cells back to `prev_end`
+    /// and up to `next_start` (module doc); `z` judges the height's significance.
+    pub(crate) fn measure(
+        &self,
+        s: usize,
+        e: usize,
+        prev_end: usize,
+        next_start: usize,
+        z: f64,
+    ) -> Measured {
+        let mut m = Measured {
+            shape: Shape::Edge,
+            height_mm: None,
+            height_sd_mm: None,
+            duration_s: None,
+            mean_rate_m_per_s: None,
+            duration_upper_bound_s: None,
+            abs_rate_lower_bound_m_per_s: None,
+        };
+        let span = e - s;
+        let b0 = prev_end.max(s.saturating_sub(span));
+        let a1 = next_start.min(e + span);
+        if b0 >= s || a1 <= e {
+            return m;
+        }
+        let before = self.window(b0, s);
+        let after = self.window(e, a1);
+        let diff: Vec<f64> = after.iter().zip(&before).map(|(a, b)| a - b).collect();
+        let (h, sd_h) = self.linear(&diff);
+        m.height_mm = Some(h);
+        m.height_sd_mm = Some(sd_h);
+        if h.abs() <= z * sd_h {
+            m.shape = Shape::Excursion;
+            return m;
+        }
+        let l0 = self.linear(&before).0;
+        let l1 = self.linear(&after).0;
+        // Levels L0, x_s..x_{e−1}, L1 and the boundaries s..=e between them.
+        let mut prev = l0;
+        let mut mass = Vec::with_capacity(span + 1);
+        for j in s..=e {
+            let y = if j < e { self.cells[j] } else { l1 };
+            mass.push((self.time_s(j), (y - prev) / h));
+            prev = y;
+        }
+        let mean: f64 = mass.iter().map(|(t, p)| t * p).sum();
+        let var: f64 = mass.iter().map(|(t, p)| (t - mean).powi(2) * p).sum();
+        let tau = (self.time_s(e) - self.time_s(s)) / span as f64;
+        let finest = 2.0 * tau;
+        let d2 = 12.0 * var - tau * tau;
+        if d2 >= finest * finest {
+            let d = d2.sqrt();
+            m.shape = Shape::Ramp;
+            m.duration_s = Some(d);
+            m.mean_rate_m_per_s = Some(h / d * 1e-3);
+        } else {
+            m.shape = Shape::Step;
+            m.duration_upper_bound_s = Some(finest);
+            m.abs_rate_lower_bound_m_per_s = Some(h.abs() / finest * 1e-3);
+        }
+        m
+    }
+}
