@@ -5,3 +5,4 @@
 mod levels;
 mod scalogram_figures;
 mod simulation;
+mod transients;

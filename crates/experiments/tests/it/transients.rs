@@ -1,0 +1,131 @@
+//! Haar events through the library (issue 32): one transition is one event whatever the
+//! seed (a slow ramp whose finest coefficients sit near the threshold, a step, an impulse),
+//! two steps with steady depth between them stay two, and the measured duration and mean
+//! rate are those of ramps of known slope, while steps get bounds only.
+
+use tofprobe_design::{Document, ProbeCache, ResolvedDesign, resolve_with};
+use tofprobe_dsp::haar::{Event, Shape};
+use tofprobe_experiments::transients::bit_true_haar;
+
+const SLOW_RAMP: &str = include_str!("../../../../scenes/slow-ramp.toml");
+/// Finest wavelet at U = 6 of 2^19 pulses at 10 MHz (s).
+const T6: f64 = 524288.0 / 10e6 / 64.0;
+const SEEDS: std::ops::RangeInclusive<u64> = 1..=10;
+
+/// The slow-ramp scene with its motion replaced by `motions` (TOML) and seed `seed`.
+fn design(motions: &str, seed: u64) -> ResolvedDesign {
+    let head = SLOW_RAMP.split("[[scene.motion]]").next().expect("head");
+    let tail = SLOW_RAMP.split("[acquisition]").nth(1).expect("tail");
+    let text = format!("{head}{motions}\n[acquisition]{tail}")
+        .replacen("seed = 1", &format!("seed = {seed}"), 1);
+    let doc = Document::from_toml_str(&text, "scene.toml").expect("parses");
+    resolve_with(doc, "scene.toml", &mut ProbeCache::default()).expect("resolves")
+}
+
+fn ramp(start_s: f64, duration_s: f64, height_mm: f64) -> String {
+    format!(
+        "[[scene.motion]]\nkind = \"ramp\"\nstart_s = {start_s:e}\nduration_s = {duration_s:e}\nheight_mm = {height_mm}\n"
+    )
+}
+
+fn step(at_s: f64, height_mm: f64) -> String {
+    format!("[[scene.motion]]\nkind = \"step\"\nat_s = {at_s:e}\nheight_mm = {height_mm}\n")
+}
+
+fn events(motions: &str, seed: u64) -> (Vec<Event>, String) {
+    let (a, _) = bit_true_haar(&design(motions, seed)).expect("simulates");
+    (a.events.events.clone(), a.events.text())
+}
+
+/// The issue's ramp (−6 mm over 8 ms, ρ_s = 1, 2^19 pulses, U = 6): one event for every
+/// seed, a resolved ramp whose measured mean rate is −0.75 m/s within 20 % and duration
+/// 8 ms within 20 %, the height −6 mm within 5 sd. The paper's −4w/T_u is not that rate.
+#[test]
+fn a_slow_ramp_is_one_event_with_its_rate_for_every_seed() {
+    for seed in SEEDS {
+        let (ev, text) = events(&ramp(20.3e-3, 8e-3, -6.0), seed);
+        assert_eq!(ev.len(), 1, "seed {seed}:\n{text}");
+        let e = &ev[0];
+        assert_eq!(e.shape, Shape::Ramp, "seed {seed}:\n{text}");
+        let rate = e.mean_rate_m_per_s.expect("a ramp's rate");
+        assert!((rate / -0.75 - 1.0).abs() < 0.2, "seed {seed}:\n{text}");
+        let d = e.duration_s.expect("a ramp's duration");
+        assert!((d / 8e-3 - 1.0).abs() < 0.2, "seed {seed}:\n{text}");
+        let (h, sd) = (e.height_mm.unwrap(), e.height_sd_mm.unwrap());
+        assert!((h + 6.0).abs() < 5.0 * sd + 0.05, "seed {seed}:\n{text}");
+        assert!(text.contains("measured mean rate"), "{text}");
+    }
+}
+
+/// A 10 mm step, and a 3 mm impulse of 100 µs: one event each for every seed. The step is
+/// step-like (no duration resolved): its duration is bounded by one finest wavelet, its
+/// |rate| from below by |h|/T_6, its height is +10 mm within 5 sd, and the paper's
+/// estimator is flagged as averaged over a longer wavelet. The impulse has no net height.
+#[test]
+fn a_step_and_an_impulse_are_one_event_each_for_every_seed() {
+    let impulse = "[[scene.motion]]\nkind = \"impulse\"\nstart_s = 30.1e-3\nwidth_s = 1.0e-4\nheight_mm = 3.0\n";
+    for seed in SEEDS {
+        let (ev, text) = events(&step(23.3e-3, 10.0), seed);
+        assert_eq!(ev.len(), 1, "seed {seed}:\n{text}");
+        let e = &ev[0];
+        assert_eq!(e.shape, Shape::Step, "seed {seed}:\n{text}");
+        assert!(e.start_s <= 23.3e-3 && 23.3e-3 < e.end_s, "{text}");
+        assert!((e.duration_upper_bound_s.unwrap() / T6 - 1.0).abs() < 1e-12);
+        let (h, sd) = (e.height_mm.unwrap(), e.height_sd_mm.unwrap());
+        assert!((h - 10.0).abs() < 5.0 * sd + 0.05, "seed {seed}:\n{text}");
+        let lb = e.abs_rate_lower_bound_m_per_s.unwrap();
+        assert!((lb - h / T6 * 1e-3).abs() < 1e-12, "{text}");
+        assert!(e.duration_s.is_none() && e.mean_rate_m_per_s.is_none());
+        assert!(e.peak_wavelet_longer_than_event, "{text}");
+        assert!(text.contains("step-like") && text.contains("not its rate"), "{text}");
+
+        let (ev, text) = events(impulse, seed);
+        assert_eq!(ev.len(), 1, "seed {seed}:\n{text}");
+        assert_eq!(ev[0].shape, Shape::Excursion, "seed {seed}:\n{text}");
+        assert!(ev[0].mean_rate_m_per_s.is_none(), "{text}");
+    }
+}
+
+/// Two steps 4.6 ms apart (steady depth between them) stay two events for every seed,
+/// whether they return (+3, −3 mm) or climb (+3, +3 mm), each a step of its own height.
+#[test]
+fn two_steps_a_few_ms_apart_stay_two_for_every_seed() {
+    for second in [-3.0, 3.0] {
+        let m = format!("{}{}", step(15.3e-3, 3.0), step(19.9e-3, second));
+        for seed in SEEDS {
+            let (ev, text) = events(&m, seed);
+            assert_eq!(ev.len(), 2, "seed {seed}, second {second}:\n{text}");
+            for (e, (at, h)) in ev.iter().zip([(15.3e-3, 3.0), (19.9e-3, second)]) {
+                assert!(e.start_s <= at && at < e.end_s, "{text}");
+                assert_eq!(e.shape, Shape::Step, "{text}");
+                let (hm, sd) = (e.height_mm.unwrap(), e.height_sd_mm.unwrap());
+                assert!((hm - h).abs() < 5.0 * sd + 0.05, "{text}");
+            }
+        }
+    }
+}
+
+/// Ramps of known slope spanning ≥ 2 finest wavelets (1.7 to 20 ms, both directions):
+/// the measured mean rate is within 20 % of height/duration; a ramp shorter than one
+/// finest wavelet (0.4 ms) is step-like, with bounds that hold (D < T_6, |r| > bound).
+#[test]
+fn ramps_of_known_slope_give_their_rate_and_short_ones_are_steps() {
+    for (i, (dur, h)) in [(1.7e-3, 4.0), (3e-3, -5.0), (8e-3, 6.0), (20e-3, -10.0)]
+        .into_iter()
+        .enumerate()
+    {
+        let (ev, text) = events(&ramp(10.3e-3, dur, h), 3 + i as u64);
+        assert_eq!(ev.len(), 1, "{dur} s:\n{text}");
+        let e = &ev[0];
+        assert_eq!(e.shape, Shape::Ramp, "{dur} s:\n{text}");
+        let truth = h / dur * 1e-3;
+        let rate = e.mean_rate_m_per_s.unwrap();
+        assert!((rate / truth - 1.0).abs() < 0.2, "{truth} m/s:\n{text}");
+    }
+    let (ev, text) = events(&ramp(10.3e-3, 4e-4, 5.0), 7);
+    assert_eq!(ev.len(), 1, "{text}");
+    let e = &ev[0];
+    assert_eq!(e.shape, Shape::Step, "{text}");
+    assert!(4e-4 < e.duration_upper_bound_s.unwrap());
+    assert!(5.0 / 4e-4 * 1e-3 > e.abs_rate_lower_bound_m_per_s.unwrap(), "{text}");
+}
