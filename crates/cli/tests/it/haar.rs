@@ -74,13 +74,75 @@ fn simulate_fig12_prints_the_step_event_with_its_rate() {
         .expect("centre");
     assert!((centre - 17.2032).abs() <= 0.8192, "{line}");
     let rate: f64 = line
-        .split("dδ/dt = ")
+        .split("paper's estimator −4w/T_u = ")
         .nth(1)
         .and_then(|s| s.split(" m/s").next())
         .and_then(|s| s.trim().parse().ok())
         .expect("rate");
     assert!((rate - 26.79).abs() < 0.29, "{line}");
     assert!(line.contains("peak w(5,10) = -"), "{line}");
+    // The 0.4 ms ramp is shorter than a finest wavelet (0.819 ms): step-like, with bounds,
+    // and the paper's figure flagged as averaged over a longer wavelet.
+    assert!(
+        line.contains("step-like (no finite duration resolved)"),
+        "{line}"
+    );
+    assert!(line.contains("duration < 0.819 ms"), "{line}");
+    assert!(line.contains("not its rate"), "{line}");
+}
+
+const SLOW_RAMP: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/slow-ramp.toml");
+
+/// Issue 32 through the binary: the slow ramp (−6 mm over 8 ms, ρ_s = 1, 2^19 pulses,
+/// U = 6) is one event, in text and in `--json`, a resolved ramp whose measured mean rate
+/// is −0.75 m/s within 20 % and duration 8 ms within 20 %; the paper's estimator sits
+/// under its own key, and every number's key names its unit.
+#[test]
+fn simulate_a_slow_ramp_reports_one_event_with_its_measured_rate() {
+    let o = tofprobe(&["simulate", SLOW_RAMP]);
+    let text = stdout(&o);
+    assert!(o.status.success(), "{text}{}", stderr(&o));
+    assert!(text.contains("1 event(s)"), "{text}");
+    assert!(
+        text.contains("event 1:") && !text.contains("event 2:"),
+        "{text}"
+    );
+    let line = text.lines().find(|l| l.contains("event 1:")).unwrap();
+    let rate: f64 = line
+        .split("height/duration = ")
+        .nth(1)
+        .and_then(|s| s.split(" m/s").next())
+        .and_then(|s| s.trim().parse().ok())
+        .expect("the measured rate");
+    assert!((rate / -0.75 - 1.0).abs() < 0.2, "{line}");
+
+    let o = tofprobe(&["simulate", SLOW_RAMP, "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    let ev = v["haar"]["events"]["events"].as_array().expect("events");
+    assert_eq!(ev.len(), 1, "{}", v["haar"]["events"]);
+    let e = &ev[0];
+    assert_eq!(e["shape"], "ramp");
+    let r = e["mean_rate_m_per_s"].as_f64().expect("measured rate");
+    assert!((r / -0.75 - 1.0).abs() < 0.2, "{e}");
+    let d = e["duration_s"].as_f64().expect("measured duration");
+    assert!((d / 8e-3 - 1.0).abs() < 0.2, "{e}");
+    assert!(e["height_mm"].as_f64().unwrap() < -5.0, "{e}");
+    assert!(e["paper_rate_m_per_s"].as_f64().is_some(), "{e}");
+    assert!(e.get("rate_m_per_s").is_none(), "{e}");
+    assert!(e["duration_upper_bound_s"].is_null() && e["abs_rate_lower_bound_m_per_s"].is_null());
+    // Fig. 12's 0.4 ms ramp is step-like in JSON too: bounds, no measured rate.
+    let o = tofprobe(&["simulate", SCENE, "--json"]);
+    let v: Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    let e = &v["haar"]["events"]["events"][0];
+    assert_eq!(e["shape"], "step", "{e}");
+    assert!(e["mean_rate_m_per_s"].is_null(), "{e}");
+    assert_eq!(e["peak_wavelet_longer_than_event"], true, "{e}");
+    let lb = e["abs_rate_lower_bound_m_per_s"]
+        .as_f64()
+        .expect("a lower bound");
+    // |h|/T_6 = 25 mm / 0.8192 ms = 30.5 m/s: below the true 62.5 m/s, as a bound must be.
+    assert!(lb > 25.0 && lb < 62.5, "{e}");
 }
 
 #[test]

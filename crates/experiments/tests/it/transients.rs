@@ -16,8 +16,11 @@ const SEEDS: std::ops::RangeInclusive<u64> = 1..=10;
 fn design(motions: &str, seed: u64) -> ResolvedDesign {
     let head = SLOW_RAMP.split("[[scene.motion]]").next().expect("head");
     let tail = SLOW_RAMP.split("[acquisition]").nth(1).expect("tail");
-    let text = format!("{head}{motions}\n[acquisition]{tail}")
-        .replacen("seed = 1", &format!("seed = {seed}"), 1);
+    let text = format!("{head}{motions}\n[acquisition]{tail}").replacen(
+        "seed = 1",
+        &format!("seed = {seed}"),
+        1,
+    );
     let doc = Document::from_toml_str(&text, "scene.toml").expect("parses");
     resolve_with(doc, "scene.toml", &mut ProbeCache::default()).expect("resolves")
 }
@@ -77,7 +80,10 @@ fn a_step_and_an_impulse_are_one_event_each_for_every_seed() {
         assert!((lb - h / T6 * 1e-3).abs() < 1e-12, "{text}");
         assert!(e.duration_s.is_none() && e.mean_rate_m_per_s.is_none());
         assert!(e.peak_wavelet_longer_than_event, "{text}");
-        assert!(text.contains("step-like") && text.contains("not its rate"), "{text}");
+        assert!(
+            text.contains("step-like") && text.contains("not its rate"),
+            "{text}"
+        );
 
         let (ev, text) = events(impulse, seed);
         assert_eq!(ev.len(), 1, "seed {seed}:\n{text}");
@@ -127,5 +133,8 @@ fn ramps_of_known_slope_give_their_rate_and_short_ones_are_steps() {
     let e = &ev[0];
     assert_eq!(e.shape, Shape::Step, "{text}");
     assert!(4e-4 < e.duration_upper_bound_s.unwrap());
-    assert!(5.0 / 4e-4 * 1e-3 > e.abs_rate_lower_bound_m_per_s.unwrap(), "{text}");
+    assert!(
+        5.0 / 4e-4 * 1e-3 > e.abs_rate_lower_bound_m_per_s.unwrap(),
+        "{text}"
+    );
 }
