@@ -226,3 +226,51 @@ impl<'a> Profile<'a> {
         m
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Noiseless frames of 4096 samples, U = 5 (64 cells of 64 samples, τ = 64 samples).
+    fn profile_of(depth: impl Fn(usize) -> f64) -> (Scalogram, Vec<f64>) {
+        let x: Vec<f64> = (0..4096).map(depth).collect();
+        (
+            Scalogram::from_depths_mm(&x, 5, 1.0).unwrap(),
+            vec![0.01; 63],
+        )
+    }
+
+    /// The inverse transform gives the cells' means; a linear ramp over 16 cells (1024
+    /// samples) measures D = 1024 samples (cell-aligned: the box correction is exact to
+    /// the discretisation, 1 %) and h = 3 mm; a step inside a cell is step-like; a flat gap
+    /// does not move, the ramp's does.
+    #[test]
+    fn ramp_step_and_gap_from_the_profile() {
+        let ramp = |i: usize| 3.0 * ((i as f64 - 1024.0) / 1024.0).clamp(0.0, 1.0);
+        let (s, sd) = profile_of(ramp);
+        let p = Profile::new(&s, &sd, 4096);
+        let mean = (0..4096).map(ramp).sum::<f64>() / 4096.0;
+        for c in [0, 20, 40, 63] {
+            let truth = (c * 64..(c + 1) * 64).map(ramp).sum::<f64>() / 64.0 - mean;
+            assert!((p.cells[c] - truth).abs() < 1e-9, "cell {c}");
+        }
+        let m = p.measure(16, 32, 0, 64, 3.0);
+        assert_eq!(m.shape, Shape::Ramp);
+        assert!((m.height_mm.unwrap() - 3.0).abs() < 1e-9);
+        assert!((m.duration_s.unwrap() / 1024.0 - 1.0).abs() < 0.01, "{m:?}");
+        assert!((m.mean_rate_m_per_s.unwrap() / (3.0 / 1024.0 * 1e-3) - 1.0).abs() < 0.01);
+        assert!(p.moves_across(20, 28, 3.0) && !p.moves_across(40, 48, 3.0));
+        // A gap under two finest wavelets is never judged here.
+        assert!(!p.moves_across(20, 22, 3.0));
+
+        let (s, sd) = profile_of(|i| if i >= 1000 { -2.0 } else { 0.0 });
+        let p = Profile::new(&s, &sd, 4096);
+        let m = p.measure(14, 16, 0, 64, 3.0);
+        assert_eq!(m.shape, Shape::Step, "{m:?}");
+        assert!((m.height_mm.unwrap() + 2.0).abs() < 1e-9);
+        assert_eq!(m.duration_upper_bound_s, Some(128.0));
+        assert!((m.abs_rate_lower_bound_m_per_s.unwrap() - 2.0 / 128.0 * 1e-3).abs() < 1e-15);
+        // At the frame's edge there is no level before: no height.
+        assert_eq!(p.measure(0, 16, 0, 64, 3.0).shape, Shape::Edge);
+    }
+}
