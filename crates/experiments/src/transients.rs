@@ -2,12 +2,13 @@
 //! trade-off): the pixel's registers (transaction model, cycle model or RTL readout — they
 //! are equal, crates/pixel/tests/equivalence.rs and the co-simulation) → normalised
 //! coefficients in mm (the scalogram) → per-scale thresholds from the closed-form noise of
-//! the scene's static depth at a stated family-wise false-alarm rate → events (time, span,
-//! duration scale, sign, ramp rate).
+//! the scene's static depth at a stated family-wise false-alarm rate → events (one per
+//! transition: time, span, sign, the measured height, duration and mean rate — or a step's
+//! bounds — and the paper's ramp-rate estimator, labelled as the paper's).
 //!
 //! Sign convention (the paper's): w > 0 when the depth is larger in the wavelet's first
-//! half, i.e. a depth *decrease* gives a positive coefficient. The ramp rate is dδ/dt in
-//! m/s, positive when the depth increases (`tofprobe_dsp::haar::events`).
+//! half, i.e. a depth *decrease* gives a positive coefficient. Every rate is dδ/dt in m/s,
+//! positive when the depth increases (`tofprobe_dsp::haar::events`).
 
 use std::fmt::Write as _;
 use std::time::Instant;

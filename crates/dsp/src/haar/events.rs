@@ -92,11 +92,17 @@ pub struct Event {
     pub height_sd_mm: Option<f64>,
     /// Measured duration of a resolved transition (s; `shape` = ramp).
     pub duration_s: Option<f64>,
+    /// Its sd under the noise model (s, delta method).
+    pub duration_sd_s: Option<f64>,
     /// Measured mean rate dδ/dt = height / duration (m/s; `shape` = ramp).
     pub mean_rate_m_per_s: Option<f64>,
-    /// A step's duration is below this: one finest wavelet (s; `shape` = step).
+    /// Its sd under the noise model (m/s, delta method).
+    pub mean_rate_sd_m_per_s: Option<f64>,
+    /// A step's duration is below this: one finest wavelet, or more when the noise
+    /// allows a longer one (s; `shape` = step).
     pub duration_upper_bound_s: Option<f64>,
-    /// A step's |dδ/dt| is above this: |height| / one finest wavelet (m/s; `shape` = step).
+    /// A step's |dδ/dt| is above this: |height| / the duration's bound (m/s; `shape` =
+    /// step).
     pub abs_rate_lower_bound_m_per_s: Option<f64>,
     /// Finest and coarsest scale among the event's coefficients.
     pub finest_scale: u32,
@@ -111,11 +117,13 @@ impl Event {
     pub fn text_line(&self) -> String {
         let measured = match self.shape {
             Shape::Ramp => format!(
-                "ramp: height {:+.3} ± {:.3} mm over {:.3} ms, measured mean rate dδ/dt = height/duration = {:+.3} m/s",
+                "ramp: height {:+.3} ± {:.3} mm over {:.3} ± {:.3} ms, measured mean rate dδ/dt = height/duration = {:+.3} ± {:.3} m/s",
                 self.height_mm.unwrap_or(f64::NAN),
                 self.height_sd_mm.unwrap_or(f64::NAN),
                 self.duration_s.unwrap_or(f64::NAN) * 1e3,
+                self.duration_sd_s.unwrap_or(f64::NAN) * 1e3,
                 self.mean_rate_m_per_s.unwrap_or(f64::NAN),
+                self.mean_rate_sd_m_per_s.unwrap_or(f64::NAN),
             ),
             Shape::Step => format!(
                 "step-like (no finite duration resolved): height {:+.3} ± {:.3} mm, duration < {:.3} ms, |dδ/dt| > {:.3} m/s",
@@ -288,7 +296,7 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
             let m = profile.measure(st, e, prev_end, next_start, t.z);
             let longer = match m.shape {
                 Shape::Ramp => m.duration_s.is_some_and(|x| d > x),
-                // Shorter than one finest wavelet, the shortest there is.
+                // Not resolved by the finest wavelets: every wavelet is longer.
                 Shape::Step => true,
                 Shape::Excursion | Shape::Edge => d > profile.time_s(e) - profile.time_s(st),
             };
@@ -311,6 +319,8 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
                 height_sd_mm: m.height_sd_mm,
                 duration_s: m.duration_s,
                 mean_rate_m_per_s: m.mean_rate_m_per_s,
+                duration_sd_s: m.duration_sd_s,
+                mean_rate_sd_m_per_s: m.mean_rate_sd_m_per_s,
                 duration_upper_bound_s: m.duration_upper_bound_s,
                 abs_rate_lower_bound_m_per_s: m.abs_rate_lower_bound_m_per_s,
                 finest_scale: regs.iter().map(|&r| s.coefficients[r].u).max().unwrap_or(0),

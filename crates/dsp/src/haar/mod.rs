@@ -17,8 +17,9 @@
 //! The transient analysis built on them lives in the submodules: [`analysis`] turns the
 //! pixel's Haar registers into typed coefficients in mm (the scalogram), [`noise`] gives
 //! each coefficient's noise in closed form and the detection thresholds, [`events`] turns
-//! the coefficients that stand out of the noise into events with a ramp-rate estimate,
-//! [`checks`] validates Haar frames and notes transients outside them, [`montecarlo`]
+//! the coefficients that stand out of the noise into events (one per transition, grouped
+//! across scales), [`profile`] measures an event's height, duration and mean rate from the
+//! inverse transform (the paper's ramp-rate estimate beside them), [`checks`] validates Haar frames and notes transients outside them, [`montecarlo`]
 //! checks the noise model by simulation, and [`paper`] computes the paper's Fig. 3 and
 //! Fig. 12 results.
 

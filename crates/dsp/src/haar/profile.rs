@@ -13,7 +13,9 @@
 //! noise model's independent coefficients ([`super::Thresholds`]).
 //!
 //! # Height, duration, mean rate
-//! An event spanning cells [S, E) has a level before it, L0 = the mean over up to E − S
+//! An event spanning cells [S, E), widened by one finest wavelet each side (a transition's
+//! faint ends may fall short of the threshold) without reaching its neighbours, has a level
+//! before it, L0 = the mean over up to E − S
 //! cells before S (not reaching the previous event), and after it, L1 likewise; its height
 //! is h = L1 − L0 (mm, positive when the depth increases), from the coarse structure of the
 //! coefficients (a difference of window means). The depth steps between the consecutive
@@ -21,14 +23,23 @@
 //! cell boundaries t_j; its variance is that of the transition's dδ/dt convolved with the
 //! cells' box of width τ, so a linear ramp of duration D gives 12·var = D² + τ², and the
 //! duration is D̂ = √(12·var − τ²) at the resolution of the finest scale. A transition is
-//! *resolved* when D̂ ≥ T_U (one finest wavelet = 2τ: a step inside one cell gives at most
-//! √2·τ); then its mean rate is h/D̂. Otherwise it is *step-like*: its duration is below
-//! one finest wavelet and |rate| above |h|/T_U, and only those bounds are given.
+//! *resolved* when D̂² exceeds T_U² (one finest wavelet = 2τ: a noiseless step inside one
+//! cell gives at most 2τ²) by 2 sd of D̂²; then its mean rate is h/D̂. Otherwise it is
+//! *step-like*: its duration is below the bound √max(T_U², D̂² + 2 sd) and |rate| above
+//! |h| over that bound, and only those bounds are given. The sd of D̂² and of h/D̂ are the
+//! delta method's (their gradients over the cells, through the same linear noise).
 
 use serde::{Deserialize, Serialize};
 
 use super::analysis::Scalogram;
 use super::support;
+
+/// Cells (one finest wavelet) added to each side of an event's span for its measurement.
+const GUARD: usize = 2;
+
+/// A duration is resolved when D̂² exceeds T_U² by this many sd of D̂²; a step's upper
+/// bound is √max(T_U², D̂² + this · sd).
+const RESOLVED_Z: f64 = 2.0;
 
 /// The cell profile of one scalogram with its noise model.
 pub(crate) struct Profile<'a> {
@@ -63,7 +74,9 @@ pub(crate) struct Measured {
     pub height_mm: Option<f64>,
     pub height_sd_mm: Option<f64>,
     pub duration_s: Option<f64>,
+    pub duration_sd_s: Option<f64>,
     pub mean_rate_m_per_s: Option<f64>,
+    pub mean_rate_sd_m_per_s: Option<f64>,
     pub duration_upper_bound_s: Option<f64>,
     pub abs_rate_lower_bound_m_per_s: Option<f64>,
 }
@@ -133,6 +146,26 @@ impl<'a> Profile<'a> {
         (value, var.sqrt())
     }
 
+    /// 12·var − τ² of the depth steps over cells [s, e) of profile `x` (module doc), the
+    /// levels from the windows [b0, s) and [e, a1).
+    fn duration_squared(&self, x: &[f64], s: usize, e: usize, (b0, a1): (usize, usize)) -> f64 {
+        let mean_of = |a: usize, b: usize| x[a..b].iter().sum::<f64>() / (b - a) as f64;
+        let (l0, l1) = (mean_of(b0, s), mean_of(e, a1));
+        let h = l1 - l0;
+        // Levels L0, x_s..x_{e−1}, L1 and the boundaries s..=e between them.
+        let mut prev = l0;
+        let mut mass = Vec::with_capacity(e - s + 1);
+        for j in s..=e {
+            let y = if j < e { x[j] } else { l1 };
+            mass.push((self.time_s(j), (y - prev) / h));
+            prev = y;
+        }
+        let mean: f64 = mass.iter().map(|(t, p)| t * p).sum();
+        let var: f64 = mass.iter().map(|(t, p)| (t - mean).powi(2) * p).sum();
+        let tau = (self.time_s(e) - self.time_s(s)) / (e - s) as f64;
+        12.0 * var - tau * tau
+    }
+
     /// Mean of cells [a, b) as weights.
     fn window(&self, a: usize, b: usize) -> Vec<f64> {
         let mut w = vec![0.0; self.len()];
@@ -178,10 +211,16 @@ impl<'a> Profile<'a> {
             height_mm: None,
             height_sd_mm: None,
             duration_s: None,
+            duration_sd_s: None,
             mean_rate_m_per_s: None,
+            mean_rate_sd_m_per_s: None,
             duration_upper_bound_s: None,
             abs_rate_lower_bound_m_per_s: None,
         };
+        // A guard of one finest wavelet each side: a transition's faint ends (a ramp's end
+        // inside a finest wavelet) may fall short of the threshold, outside the leaves.
+        let s = s.saturating_sub(GUARD).max(prev_end);
+        let e = (e + GUARD).min(next_start);
         let span = e - s;
         let b0 = prev_end.max(s.saturating_sub(span));
         let a1 = next_start.min(e + span);
@@ -198,30 +237,41 @@ impl<'a> Profile<'a> {
             m.shape = Shape::Excursion;
             return m;
         }
-        let l0 = self.linear(&before).0;
-        let l1 = self.linear(&after).0;
-        // Levels L0, x_s..x_{e−1}, L1 and the boundaries s..=e between them.
-        let mut prev = l0;
-        let mut mass = Vec::with_capacity(span + 1);
-        for j in s..=e {
-            let y = if j < e { self.cells[j] } else { l1 };
-            mass.push((self.time_s(j), (y - prev) / h));
-            prev = y;
-        }
-        let mean: f64 = mass.iter().map(|(t, p)| t * p).sum();
-        let var: f64 = mass.iter().map(|(t, p)| (t - mean).powi(2) * p).sum();
+        let d2 = self.duration_squared(&self.cells, s, e, (b0, a1));
         let tau = (self.time_s(e) - self.time_s(s)) / span as f64;
         let finest = 2.0 * tau;
-        let d2 = 12.0 * var - tau * tau;
-        if d2 >= finest * finest {
-            let d = d2.sqrt();
+        // sd of D̂² and of h/D̂ by the delta method: their gradients over the cells
+        // (finite differences; D̂² is smooth in the cells, h/D̂ where D̂ > 0).
+        let d = d2.max(0.0).sqrt();
+        let eps = 1e-6 * sd_h.max(1e-12);
+        let mut x = self.cells.clone();
+        let mut g2 = vec![0.0; self.len()];
+        let mut gr = vec![0.0; self.len()];
+        let h_of = |x: &[f64]| {
+            let l = |w: &[f64]| w.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+            l(&after) - l(&before)
+        };
+        for c in b0..a1 {
+            x[c] += eps;
+            let dc2 = self.duration_squared(&x, s, e, (b0, a1));
+            g2[c] = (dc2 - d2) / eps;
+            if d > 0.0 {
+                gr[c] = (h_of(&x) / dc2.max(0.0).sqrt() - h / d) / eps * 1e-3;
+            }
+            x[c] = self.cells[c];
+        }
+        let sd2 = self.linear(&g2).1;
+        if d2 - RESOLVED_Z * sd2 >= finest * finest {
             m.shape = Shape::Ramp;
             m.duration_s = Some(d);
+            m.duration_sd_s = Some(sd2 / (2.0 * d));
             m.mean_rate_m_per_s = Some(h / d * 1e-3);
+            m.mean_rate_sd_m_per_s = Some(self.linear(&gr).1);
         } else {
+            let bound = (d2 + RESOLVED_Z * sd2).max(finest * finest).sqrt();
             m.shape = Shape::Step;
-            m.duration_upper_bound_s = Some(finest);
-            m.abs_rate_lower_bound_m_per_s = Some(h.abs() / finest * 1e-3);
+            m.duration_upper_bound_s = Some(bound);
+            m.abs_rate_lower_bound_m_per_s = Some(h.abs() / bound * 1e-3);
         }
         m
     }
@@ -263,13 +313,25 @@ mod tests {
         // A gap under two finest wavelets is never judged here.
         assert!(!p.moves_across(20, 22, 3.0));
 
-        let (s, sd) = profile_of(|i| if i >= 1000 { -2.0 } else { 0.0 });
+        // A step with (almost) no noise: the bound is one finest wavelet.
+        let (s, _) = profile_of(|i| if i >= 1000 { -2.0 } else { 0.0 });
+        let sd = vec![1e-9; 63];
         let p = Profile::new(&s, &sd, 4096);
         let m = p.measure(14, 16, 0, 64, 3.0);
         assert_eq!(m.shape, Shape::Step, "{m:?}");
         assert!((m.height_mm.unwrap() + 2.0).abs() < 1e-9);
         assert_eq!(m.duration_upper_bound_s, Some(128.0));
         assert!((m.abs_rate_lower_bound_m_per_s.unwrap() - 2.0 / 128.0 * 1e-3).abs() < 1e-15);
+        // With noise the bound widens, and the rate's bound follows it.
+        let noisy = vec![0.01; 63];
+        let q = Profile::new(&s, &noisy, 4096);
+        let m = q.measure(14, 16, 0, 64, 3.0);
+        let ub = m.duration_upper_bound_s.unwrap();
+        assert!(
+            m.shape == Shape::Step && (128.0..256.0).contains(&ub),
+            "{m:?}"
+        );
+        assert!((m.abs_rate_lower_bound_m_per_s.unwrap() - 2.0 / ub * 1e-3).abs() < 1e-15);
         // At the frame's edge there is no level before: no height.
         assert_eq!(p.measure(0, 16, 0, 64, 3.0).shape, Shape::Edge);
     }

@@ -42,9 +42,13 @@ fn events(motions: &str, seed: u64) -> (Vec<Event>, String) {
 
 /// The ramp (−6 mm over 8 ms, ρ_s = 1, 2^19 pulses, U = 6): one event for every
 /// seed, a resolved ramp whose measured mean rate is −0.75 m/s within 20 % and duration
-/// 8 ms within 20 %, the height −6 mm within 5 sd. The paper's −4w/T_u is not that rate.
+/// 8 ms within 20 %, the height −6 mm within 5 sd. The rate's stated sd (delta method)
+/// is the spread over the seeds: the sample sd of 10 draws lies within [0.4, 2] of it
+/// (χ²₉ puts 99.8 % of the ratio inside).
 #[test]
 fn a_slow_ramp_is_one_event_with_its_rate_for_every_seed() {
+    let mut rates = Vec::new();
+    let mut sds = Vec::new();
     for seed in SEEDS {
         let (ev, text) = events(&ramp(20.3e-3, 8e-3, -6.0), seed);
         assert_eq!(ev.len(), 1, "seed {seed}:\n{text}");
@@ -57,11 +61,22 @@ fn a_slow_ramp_is_one_event_with_its_rate_for_every_seed() {
         let (h, sd) = (e.height_mm.unwrap(), e.height_sd_mm.unwrap());
         assert!((h + 6.0).abs() < 5.0 * sd + 0.05, "seed {seed}:\n{text}");
         assert!(text.contains("measured mean rate"), "{text}");
+        rates.push(rate);
+        sds.push(e.mean_rate_sd_m_per_s.expect("its sd"));
     }
+    let n = rates.len() as f64;
+    let mean = rates.iter().sum::<f64>() / n;
+    let spread = (rates.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let stated = sds.iter().sum::<f64>() / n;
+    assert!(
+        (0.4..2.0).contains(&(spread / stated)),
+        "rates {rates:?}: spread {spread} vs stated {stated}"
+    );
 }
 
 /// A 10 mm step, and a 3 mm impulse of 100 µs: one event each for every seed. The step is
-/// step-like (no duration resolved): its duration is bounded by one finest wavelet, its
+/// step-like (no duration resolved): its duration is bounded by one finest wavelet (or a little more when the
+/// noise allows: below two), its
 /// |rate| from below by |h|/T_6, its height is +10 mm within 5 sd, and the paper's
 /// estimator is flagged as averaged over a longer wavelet. The impulse has no net height.
 #[test]
@@ -73,11 +88,12 @@ fn a_step_and_an_impulse_are_one_event_each_for_every_seed() {
         let e = &ev[0];
         assert_eq!(e.shape, Shape::Step, "seed {seed}:\n{text}");
         assert!(e.start_s <= 23.3e-3 && 23.3e-3 < e.end_s, "{text}");
-        assert!((e.duration_upper_bound_s.unwrap() / T6 - 1.0).abs() < 1e-12);
+        let ub = e.duration_upper_bound_s.unwrap();
+        assert!(ub >= T6 * (1.0 - 1e-12) && ub < 2.0 * T6, "{text}");
         let (h, sd) = (e.height_mm.unwrap(), e.height_sd_mm.unwrap());
         assert!((h - 10.0).abs() < 5.0 * sd + 0.05, "seed {seed}:\n{text}");
         let lb = e.abs_rate_lower_bound_m_per_s.unwrap();
-        assert!((lb - h / T6 * 1e-3).abs() < 1e-12, "{text}");
+        assert!((lb - h / ub * 1e-3).abs() < 1e-12, "{text}");
         assert!(e.duration_s.is_none() && e.mean_rate_m_per_s.is_none());
         assert!(e.peak_wavelet_longer_than_event, "{text}");
         assert!(
