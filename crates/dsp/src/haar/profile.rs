@@ -155,8 +155,8 @@ impl<'a> Profile<'a> {
         // Levels L0, x_s..x_{e−1}, L1 and the boundaries s..=e between them.
         let mut prev = l0;
         let mut mass = Vec::with_capacity(e - s + 1);
-        for j in s..=e {
-            let y = if j < e { x[j] } else { l1 };
+        let levels = x[s..e].iter().copied().chain(std::iter::once(l1));
+        for (j, y) in (s..=e).zip(levels) {
             mass.push((self.time_s(j), (y - prev) / h));
             prev = y;
         }

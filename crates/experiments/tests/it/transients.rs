@@ -89,7 +89,7 @@ fn a_step_and_an_impulse_are_one_event_each_for_every_seed() {
         assert_eq!(e.shape, Shape::Step, "seed {seed}:\n{text}");
         assert!(e.start_s <= 23.3e-3 && 23.3e-3 < e.end_s, "{text}");
         let ub = e.duration_upper_bound_s.unwrap();
-        assert!(ub >= T6 * (1.0 - 1e-12) && ub < 2.0 * T6, "{text}");
+        assert!((T6 * (1.0 - 1e-12)..2.0 * T6).contains(&ub), "{text}");
         let (h, sd) = (e.height_mm.unwrap(), e.height_sd_mm.unwrap());
         assert!((h - 10.0).abs() < 5.0 * sd + 0.05, "seed {seed}:\n{text}");
         let lb = e.abs_rate_lower_bound_m_per_s.unwrap();
