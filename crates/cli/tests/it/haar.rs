@@ -111,7 +111,7 @@ fn simulate_a_slow_ramp_reports_one_event_with_its_measured_rate() {
     let rate: f64 = line
         .split("height/duration = ")
         .nth(1)
-        .and_then(|s| s.split(" m/s").next())
+        .and_then(|s| s.split(" ± ").next())
         .and_then(|s| s.trim().parse().ok())
         .expect("the measured rate");
     assert!((rate / -0.75 - 1.0).abs() < 0.2, "{line}");
