@@ -266,3 +266,76 @@ fn bench_array_prints_its_rates() {
     }
     assert!(r["projected_64x64_1e7_seconds"].as_f64().unwrap() > 0.0);
 }
+
+/// The set as its users read it: numpy.load reads the .npy arrays and pyuff the UFF file
+/// (scripts/array-crosscheck.sh, in the cached venv), and they agree with the summary, the
+/// pixel grid and the maps; a perturbed map is caught. Needs python3 (required under CI).
+#[test]
+fn numpy_and_pyuff_read_the_set() {
+    if !tofprobe_testkit::tools::have(&["python3"], "the numpy/pyuff reading of an array set") {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = config(
+        tmp.path(),
+        "plate.toml",
+        PLATE,
+        "rows = 3\ncols = 5\npitch_um = 30.0\nfield_of_view_deg = 30.0\ndistance_mm = 100.0",
+    );
+    let out = tmp.path().join("out");
+    let o = run(&[
+        "simulate",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let check = |extra: &[&str]| {
+        Command::new("bash")
+            .arg(root.join("scripts/array-crosscheck.sh"))
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = check(&[]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && text.contains("array-check: ok (3 x 5 pixels, 4 bins"),
+        "{text}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        !check(&["--break"]).status.success(),
+        "a perturbed map must fail"
+    );
+}
+
+/// The Haar example as users run it: `simulate scenes/edge-sweep.toml --out DIR` finds a
+/// transition in every pixel, writes the event-time map, and fits the edge at its 10 m/s
+/// along +x within 5 % and 3°.
+#[test]
+fn the_edge_sweep_example_measures_its_edge() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let out = tmp.path().join("edge");
+    let o = run(&[
+        "simulate",
+        root.join("scenes/edge-sweep.toml").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(s["event_pixels"], 1024);
+    let v = s["edge_velocity_mm_per_s"].as_f64().unwrap();
+    assert!((v / 10_000.0 - 1.0).abs() < 0.05, "{v}");
+    assert!(s["edge_direction_deg"].as_f64().unwrap().abs() < 3.0);
+    let t = npy::from_bytes(&std::fs::read(out.join("event_time_ms.npy")).unwrap()).unwrap();
+    assert_eq!(t.shape, vec![32, 32]);
+    // Column 0 (x = 0.5 mm) steps at (0.5 + 1) mm / 10 m/s = 0.15 ms, column 31 at 3.25 ms.
+    let col = |c: usize| (0..32).map(|r| t.data[r * 32 + c]).sum::<f64>() / 32.0;
+    assert!((col(0) - 0.15).abs() < 0.1 && (col(31) - 3.25).abs() < 0.1);
+}
