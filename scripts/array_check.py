@@ -1,7 +1,8 @@
 """Reads an array output set (tofprobe simulate CONFIG --out DIR) with the tools its users
 have: numpy.load for the .npy arrays and pyuff for vibration.uff. Checks the shapes against
 summary.json, the UFF nodes against the pixel centres, and every data set 55 against the
-amplitude and phase maps (the UFF holds 6 significant digits: relative 1e-5 plus 1e-9 mm).
+amplitude and phase maps (6 significant digits: relative 1e-5), and every pixel's data set
+58 spectrum against the same maps (12 significant digits: relative 1e-9).
 Exits non-zero on any difference; --break perturbs one value to show the check can fail.
 Usage: python array_check.py DIR [--break]"""
 import json
@@ -29,7 +30,7 @@ def main(d, broken):
         assert abs(amp[b["index"]].mean() - b["mean_amplitude_um"]) < 1e-9 * max(1, b["mean_amplitude_um"])
     uff = pyuff.UFF(f"{d}/vibration.uff")
     types = list(uff.get_set_types())
-    assert types == [151, 164, 15] + [55] * B, types
+    assert types == [151, 164, 15] + [55] * B + [58] * (R * C), types
     sets = uff.read_sets()
     nodes = sets[2]
     mm = s["mm_per_pixel"]
@@ -47,6 +48,17 @@ def main(d, broken):
         if (err > 0).any():
             i = int(np.argmax(err > 0))
             print(f"array-check: bin {b} pixel {divmod(i, C)}: UFF {z[i]} vs maps {want[i]}")
+            sys.exit(1)
+    for k in range(R * C):
+        d58 = sets[3 + B + k]
+        assert int(d58["rsp_node"]) == k + 1, d58["rsp_node"]
+        r, c = divmod(k, C)
+        want = amp[:, r, c] * np.exp(1j * np.radians(ph[:, r, c]))
+        got = np.asarray(d58["data"]) * 1000.0
+        freqs = [b["frequency_hz"] for b in s["bins"]]
+        assert np.allclose(d58["x"], freqs, rtol=1e-5), (d58["x"], freqs)
+        if (np.abs(got - want) > 1e-9 * np.abs(want) + 1e-9).any():
+            print(f"array-check: data set 58 of pixel ({r}, {c}): {got} vs {want}")
             sys.exit(1)
     print(f"array-check: ok ({R} x {C} pixels, {B} bins: numpy and pyuff agree with the maps)")
 

@@ -91,7 +91,12 @@ fn an_array_simulation_writes_its_whole_set() {
         .filter(|w| w[0] == "    -1" && w[1].len() == 80)
         .map(|w| w[1].trim())
         .collect();
-    assert_eq!(sets, vec!["151", "164", "15", "55", "55", "55", "55"]);
+    let mut want = vec!["151", "164", "15", "55", "55", "55", "55"];
+    want.extend(["58"; 12]);
+    assert_eq!(
+        sets, want,
+        "header, units, nodes, a shape per bin, a spectrum per pixel"
+    );
     assert!(
         std::fs::read_to_string(out.join("deflection.svg"))
             .unwrap()
