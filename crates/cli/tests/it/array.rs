@@ -206,6 +206,30 @@ fn bad_arrays_are_refused_by_field_and_nothing_is_written() {
     // ρ_s = 0.5: half the pulses detect (no background), ± 5σ of a binomial of 40,000.
     let det = s["mean_detections_per_pixel"].as_f64().unwrap();
     assert!((det - 20_000.0).abs() < 5.0 * 100.0 / 4.0, "{det}");
+    // A .npy map of R × C floats: ρ_s = 0.25 everywhere.
+    let npy_map = tmp.path().join("refl.npy");
+    std::fs::write(&npy_map, npy::to_bytes(&[4, 4], &[0.25f64; 16]).unwrap()).unwrap();
+    let cfg = config(
+        tmp.path(),
+        "npy.toml",
+        PLATE,
+        &format!("{ok_array}\nsignal_map = {{ kind = \"image\", path = \"refl.npy\" }}"),
+    );
+    let o = run(&["simulate", cfg.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let det = s["mean_detections_per_pixel"].as_f64().unwrap();
+    // 10,000 ± 5σ (σ = √(40,000·0.25·0.75)/4 pixels averaged = 87/4).
+    assert!((det - 10_000.0).abs() < 5.0 * 87.0 / 4.0, "{det}");
+    // A map of the wrong shape is refused naming the field.
+    std::fs::write(&npy_map, npy::to_bytes(&[2, 8], &[0.25f64; 16]).unwrap()).unwrap();
+    let o = run(&["simulate", cfg.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("array.signal_map.path") && err.contains("[2, 8]"),
+        "{err}"
+    );
 }
 
 #[test]
