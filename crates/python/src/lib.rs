@@ -146,7 +146,8 @@ impl Design {
     /// The resolved values as a dict: ``mode``, ``bins`` (ROM bin indices k),
     /// ``frequencies_hz`` (f_k = k·f_s/L), ``tdc_bits`` (T), ``width`` (W),
     /// ``frame_pulses`` (N), ``rom_depth`` (L), ``registers`` (2B, or 2^(U+1) − 1 Haar),
-    /// ``shift`` (S), ``frac_bits`` (F), ``adders`` (A), ``cycles_per_pulse`` (C),
+    /// ``shift`` (S), ``frac_bits`` (F), ``register_frac_bits`` (G: the registers count
+    /// 2^−G codes), ``adders`` (A), ``cycles_per_pulse`` (C),
     /// ``pulses`` (the acquisition), ``seed``, ``laser_rate_hz``, ``tdc_lsb_mm``, ``notes``
     /// and ``array`` (``(rows, cols)`` or ``None``).
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -170,6 +171,7 @@ impl Design {
         out.set_item("registers", p.registers())?;
         out.set_item("shift", p.shift)?;
         out.set_item("frac_bits", p.frac_bits)?;
+        out.set_item("register_frac_bits", p.register_frac_bits())?;
         out.set_item("adders", p.adders)?;
         out.set_item("cycles_per_pulse", p.cycles_per_pulse)?;
         out.set_item("haar_scales", p.haar_scales)?;

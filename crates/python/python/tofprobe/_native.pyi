@@ -20,6 +20,7 @@ class Summary(TypedDict):
     registers: int
     shift: int
     frac_bits: int
+    register_frac_bits: int
     adders: int
     cycles_per_pulse: int
     haar_scales: int
