@@ -66,9 +66,7 @@ impl Design {
         if let Some(r) = self.rom.get() {
             return Ok(r.as_ref());
         }
-        let r = py
-            .detach(|| self.inner.probe_rom())
-            .map_err(value_error)?;
+        let r = py.detach(|| self.inner.probe_rom()).map_err(value_error)?;
         Ok(self.rom.get_or_init(|| r).as_ref())
     }
 
@@ -209,10 +207,7 @@ impl Design {
         let (valid, tdc) = py.detach(|| {
             let record = source.record(n);
             let valid: Vec<bool> = record.iter().map(Option::is_some).collect();
-            let tdc: Vec<i32> = record
-                .iter()
-                .map(|d| d.map_or(0, |c| c as i32))
-                .collect();
+            let tdc: Vec<i32> = record.iter().map(|d| d.map_or(0, |c| c as i32)).collect();
             (valid, tdc)
         });
         PyTuple::new(
@@ -265,9 +260,7 @@ impl Design {
             for (k, v) in valid_s.chunks(CHUNK).enumerate() {
                 let first = k * CHUNK;
                 convert::detections(v, tdc_s, first, max_code, &mut buf)?;
-                driver
-                    .run(&buf, first as u64)
-                    .map_err(|e| e.to_string())?;
+                driver.run(&buf, first as u64).map_err(|e| e.to_string())?;
             }
             Ok(driver.readout().words)
         });
