@@ -3,7 +3,8 @@
 # and synthesis tests drive, then formatting, lints and every test of the workspace in
 # release mode (the Monte-Carlo and bit-true tests are numeric-heavy), then the Python
 # package's pytest suite and the users' tools checks. Every phase prints its wall time; a
-# missing EDA tool fails the tests that need it (TOFPROBE_REQUIRE_TOOLS=1: tofprobe_testkit::tools), it never skips them.
+# missing EDA tool fails the tests that need it (TOFPROBE_REQUIRE_TOOLS=1:
+# tofprobe_testkit::tools), it never skips them.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
