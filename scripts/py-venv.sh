@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Prints the path of tofprobe's Python venv for the users'-tools checks, creating it and
+# Prints the path of tofprobe's Python venv (the users'-tools checks, the Python package),
 # installing scripts/py-requirements.txt only when the requirements changed (a stamp file
 # holds their hash), so reruns cost a few milliseconds. The venv lives in
 # $TOFPROBE_PY_VENV, default target/py-venv (cache that directory in CI).

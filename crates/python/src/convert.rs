@@ -188,25 +188,12 @@ impl CodeSlice<'_> {
             CodeSlice::I64(s) => s.len(),
         }
     }
-
-    /// Code `i` widened (every integer dtype fits an i128).
-    pub fn get(&self, i: usize) -> i128 {
-        match self {
-            CodeSlice::U8(s) => i128::from(s[i]),
-            CodeSlice::U16(s) => i128::from(s[i]),
-            CodeSlice::U32(s) => i128::from(s[i]),
-            CodeSlice::U64(s) => i128::from(s[i]),
-            CodeSlice::I8(s) => i128::from(s[i]),
-            CodeSlice::I16(s) => i128::from(s[i]),
-            CodeSlice::I32(s) => i128::from(s[i]),
-            CodeSlice::I64(s) => i128::from(s[i]),
-        }
-    }
 }
 
-/// Fills `out` with the detections of pulses `first ..` of (`valid`, `tdc`): `Some(code)`
-/// where valid, `None` elsewhere (the code of an invalid pulse is ignored). A valid code
-/// outside 0 ..= `max_code` is refused, naming the pulse and the range.
+/// Fills `out` with the detections of pulses `first .. first + valid.len()` of (`valid`,
+/// `tdc`): `Some(code)` where valid, `None` elsewhere (the code of an invalid pulse is
+/// ignored). A valid code outside 0 ..= `max_code` is refused, naming the pulse and the
+/// range.
 pub fn detections(
     valid: &[bool],
     tdc: CodeSlice<'_>,
@@ -214,21 +201,57 @@ pub fn detections(
     max_code: u32,
     out: &mut Vec<Option<u32>>,
 ) -> Result<(), String> {
-    out.clear();
-    for (i, &v) in valid.iter().enumerate() {
-        let p = first + i;
-        if !v {
-            out.push(None);
-            continue;
-        }
-        let c = tdc.get(p);
-        if c < 0 || c > i128::from(max_code) {
-            return Err(format!(
-                "`tdc[{p}]` = {c} is outside the pixel's TDC codes 0 ..= {max_code} \
-                 (pixel.tdc_bits); a code in that range would work, or valid[{p}] = False"
-            ));
-        }
-        out.push(Some(c as u32));
+    let end = first + valid.len();
+    match tdc {
+        CodeSlice::U8(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::U16(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::U32(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::U64(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::I8(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::I16(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::I32(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::I64(s) => fill(valid, &s[first..end], first, max_code, out),
     }
-    Ok(())
+}
+
+/// [`detections`] for one integer type (one pass, no branch on the dtype per pulse).
+fn fill<T>(
+    valid: &[bool],
+    codes: &[T],
+    first: usize,
+    max_code: u32,
+    out: &mut Vec<Option<u32>>,
+) -> Result<(), String>
+where
+    T: Copy + Into<i128>,
+    u32: TryFrom<T>,
+{
+    out.clear();
+    let mut ok = true;
+    out.extend(valid.iter().zip(codes).map(|(&v, &c)| {
+        if !v {
+            return None;
+        }
+        match u32::try_from(c) {
+            Ok(x) if x <= max_code => Some(x),
+            _ => {
+                ok = false;
+                None
+            }
+        }
+    }));
+    if ok {
+        return Ok(());
+    }
+    let (i, c) = valid
+        .iter()
+        .zip(codes)
+        .enumerate()
+        .find(|(_, (v, c))| **v && !(0..=i128::from(max_code)).contains(&(**c).into()))
+        .map(|(i, (_, &c))| (first + i, c.into()))
+        .unwrap_or((first, -1));
+    Err(format!(
+        "`tdc[{i}]` = {c} is outside the pixel's TDC codes 0 ..= {max_code} \
+         (pixel.tdc_bits); a code in that range would work, or valid[{i}] = False"
+    ))
 }

@@ -99,3 +99,19 @@ def test_help_documents_every_call():
         method = getattr(tofprobe.Design, name)
         assert method.__doc__ and len(method.__doc__) > 40, name
     assert "valid, tdc" in tofprobe.Design.run_pixel.__text_signature__
+
+
+def test_the_installed_stubs_list_exactly_the_native_calls():
+    import ast
+    import pathlib
+
+    package = pathlib.Path(tofprobe.__file__).parent
+    assert (package / "py.typed").is_file()
+    tree = ast.parse((package / "_native.pyi").read_text())
+    (cls,) = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Design"]
+    stubbed = {n.name for n in cls.body if isinstance(n, ast.FunctionDef)}
+    native = {n for n in dir(tofprobe.Design) if not n.startswith("_")} | {"__reduce__"}
+    assert stubbed == native
+    summary = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Summary"][0]
+    keys = {n.target.id for n in summary.body if isinstance(n, ast.AnnAssign)}
+    assert keys == set(tofprobe.Design.default().summary())
