@@ -106,17 +106,21 @@ impl Document {
     }
 }
 
-/// Reads a file as UTF-8 text with a specific error for each way it can fail.
+/// Reads a file as UTF-8 text with a specific error for each way it can fail: a directory,
+/// not a regular file (`/dev/zero`, a FIFO) or larger than
+/// [`tofprobe_io::bounded::MAX_CONFIG_BYTES`] (refused before reading it), not UTF-8.
 pub fn read_text(path: &Path) -> Result<String, DesignError> {
     if path.is_dir() {
         return Err(DesignError::IsDirectory {
             path: path.to_path_buf(),
         });
     }
-    let bytes = std::fs::read(path).map_err(|source| DesignError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = tofprobe_io::read_bounded(path, tofprobe_io::bounded::MAX_CONFIG_BYTES).map_err(
+        |source| DesignError::Read {
+            path: path.to_path_buf(),
+            source,
+        },
+    )?;
     String::from_utf8(bytes).map_err(|e| DesignError::NotUtf8 {
         path: PathBuf::from(path),
         offset: e.utf8_error().valid_up_to(),
