@@ -154,3 +154,72 @@ fn timing_liberty_is_read_within_a_stated_size() {
     refused(&r, &["timing_liberty", "/dev/zero", "not a regular file"]);
     assert!(r.seconds < 2.0, "{} s", r.seconds);
 }
+
+/// The default made periodic with L = `rom_depth` over a frame of `pulses`.
+fn periodic(rom_depth: u64, pulses: u64) -> String {
+    edit(
+        default_text(),
+        &[
+            ("rom_depth = 20000 ", &format!("rom_depth = {rom_depth} ")),
+            ("duration_s = 1.0 ", &format!("pulses = {pulses} ")),
+        ],
+    )
+}
+
+/// A periodic ROM is capped from the memory it needs (2^21 entries, ≈ 340 MB in
+/// `simulate`), at resolution, so every command refuses L = 2^26 alike within a second,
+/// naming `probe.rom_depth`, the limit and the deepest depth that fits and divides N
+/// (`simulate` took 2 GB at 2^24 and aborted out of memory at 2^26; `rtl` swapped in a
+/// 4096-entry sign ROM).
+#[test]
+fn a_periodic_rom_deeper_than_its_cap_is_refused_by_every_command() {
+    let d = scratch("periodic-cap");
+    let cfg = write(&d, "deep.toml", &periodic(1 << 26, 1 << 26));
+    let out = d.join("out");
+    for args in [
+        vec!["config", s(&cfg)],
+        vec!["simulate", s(&cfg)],
+        vec!["rtl", s(&cfg), "--out", s(&out)],
+        vec!["vectors", s(&cfg), "--out", s(&out)],
+        vec!["size", s(&cfg)],
+    ] {
+        let r = run(&args, Duration::from_secs(20));
+        refused(
+            &r,
+            &[
+                "probe.rom_depth = 67108864",
+                "rom_depth <= 2097152",
+                "rom_depth = 2097152 (the deepest that fits and divides N = 67108864)",
+            ],
+        );
+        assert!(r.seconds < 1.0, "{args:?}: {} s", r.seconds);
+    }
+    assert!(!out.exists(), "a refused run wrote {}", out.display());
+    // Just past the cap on a frame it does not divide: the hint is the deepest divisor.
+    let cfg = write(&d, "past.toml", &periodic((1 << 21) + 1, 6_000_000));
+    let r = run(&["config", s(&cfg)], Duration::from_secs(20));
+    refused(&r, &["probe.rom_depth = 2097153", "rom_depth = 2000000 "]);
+}
+
+/// Below the cap, `rtl` renders the periodic ΣΔ ROM the configuration asks for at its own
+/// depth: L = 2^17 is the ROM's depth, never a substituted 4096-entry sign-of-cosine ROM.
+#[test]
+fn rtl_renders_a_periodic_rom_at_its_depth() {
+    let d = scratch("periodic-rtl");
+    let cfg = write(&d, "l17.toml", &periodic(1 << 17, 1 << 17));
+    let out = d.join("rtl");
+    let r = run(&["rtl", s(&cfg), "--out", s(&out)], Duration::from_secs(60));
+    assert_eq!(r.code, Some(0), "{}", clip(&r.stderr));
+    assert!(
+        r.stdout.contains("L = 131072") && r.stdout.contains("ΣΔ probe ROM (periodic"),
+        "{}",
+        r.stdout
+    );
+    assert!(!r.stdout.contains("sign-of-cosine"), "{}", r.stdout);
+    let hex = std::fs::read_to_string(out.join("tofprobe_probe_rom.hex")).expect("hex");
+    let entries = hex
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with("//"))
+        .count();
+    assert_eq!(entries, 1 << 17);
+}
