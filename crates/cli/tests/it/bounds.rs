@@ -223,3 +223,163 @@ fn rtl_renders_a_periodic_rom_at_its_depth() {
         .count();
     assert_eq!(entries, 1 << 17);
 }
+
+/// The HydraHarp v2 T3 sample record (BSD-3-Clause, ../shared/data/tttr).
+fn hydraharp_t3() -> Vec<u8> {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/tttr/hydraharp_v20_t3.ptu");
+    std::fs::read(p).expect("sample record")
+}
+
+/// `ptu` with the 8-byte value of header tag `ident` replaced by `value`.
+fn patch_tag(ptu: &[u8], ident: &str, value: [u8; 8]) -> Vec<u8> {
+    let mut key = ident.as_bytes().to_vec();
+    key.push(0);
+    let at = ptu
+        .windows(key.len())
+        .position(|w| w == key.as_slice())
+        .unwrap_or_else(|| panic!("tag {ident}"));
+    let mut out = ptu.to_vec();
+    out[at + 40..at + 48].copy_from_slice(&value);
+    out
+}
+
+/// The sample's header with `TTResult_NumberOfRecords` set, followed by `records`.
+fn ptu_with_records(records: &[u32]) -> Vec<u8> {
+    let src = hydraharp_t3();
+    let end = src
+        .windows(11)
+        .position(|w| w == b"Header_End\0")
+        .expect("Header_End")
+        + 48;
+    let mut out = patch_tag(
+        &src[..end],
+        "TTResult_NumberOfRecords",
+        (records.len() as i64).to_le_bytes(),
+    );
+    for r in records {
+        out.extend_from_slice(&r.to_le_bytes());
+    }
+    out
+}
+
+/// A HydraHarp v2 T3 overflow record of `wraps` × 1024 sync periods (1 ≤ wraps ≤ 1023).
+fn hh_overflow(wraps: u32) -> u32 {
+    0x8000_0000 | (63 << 25) | wraps
+}
+
+/// A record's pulses are counted from the sync counts its records carry, and a record
+/// spanning more than 2^32 pulses is refused at the record that crosses the cap, within a
+/// second. The 16-byte B&H SPC file whose "multiple macro-time overflow" record claims
+/// 2^28 − 1 overflows (≈ 1.1·10^12 pulses: about a day of CPU, walked pulse by pulse) and
+/// 30,000 all-ones HydraHarp records (1,047,552 pulses each: 13.7 s) are refused naming
+/// record 1 (byte 8) and record 4100 (byte 22200): 4100 × 1,047,552 + 1 ≤ 2^32 <
+/// 4101 × 1,047,552 + 1, and the header is 5800 bytes. At exactly 2^32 pulses a record
+/// still replays (with a configuration: no fit of the whole span), one pulse more is refused.
+#[test]
+fn records_implying_more_pulses_than_the_cap_are_refused_by_record() {
+    let d = scratch("record-span");
+    let spc = d.join("overflow.spc");
+    let words: [u32; 4] = [500, (100 << 16) | 5, 0xCFFF_FFFF, (100 << 16) | 7];
+    std::fs::write(&spc, words.map(u32::to_le_bytes).concat()).expect("spc");
+    assert_eq!(std::fs::metadata(&spc).expect("spc").len(), 16);
+    let r = run(
+        &["replay", s(&spc), "--resolution-s", "1.2e-11"],
+        Duration::from_secs(10),
+    );
+    refused(
+        &r,
+        &[
+            "overflow.spc: record 1 (byte 8)",
+            "268435455 wrap-around(s)",
+            "1099511623681 pulses",
+            "at most 4294967296 laser pulses",
+        ],
+    );
+    assert!(r.seconds < 1.0, "{} s", r.seconds);
+
+    let ptu = d.join("overflows.ptu");
+    std::fs::write(&ptu, ptu_with_records(&[u32::MAX; 30_000])).expect("ptu");
+    let r = run(&["replay", s(&ptu)], Duration::from_secs(10));
+    refused(
+        &r,
+        &[
+            "overflows.ptu: record 4100 (byte 22200)",
+            "1023 wrap-around(s)",
+            "4296010753 pulses",
+        ],
+    );
+    assert!(r.seconds < 1.0, "{} s", r.seconds);
+
+    // 4100 × 1023 + 3 wraps of 1024, then a photon at nsync 1023: last sync count
+    // 2^32 − 1, so 2^32 pulses exactly.
+    let mut records = vec![u32::MAX; 4100];
+    records.push(hh_overflow(3));
+    records.push((100 << 10) | 1023);
+    let edge = d.join("edge.ptu");
+    std::fs::write(&edge, ptu_with_records(&records)).expect("ptu");
+    let cfg = write(
+        &d,
+        "frame.toml",
+        &edit(default_text(), &[("duration_s = 1.0 ", "pulses = 20000 ")]),
+    );
+    let r = run(&["replay", s(&edge), s(&cfg)], Duration::from_secs(60));
+    assert_eq!(r.code, Some(0), "{}", clip(&r.stderr));
+    assert!(r.stdout.contains("4102 records"), "{}", r.stdout);
+    records.push(hh_overflow(1));
+    std::fs::write(&edge, ptu_with_records(&records)).expect("ptu");
+    let r = run(&["replay", s(&edge), s(&cfg)], Duration::from_secs(10));
+    refused(&r, &["record 4102 (byte 22208)", "4294967297 pulses"]);
+}
+
+/// A delay resolution of 10^-20 s (from the header or `--resolution-s`) printed σ 0 and
+/// every amplitude 0 with exit 0; it is refused naming the header tag or the option with
+/// the range 1e-15 ≤ s < 1. A sync rate of 1 Hz in the header (`TTResult_SyncRate = 1`) is
+/// refused naming that tag, not `sensor.tdc_lsb_ps` (which the fit derived from it).
+#[test]
+fn absurd_record_headers_are_refused_naming_the_header_tag() {
+    let d = scratch("record-header");
+    let src = hydraharp_t3();
+    let tiny = d.join("tiny-resolution.ptu");
+    std::fs::write(
+        &tiny,
+        patch_tag(&src, "MeasDesc_Resolution", 1e-20f64.to_le_bytes()),
+    )
+    .expect("ptu");
+    let r = run(&["replay", s(&tiny)], Duration::from_secs(20));
+    refused(
+        &r,
+        &[
+            "tiny-resolution.ptu: header tag `MeasDesc_Resolution`",
+            "1e-15 <= s < 1",
+            "found 1e-20",
+        ],
+    );
+    let good = d.join("sample.ptu");
+    std::fs::write(&good, &src).expect("ptu");
+    let r = run(
+        &["replay", s(&good), "--resolution-s", "1e-20"],
+        Duration::from_secs(20),
+    );
+    refused(&r, &["--resolution-s = 1e-20", "1e-15 <= s < 1"]);
+
+    let slow = d.join("sync-1hz.ptu");
+    std::fs::write(
+        &slow,
+        patch_tag(&src, "TTResult_SyncRate", 1i64.to_le_bytes()),
+    )
+    .expect("ptu");
+    let r = run(&["replay", s(&slow)], Duration::from_secs(20));
+    refused(
+        &r,
+        &[
+            "sync-1hz.ptu: header tag `TTResult_SyncRate`",
+            "found 1 Hz",
+            "1000 to 1e10 Hz",
+        ],
+    );
+    assert!(!r.stderr.contains("tdc_lsb_ps"), "{}", r.stderr);
+    // The unpatched sample still replays (its 1 ps bins and 5 MHz sync are inside).
+    let r = run(&["replay", s(&good)], Duration::from_secs(60));
+    assert_eq!(r.code, Some(0), "{}", clip(&r.stderr));
+}
