@@ -13,16 +13,16 @@ use crate::common::{default_text, edit};
 
 /// What a bounded run gave: exit code (`None` when killed by a signal), stderr, stdout,
 /// wall time.
-struct Run {
-    code: Option<i32>,
-    stderr: String,
-    stdout: String,
-    seconds: f64,
+pub(crate) struct Run {
+    pub(crate) code: Option<i32>,
+    pub(crate) stderr: String,
+    pub(crate) stdout: String,
+    pub(crate) seconds: f64,
 }
 
 /// Runs the binary with `args` under a 4 GiB address-space limit, killed after `limit`
 /// (then the test fails, naming the command).
-fn run(args: &[&str], limit: Duration) -> Run {
+pub(crate) fn run(args: &[&str], limit: Duration) -> Run {
     let mut cmd = Command::new("sh");
     cmd.arg("-c")
         .arg("ulimit -v 4194304 && exec \"$0\" \"$@\"")
@@ -67,7 +67,7 @@ fn run(args: &[&str], limit: Duration) -> Run {
 }
 
 /// A fresh scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
+pub(crate) fn scratch(name: &str) -> PathBuf {
     let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join("bounds")
         .join(name);
@@ -76,19 +76,19 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+pub(crate) fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, text).expect("write");
     p
 }
 
-fn s(p: &Path) -> &str {
+pub(crate) fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
 }
 
 /// A refusal: exit 2, no panic, the message holds every one of `needles`.
 #[track_caller]
-fn refused(r: &Run, needles: &[&str]) {
+pub(crate) fn refused(r: &Run, needles: &[&str]) {
     assert_eq!(r.code, Some(2), "stderr: {}", clip(&r.stderr));
     assert!(!r.stderr.contains("panicked"), "{}", clip(&r.stderr));
     for n in needles {
@@ -96,7 +96,7 @@ fn refused(r: &Run, needles: &[&str]) {
     }
 }
 
-fn clip(s: &str) -> String {
+pub(crate) fn clip(s: &str) -> String {
     s.chars().take(2000).collect()
 }
 

@@ -6,6 +6,7 @@ mod adders_auto;
 mod bench_fullband;
 mod bench_sd;
 mod bit_true;
+mod blame;
 mod bounds;
 mod cli;
 mod committed;
