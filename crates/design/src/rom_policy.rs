@@ -45,6 +45,20 @@ pub struct RtlOverrides {
 /// The generator's parameters of `design` with the overrides `o` applied.
 pub fn rtl_params(design: &ResolvedDesign, o: &RtlOverrides) -> Result<PixelParams, DesignError> {
     let mut p = design.pixel.clone();
+    // The sign ROM of `--rom-depth` is built whole too (8 bytes per entry and 64 registers):
+    // the same cap as a periodic ROM (2^30 aborted out of memory).
+    let cap = tofprobe_dsp::sd::MAX_PERIODIC_ROM_DEPTH;
+    if let Some(l) = o.rom_depth.filter(|&l| l > cap) {
+        return Err(DesignError::pixel(
+            &design.origin,
+            tofprobe_pixel::PixelError::invalid(
+                "rom_depth",
+                l,
+                format!("--rom-depth is at most {cap} entries (the ROM is built whole)"),
+                cap,
+            ),
+        ));
+    }
     if let Some(n) = o.frame_pulses {
         p.frame_pulses = n;
     }

@@ -383,3 +383,34 @@ fn absurd_record_headers_are_refused_naming_the_header_tag() {
     let r = run(&["replay", s(&good)], Duration::from_secs(60));
     assert_eq!(r.code, Some(0), "{}", clip(&r.stderr));
 }
+
+/// `--rom-depth` of the RTL commands builds its sign ROM whole as well: 2^30 aborted out of
+/// memory (8 GiB); it is refused by `rtl` and `vectors` with the same cap, 2^21.
+#[test]
+fn the_rom_depth_option_has_the_same_cap() {
+    let d = scratch("rom-depth-option");
+    for cmd in ["rtl", "vectors"] {
+        let out = d.join(cmd);
+        let r = run(
+            &[
+                cmd,
+                "--rom-depth",
+                "1073741824",
+                "--frame-pulses",
+                "64",
+                "--out",
+                s(&out),
+            ],
+            Duration::from_secs(20),
+        );
+        refused(
+            &r,
+            &[
+                "rom_depth = 1073741824",
+                "--rom-depth is at most 2097152",
+                "nearest valid value: 2097152",
+            ],
+        );
+        assert!(r.seconds < 1.0, "{cmd}: {} s", r.seconds);
+    }
+}
