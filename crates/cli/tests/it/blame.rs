@@ -8,6 +8,9 @@ use std::time::Duration;
 use crate::bounds::{clip, refused, run, s, scratch, write};
 use crate::common::{default_text, edit};
 
+/// A case: its name, the edits of the default, the message it must print.
+type Case<'a> = (&'a str, &'a [(&'a str, &'a str)], &'a str);
+
 /// Runs `config` on the default with `edits`; the refusal's stderr.
 fn config_error(name: &str, edits: &[(&str, &str)]) -> String {
     let d = scratch(&format!("blame-{name}"));
@@ -23,7 +26,7 @@ fn config_error(name: &str, edits: &[(&str, &str)]) -> String {
 /// key is reported with its real type.
 #[test]
 fn a_wrong_type_is_blamed_on_its_key_with_the_schemas_type() {
-    let cases: [(&str, &[(&str, &str)], &str); 6] = [
+    let cases: [Case; 6] = [
         (
             "jitter",
             &[
