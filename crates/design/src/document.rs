@@ -49,8 +49,25 @@ impl Document {
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Document, DesignError> {
         toml::from_str(text).map_err(|e| {
             let parser = crate::schema::clip_message(e.to_string().trim_end());
+            // The key the walk names, with where the parser stopped and (unless the walk
+            // already quotes it) what it said.
             let message = match crate::schema::wrong_type(text) {
-                Some(m) => format!("{m} ({})", parser.lines().last().unwrap_or_default()),
+                Some(m) => {
+                    let said = crate::schema::clip_message(e.message().trim());
+                    let at = e.span().map(|r| {
+                        let before = &text[..r.start.min(text.len())];
+                        let line = before.matches('\n').count() + 1;
+                        let column =
+                            before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+                        format!("line {line}, column {column}")
+                    });
+                    match (at, m.contains(&said)) {
+                        (Some(at), true) => format!("{m} (at {at})"),
+                        (Some(at), false) => format!("{m} (at {at}: {said})"),
+                        (None, true) => m,
+                        (None, false) => format!("{m} ({said})"),
+                    }
+                }
                 None => parser,
             };
             DesignError::Toml {

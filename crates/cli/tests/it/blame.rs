@@ -65,6 +65,22 @@ fn a_wrong_type_is_blamed_on_its_key_with_the_schemas_type() {
         let e = config_error(name, edits);
         assert!(e.contains(want), "{name}: want {want}\n got {e}");
     }
+    // The message keeps where the parser stopped: the line of `jitter_ps`.
+    let line = default_text()
+        .lines()
+        .position(|l| l.starts_with("jitter_ps"))
+        .expect("jitter_ps")
+        + 1;
+    let e = config_error(
+        "jitter-line",
+        &[("jitter_ps = 50.0 ", "jitter_ps = \"50\" ")],
+    );
+    assert!(
+        e.contains(&format!(
+            "(at line {line}, column 13: invalid type: string \"50\""
+        )),
+        "{e}"
+    );
     // Several string keys right, one number wrong: only the number is named.
     let e = config_error(
         "mixed",

@@ -35,8 +35,14 @@ fn the_summary_is_the_naive_statistics_of_the_record() {
     let mean = depths.iter().sum::<f64>() / n;
     let var = depths.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
     // Integer sums against f64 sums of ~6·10^4 depths near 30 mm: they agree to ~1e-9 mm.
-    assert!((s.mean_depth_mm.unwrap() - mean).abs() < 1e-9, "{s:?} vs {mean}");
-    assert!((s.sigma_depth_mm.unwrap() - var.sqrt()).abs() < 1e-9, "{s:?}");
+    assert!(
+        (s.mean_depth_mm.unwrap() - mean).abs() < 1e-9,
+        "{s:?} vs {mean}"
+    );
+    assert!(
+        (s.sigma_depth_mm.unwrap() - var.sqrt()).abs() < 1e-9,
+        "{s:?}"
+    );
     assert!((s.detection_rate - n / N as f64).abs() < 1e-15);
 }
 
@@ -53,6 +59,9 @@ fn a_fourier_simulation_carries_its_spectrum_and_no_transients() {
         assert_eq!(out.amplitude_um, Some(bin.amplitude_um));
     }
     let json = serde_json::to_value(&sim).unwrap();
-    assert_eq!(json["pulses"], N, "the summary is flattened into the object");
+    assert_eq!(
+        json["pulses"], N,
+        "the summary is flattened into the object"
+    );
     assert_eq!(json["mode"], "fourier");
 }
