@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Prints the path of tofprobe's Python venv for the users'-tools checks, creating it and
-# installing scripts/py-requirements.txt only when the requirements changed (a stamp file
-# holds their hash), so reruns cost a few milliseconds. The venv lives in
+# Prints the path of tofprobe's Python venv (the users'-tools checks, the Python package),
+# creating it and installing scripts/py-requirements.txt only when the requirements changed
+# (a stamp file holds their hash), so reruns cost a few milliseconds. The venv lives in
 # $TOFPROBE_PY_VENV, default target/py-venv (cache that directory in CI).
 # Exit status 3 with a message when python3 (with venv) is missing.
 set -euo pipefail

@@ -9,6 +9,7 @@
 //! [`output`] writes the whole set.
 
 mod error;
+pub mod events;
 pub mod maps;
 pub mod model;
 pub mod output;

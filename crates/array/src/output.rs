@@ -3,7 +3,9 @@
 //! (int64 [R, C, K]) and the detections (`detections.npy`, [R, C]); for a Fourier frame
 //! `amplitude_um.npy` and `phase_deg.npy` ([B, R, C]), a heat map of amplitude and of phase
 //! per bin, each pixel's strongest bin, the animated deflection shape at the dominant bin
-//! and the Universal File Format file `vibration.uff`; the summary with its figures, units
+//! and the Universal File Format file `vibration.uff`; for a Haar frame each pixel's
+//! transition time (`event_time_ms.npy`, −1 where none, and its heat map) and the edge
+//! velocity fitted from them; the summary with its figures, units
 //! and file names.
 
 use std::path::Path;
@@ -14,6 +16,7 @@ use tofprobe_design::ResolvedDesign;
 use tofprobe_io::npy;
 
 use crate::error::ArrayError;
+use crate::events::{EventMap, event_map};
 use crate::maps::{VibrationMaps, fourier_maps};
 use crate::model::{ArrayFrame, run_array};
 use crate::plot::{Scale, deflection_animation_svg, heat_map_svg};
@@ -42,6 +45,11 @@ pub struct ArraySummary {
     pub bins: Vec<BinSummary>,
     pub dominant_bin: Option<usize>,
     pub dominant_frequency_hz: Option<f64>,
+    /// Haar: pixels with a transition, and the edge's speed (mm/s) and direction (degrees
+    /// from +x towards +y) from the plane fit of their times (`events`).
+    pub event_pixels: Option<usize>,
+    pub edge_velocity_mm_per_s: Option<f64>,
+    pub edge_direction_deg: Option<f64>,
     /// Wall time of the array model (all pixels), s, and its rate in pixel-pulses/s.
     pub model_seconds: f64,
     pub pixel_pulses_per_s: f64,
@@ -54,6 +62,21 @@ pub struct ArraySummary {
 pub fn simulate(
     design: &ResolvedDesign,
 ) -> Result<(ArrayFrame, Option<VibrationMaps>, ArraySummary), ArrayError> {
+    simulate_all(design).map(|(f, m, _, s)| (f, m, s))
+}
+
+/// [`simulate`] with the Haar event map.
+fn simulate_all(
+    design: &ResolvedDesign,
+) -> Result<
+    (
+        ArrayFrame,
+        Option<VibrationMaps>,
+        Option<EventMap>,
+        ArraySummary,
+    ),
+    ArrayError,
+> {
     let Some(a) = &design.array else {
         return Err(ArrayError::Shape(format!(
             "`{}` has no [array] section",
@@ -68,6 +91,7 @@ pub fn simulate(
         Some(rom) => Some(fourier_maps(design, rom, &frame)?),
         None => None,
     };
+    let events = maps.is_none().then(|| event_map(design, &frame));
     let pixels = (frame.rows * frame.cols) as f64;
     let bins = maps
         .as_ref()
@@ -95,11 +119,14 @@ pub fn simulate(
         bins,
         dominant_bin: maps.as_ref().map(|m| m.dominant_bin),
         dominant_frequency_hz: maps.as_ref().map(|m| m.frequencies_hz[m.dominant_bin]),
+        event_pixels: events.as_ref().map(|e| e.pixels),
+        edge_velocity_mm_per_s: events.as_ref().and_then(|e| e.velocity_mm_per_s),
+        edge_direction_deg: events.as_ref().and_then(|e| e.direction_deg),
         model_seconds,
         pixel_pulses_per_s: pixels * design.pixel.frame_pulses as f64 / model_seconds.max(1e-9),
         files: Vec::new(),
     };
-    Ok((frame, maps, summary))
+    Ok((frame, maps, events, summary))
 }
 
 /// The files of the set, in order, without the summary.
@@ -107,6 +134,7 @@ pub fn files(
     design: &ResolvedDesign,
     frame: &ArrayFrame,
     maps: Option<&VibrationMaps>,
+    events: Option<&EventMap>,
 ) -> Result<Vec<(String, Vec<u8>)>, ArrayError> {
     let (r, c) = (frame.rows, frame.cols);
     let io = |name: &str, e: String| ArrayError::Output {
@@ -132,10 +160,33 @@ pub fn files(
             .map_err(|e| io("detections.npy", e.to_string()))?,
         ),
     ];
+    let mm = design.array.as_ref().map_or(1.0, |a| a.mm_per_pixel);
+    if let Some(e) = events {
+        out.push((
+            "event_time_ms.npy".into(),
+            npy::to_bytes(&[r, c], &e.time_ms)
+                .map_err(|x| io("event_time_ms.npy", x.to_string()))?,
+        ));
+        // Pixels without a transition (−1) drawn as 0 ms.
+        let shown: Vec<f64> = e.time_ms.iter().map(|&t| t.max(0.0)).collect();
+        out.push((
+            "event_time.svg".into(),
+            heat_map_svg(
+                "transition time per pixel",
+                "time (ms)",
+                &shown,
+                r,
+                c,
+                mm,
+                Scale::Amplitude,
+            )
+            .map_err(|x| io("event_time.svg", x))?
+            .into_bytes(),
+        ));
+    }
     let Some(m) = maps else {
         return Ok(out);
     };
-    let mm = design.array.as_ref().map_or(1.0, |a| a.mm_per_pixel);
     let b = m.bins();
     out.push((
         "amplitude_um.npy".into(),
@@ -210,8 +261,8 @@ pub fn files(
 
 /// Runs the array and writes its set into `dir` (whole or absent); returns the summary.
 pub fn run_and_write(design: &ResolvedDesign, dir: &Path) -> Result<ArraySummary, ArrayError> {
-    let (frame, maps, mut summary) = simulate(design)?;
-    let files = files(design, &frame, maps.as_ref())?;
+    let (frame, maps, events, mut summary) = simulate_all(design)?;
+    let files = files(design, &frame, maps.as_ref(), events.as_ref())?;
     let out_err = |e: std::io::Error| ArrayError::Output {
         path: dir.to_path_buf(),
         message: e.to_string(),

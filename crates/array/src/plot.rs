@@ -96,6 +96,7 @@ pub fn heat_map_svg(
         chart
             .configure_mesh()
             .disable_mesh()
+            .label_style(("sans-serif", 13))
             .x_desc("column (pixel)")
             .y_desc("row (pixel)")
             .draw()
@@ -119,6 +120,8 @@ pub fn heat_map_svg(
         bar.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
+            .y_label_style(("sans-serif", 13))
+            .axis_desc_style(("sans-serif", 14))
             .y_desc(unit)
             .draw()
             .map_err(|x| e(&x))?;

@@ -3,21 +3,34 @@
 //! (units: mm, mN, °C — lengths in the file are mm), 15 (the pixel grid as nodes, node
 //! r·C + c + 1 at the pixel's centre on the scene plane, z = 0) and one data set 55 per bin
 //! (frequency response, complex, three values per node: x and y 0, z the pixel's complex
-//! deflection amplitude·e^{jφ} in mm). Deterministic: the dates are fixed, not the clock's.
+//! deflection amplitude·e^{jφ} in mm), then one data set 58 per pixel (its spectrum at the
+//! probed bins: a general function of frequency, complex, uneven abscissa in Hz, ordinate
+//! displacement in mm, response node = the pixel, direction +z). Deterministic: the dates
+//! are fixed, not the clock's.
 
 use tofprobe_design::ResolvedDesign;
 
 use crate::maps::VibrationMaps;
 
-/// C's `%13.5e`: a sign, one digit, five decimals, `e`, a sign and two exponent digits,
-/// right-aligned in 13 columns.
-fn e13(x: f64) -> String {
+/// C's `%W.Pe`: a sign, one digit, P decimals, `e`, a sign and at least two exponent
+/// digits, right-aligned in W columns (non-finite values written as 0).
+fn e(x: f64, width: usize, precision: usize) -> String {
     let x = if x.is_finite() { x } else { 0.0 };
-    let s = format!("{x:.5e}");
+    let s = format!("{x:.precision$e}");
     let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
     let e: i32 = e.parse().unwrap_or(0);
     let sign = if e < 0 { '-' } else { '+' };
-    format!("{:>13}", format!("{m}e{sign}{:02}", e.abs()))
+    format!("{:>width$}", format!("{m}e{sign}{:02}", e.abs()))
+}
+
+/// `%13.5e`.
+fn e13(x: f64) -> String {
+    e(x, 13, 5)
+}
+
+/// `%20.11e`.
+fn e20(x: f64) -> String {
+    e(x, 20, 11)
 }
 
 /// `%-80s`, cut to 80 characters of printable ASCII.
@@ -134,12 +147,76 @@ pub fn write(design: &ResolvedDesign, m: &VibrationMaps) -> String {
         }
         end(&mut s);
     }
+
+    let n = m.rows * m.cols;
+    for node in 0..n {
+        start(&mut s, 58);
+        s.push_str(&format!(
+            "{}\n",
+            a80(&format!(
+                "spectrum of pixel ({}, {})",
+                node / m.cols,
+                node % m.cols
+            ))
+        ));
+        for _ in 0..4 {
+            s.push_str(&format!("{}\n", a80("NONE")));
+        }
+        // Function type 0 (general), id 0, version 0, load case 0; response "pixel" at the
+        // node, direction 3 (+z); no reference.
+        s.push_str(&format!(
+            "{:>5}{:>10}{:>5}{:>10} {:>10}{:>10}{:>4} {:>10}{:>10}{:>4}\n",
+            0,
+            0,
+            0,
+            0,
+            "pixel",
+            node + 1,
+            3,
+            "NONE",
+            0,
+            0
+        ));
+        // Complex double (6), B points, uneven spacing (0).
+        s.push_str(&format!(
+            "{:>10}{:>10}{:>10}{}{}{}\n",
+            6,
+            m.bins(),
+            0,
+            e13(0.0),
+            e13(0.0),
+            e13(0.0)
+        ));
+        // Abscissa: frequency (18) in Hz; ordinate: displacement (8), length exponent 1,
+        // in mm; no denominator, no z axis.
+        for (kind, len, label, unit) in [
+            (18, 0, "Frequency", "Hz"),
+            (8, 1, "Displacement", "mm"),
+            (0, 0, "NONE", "NONE"),
+            (0, 0, "NONE", "NONE"),
+        ] {
+            s.push_str(&format!(
+                "{kind:>10}{len:>5}{:>5}{:>5} {label:<20} {unit:<20}\n",
+                0, 0
+            ));
+        }
+        for b in 0..m.bins() {
+            let (a, p) = (m.amplitude(b)[node] / 1000.0, m.phase(b)[node].to_radians());
+            s.push_str(&format!(
+                "{}{}{}\n",
+                e13(m.frequencies_hz[b]),
+                e20(a * p.cos()),
+                e20(a * p.sin())
+            ));
+        }
+        end(&mut s);
+    }
     s
 }
 
 #[cfg(test)]
 mod tests {
-    use super::e13;
+    use super::{e13, e20};
 
     /// The same text as C's printf("%13.5e").
     #[test]
@@ -149,5 +226,6 @@ mod tests {
         assert_eq!(e13(0.0), "  0.00000e+00");
         assert_eq!(e13(f64::NAN), "  0.00000e+00");
         assert_eq!(e13(1e300).len(), 13);
+        assert_eq!(e20(-1.5), "  -1.50000000000e+00");
     }
 }

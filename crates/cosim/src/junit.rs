@@ -154,8 +154,9 @@ pub fn suite(name: &str, hash: &str, r: &CosimReport) -> Suite {
 
 /// `text` escaped for XML 1.0 character data and attribute values: the five markup
 /// characters as entities, tab/newline/carriage return as character references (so an
-/// attribute keeps them), every other control character (not allowed in XML 1.0 at all)
-/// as U+FFFD.
+/// attribute keeps them), and every character XML 1.0 does not allow (its `Char`
+/// production: other control characters, the noncharacters U+FFFE and U+FFFF) or
+/// discourages (C1 controls) as U+FFFD.
 pub fn escape(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for c in text.chars() {
@@ -168,7 +169,7 @@ pub fn escape(text: &str) -> String {
             '\t' => out.push_str("&#9;"),
             '\n' => out.push_str("&#10;"),
             '\r' => out.push_str("&#13;"),
-            c if c.is_control() => out.push('\u{fffd}'),
+            c if c.is_control() || matches!(c, '\u{fffe}' | '\u{ffff}') => out.push('\u{fffd}'),
             c => out.push(c),
         }
     }
@@ -307,5 +308,10 @@ mod tests {
     fn escape_leaves_no_markup_and_no_line_break() {
         let e = escape("a<b>&\"c'\nd\u{1}");
         assert_eq!(e, "a&lt;b&gt;&amp;&quot;c&apos;&#10;d\u{fffd}");
+        // Outside XML 1.0's Char production: replaced; the rest of the plane is kept.
+        assert_eq!(
+            escape("x\u{fffe}\u{ffff}\u{1f}\u{85}\u{fffd}\u{10000}"),
+            "x\u{fffd}\u{fffd}\u{fffd}\u{fffd}\u{fffd}\u{10000}"
+        );
     }
 }

@@ -52,8 +52,25 @@ impl Document {
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Document, DesignError> {
         toml::from_str(text).map_err(|e| {
             let parser = crate::schema::clip_message(e.to_string().trim_end());
+            // The key the walk names, with where the parser stopped and (unless the walk
+            // already quotes it) what it said.
             let message = match crate::schema::wrong_type(text) {
-                Some(m) => format!("{m} ({})", parser.lines().last().unwrap_or_default()),
+                Some(m) => {
+                    let said = crate::schema::clip_message(e.message().trim());
+                    let at = e.span().map(|r| {
+                        let before = &text[..r.start.min(text.len())];
+                        let line = before.matches('\n').count() + 1;
+                        let column =
+                            before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+                        format!("line {line}, column {column}")
+                    });
+                    match (at, m.contains(&said)) {
+                        (Some(at), true) => format!("{m} (at {at})"),
+                        (Some(at), false) => format!("{m} (at {at}: {said})"),
+                        (None, true) => m,
+                        (None, false) => format!("{m} ({said})"),
+                    }
+                }
                 None => parser,
             };
             DesignError::Toml {
@@ -109,17 +126,21 @@ impl Document {
     }
 }
 
-/// Reads a file as UTF-8 text with a specific error for each way it can fail.
+/// Reads a file as UTF-8 text with a specific error for each way it can fail: a directory,
+/// not a regular file (`/dev/zero`, a FIFO) or larger than
+/// [`tofprobe_io::bounded::MAX_CONFIG_BYTES`] (refused before reading it), not UTF-8.
 pub fn read_text(path: &Path) -> Result<String, DesignError> {
     if path.is_dir() {
         return Err(DesignError::IsDirectory {
             path: path.to_path_buf(),
         });
     }
-    let bytes = std::fs::read(path).map_err(|source| DesignError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = tofprobe_io::read_bounded(path, tofprobe_io::bounded::MAX_CONFIG_BYTES).map_err(
+        |source| DesignError::Read {
+            path: path.to_path_buf(),
+            source,
+        },
+    )?;
     String::from_utf8(bytes).map_err(|e| DesignError::NotUtf8 {
         path: PathBuf::from(path),
         offset: e.utf8_error().valid_up_to(),

@@ -100,6 +100,20 @@ pub fn resolve_timed(
     }
     d.probe.validate().map_err(probe_err)?;
     let frame = d.pixel.frame_pulses.unwrap_or(d.pulses());
+    // A frame is part of the acquisition (docs: "N: pulses per frame; default: the whole
+    // acquisition"): a longer one would read pulses that were never simulated.
+    if frame > d.pulses() {
+        return Err(pixel_err(PixelError::invalid(
+            "frame_pulses",
+            frame,
+            format!(
+                "a frame is at most the acquisition's {} pulses (acquisition.pulses, or \
+                 acquisition.duration_s × sensor.laser_rate_hz)",
+                d.pulses()
+            ),
+            format!("{} (or leave pixel.frame_pulses out)", d.pulses()),
+        )));
+    }
     d.probe.check_frame(frame).map_err(probe_err)?;
     // The pixel reads the ROM the probe design generates: its depth defaults to the
     // `[probe]` design's (L = N windowed, `probe.rom_depth` periodic).

@@ -8,7 +8,9 @@
 //! of a few hundred pulses at least (a windowed ROM of a 64-pulse frame has none; the
 //! default's periodic ROM keeps its 20,000 entries however short the frame), and a
 //! windowed ROM is N entries deep, so frames beyond [`MAX_SD_ROM_DEPTH`] keep the short
-//! periodic sign probe rather than a ROM file of more than 2^24 lines. `tofprobe rtl`
+//! periodic sign probe rather than a ROM file of more than 2^24 lines. A periodic ROM is
+//! never swapped: its depth is capped at resolution
+//! ([`tofprobe_dsp::sd::MAX_PERIODIC_ROM_DEPTH`]), for every command alike. `tofprobe rtl`
 //! itself renders the same ROM (the committed `rtl/` holds the default's): see
 //! testbench/README.md.
 
@@ -24,8 +26,10 @@ use crate::resolve::ResolvedDesign;
 /// this depth (bin spacing f_s/L), not a 10^7-entry ROM.
 pub const LONG_FRAME_ROM_DEPTH: usize = 4096;
 
-/// Deepest ΣΔ ROM `tofprobe rtl` renders into a chip ROM (2^16 entries; deeper is a
-/// windowed long-frame ROM, which no chip would store).
+/// Deepest windowed ΣΔ ROM `tofprobe rtl` renders into a chip ROM (2^16 entries; deeper is
+/// a long frame's ROM, which no chip would store: the sign probe stands in, with a note). A
+/// periodic ROM is rendered at its own depth, capped at resolution by
+/// [`tofprobe_dsp::sd::MAX_PERIODIC_ROM_DEPTH`] for every command alike.
 pub const MAX_RENDERED_SD_DEPTH: usize = 1 << 16;
 
 /// The RTL commands' overrides of the resolved design: N and L of the simulated frame.
@@ -41,17 +45,33 @@ pub struct RtlOverrides {
 /// The generator's parameters of `design` with the overrides `o` applied.
 pub fn rtl_params(design: &ResolvedDesign, o: &RtlOverrides) -> Result<PixelParams, DesignError> {
     let mut p = design.pixel.clone();
+    // The sign ROM of `--rom-depth` is built whole too (8 bytes per entry and 64 registers):
+    // the same cap as a periodic ROM (2^30 aborted out of memory).
+    let cap = tofprobe_dsp::sd::MAX_PERIODIC_ROM_DEPTH;
+    if let Some(l) = o.rom_depth.filter(|&l| l > cap) {
+        return Err(DesignError::pixel(
+            &design.origin,
+            tofprobe_pixel::PixelError::invalid(
+                "rom_depth",
+                l,
+                format!("--rom-depth is at most {cap} entries (the ROM is built whole)"),
+                cap,
+            ),
+        ));
+    }
     if let Some(n) = o.frame_pulses {
         p.frame_pulses = n;
     }
+    // A windowed long frame (L = N) keeps the short periodic sign probe; a periodic ROM is
+    // the chip's as configured (its depth is capped at resolution, never swapped here).
+    let windowed = design.document.probe.rom_mode == RomMode::Windowed;
     p.rom_depth = match o.rom_depth {
         Some(l) => l,
-        None if p.rom_depth > 65_536 => LONG_FRAME_ROM_DEPTH,
+        None if windowed && p.rom_depth > MAX_RENDERED_SD_DEPTH => LONG_FRAME_ROM_DEPTH,
         None => p.rom_depth,
     };
     // A periodic chip ROM stays L deep for a short frame (the frame reads its first N
     // entries); a windowed ROM is one frame deep by definition.
-    let windowed = design.document.probe.rom_mode == RomMode::Windowed;
     if o.frame_pulses.is_some() && o.rom_depth.is_none() && windowed {
         p.rom_depth = p.rom_depth.min(p.frame_pulses.max(1) as usize);
     }
@@ -60,7 +80,7 @@ pub fn rtl_params(design: &ResolvedDesign, o: &RtlOverrides) -> Result<PixelPara
 }
 
 /// The ROM `tofprobe rtl` renders for `p` (setting `p.rom_depth` to its depth): the sign
-/// probe when `--rom-depth` is given or the ΣΔ ROM would exceed [`MAX_RENDERED_SD_DEPTH`],
+/// probe when `--rom-depth` is given or a windowed ΣΔ ROM would exceed [`MAX_RENDERED_SD_DEPTH`],
 /// else [`rtl_rom`].
 pub fn chip_rom(
     design: &ResolvedDesign,
@@ -69,7 +89,8 @@ pub fn chip_rom(
 ) -> Result<RtlRom, DesignError> {
     let probe = &design.document.probe;
     let sd_depth = probe.depth(p.frame_pulses);
-    if o.rom_depth.is_some() || sd_depth > MAX_RENDERED_SD_DEPTH {
+    let windowed = probe.rom_mode == RomMode::Windowed;
+    if o.rom_depth.is_some() || (windowed && sd_depth > MAX_RENDERED_SD_DEPTH) {
         let why = if o.rom_depth.is_some() {
             "--rom-depth given".to_string()
         } else {

@@ -1,86 +1,147 @@
-//! The types the document's keys take, to name the key when the TOML does not fit them.
-//! The toml crate reports a wrong type inside an array of tables (`[[scene.motion]]`) or an
-//! enum at the table's header with no key ("invalid type: string "x", expected f64"); this
-//! walk finds the key, so the message names the field, the value and the type it needs.
+//! Naming the key whose value does not fit the document's schema. The toml crate reports a
+//! wrong type inside an array of tables (`[[scene.motion]]`) or an enum at the table's
+//! header with no key ("invalid type: string "x", expected f64"); this walk finds the key,
+//! so the message names the field, the value and the type it needs. The types are not
+//! listed here: each key is tried alone against the document's own serde types
+//! ([`Document`]), so every key — a new one included — is judged by the one schema.
 
-use toml::Value;
+use serde::Deserialize;
+use toml::{Table, Value};
 
-/// The type a key needs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Kind {
-    Number,
-    Integer,
-    Bool,
-    Text,
-    Numbers,
-    IntegerOrAuto,
+use crate::document::Document;
+
+/// Whether `value` fits key `key` of section `section` (`scene.motion` entries: `entry`
+/// holds the entry's `kind`): the document's own serde types are asked, with a document
+/// holding only this one key. A wrong type or value fails there at the key, before serde
+/// notices the keys that are missing, so "missing field" means the key fits; an unknown key
+/// is the parser's to report (with its line). `Some(serde's message)` when it does not fit.
+fn misfit(section: &str, key: &str, value: &Value, entry: Option<&Value>) -> Option<String> {
+    let mut body = Table::new();
+    body.insert(key.to_string(), value.clone());
+    let body = match entry {
+        None => body,
+        Some(kind) => {
+            if key != "kind" {
+                body.insert("kind".into(), kind.clone());
+            }
+            let mut scene = Table::new();
+            scene.insert("motion".into(), Value::Array(vec![Value::Table(body)]));
+            scene
+        }
+    };
+    let mut doc = Table::new();
+    doc.insert(section.to_string(), Value::Table(body));
+    let e = Document::deserialize(Value::Table(doc)).err()?;
+    let m = e.message().trim();
+    (!(m.starts_with("missing field") || m.starts_with("unknown field"))).then(|| m.to_string())
 }
 
-impl Kind {
-    fn fits(self, v: &Value) -> bool {
-        match self {
-            Kind::Number => v.is_float() || v.is_integer(),
-            Kind::Integer => v.as_integer().is_some_and(|i| i >= 0),
-            Kind::Bool => v.is_bool(),
-            Kind::Text => v.is_str(),
-            Kind::Numbers => v
-                .as_array()
-                .is_some_and(|a| a.iter().all(|x| x.is_float() || x.is_integer())),
-            Kind::IntegerOrAuto => {
-                v.as_integer().is_some_and(|i| i >= 0) || v.as_str() == Some("auto")
+/// What key `key` takes, in the document's words ("a number", "an integer >= 0 or
+/// \"auto\"", "one of `flops`, `clock_gated`"), found by trying a sample of each TOML type
+/// against the schema ([`misfit`]); a name-valued key whose names serde does not list (an
+/// untagged choice) is shown by its default value.
+fn describe(section: &str, key: &str, entry: Option<&Value>) -> String {
+    let fits = |v: Value| misfit(section, key, &v, entry).is_none();
+    let mut kinds = Vec::new();
+    if fits(Value::Float(1.5)) {
+        kinds.push("a number".to_string());
+    } else if fits(Value::Integer(1)) {
+        kinds.push(
+            if fits(Value::Integer(-1)) {
+                "an integer"
+            } else {
+                "an integer >= 0"
+            }
+            .into(),
+        );
+    }
+    if fits(Value::Boolean(true)) {
+        kinds.push("true or false".into());
+    }
+    let odd = Value::String("\u{1}".into());
+    if fits(odd.clone()) {
+        kinds.push("a string".into());
+    } else {
+        let names = misfit(section, key, &odd, entry)
+            .and_then(|m| {
+                m.split_once(", expected ")
+                    .map(|(_, n)| n.trim().to_string())
+            })
+            .filter(|n| n.contains('`'));
+        match names {
+            Some(n) => kinds.push(if n.starts_with("one of") {
+                n
+            } else {
+                format!("one of {n}")
+            }),
+            None => {
+                if let Some(Value::String(d)) = default_value(section, key, entry)
+                    && d != "auto"
+                {
+                    kinds.push(format!("a name such as \"{d}\""));
+                }
+                if fits(Value::String("auto".into())) {
+                    kinds.push("\"auto\"".into());
+                }
             }
         }
     }
-
-    fn needs(self) -> &'static str {
-        match self {
-            Kind::Number => "a number",
-            Kind::Integer => "an integer >= 0",
-            Kind::Bool => "true or false",
-            Kind::Text => "a string",
-            Kind::Numbers => "an array of numbers",
-            Kind::IntegerOrAuto => "an integer >= 0 or \"auto\"",
-        }
+    if fits(Value::Array(vec![Value::Float(1.5)])) {
+        kinds.push("an array of numbers".into());
+    } else if fits(Value::Array(Vec::new())) {
+        kinds.push("an array".into());
+    }
+    if kinds.is_empty() {
+        "another value".into()
+    } else {
+        kinds.join(" or ")
     }
 }
 
-/// The key's type in a table (`motion` = an entry of `[[scene.motion]]`).
-fn kind(table: &str, key: &str) -> Option<Kind> {
-    use Kind::*;
-    Some(match (table, key) {
-        ("sensor", _) => Number,
-        ("scene", "depth_mm") => Number,
-        ("acquisition", "duration_s") => Number,
-        ("acquisition", "pulses" | "seed") => Integer,
-        ("pixel", "mode") => Text,
-        ("pixel", "bins" | "width") => IntegerOrAuto,
-        ("pixel", "frequencies_hz") => Numbers,
-        ("pixel", _) => Integer,
-        ("probe", "osr" | "h_inf" | "amplitude") => Number,
-        ("probe", "order" | "rom_depth") => Integer,
-        ("probe", "optimised_zeros") => Bool,
-        ("probe", "window" | "rom_mode" | "convention") => Text,
-        ("motion", "kind") => Text,
-        ("motion", "depths_mm") => Numbers,
-        ("motion", "m" | "n" | "blades") => Integer,
-        ("array", "rows" | "cols") => Integer,
-        ("array", "pitch_um" | "mm_per_pixel" | "field_of_view_deg" | "distance_mm") => Number,
-        ("motion", _) => Number,
-        _ => return None,
-    })
+/// The embedded default's value of a key (absent keys at their serde defaults), for
+/// [`describe`]; motions only for the default's kind.
+fn default_value(section: &str, key: &str, entry: Option<&Value>) -> Option<Value> {
+    let doc = Document::from_toml_str(crate::DEFAULT_TOML, crate::DEFAULT_ORIGIN).ok()?;
+    let v = Value::try_from(doc).ok()?;
+    let sec = v.get(section)?;
+    match entry {
+        None => sec.get(key).cloned(),
+        Some(kind) => sec
+            .get("motion")?
+            .as_array()?
+            .iter()
+            .find(|m| m.get("kind") == Some(kind))?
+            .get(key)
+            .cloned(),
+    }
 }
 
-/// The first key of `text` (a TOML document) whose value has the wrong type, as
-/// "`path` = value: expected …"; `None` when every known key has its type (or the text is
-/// not TOML at all: the parser's own message says where).
+/// The first key of `text` (a TOML document) whose value does not fit, as
+/// "`path` = value has the wrong type: expected …" (or "is not accepted: …" for a value of
+/// the right type that is not one of the key's values); `None` when every key fits (or the
+/// text is not TOML at all: the parser's own message says where). Every key's type comes
+/// from the document's serde types ([`Document`]), so a new key needs no entry here.
 pub fn wrong_type(text: &str) -> Option<String> {
-    let doc: toml::Table = toml::from_str(text).ok()?;
-    let report = |path: String, v: &Value, k: Kind| {
+    let doc: Table = toml::from_str(text).ok()?;
+    // A wrong type (or an integer out of its type's range, or no alternative of a choice)
+    // is described by what the key takes; a value of the right type that is not one of the
+    // key's names keeps serde's message, which lists them.
+    let report = |path: String, v: &Value, m: String, sec: &str, key: &str, e: Option<&Value>| {
         let shown = tofprobe_io::text::clip(&v.to_string(), 60);
-        format!(
-            "`{path}` = {shown} has the wrong type: expected {}",
-            k.needs()
-        )
+        if m.starts_with("invalid type")
+            || m.starts_with("invalid value")
+            || m.starts_with("data did not match")
+        {
+            format!(
+                "`{path}` = {shown} has the wrong type: expected {}",
+                describe(sec, key, e)
+            )
+        } else {
+            format!(
+                "`{path}` = {shown} is not accepted: {}",
+                tofprobe_io::text::clip(&m, 200)
+            )
+        }
     };
     for (section, body) in &doc {
         let Some(t) = body.as_table() else {
@@ -95,16 +156,31 @@ pub fn wrong_type(text: &str) -> Option<String> {
                     );
                 };
                 for (i, m) in list.iter().enumerate() {
-                    for (mk, mv) in m.as_table().into_iter().flatten() {
-                        if let Some(k) = kind("motion", mk).filter(|k| !k.fits(mv)) {
-                            return Some(report(format!("scene.motion[{i}].{mk}"), mv, k));
+                    let Some(m) = m.as_table() else {
+                        return Some(format!(
+                            "`scene.motion[{i}]` has the wrong type: expected a table"
+                        ));
+                    };
+                    let kind = m
+                        .get("kind")
+                        .cloned()
+                        .unwrap_or(Value::String(String::new()));
+                    // The kind first: every other key is judged against it.
+                    let keys = m
+                        .iter()
+                        .filter(|(k, _)| *k == "kind")
+                        .chain(m.iter().filter(|(k, _)| *k != "kind"));
+                    for (mk, mv) in keys {
+                        if let Some(e) = misfit("scene", mk, mv, Some(&kind)) {
+                            let path = format!("scene.motion[{i}].{mk}");
+                            return Some(report(path, mv, e, "scene", mk, Some(&kind)));
                         }
                     }
                 }
                 continue;
             }
-            if let Some(k) = kind(section, key).filter(|k| !k.fits(v)) {
-                return Some(report(format!("{section}.{key}"), v, k));
+            if let Some(e) = misfit(section, key, v, None) {
+                return Some(report(format!("{section}.{key}"), v, e, section, key, None));
             }
         }
     }
@@ -138,5 +214,71 @@ mod tests {
                 .contains("probe.osr")
         );
         assert_eq!(clip_message(&"y".repeat(10_000)).len(), 200);
+    }
+
+    /// Every key's type comes from the schema: string keys are strings or names, choices
+    /// take an integer or "auto", and a valid `adders = "auto"` is not blamed for a wrong
+    /// `jitter_ps` elsewhere (the old table took every unlisted `[pixel]` key for an integer).
+    #[test]
+    fn each_key_is_judged_by_the_schema() {
+        let cases = [
+            (
+                "[sensor]\njitter_ps = \"50\"\n[pixel]\nadders = \"auto\"\n",
+                "`sensor.jitter_ps` = \"50\" has the wrong type: expected a number",
+            ),
+            (
+                "[pixel]\nregister_file = 3\n",
+                "`pixel.register_file` = 3 has the wrong type: expected one of `flops` or `clock_gated`",
+            ),
+            (
+                "[pixel]\nregister_file = \"latch\"\n",
+                "`pixel.register_file` = \"latch\" is not accepted: unknown variant `latch`, expected `flops` or `clock_gated`",
+            ),
+            (
+                "[pixel]\nprefilter_rounding = 1.5\n",
+                "`pixel.prefilter_rounding` = 1.5 has the wrong type: expected one of `floor` or `nearest`",
+            ),
+            (
+                "[pixel]\ntiming_liberty = 3\n",
+                "`pixel.timing_liberty` = 3 has the wrong type: expected a string",
+            ),
+            (
+                "[pixel]\nadders = \"Auto\"\n",
+                "`pixel.adders` = \"Auto\" has the wrong type: expected an integer >= 0 or \"auto\"",
+            ),
+            (
+                "[pixel]\nmode = 1\n",
+                "`pixel.mode` = 1 has the wrong type: expected a name such as \"fourier\" or \"auto\"",
+            ),
+            (
+                "[pixel]\nfrequencies_hz = [\"a\"]\n",
+                "`pixel.frequencies_hz` = [\"a\"] has the wrong type: expected an array of numbers",
+            ),
+            (
+                "[probe]\noptimised_zeros = 1\n",
+                "`probe.optimised_zeros` = 1 has the wrong type: expected true or false",
+            ),
+            (
+                "[acquisition]\npulses = -5\n",
+                "`acquisition.pulses` = -5 has the wrong type: expected an integer >= 0",
+            ),
+            (
+                "[array]\nrows = \"x\"\n",
+                "`array.rows` = \"x\" has the wrong type: expected an integer >= 0",
+            ),
+            (
+                "[[scene.motion]]\nkind = 3\n",
+                "`scene.motion[0].kind` = 3 has the wrong type: expected one of `sine`, `square`, `disk`, `step`, `ramp`, `impulse`, `plate_mode`, `rotor`, `edge`",
+            ),
+        ];
+        for (text, want) in cases {
+            assert_eq!(wrong_type(text).as_deref(), Some(want), "{text:?}");
+        }
+        for fine in [
+            "[pixel]\nadders = \"auto\"\nregister_file = \"clock_gated\"\ntiming_liberty = \"sky130\"\n",
+            "[pixel]\nprefilter_rounding = \"nearest\"\nmode = \"haar\"\nbins = 4\n",
+        ] {
+            assert_eq!(wrong_type(fine), None, "{fine:?}");
+        }
     }
 }

@@ -107,10 +107,12 @@ fn tokenize(text: &str) -> Vec<Tok> {
 impl Liberty {
     /// Reads and parses `path`. Errors name the file and say what to pass instead.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| EdaError::LibertyUnreadable {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
+        // Regular files of a bounded size only: `/dev/zero` would grow without end.
+        let text = tofprobe_io::read_bounded_text(path, tofprobe_io::bounded::MAX_LIBERTY_BYTES)
+            .map_err(|e| EdaError::LibertyUnreadable {
+                path: path.to_path_buf(),
+                reason: e.to_string(),
+            })?;
         Self::parse(path, &text)
     }
 

@@ -189,10 +189,13 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
     for w in &spec.keep {
         h.feed(b"keep").feed(w.as_bytes());
     }
-    let lib_text = std::fs::read(&spec.liberty).map_err(|e| EdaError::LibertyUnreadable {
-        path: spec.liberty.clone(),
-        reason: e.to_string(),
-    })?;
+    let lib_text =
+        tofprobe_io::read_bounded(&spec.liberty, tofprobe_io::bounded::MAX_LIBERTY_BYTES).map_err(
+            |e| EdaError::LibertyUnreadable {
+                path: spec.liberty.clone(),
+                reason: e.to_string(),
+            },
+        )?;
     h.feed(&lib_text).feed(yosys_version(&yosys).as_bytes());
     let key = h.hex();
     let dir = cache_root.join(&key);

@@ -11,6 +11,7 @@ pub mod error;
 pub mod level;
 pub mod options;
 pub mod paper;
+pub mod record_bounds;
 pub mod records;
 pub mod replay;
 pub mod scalogram;

@@ -27,6 +27,7 @@ use tofprobe_scene::tttr::{
 };
 
 use crate::error::ExperimentError;
+use crate::record_bounds;
 
 /// Half-width of the fitted window in units of the fitted σ.
 pub const WINDOW_SIGMAS: f64 = 8.0;
@@ -122,20 +123,28 @@ fn scene_err(_origin: &str) -> impl Fn(SceneError) -> ExperimentError + '_ {
     ExperimentError::from
 }
 
+/// What the record may ask of a replay, checked before a pulse is streamed
+/// ([`crate::record_bounds`]): the pulses it spans, its resolution.
+fn check_record(path: &Path, req: &ReplayRequest) -> Result<(), ExperimentError> {
+    let r = tttr::open(path)?;
+    record_bounds::resolution_s(path, r.header(), req.resolution_s)?;
+    record_bounds::check_span(path)?;
+    Ok(())
+}
+
 /// The record's delay bin (T3) or time unit (T2) in ps, as the replay will use it.
 fn unit_ps(path: &Path, req: &ReplayRequest) -> Result<f64, ExperimentError> {
     let r = tttr::open(path).map_err(scene_err(DEFAULT_ORIGIN))?;
-    let s = req
-        .resolution_s
-        .or(r.header().resolution_s)
-        .ok_or_else(|| ExperimentError::Option {
+    let s = record_bounds::resolution_s(path, r.header(), req.resolution_s)?.ok_or_else(|| {
+        ExperimentError::Option {
             option: "resolution-s".into(),
             value: "(none)".into(),
             allowed: format!(
                 "the delay bin in seconds: {} does not state it (SPC: TAC range / ADC bins)",
                 path.display()
             ),
-        })?;
+        }
+    })?;
     Ok(s * 1e12)
 }
 
@@ -151,17 +160,9 @@ fn options(window: TdcWindow, req: &ReplayRequest) -> ReplayOptions {
 /// First pass: the delay histogram over the whole sync period, its peak and FWHM.
 pub fn fit_sensor(path: &Path, req: &ReplayRequest) -> Result<FittedSensor, ExperimentError> {
     let e = scene_err(DEFAULT_ORIGIN);
+    check_record(path, req)?;
     let reader = tttr::open(path).map_err(&e)?;
-    let sync_rate_hz = reader
-        .header()
-        .sync_rate_hz
-        .or_else(|| reader.header().global_resolution_s.map(|g| 1.0 / g))
-        .filter(|r| r.is_finite() && *r > 0.0)
-        .ok_or_else(|| ExperimentError::Option {
-            option: "CONFIG".into(),
-            value: path.display().to_string(),
-            allowed: "a record whose header gives the sync rate, or a configuration".into(),
-        })?;
+    let sync_rate_hz = record_bounds::sync_rate_hz(path, reader.header())?;
     let period_ps = 1e12 / sync_rate_hz;
     let unit = unit_ps(path, req)?;
     let lsb = unit.max(period_ps / HIST_CODES);
@@ -266,6 +267,7 @@ pub fn replay(
     let (fitted, owned);
     let design = match design {
         Some(d) => {
+            check_record(path, req)?;
             fitted = None;
             d
         }

@@ -63,11 +63,15 @@ pub fn decide(design: ResolvedDesign) -> Result<ResolvedDesign, FlowError> {
     resolve(design.document, &design.origin, &mut ProbeCache::default())
 }
 
+/// An error naming `timing_liberty`: its value is echoed clipped, in the reason too (a
+/// liberty error repeats the path: a megabyte value made a two-megabyte message).
 fn key_error(value: &str, reason: impl ToString) -> PixelError {
+    let shown = tofprobe_io::text::clip(value, 60);
+    let reason = reason.to_string().replace(value, &shown);
     PixelError::invalid(
         "timing_liberty",
-        format!("\"{}\"", tofprobe_io::text::clip(value, 60)),
-        reason,
+        format!("\"{shown}\""),
+        tofprobe_io::text::clip(&reason, 4 * tofprobe_io::text::MAX_TEXT),
         "\"osu018\", \"sky130\" or the path of a liberty with timing",
     )
 }

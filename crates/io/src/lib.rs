@@ -1,7 +1,8 @@
 //! The workspace's foundation utilities, written once and used by every crate: whole-or-absent
 //! file output ([`write_atomic`] for one file, [`OutputSet`] for a command's set of files),
 //! the registry of live temporaries that an interrupt removes ([`live`]), the cleaning of
-//! temporaries left by killed runs ([`stale`]), the sanitising of user text
+//! temporaries left by killed runs ([`stale`]), inputs read within a stated size
+//! ([`bounded`]: regular files only, so `/dev/zero` cannot exhaust memory), the sanitising of user text
 //! before it reaches a generated file ([`text`]) and the FNV-1a content hash ([`fnv1a64`],
 //! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries.
 //!
@@ -9,6 +10,7 @@
 //! the path it was writing.
 
 mod atomic;
+pub mod bounded;
 pub mod live;
 pub mod npy;
 mod set;
@@ -16,6 +18,7 @@ pub mod stale;
 pub mod text;
 
 pub use atomic::write_atomic;
+pub use bounded::{read_bounded, read_bounded_text};
 pub use set::{OutputSet, STAGE_PREFIX, recover};
 
 /// FNV-1a 64-bit offset basis: the hash of no bytes.

@@ -91,7 +91,12 @@ fn an_array_simulation_writes_its_whole_set() {
         .filter(|w| w[0] == "    -1" && w[1].len() == 80)
         .map(|w| w[1].trim())
         .collect();
-    assert_eq!(sets, vec!["151", "164", "15", "55", "55", "55", "55"]);
+    let mut want = vec!["151", "164", "15", "55", "55", "55", "55"];
+    want.extend(["58"; 12]);
+    assert_eq!(
+        sets, want,
+        "header, units, nodes, a shape per bin, a spectrum per pixel"
+    );
     assert!(
         std::fs::read_to_string(out.join("deflection.svg"))
             .unwrap()
@@ -201,6 +206,30 @@ fn bad_arrays_are_refused_by_field_and_nothing_is_written() {
     // ρ_s = 0.5: half the pulses detect (no background), ± 5σ of a binomial of 40,000.
     let det = s["mean_detections_per_pixel"].as_f64().unwrap();
     assert!((det - 20_000.0).abs() < 5.0 * 100.0 / 4.0, "{det}");
+    // A .npy map of R × C floats: ρ_s = 0.25 everywhere.
+    let npy_map = tmp.path().join("refl.npy");
+    std::fs::write(&npy_map, npy::to_bytes(&[4, 4], &[0.25f64; 16]).unwrap()).unwrap();
+    let cfg = config(
+        tmp.path(),
+        "npy.toml",
+        PLATE,
+        &format!("{ok_array}\nsignal_map = {{ kind = \"image\", path = \"refl.npy\" }}"),
+    );
+    let o = run(&["simulate", cfg.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let det = s["mean_detections_per_pixel"].as_f64().unwrap();
+    // 10,000 ± 5σ (σ = √(40,000·0.25·0.75)/4 pixels averaged = 87/4).
+    assert!((det - 10_000.0).abs() < 5.0 * 87.0 / 4.0, "{det}");
+    // A map of the wrong shape is refused naming the field.
+    std::fs::write(&npy_map, npy::to_bytes(&[2, 8], &[0.25f64; 16]).unwrap()).unwrap();
+    let o = run(&["simulate", cfg.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("array.signal_map.path") && err.contains("[2, 8]"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -265,4 +294,77 @@ fn bench_array_prints_its_rates() {
         assert!(run["peak_memory_bytes"].as_f64().unwrap() < 1e9);
     }
     assert!(r["projected_64x64_1e7_seconds"].as_f64().unwrap() > 0.0);
+}
+
+/// The set as its users read it: numpy.load reads the .npy arrays and pyuff the UFF file
+/// (scripts/array-crosscheck.sh, in the cached venv), and they agree with the summary, the
+/// pixel grid and the maps; a perturbed map is caught. Needs python3 (required under CI).
+#[test]
+fn numpy_and_pyuff_read_the_set() {
+    if !tofprobe_testkit::tools::have(&["python3"], "the numpy/pyuff reading of an array set") {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = config(
+        tmp.path(),
+        "plate.toml",
+        PLATE,
+        "rows = 3\ncols = 5\npitch_um = 30.0\nfield_of_view_deg = 30.0\ndistance_mm = 100.0",
+    );
+    let out = tmp.path().join("out");
+    let o = run(&[
+        "simulate",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let check = |extra: &[&str]| {
+        Command::new("bash")
+            .arg(root.join("scripts/array-crosscheck.sh"))
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = check(&[]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && text.contains("array-check: ok (3 x 5 pixels, 4 bins"),
+        "{text}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        !check(&["--break"]).status.success(),
+        "a perturbed map must fail"
+    );
+}
+
+/// The Haar example as users run it: `simulate scenes/edge-sweep.toml --out DIR` finds a
+/// transition in every pixel, writes the event-time map, and fits the edge at its 10 m/s
+/// along +x within 5 % and 3°.
+#[test]
+fn the_edge_sweep_example_measures_its_edge() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let out = tmp.path().join("edge");
+    let o = run(&[
+        "simulate",
+        root.join("scenes/edge-sweep.toml").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(s["event_pixels"], 1024);
+    let v = s["edge_velocity_mm_per_s"].as_f64().unwrap();
+    assert!((v / 10_000.0 - 1.0).abs() < 0.05, "{v}");
+    assert!(s["edge_direction_deg"].as_f64().unwrap().abs() < 3.0);
+    let t = npy::from_bytes(&std::fs::read(out.join("event_time_ms.npy")).unwrap()).unwrap();
+    assert_eq!(t.shape, vec![32, 32]);
+    // Column 0 (x = 0.5 mm) steps at (0.5 + 1) mm / 10 m/s = 0.15 ms, column 31 at 3.25 ms.
+    let col = |c: usize| (0..32).map(|r| t.data[r * 32 + c]).sum::<f64>() / 32.0;
+    assert!((col(0) - 0.15).abs() < 0.1 && (col(31) - 3.25).abs() < 0.1);
 }

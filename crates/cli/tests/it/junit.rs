@@ -326,6 +326,42 @@ fn configuration_name_is_escaped_and_foreign_files_refused() {
     );
 }
 
+/// Whether `c` is in XML 1.0's `Char` production (#x9 | #xA | #xD | [#x20-#xD7FF] |
+/// [#xE000-#xFFFD] | [#x10000-#x10FFFF]).
+fn xml_char(c: char) -> bool {
+    matches!(c, '\t' | '\n' | '\r' | '\u{20}'..='\u{d7ff}' | '\u{e000}'..='\u{fffd}')
+        || c >= '\u{10000}'
+}
+
+/// A configuration named with characters XML 1.0 does not allow (the noncharacters U+FFFE
+/// and U+FFFF, a C0 control) gives a report every character of which is XML (U+FFFE went
+/// into the file raw, and XML parsers refused it), the name's other characters kept.
+#[test]
+fn configuration_name_with_xml_invalid_characters_is_replaced() {
+    if !tools() {
+        eprintln!("*** SKIPPED: EDA tools missing (scripts/install-tools.sh) ***");
+        return;
+    }
+    let d = scratch("noncharacters");
+    let rtl = copy_short(&d);
+    let name = "cfg\u{fffe}x\u{ffff}y\u{1b}z";
+    let config = d.join(format!("{name}.toml"));
+    std::fs::write(&config, default_text()).expect("config");
+    let file = d.join("report.xml");
+    let o = cosim(&rtl, &d, &file, &[config.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let xml = std::fs::read_to_string(&file).expect("report");
+    let bad: Vec<char> = xml.chars().filter(|c| !xml_char(*c)).collect();
+    assert!(bad.is_empty(), "characters outside XML 1.0: {bad:?}");
+    let els = parse(&xml);
+    let case = els.iter().find(|e| e.name == "testcase").expect("case");
+    assert!(
+        case.attrs["classname"].starts_with("cfg\u{fffd}x\u{fffd}y\u{fffd}z."),
+        "{:?}",
+        case.attrs["classname"]
+    );
+}
+
 /// The checker above can fail: crossed tags, a raw `<` in a value, an unknown entity.
 #[test]
 fn checker_rejects_malformed_xml() {

@@ -7,6 +7,8 @@ mod array;
 mod bench_fullband;
 mod bench_sd;
 mod bit_true;
+mod blame;
+mod bounds;
 mod cli;
 mod committed;
 mod common;

@@ -142,6 +142,14 @@ impl Default for ProbeConfig {
     }
 }
 
+/// Deepest periodic ROM (2^21 entries), capped from the memory it needs as the windowed
+/// ROM is (`tofprobe_design::MAX_WINDOWED_FRAME`, ≈ 400 MB): the periodic ROM is generated
+/// whole with its wrap search, and `simulate` peaks at ≈ 160 bytes per entry (measured:
+/// 168 MB at 2^20, 341 MB at 2^21, 543 MB at 2^22; 2^24 took 2 GB and 2^26 aborted out of
+/// memory after 5 minutes). Bins 2^21 deep are f_s/2^21 apart (4.8 Hz at 10 MHz); finer
+/// bins are a windowed ROM's (L = N).
+pub const MAX_PERIODIC_ROM_DEPTH: usize = 1 << 21;
+
 /// Smallest probe amplitude A_p accepted: 1 % of full scale, 40 dB down, where an order-1
 /// OSR-4 design (the coarsest allowed) still keeps the probe above its in-band
 /// quantisation noise.
@@ -177,14 +185,41 @@ impl ProbeConfig {
     /// must be a whole number of periods: otherwise every frame boundary is a phase jump
     /// of the probe and its bins are no longer orthogonal over the frame. The error gives
     /// the largest depth ≤ L that divides N and the nearest whole-period frame.
+    ///
+    /// First, a periodic ROM deeper than [`MAX_PERIODIC_ROM_DEPTH`] is refused with the
+    /// deepest one that fits and divides N (so the divisor search below is bounded too).
     pub fn check_frame(&self, frame_pulses: u64) -> Result<(), DspError> {
         let l = self.rom_depth as u64;
-        if self.rom_mode != RomMode::Periodic || l == 0 || frame_pulses.is_multiple_of(l) {
+        if self.rom_mode != RomMode::Periodic {
             return Ok(());
         }
-        let divisor = (16..=l.min(frame_pulses))
-            .rev()
-            .find(|&d| frame_pulses.is_multiple_of(d));
+        let largest_divisor = |at_most: u64| {
+            (16..=at_most.min(frame_pulses))
+                .rev()
+                .find(|&d| frame_pulses.is_multiple_of(d))
+        };
+        if self.rom_depth > MAX_PERIODIC_ROM_DEPTH {
+            let cap = MAX_PERIODIC_ROM_DEPTH as u64;
+            let hint = match largest_divisor(cap) {
+                Some(d) => format!(
+                    "rom_depth = {d} (the deepest that fits and divides N = {frame_pulses})"
+                ),
+                None => format!("rom_depth <= {cap}"),
+            };
+            return Err(DspError::out_of_range(
+                "probe.rom_depth",
+                self.rom_depth,
+                format!(
+                    "16 <= rom_depth <= {cap} in periodic mode (the ROM is built whole: \
+                     ≈ 160 bytes per entry, ≈ 340 MB at the limit)"
+                ),
+            )
+            .with_hint(hint));
+        }
+        if l == 0 || frame_pulses.is_multiple_of(l) {
+            return Ok(());
+        }
+        let divisor = largest_divisor(l);
         let periods = ((frame_pulses as f64 / l as f64).round() as u64).max(1);
         let mut hint = format!("a frame of {} pulses ({periods} period(s))", periods * l);
         if let Some(d) = divisor {

@@ -15,7 +15,7 @@ pub mod quality;
 pub mod realize;
 pub mod wrap;
 
-pub use config::{ProbeConfig, ProbeConvention, RomMode};
+pub use config::{MAX_PERIODIC_ROM_DEPTH, ProbeConfig, ProbeConvention, RomMode};
 pub use fullband::FullBandProber;
 pub use isa::KernelPath;
 pub use modulator::Modulator;

@@ -1,0 +1,61 @@
+"""Type stubs of tofprobe's native module (crates/python/src/lib.rs)."""
+
+import os
+from typing import Any, TypedDict
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class Summary(TypedDict):
+    origin: str
+    mode: str
+    bins: list[int]
+    frequencies_hz: list[float]
+    tdc_bits: int
+    width: int
+    frame_pulses: int
+    rom_depth: int
+    registers: int
+    shift: int
+    frac_bits: int
+    register_frac_bits: int
+    adders: int
+    cycles_per_pulse: int
+    haar_scales: int
+    pulses: int
+    seed: int
+    laser_rate_hz: float
+    tdc_lsb_mm: float
+    notes: list[str]
+    array: tuple[int, int] | None
+
+class Design:
+    """A tofprobe design resolved once; see ``help(tofprobe.Design)``."""
+
+    @staticmethod
+    def default() -> Design: ...
+    @staticmethod
+    def from_toml(source: str | os.PathLike[str]) -> Design: ...
+    @staticmethod
+    def from_json(text: str) -> Design: ...
+    def to_json(self) -> str: ...
+    def to_toml(self) -> str: ...
+    @property
+    def origin(self) -> str: ...
+    def summary(self) -> Summary: ...
+    def simulate_scene(
+        self, seed: int | None = None, pixel: tuple[int, int] | None = None
+    ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.int32]]: ...
+    def run_pixel(
+        self, valid: npt.ArrayLike, tdc: npt.ArrayLike
+    ) -> npt.NDArray[np.int64]: ...
+    def spectrum(
+        self, registers: npt.ArrayLike, pulses: int | None = None
+    ) -> tuple[
+        npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]
+    ]: ...
+    def probe_rom(self) -> npt.NDArray[np.int8]: ...
+    def simulate_array(self) -> dict[str, npt.NDArray[Any]]: ...
+    def __reduce__(self) -> tuple[Any, tuple[str]]: ...

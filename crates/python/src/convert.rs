@@ -1,0 +1,257 @@
+//! numpy in, Rust slices out, and the errors on the way: every array argument is taken
+//! through `numpy.asarray`, checked for its dimension and dtype (a `TypeError` naming the
+//! argument otherwise) and borrowed without a copy when it is aligned and contiguous (an
+//! array rebuilt from a pickle or a Dask frame may be neither: it is copied once, then
+//! borrowed). Library errors become `ValueError` with the library's message, which names
+//! the field, the value and the allowed range.
+
+use numpy::{Element, PyReadonlyArray1};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+/// A library error as a Python `ValueError` carrying its message.
+pub fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// `numpy.asarray(obj)`, refused unless it is one-dimensional; `name` is the argument.
+pub fn as_1d<'py>(name: &str, obj: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    let py = obj.py();
+    let array = py.import("numpy")?.call_method1("asarray", (obj,))?;
+    let ndim: usize = array.getattr("ndim")?.extract()?;
+    if ndim != 1 {
+        let shape = array.getattr("shape")?.str()?.to_string();
+        return Err(PyValueError::new_err(format!(
+            "`{name}` must be a one-dimensional array, got shape {shape}"
+        )));
+    }
+    Ok(array)
+}
+
+/// The dtype's name of an array (for messages).
+pub fn dtype_name(array: &Bound<'_, PyAny>) -> String {
+    array
+        .getattr("dtype")
+        .and_then(|d| d.str())
+        .map(|s| s.to_string())
+        .unwrap_or_else(|_| "?".into())
+}
+
+/// A borrowed 1-D array of `T`, or `None` when its dtype is not `T`. Copies first when the
+/// array is misaligned or not contiguous (then `as_slice` would refuse it).
+pub fn try_borrow<'py, T: Element>(
+    array: &Bound<'py, PyAny>,
+) -> PyResult<Option<PyReadonlyArray1<'py, T>>> {
+    let Ok(a) = array.extract::<PyReadonlyArray1<'py, T>>() else {
+        return Ok(None);
+    };
+    if a.as_slice().is_ok() {
+        return Ok(Some(a));
+    }
+    // `.copy()` is C-contiguous and aligned.
+    let copy = array.call_method0("copy")?;
+    Ok(Some(copy.extract::<PyReadonlyArray1<'py, T>>()?))
+}
+
+/// The slice of a borrowed array ([`try_borrow`] made it contiguous).
+pub fn slice<'a, T: Element>(a: &'a PyReadonlyArray1<'_, T>, name: &str) -> PyResult<&'a [T]> {
+    a.as_slice()
+        .map_err(|e| PyValueError::new_err(format!("`{name}`: {e}")))
+}
+
+/// A bool array argument (`valid`): refused with a `TypeError` for any other dtype.
+pub fn bool_array<'py>(
+    name: &str,
+    obj: &Bound<'py, PyAny>,
+) -> PyResult<PyReadonlyArray1<'py, bool>> {
+    let array = as_1d(name, obj)?;
+    try_borrow::<bool>(&array)?.ok_or_else(|| {
+        PyTypeError::new_err(format!(
+            "`{name}` must be a bool array, got dtype {}",
+            dtype_name(&array)
+        ))
+    })
+}
+
+/// A register array argument: int64, or any integer dtype converted to it (`TypeError`
+/// for floats and the rest).
+pub fn int64_array<'py>(
+    name: &str,
+    obj: &Bound<'py, PyAny>,
+) -> PyResult<PyReadonlyArray1<'py, i64>> {
+    let array = as_1d(name, obj)?;
+    if let Some(a) = try_borrow::<i64>(&array)? {
+        return Ok(a);
+    }
+    let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
+    if kind != "i" && kind != "u" {
+        return Err(PyTypeError::new_err(format!(
+            "`{name}` must be an integer array (int64), got dtype {}",
+            dtype_name(&array)
+        )));
+    }
+    let converted = array.call_method1("astype", ("int64",))?;
+    converted.extract::<PyReadonlyArray1<'py, i64>>()
+}
+
+/// The TDC codes of one pulse stream in any integer dtype, borrowed.
+pub enum Codes<'py> {
+    U8(PyReadonlyArray1<'py, u8>),
+    U16(PyReadonlyArray1<'py, u16>),
+    U32(PyReadonlyArray1<'py, u32>),
+    U64(PyReadonlyArray1<'py, u64>),
+    I8(PyReadonlyArray1<'py, i8>),
+    I16(PyReadonlyArray1<'py, i16>),
+    I32(PyReadonlyArray1<'py, i32>),
+    I64(PyReadonlyArray1<'py, i64>),
+}
+
+impl std::fmt::Debug for Codes<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Codes")
+    }
+}
+
+/// The `tdc` argument: any integer dtype, one-dimensional (`TypeError` otherwise).
+pub fn codes<'py>(name: &str, obj: &Bound<'py, PyAny>) -> PyResult<Codes<'py>> {
+    let a = as_1d(name, obj)?;
+    if let Some(x) = try_borrow::<i32>(&a)? {
+        return Ok(Codes::I32(x));
+    }
+    if let Some(x) = try_borrow::<i64>(&a)? {
+        return Ok(Codes::I64(x));
+    }
+    if let Some(x) = try_borrow::<u16>(&a)? {
+        return Ok(Codes::U16(x));
+    }
+    if let Some(x) = try_borrow::<u8>(&a)? {
+        return Ok(Codes::U8(x));
+    }
+    if let Some(x) = try_borrow::<u32>(&a)? {
+        return Ok(Codes::U32(x));
+    }
+    if let Some(x) = try_borrow::<u64>(&a)? {
+        return Ok(Codes::U64(x));
+    }
+    if let Some(x) = try_borrow::<i16>(&a)? {
+        return Ok(Codes::I16(x));
+    }
+    if let Some(x) = try_borrow::<i8>(&a)? {
+        return Ok(Codes::I8(x));
+    }
+    Err(PyTypeError::new_err(format!(
+        "`{name}` must be an integer array (TDC codes), got dtype {}",
+        dtype_name(&a)
+    )))
+}
+
+/// A TDC code stream borrowed from numpy, whatever its integer type.
+#[derive(Debug, Clone, Copy)]
+pub enum CodeSlice<'a> {
+    U8(&'a [u8]),
+    U16(&'a [u16]),
+    U32(&'a [u32]),
+    U64(&'a [u64]),
+    I8(&'a [i8]),
+    I16(&'a [i16]),
+    I32(&'a [i32]),
+    I64(&'a [i64]),
+}
+
+impl<'py> Codes<'py> {
+    /// The borrowed slice.
+    pub fn slice(&self, name: &str) -> PyResult<CodeSlice<'_>> {
+        Ok(match self {
+            Codes::U8(a) => CodeSlice::U8(slice(a, name)?),
+            Codes::U16(a) => CodeSlice::U16(slice(a, name)?),
+            Codes::U32(a) => CodeSlice::U32(slice(a, name)?),
+            Codes::U64(a) => CodeSlice::U64(slice(a, name)?),
+            Codes::I8(a) => CodeSlice::I8(slice(a, name)?),
+            Codes::I16(a) => CodeSlice::I16(slice(a, name)?),
+            Codes::I32(a) => CodeSlice::I32(slice(a, name)?),
+            Codes::I64(a) => CodeSlice::I64(slice(a, name)?),
+        })
+    }
+}
+
+impl CodeSlice<'_> {
+    /// Number of codes.
+    pub fn len(&self) -> usize {
+        match self {
+            CodeSlice::U8(s) => s.len(),
+            CodeSlice::U16(s) => s.len(),
+            CodeSlice::U32(s) => s.len(),
+            CodeSlice::U64(s) => s.len(),
+            CodeSlice::I8(s) => s.len(),
+            CodeSlice::I16(s) => s.len(),
+            CodeSlice::I32(s) => s.len(),
+            CodeSlice::I64(s) => s.len(),
+        }
+    }
+}
+
+/// Fills `out` with the detections of pulses `first .. first + valid.len()` of (`valid`,
+/// `tdc`): `Some(code)` where valid, `None` elsewhere (the code of an invalid pulse is
+/// ignored). A valid code outside 0 ..= `max_code` is refused, naming the pulse and the
+/// range.
+pub fn detections(
+    valid: &[bool],
+    tdc: CodeSlice<'_>,
+    first: usize,
+    max_code: u32,
+    out: &mut Vec<Option<u32>>,
+) -> Result<(), String> {
+    let end = first + valid.len();
+    match tdc {
+        CodeSlice::U8(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::U16(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::U32(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::U64(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::I8(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::I16(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::I32(s) => fill(valid, &s[first..end], first, max_code, out),
+        CodeSlice::I64(s) => fill(valid, &s[first..end], first, max_code, out),
+    }
+}
+
+/// [`detections`] for one integer type (one pass, no branch on the dtype per pulse).
+fn fill<T>(
+    valid: &[bool],
+    codes: &[T],
+    first: usize,
+    max_code: u32,
+    out: &mut Vec<Option<u32>>,
+) -> Result<(), String>
+where
+    T: Copy + Into<i128>,
+    u32: TryFrom<T>,
+{
+    out.clear();
+    let mut ok = true;
+    out.extend(valid.iter().zip(codes).map(|(&v, &c)| {
+        if !v {
+            return None;
+        }
+        match u32::try_from(c) {
+            Ok(x) if x <= max_code => Some(x),
+            _ => {
+                ok = false;
+                None
+            }
+        }
+    }));
+    if ok {
+        return Ok(());
+    }
+    let (i, c) = valid
+        .iter()
+        .zip(codes)
+        .enumerate()
+        .find(|(_, (v, c))| **v && !(0..=i128::from(max_code)).contains(&(**c).into()))
+        .map(|(i, (_, &c))| (first + i, c.into()))
+        .unwrap_or((first, -1));
+    Err(format!(
+        "`tdc[{i}]` = {c} is outside the pixel's TDC codes 0 ..= {max_code} \
+         (pixel.tdc_bits); a code in that range would work, or valid[{i}] = False"
+    ))
+}

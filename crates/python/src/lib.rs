@@ -1,0 +1,365 @@
+//! The Python package `tofprobe` (module `tofprobe._native`): a resolved design as
+//! `tofprobe.Design`, numpy arrays in and out. Conversion only: every computation is a
+//! library entry — the one resolution (`tofprobe_design`), the photon source
+//! (`tofprobe_scene::PhotonSource`), the pixel's `FrameDriver`, the one readout → phasor
+//! function (`tofprobe_pixel::spectrum::phasors`) and the array model
+//! (`tofprobe_array::output::simulate`) — run with the GIL released (`Python::detach`).
+//! Errors are `ValueError`s carrying the library's message (it names the field, the value
+//! and what would work) or `TypeError`s naming the argument of a wrong dtype.
+
+mod convert;
+
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString, PyTuple};
+use tofprobe_design::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, ResolvedDesign};
+use tofprobe_dsp::sd::ProbeRom;
+use tofprobe_pixel::FrameDriver;
+
+use convert::{CodeSlice, value_error};
+
+/// Origin of a design given as TOML text.
+const TEXT_ORIGIN: &str = "<TOML text>";
+
+/// Pulses converted and run per step of `run_pixel` (64 k: the detections stay in cache).
+const CHUNK: usize = 1 << 16;
+
+/// A tofprobe design resolved once (``tofprobe config``'s resolution): sensor, scene,
+/// acquisition, the pixel's parameters and widths, the Fourier bins and the ΣΔ probe.
+///
+/// Build one with ``Design.default()`` (the embedded paper Fig. 8 case),
+/// ``Design.from_toml(path_or_text)`` or ``Design.from_json(text)``; then
+/// ``simulate_scene`` → ``run_pixel`` → ``spectrum`` is ``tofprobe simulate``'s bit-true
+/// frame with numpy arrays at each step, and ``simulate_array`` runs an ``[array]`` design.
+/// Computations release the GIL; do not mutate an input array from another thread during a
+/// call. A Design is immutable and picklable.
+#[pyclass(module = "tofprobe._native", name = "Design", frozen)]
+#[derive(Debug)]
+struct Design {
+    inner: ResolvedDesign,
+    /// The probe ROM (Fourier), generated on first use.
+    rom: OnceLock<Option<ProbeRom>>,
+}
+
+impl Design {
+    fn new(inner: ResolvedDesign) -> Self {
+        Design {
+            inner,
+            rom: OnceLock::new(),
+        }
+    }
+
+    fn resolve(text: &str, origin: &str) -> PyResult<Self> {
+        let doc = Document::from_toml_str(text, origin).map_err(value_error)?;
+        tofprobe_design::resolve(doc, origin)
+            .map(Design::new)
+            .map_err(value_error)
+    }
+
+    /// The probe ROM (`None` in Haar mode), generated once without the GIL.
+    fn rom(&self, py: Python<'_>) -> PyResult<Option<&ProbeRom>> {
+        if let Some(r) = self.rom.get() {
+            return Ok(r.as_ref());
+        }
+        let r = py.detach(|| self.inner.probe_rom()).map_err(value_error)?;
+        Ok(self.rom.get_or_init(|| r).as_ref())
+    }
+
+    /// The probe ROM, refused in Haar mode (`what` names the call).
+    fn fourier_rom(&self, py: Python<'_>, what: &str) -> PyResult<&ProbeRom> {
+        self.rom(py)?.ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "{what} needs a Fourier pixel, and pixel.mode of `{}` resolved to \"{}\" \
+                 (set pixel.mode = \"fourier\")",
+                self.inner.origin, self.inner.pixel.mode
+            ))
+        })
+    }
+
+    /// The largest TDC code the pixel takes: 2^T − 1.
+    fn max_code(&self) -> u32 {
+        ((1u64 << self.inner.pixel.tdc_bits.min(32)) - 1) as u32
+    }
+}
+
+#[pymethods]
+impl Design {
+    /// The embedded default design (the paper's Fig. 8: a 0.1 mm, 4.5 kHz sine; 10^7
+    /// pulses; 16 bins), as ``tofprobe`` commands use without a configuration.
+    #[staticmethod]
+    fn default() -> PyResult<Self> {
+        Design::resolve(DEFAULT_TOML, DEFAULT_ORIGIN)
+    }
+
+    /// A design from a TOML file or TOML text, resolved (validated and completed).
+    ///
+    /// ``source`` is a path (``str`` or ``os.PathLike``) or the TOML text itself: a
+    /// ``str`` holding a newline or ``=`` is text, any other ``str`` a path. Raises
+    /// ``ValueError`` naming the key and the allowed values for a document that does not
+    /// resolve, and for a file that cannot be read.
+    #[staticmethod]
+    fn from_toml(source: &Bound<'_, PyAny>) -> PyResult<Self> {
+        if let Ok(s) = source.cast::<PyString>() {
+            let s = s.to_cow()?;
+            if s.contains('\n') || s.contains('=') {
+                return Design::resolve(&s, TEXT_ORIGIN);
+            }
+        }
+        let path: PathBuf = source.extract()?;
+        tofprobe_design::load(Some(&path))
+            .map(Design::new)
+            .map_err(value_error)
+    }
+
+    /// A design serialised by ``to_json`` (no resolution runs again).
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        ResolvedDesign::from_json(text)
+            .map(Design::new)
+            .map_err(value_error)
+    }
+
+    /// The resolved design as JSON (floats round-trip exactly); ``from_json`` reads it.
+    fn to_json(&self) -> PyResult<String> {
+        self.inner.to_json().map_err(value_error)
+    }
+
+    /// The configuration document as TOML text (``Design.from_toml`` reads it back to the
+    /// same resolution).
+    fn to_toml(&self) -> PyResult<String> {
+        toml::to_string(&self.inner.document).map_err(value_error)
+    }
+
+    /// Where the design came from: the file path, ``<embedded default>`` or ``<TOML text>``.
+    #[getter]
+    fn origin(&self) -> &str {
+        &self.inner.origin
+    }
+
+    /// The resolved values as a dict: ``mode``, ``bins`` (ROM bin indices k),
+    /// ``frequencies_hz`` (f_k = k·f_s/L), ``tdc_bits`` (T), ``width`` (W),
+    /// ``frame_pulses`` (N), ``rom_depth`` (L), ``registers`` (2B, or 2^(U+1) − 1 Haar),
+    /// ``shift`` (S), ``frac_bits`` (F), ``register_frac_bits`` (G: the registers count
+    /// 2^−G codes), ``adders`` (A), ``cycles_per_pulse`` (C),
+    /// ``pulses`` (the acquisition), ``seed``, ``laser_rate_hz``, ``tdc_lsb_mm``, ``notes``
+    /// and ``array`` (``(rows, cols)`` or ``None``).
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = &self.inner;
+        let p = &d.pixel;
+        let fs = d.sensor().laser_rate_hz;
+        let out = PyDict::new(py);
+        out.set_item("origin", &d.origin)?;
+        out.set_item("mode", p.mode.to_string())?;
+        out.set_item("bins", d.bins.clone())?;
+        let freqs: Vec<f64> = d
+            .bins
+            .iter()
+            .map(|&k| tofprobe_dsp::dft::bin_frequency_hz(k as f64, p.rom_depth, fs))
+            .collect();
+        out.set_item("frequencies_hz", freqs)?;
+        out.set_item("tdc_bits", p.tdc_bits)?;
+        out.set_item("width", p.width)?;
+        out.set_item("frame_pulses", p.frame_pulses)?;
+        out.set_item("rom_depth", p.rom_depth)?;
+        out.set_item("registers", p.registers())?;
+        out.set_item("shift", p.shift)?;
+        out.set_item("frac_bits", p.frac_bits)?;
+        out.set_item("register_frac_bits", p.register_frac_bits())?;
+        out.set_item("adders", p.adders)?;
+        out.set_item("cycles_per_pulse", p.cycles_per_pulse)?;
+        out.set_item("haar_scales", p.haar_scales)?;
+        out.set_item("pulses", d.pulses())?;
+        out.set_item("seed", d.document.acquisition.seed)?;
+        out.set_item("laser_rate_hz", fs)?;
+        out.set_item("tdc_lsb_mm", d.sensor().tdc_lsb_mm())?;
+        out.set_item("notes", d.notes.clone())?;
+        out.set_item("array", d.array.as_ref().map(|a| (a.rows, a.cols)))?;
+        Ok(out)
+    }
+
+    /// One frame's photons: ``(valid, tdc)``, numpy ``bool`` and ``int32`` arrays of N =
+    /// ``frame_pulses`` pulses (``tdc`` is 0 where ``valid`` is False). The same photons as
+    /// ``tofprobe simulate``'s bit-true frame; ``seed`` replaces ``[acquisition] seed``.
+    /// For an ``[array]`` design, ``pixel=(row, col)`` gives that pixel's own stream (its
+    /// rates, the scene at its centre, its own seed), the one ``simulate_array`` runs.
+    #[pyo3(signature = (seed=None, pixel=None))]
+    fn simulate_scene<'py>(
+        &self,
+        py: Python<'py>,
+        seed: Option<u64>,
+        pixel: Option<(usize, usize)>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let mut design = self.inner.clone();
+        if let Some(s) = seed {
+            design.document.acquisition.seed = s;
+        }
+        let source = match pixel {
+            Some((r, c)) => design.pixel_source(r, c),
+            None => design.photon_source(),
+        }
+        .map_err(value_error)?;
+        let n = design.pixel.frame_pulses;
+        let (valid, tdc) = py.detach(|| {
+            let record = source.record(n);
+            let valid: Vec<bool> = record.iter().map(Option::is_some).collect();
+            let tdc: Vec<i32> = record.iter().map(|d| d.map_or(0, |c| c as i32)).collect();
+            (valid, tdc)
+        });
+        PyTuple::new(
+            py,
+            [
+                valid.into_pyarray(py).into_any(),
+                tdc.into_pyarray(py).into_any(),
+            ],
+        )
+    }
+
+    /// The registers after one frame of ``(valid, tdc)`` through the bit-true pixel (the
+    /// transaction level, ``tofprobe_pixel::FrameDriver``): an int64 array of the
+    /// sign-extended register words (2B: I and Q of each bin; Haar 2^(U+1) − 1).
+    ///
+    /// ``valid`` is a 1-D bool array, ``tdc`` a 1-D integer array of the same length, at
+    /// most ``frame_pulses`` pulses; pulse i reads ROM address i mod L. A valid pulse's
+    /// code must be in 0 .. 2^T − 1 (``tdc_bits``); an invalid pulse's code is ignored.
+    fn run_pixel<'py>(
+        &self,
+        py: Python<'py>,
+        valid: &Bound<'py, PyAny>,
+        tdc: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let valid_a = convert::bool_array("valid", valid)?;
+        let tdc_a = convert::codes("tdc", tdc)?;
+        let valid_s = convert::slice(&valid_a, "valid")?;
+        let tdc_s: CodeSlice<'_> = tdc_a.slice("tdc")?;
+        if valid_s.len() != tdc_s.len() {
+            return Err(PyValueError::new_err(format!(
+                "`valid` has {} pulses and `tdc` {}: one code per pulse",
+                valid_s.len(),
+                tdc_s.len()
+            )));
+        }
+        let n = self.inner.pixel.frame_pulses;
+        if valid_s.len() as u64 > n {
+            return Err(PyValueError::new_err(format!(
+                "{} pulses exceed one frame of pixel.frame_pulses = {n}: pass at most {n} \
+                 (one frame; call once per frame)",
+                valid_s.len()
+            )));
+        }
+        let rom = self.rom(py)?.map(|r| &r.image);
+        let params = &self.inner.pixel;
+        let max_code = self.max_code();
+        let words = py.detach(|| -> Result<Vec<i64>, String> {
+            let mut driver = FrameDriver::new(params, rom).map_err(|e| e.to_string())?;
+            let mut buf = Vec::with_capacity(CHUNK);
+            for (k, v) in valid_s.chunks(CHUNK).enumerate() {
+                let first = k * CHUNK;
+                convert::detections(v, tdc_s, first, max_code, &mut buf)?;
+                driver.run(&buf, first as u64).map_err(|e| e.to_string())?;
+            }
+            Ok(driver.readout().words)
+        });
+        Ok(words.map_err(PyValueError::new_err)?.into_pyarray(py))
+    }
+
+    /// The spectrum of a Fourier frame's registers (``tofprobe_pixel::spectrum::phasors``,
+    /// the one readout → phasor function): ``(frequencies_hz, amplitude_um, phase_deg)``,
+    /// float64 arrays of B bins in ROM order. ``pulses`` is the frame's length (default
+    /// N = ``frame_pulses``).
+    #[pyo3(signature = (registers, pulses=None))]
+    fn spectrum<'py>(
+        &self,
+        py: Python<'py>,
+        registers: &Bound<'py, PyAny>,
+        pulses: Option<u64>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let regs = convert::int64_array("registers", registers)?;
+        let words = convert::slice(&regs, "registers")?;
+        let rom = self.fourier_rom(py, "spectrum")?;
+        let pulses = pulses.unwrap_or(self.inner.pixel.frame_pulses);
+        let lsb_mm = self.inner.sensor().tdc_lsb_mm();
+        let bins = tofprobe_pixel::spectrum::phasors(&self.inner.pixel, rom, words, pulses, lsb_mm)
+            .map_err(value_error)?;
+        let f: Vec<f64> = bins.iter().map(|b| b.frequency_hz).collect();
+        let a: Vec<f64> = bins.iter().map(|b| b.amplitude_um).collect();
+        let p: Vec<f64> = bins.iter().map(|b| b.phase_deg).collect();
+        PyTuple::new(
+            py,
+            [
+                f.into_pyarray(py).into_any(),
+                a.into_pyarray(py).into_any(),
+                p.into_pyarray(py).into_any(),
+            ],
+        )
+    }
+
+    /// The ΣΔ probe ROM the pixel reads: an int8 array [L, 2B] of ±1 (row = ROM address,
+    /// column = register: 2k is bin k's I, 2k + 1 its Q). ``ValueError`` in Haar mode.
+    fn probe_rom<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let rom = self.fourier_rom(py, "probe_rom")?;
+        let (l, r) = (rom.image.depth(), rom.image.registers());
+        let bits = py.detach(|| {
+            let mut v = Vec::with_capacity(l * r);
+            for a in 0..l {
+                v.extend((0..r).map(|j| if rom.image.bit(a, j) { 1i8 } else { -1i8 }));
+            }
+            v
+        });
+        let array = Array2::from_shape_vec((l, r), bits).map_err(value_error)?;
+        Ok(array.into_pyarray(py).into_any())
+    }
+
+    /// Runs an ``[array]`` design (``tofprobe simulate CONFIG --out DIR``'s model, nothing
+    /// written): a dict of numpy arrays ``registers`` (int64 [R, C, K]), ``detections``
+    /// (uint64 [R, C]) and, for a Fourier pixel, ``frequencies_hz`` ([B]),
+    /// ``amplitude_um`` and ``phase_deg`` (float64 [B, R, C]). Pixel (r, c)'s registers
+    /// are ``run_pixel(*simulate_scene(pixel=(r, c)))``.
+    fn simulate_array<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let design = &self.inner;
+        let (frame, maps, _) = py
+            .detach(|| tofprobe_array::output::simulate(design))
+            .map_err(value_error)?;
+        let (r, c, k) = (frame.rows, frame.cols, frame.registers_per_pixel);
+        let out = PyDict::new(py);
+        let regs = Array3::from_shape_vec((r, c, k), frame.registers).map_err(value_error)?;
+        out.set_item("registers", regs.into_pyarray(py))?;
+        let det = Array2::from_shape_vec((r, c), frame.detections).map_err(value_error)?;
+        out.set_item("detections", det.into_pyarray(py))?;
+        if let Some(m) = maps {
+            let b = m.bins();
+            out.set_item("frequencies_hz", m.frequencies_hz.into_pyarray(py))?;
+            let amp = Array3::from_shape_vec((b, r, c), m.amplitude_um).map_err(value_error)?;
+            out.set_item("amplitude_um", amp.into_pyarray(py))?;
+            let ph = Array3::from_shape_vec((b, r, c), m.phase_deg).map_err(value_error)?;
+            out.set_item("phase_deg", ph.into_pyarray(py))?;
+        }
+        Ok(out)
+    }
+
+    /// Pickling: the resolved design travels as its JSON.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let ctor = slf.get_type().getattr("from_json")?;
+        Ok((ctor, (slf.get().to_json()?,)))
+    }
+
+    fn __repr__(&self) -> String {
+        let p = &self.inner.pixel;
+        format!(
+            "Design(origin={:?}, mode={}, B={}, W={}, N={}, L={})",
+            self.inner.origin, p.mode, p.bins, p.width, p.frame_pulses, p.rom_depth
+        )
+    }
+}
+
+/// tofprobe's library from Python: ``tofprobe.Design``.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Design>()?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Builds the Python package `tofprobe` (crates/python: pyo3 + maturin, an abi3 wheel) in
+# release mode in the workspace's target dir (reusing the library crates `cargo test
+# --release` compiled), installs it into the scripts' venv (scripts/py-venv.sh) and runs
+# its pytest suite (crates/python/tests). Prints the build and test times.
+# A missing python3 fails under CI (TOFPROBE_REQUIRE_TOOLS=1 or CI set) and skips otherwise.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+if ! command -v python3 >/dev/null 2>&1; then
+  if [ "${TOFPROBE_REQUIRE_TOOLS:-0}" = 1 ] || { [ -n "${CI:-}" ] && [ "${CI}" != false ]; }; then
+    echo "python-package: FAILED: python3 not found, and CI requires the Python package's tests" >&2
+    exit 1
+  fi
+  echo "python-package: SKIPPED (python3 not found): the Python package was not built or tested"
+  exit 0
+fi
+venv="$("$root/scripts/py-venv.sh")"
+target="${CARGO_TARGET_DIR:-$root/target}"
+wheels="$target/python-wheels"
+start=$(date +%s)
+rm -rf "$wheels"
+# --release: the profile `cargo test --release` built the library crates in.
+"$venv/bin/maturin" build --release --quiet -m "$root/crates/python/Cargo.toml" \
+  --interpreter "$venv/bin/python" --out "$wheels" >&2
+"$venv/bin/python" -m pip install -q --disable-pip-version-check --no-deps --force-reinstall \
+  "$wheels"/tofprobe-*.whl >&2
+built=$(date +%s)
+# The CLI binary the bit-identity test compares with (built by `cargo test --release`).
+export TOFPROBE_CLI="${TOFPROBE_CLI:-$target/release/tofprobe}"
+(cd "$root/crates/python" && "$venv/bin/python" -m pytest -q -p no:cacheprovider)
+echo "python-package: ok (build+install $(( built - start )) s, pytest $(( $(date +%s) - built )) s)"
