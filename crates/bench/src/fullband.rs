@@ -69,6 +69,9 @@ pub struct FullBandReport {
     pub full_band_seconds_at_this_rate: f64,
     pub full_band_seconds_idle: Option<f64>,
     pub target_seconds: f64,
+    /// The ΣΔ pass's time on idle cores (its CPU time ÷ threads; wall time where CPU time
+    /// is not measured), s: what `pass` compares with the target.
+    pub judged_seconds: f64,
     pub periodic: Option<BandOut>,
     pub svg: Option<String>,
     pub pass: bool,
@@ -164,6 +167,7 @@ pub fn measure(
     let scalar = scalar_reference_rate(&design, &speed_record(N_SCALAR))?;
     let steps_per_cpu_second = cpu.map(|c| spec.steps as f64 / c);
     let per_core = windowed.steps_per_s / threads as f64;
+    let judged = cpu.map_or(windowed.sd_seconds, |c| c / threads as f64);
     Ok(FullBandReport {
         configuration: loaded.origin.clone(),
         pulses,
@@ -181,7 +185,10 @@ pub fn measure(
         full_band_seconds_idle: steps_per_cpu_second
             .map(|r| FULL_BAND_STEPS / (r * threads as f64)),
         target_seconds: TARGET_S,
-        pass: windowed.sd_seconds <= TARGET_S,
+        judged_seconds: judged,
+        // Judged on CPU time spread over the threads (the run on idle cores): wall time on a
+        // shared machine also counts the waits for a core.
+        pass: judged <= TARGET_S,
         windowed,
         periodic,
         svg,

@@ -39,9 +39,14 @@ pub struct BitTrueOut {
     pub frame_pulses: u64,
     /// One entry per bin, ROM order.
     pub bins: Vec<BinOut>,
-    /// Median amplitude over the bins, µm (noise estimate when most bins hold no tone);
-    /// `null` when the frame has no detections.
+    /// The paper's noise statistic: the mean amplitude over the bins away from the scene's
+    /// tones (more than 1.5 ROM bins f_s/L from each), µm; over all bins when every bin
+    /// holds a tone. `null` when the frame has no detections.
     pub noise_estimate_um: Option<f64>,
+    /// Bins the noise estimate averages.
+    pub noise_bins: usize,
+    /// Median amplitude over all the bins, tones included, µm; `null` without detections.
+    pub median_amplitude_um: Option<f64>,
     /// Wall time of ROM generation (s).
     pub rom_seconds: f64,
     /// ROM organisation: "windowed" or "periodic".
@@ -222,6 +227,31 @@ pub fn write_plot(
 }
 
 /// Runs the bit-true pixel over one frame (Fourier mode; `None` in Haar mode);
+/// The paper's noise statistic over a spectrum: the mean amplitude of the bins more than
+/// 1.5 bin widths from every tone, and how many bins that is (all bins when none is away).
+pub fn noise_away_from_tones(
+    frequencies_hz: &[f64],
+    amplitudes: &[f64],
+    tones: &[(f64, f64)],
+    bin_hz: f64,
+) -> (f64, usize) {
+    let away: Vec<f64> = frequencies_hz
+        .iter()
+        .zip(amplitudes)
+        .filter(|(f, _)| tones.iter().all(|(t, _)| (*f - t).abs() > 1.5 * bin_hz))
+        .map(|(_, &a)| a)
+        .collect();
+    let used = if away.is_empty() {
+        amplitudes
+    } else {
+        &away[..]
+    };
+    (
+        used.iter().sum::<f64>() / used.len().max(1) as f64,
+        used.len(),
+    )
+}
+
 /// `empty_frame`: the frame has no detections, and its figures are absent, not 0.
 fn bit_true(
     design: &ResolvedDesign,
@@ -238,6 +268,10 @@ fn bit_true(
     let lsb_mm = design.sensor().tdc_lsb_mm();
     let spectrum = run_spectrum(&setup, source, lsb_mm, &design.origin)?;
     let model_seconds = t1.elapsed().as_secs_f64();
+    let bin_hz = design.sensor().laser_rate_hz / setup.params.rom_depth as f64;
+    let amplitudes: Vec<f64> = spectrum.bins.iter().map(|b| b.amplitude_um).collect();
+    let frequencies: Vec<f64> = spectrum.bins.iter().map(|b| b.frequency_hz).collect();
+    let noise = noise_away_from_tones(&frequencies, &amplitudes, design.tones(), bin_hz);
     let out = BitTrueOut {
         width_bits: setup.params.width,
         frame_pulses: setup.params.frame_pulses,
@@ -250,7 +284,9 @@ fn bit_true(
                 phase_deg: (!empty_frame).then_some(b.phase_deg),
             })
             .collect(),
-        noise_estimate_um: (!empty_frame).then_some(spectrum.median_amplitude_um),
+        noise_estimate_um: (!empty_frame).then_some(noise.0),
+        noise_bins: noise.1,
+        median_amplitude_um: (!empty_frame).then_some(spectrum.median_amplitude_um),
         rom_seconds,
         rom_mode: setup.rom.mode.name().to_string(),
         rom_depth: setup.rom.depth(),

@@ -58,6 +58,23 @@ fn a_fourier_simulation_carries_its_spectrum_and_no_transients() {
     for (out, bin) in b.bins.iter().zip(&spectrum.bins) {
         assert_eq!(out.amplitude_um, Some(bin.amplitude_um));
     }
+    // The paper's noise statistic: the mean |Y| of the bins away from the 4.5 kHz tone
+    // (more than 1.5 bins of f_s/L from it), not the median of all bins, tone included.
+    let bin_hz = 10e6 / d.pixel.rom_depth as f64;
+    let away: Vec<f64> = b
+        .bins
+        .iter()
+        .filter(|x| (x.frequency_hz - 4500.0).abs() > 1.5 * bin_hz)
+        .map(|x| x.amplitude_um.unwrap())
+        .collect();
+    assert!(
+        !away.is_empty() && away.len() < b.bins.len(),
+        "the tone is a bin"
+    );
+    let mean = away.iter().sum::<f64>() / away.len() as f64;
+    assert!((b.noise_estimate_um.unwrap() - mean).abs() < 1e-12);
+    assert_eq!(b.noise_bins, away.len());
+    assert_eq!(b.median_amplitude_um, Some(spectrum.median_amplitude_um));
     let json = serde_json::to_value(&sim).unwrap();
     assert_eq!(
         json["pulses"], N,

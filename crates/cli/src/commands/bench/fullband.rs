@@ -142,8 +142,11 @@ fn print_text(r: &FullBandReport) {
         None => println!(),
     }
     println!(
-        "  target <= {:.0} s: {}",
+        "  target <= {:.0} s, judged on CPU time over {} threads ({:.1} s; wall {:.1} s): {}",
         r.target_seconds,
+        r.threads,
+        r.judged_seconds,
+        r.windowed.sd_seconds,
         if r.pass { "pass" } else { "FAIL" }
     );
     if let Some(p) = &r.periodic {

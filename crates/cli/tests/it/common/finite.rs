@@ -14,6 +14,7 @@ pub const NULLABLE: &[&str] = &[
     "amplitude_um",
     "phase_deg",
     "noise_estimate_um",
+    "median_amplitude_um",
     "float_amplitude_um",
     "measured_floor_um",
     // replay: the closed-form floor needs ρ > 0 and two detections.
