@@ -68,7 +68,7 @@ pub(crate) fn write(path: &Path, s: &BandSpectrum, origin: &str) -> Result<(), B
             .map_err(err)?;
         root.present().map_err(err)?;
     }
-    tofprobe_io::write_atomic(path, text.as_bytes()).map_err(|e| BenchError::Output {
+    tofprobe_io::write_svg_atomic(path, text.as_bytes()).map_err(|e| BenchError::Output {
         path: path.to_path_buf(),
         message: e.to_string(),
     })

@@ -53,7 +53,7 @@ pub(crate) fn write(m: &Modulator, path: &Path) -> Result<(), BenchError> {
             .label("f_s / (2 OSR) = 156 kHz");
         root.present().map_err(err)?;
     }
-    tofprobe_dsp::rom::write_atomic(path, text.as_bytes()).map_err(|e| BenchError::Output {
+    tofprobe_io::write_svg_atomic(path, text.as_bytes()).map_err(|e| BenchError::Output {
         path: path.to_path_buf(),
         message: e.to_string(),
     })

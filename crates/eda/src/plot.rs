@@ -139,5 +139,6 @@ pub fn write_sweep_svg(report: &SizeReport, path: &Path) -> Result<()> {
         path: path.to_path_buf(),
         reason,
     })?;
-    crate::fsutil::write_atomic(path, svg.as_bytes())
+    tofprobe_io::write_svg_atomic(path, svg.as_bytes())
+        .map_err(|e| crate::EdaError::io("writing", path, e))
 }

@@ -166,7 +166,8 @@ pub fn write_scalogram_svg(
         path: path.to_path_buf(),
         reason,
     })?;
-    tofprobe_eda::fsutil::write_atomic(path, svg.as_bytes())
+    tofprobe_io::write_svg_atomic(path, svg.as_bytes())
+        .map_err(|e| EdaError::io("writing", path, e))
 }
 
 /// The JSON document of a scalogram and its events.

@@ -112,7 +112,10 @@ pub fn write_svg(
             .map_err(|e| err(&e))?;
         root.present().map_err(|e| err(&e))?;
     }
-    write_atomic(path, svg.as_bytes())
+    tofprobe_io::write_svg_atomic(path, svg.as_bytes()).map_err(|e| ExperimentError::Output {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
 }
 
 /// Writes `bytes` to `path` atomically ([`tofprobe_io::write_atomic`]): the study's one

@@ -63,6 +63,34 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> std::io::Result<()> {
     Ok(())
 }
 
+/// [`write_atomic`] for an SVG the user named (`--svg FILE`): an existing file at `path`
+/// is replaced only if it is an SVG (its first non-blank bytes `<svg` or `<?xml`), never a
+/// foreign file; the refusal is an `AlreadyExists` error naming why.
+pub fn write_svg_atomic(path: &Path, contents: &[u8]) -> std::io::Result<()> {
+    if let Ok(meta) = std::fs::symlink_metadata(path) {
+        let foreign = |why: String| {
+            std::io::Error::new(
+                std::io::ErrorKind::AlreadyExists,
+                format!("refusing to replace it: {why}; remove it or choose another path"),
+            )
+        };
+        if !meta.is_file() {
+            return Err(foreign("it exists and is not a regular file".into()));
+        }
+        let mut head = [0u8; 256];
+        let n = std::fs::File::open(path).and_then(|mut f| {
+            use std::io::Read;
+            f.read(&mut head)
+        })?;
+        let text = String::from_utf8_lossy(&head[..n]);
+        let t = text.trim_start();
+        if !(t.starts_with("<svg") || t.starts_with("<?xml")) {
+            return Err(foreign("it exists and is not an SVG".into()));
+        }
+    }
+    write_atomic(path, contents)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -17,7 +17,7 @@ mod set;
 pub mod stale;
 pub mod text;
 
-pub use atomic::write_atomic;
+pub use atomic::{write_atomic, write_svg_atomic};
 pub use bounded::{read_bounded, read_bounded_text};
 pub use set::{OutputSet, STAGE_PREFIX, recover};
 

@@ -284,3 +284,42 @@ fn a_full_disk_leaves_no_partial_set() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(left.is_empty(), "a full disk left {left:?}");
 }
+
+/// `--svg FILE` never replaces a user's file that is not an SVG (issue 31): `simulate`
+/// refuses with exit 2 naming why and leaves the file as it was; an SVG at the path (its
+/// own earlier plot) is replaced.
+#[test]
+fn an_svg_path_holding_a_foreign_file_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let notes = tmp.path().join("notes.svg");
+    std::fs::write(&notes, "my lab notes\n").unwrap();
+    let cfg = tmp.path().join("short.toml");
+    std::fs::write(
+        &cfg,
+        tofprobe_design::DEFAULT_TOML.replacen("duration_s = 1.0", "pulses = 40000", 1),
+    )
+    .unwrap();
+    let run = |svg: &std::path::Path| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+            .arg("simulate")
+            .arg(&cfg)
+            .arg("--svg")
+            .arg(svg)
+            .output()
+            .unwrap()
+    };
+    let o = run(&notes);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("not an SVG"), "{err}");
+    assert_eq!(std::fs::read_to_string(&notes).unwrap(), "my lab notes\n");
+    let plot = tmp.path().join("plot.svg");
+    std::fs::write(&plot, "<svg xmlns=\"http://www.w3.org/2000/svg\"></svg>\n").unwrap();
+    let o = run(&plot);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        std::fs::read_to_string(&plot)
+            .unwrap()
+            .contains("bit-true spectrum")
+    );
+}

@@ -8,11 +8,15 @@ use plotters::prelude::*;
 
 use super::SceneResult;
 use crate::error::ExperimentError;
-use crate::spectrum::write_atomic;
 
 /// Writes the SVG atomically; levels without a tone amplitude are left out.
 pub fn pareto_svg(path: &Path, scenes: &[SceneResult]) -> Result<(), ExperimentError> {
-    write_atomic(path, pareto_svg_text(path, scenes)?.as_bytes())
+    tofprobe_io::write_svg_atomic(path, pareto_svg_text(path, scenes)?.as_bytes()).map_err(|e| {
+        ExperimentError::Output {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        }
+    })
 }
 
 /// The text of [`pareto_svg`], for a caller that writes it as part of a set of files;
