@@ -1,7 +1,7 @@
 //! Haar arrays: each pixel's transition time, and the velocity of an edge across the
-//! sensor. The registers hold the Haar detail sums of a pixel's held depth codes; with the
-//! frame's total set to 0 they give the mean depth (relative) of each of the 2^(U+1) finest
-//! half-wavelets, exactly. For one transition from level a (first segment) to b (last
+//! sensor. A pixel's registers, as its scalogram (`Scalogram::from_registers`), give the
+//! mean depth (relative to the frame's) of each of the 2^(U+1) finest half-wavelets through
+//! the one inverse transform, `Scalogram::cell_means_mm`. For one transition from level a (first segment) to b (last
 //! segment) at time τ, segment j's mean is a·f_j + b·(1 − f_j), f_j its fraction before
 //! τ, so τ = Σ_j (m_j − b)/(a − b) · (its duration): exact for a noiseless step wherever it
 //! falls, the "area" estimator. A pixel whose |a − b| is below 8 σ of a segment mean has no
@@ -11,6 +11,7 @@
 
 use serde::Serialize;
 use tofprobe_design::ResolvedDesign;
+use tofprobe_dsp::haar::analysis::Scalogram;
 
 use crate::model::ArrayFrame;
 
@@ -27,26 +28,7 @@ pub struct EventMap {
     pub direction_deg: Option<f64>,
 }
 
-/// Relative mean codes of the 2^(U+1) finest half-wavelets from Haar detail sums
-/// (register order, + half first), the frame's total taken as 0.
-pub fn segment_means(words: &[i64], u_max: u32, pulses: u64) -> Vec<f64> {
-    let mut sums = vec![0.0f64];
-    for u in 0..=u_max {
-        let base = (1usize << u) - 1;
-        sums = sums
-            .iter()
-            .enumerate()
-            .flat_map(|(v, &p)| {
-                let d = words[base + v] as f64;
-                [(p + d) / 2.0, (p - d) / 2.0]
-            })
-            .collect();
-    }
-    let len = pulses as f64 / sums.len() as f64;
-    sums.into_iter().map(|s| s / len).collect()
-}
-
-/// The transition time (s) of one pixel's words, or `None` below `min_step` codes.
+/// The transition time (s) of one pixel's cell means `m`, or `None` below `min_step`.
 pub fn transition_time_s(m: &[f64], segment_s: f64, min_step: f64) -> Option<f64> {
     let (a, b) = (*m.first()?, *m.last()?);
     if (a - b).abs() < min_step {
@@ -72,7 +54,13 @@ pub fn event_map(design: &ResolvedDesign, frame: &ArrayFrame) -> EventMap {
     let mut points = Vec::new();
     for (p, t) in time_ms.iter_mut().enumerate() {
         let (r, c) = (p / frame.cols, p % frame.cols);
-        let m = segment_means(frame.pixel(r, c), u, n);
+        // The resolution validated U and N, and the frame holds 2^(U+1) − 1 words per pixel.
+        let Ok(scalogram) =
+            Scalogram::from_registers(frame.pixel(r, c), n, u, s.tdc_lsb_mm(), s.laser_rate_hz)
+        else {
+            continue;
+        };
+        let m = scalogram.cell_means_mm();
         if let Some(ts) = transition_time_s(&m, segment_s, min_step) {
             *t = ts * 1e3;
             points.push(((c as f64 + 0.5) * mm, (r as f64 + 0.5) * mm, ts));
@@ -129,14 +117,17 @@ mod tests {
     use super::*;
 
     /// A noiseless step of 10 codes at pulse 300 of 1024 (U = 3: 16 segments of 64): the
-    /// detail sums of the record, inverted, put the step at 300 pulses exactly.
+    /// detail sums of the record, as a scalogram of 1 mm codes and inverted, put the step at
+    /// 300 pulses exactly.
     #[test]
     fn the_area_estimator_is_exact_on_a_step() {
         let x: Vec<i64> = (0..1024).map(|n| if n < 300 { 40 } else { 30 }).collect();
         let words = tofprobe_dsp::haar::haar_sums(&x, 3).unwrap();
-        let m = segment_means(&words, 3, 1024);
+        let m = Scalogram::from_registers(&words, 1024, 3, 1.0, 1.0)
+            .unwrap()
+            .cell_means_mm();
         assert_eq!(m.len(), 16);
-        // Segment 0 is 40 codes above segment 15 (relative levels).
+        // Segment 0 is 10 mm above segment 15 (relative levels).
         assert!((m[0] - m[15] - 10.0).abs() < 1e-12);
         let t = transition_time_s(&m, 64.0, 1.0).unwrap();
         assert!((t - 300.0).abs() < 1e-9, "{t}");

@@ -69,15 +69,16 @@ pub fn run_pixel(
     // The folded driver when it pays (periodic ROM, Fourier), the transaction driver
     // otherwise: bit-identical registers either way.
     let mut tm = FrameDriver::new(&design.pixel, rom).map_err(err)?;
-    let mut result = Ok(());
-    let mut detections = 0u64;
-    source.for_each_chunk(design.pixel.frame_pulses, CHUNK, |first, chunk| {
-        if result.is_ok() {
-            detections += chunk.iter().filter(|d| d.is_some()).count() as u64;
-            result = tm.run(chunk, first);
-        }
-    });
-    result.map_err(err)?;
+    // The source counts the detections as it draws them: no second pass over the pulses.
+    let n = design.pixel.frame_pulses;
+    let mut buf = vec![None; CHUNK.min(n as usize)];
+    let (mut first, mut detections) = (0u64, 0u64);
+    while first < n {
+        let k = (n - first).min(buf.len() as u64) as usize;
+        detections += source.fill_counted(first, &mut buf[..k]).detections;
+        tm.run(&buf[..k], first).map_err(err)?;
+        first += k as u64;
+    }
     Ok((tm.readout().words, detections))
 }
 

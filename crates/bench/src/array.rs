@@ -73,21 +73,17 @@ fn array_design(
     doc.acquisition.pulses = Some(pulses);
     doc.acquisition.duration_s = None;
     doc.pixel.frame_pulses = None;
-    if doc.array.is_none() {
-        doc.array = Some(ArrayConfig {
-            rows,
-            cols,
-            pitch_um: 30.0,
-            mm_per_pixel: Some(1.0),
-            field_of_view_deg: None,
-            distance_mm: None,
-            signal_map: None,
-            background_map: None,
-        });
-    } else if let Some(a) = doc.array.as_mut() {
-        a.rows = rows;
-        a.cols = cols;
-    }
+    let a = doc.array.get_or_insert(ArrayConfig {
+        rows,
+        cols,
+        pitch_um: 30.0,
+        mm_per_pixel: Some(1.0),
+        field_of_view_deg: None,
+        distance_mm: None,
+        signal_map: None,
+        background_map: None,
+    });
+    (a.rows, a.cols) = (rows, cols);
     Ok(resolve(doc, &base.origin)?)
 }
 

@@ -85,6 +85,23 @@ fn pulses_usize(pulses: u64) -> Result<usize, DspError> {
 }
 
 impl Scalogram {
+    /// The inverse Haar transform: the mean depth (mm, relative to the frame's mean) of
+    /// each of the 2^(U+1) half-wavelets of the finest scale, in time order. A coefficient
+    /// w (mean of its first half − mean of its second, halved) adds +w to the cells of its
+    /// first half and −w to those of its second; exact for the pixel's power-of-two frames.
+    pub fn cell_means_mm(&self) -> Vec<f64> {
+        let nc = 1usize << (self.scales + 1);
+        let mut cells = vec![0.0; nc];
+        for c in &self.coefficients {
+            let per = nc >> c.u;
+            let st = c.v * per;
+            for (k, x) in cells[st..st + per].iter_mut().enumerate() {
+                *x += if k < per / 2 { c.value_mm } else { -c.value_mm };
+            }
+        }
+        cells
+    }
+
     /// From the pixel's Haar registers (register order 2^u − 1 + v, sign-extended): each
     /// divided by its wavelet's length and multiplied by `mm_per_code` (the TDC LSB in mm,
     /// `SensorConfig::tdc_lsb_mm()`).

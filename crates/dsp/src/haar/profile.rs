@@ -83,16 +83,8 @@ pub(crate) struct Measured {
 
 impl<'a> Profile<'a> {
     pub(crate) fn new(s: &Scalogram, sd_mm: &'a [f64], n: usize) -> Profile<'a> {
-        let nc = 1usize << (s.scales + 1);
-        let mut cells = vec![0.0; nc];
-        for c in &s.coefficients {
-            let per = nc >> c.u;
-            let st = c.v * per;
-            for (k, x) in cells[st..st + per].iter_mut().enumerate() {
-                *x += if k < per / 2 { c.value_mm } else { -c.value_mm };
-            }
-        }
-        let mut edges = Vec::with_capacity(nc + 1);
+        let cells = s.cell_means_mm();
+        let mut edges = Vec::with_capacity(cells.len() + 1);
         for v in 0..(1usize << s.scales) {
             let (a, m, _) = support(n, s.scales, v);
             edges.push(a);
