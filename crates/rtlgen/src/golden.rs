@@ -151,6 +151,11 @@ pub fn sequence_for<'a>(
 }
 
 /// Runs the pixel crate's cycle model through `seq` and records the golden data.
+///
+/// The sequence is walked as an iterator (its counters, no division per cycle), and the
+/// pulse index is counted: pulse strobes are presented in index order in both sequencers
+/// (`Sequencer::pulse_index` of the cycle, tested in crates/rtlgen/tests), so the k-th
+/// strobe is pulse k − 1 and a digest window closes after every D strobes.
 pub fn run(p: &PixelParams, seq: &Sequencer<'_>, o: &GoldenOptions) -> Result<Golden, RtlError> {
     let mut model = CycleModel::new(p)?;
     let mut g = Golden {
@@ -161,19 +166,22 @@ pub fn run(p: &PixelParams, seq: &Sequencer<'_>, o: &GoldenOptions) -> Result<Go
     let mut frame_words = Vec::with_capacity(r + 1);
     let mut prev = PinsOut::default();
     let (mut count, mut h) = (0u64, DIGEST_INIT);
-    let mut window = 0u64;
-    for c in 0..seq.total_cycles() {
-        if let Some(pi) = seq.pulse_index(c) {
-            g.pulses = pi + 1;
-            let w = pi / o.digest_pulses.max(1);
-            if w != window {
+    let digest_pulses = o.digest_pulses.max(1);
+    // Pulse strobes left in the current digest window.
+    let mut window_left = digest_pulses;
+    let (lo, hi) = o.trace_window;
+    for (c, pins) in (0u64..).zip(seq.clone()) {
+        if pins.pulse {
+            if window_left == 0 {
                 g.digests.push((count, h));
                 (count, h) = (0, DIGEST_INIT);
-                window = w;
+                window_left = digest_pulses;
             }
+            window_left -= 1;
+            g.pulses += 1;
         }
-        let out = model.step(&seq.pins(c));
-        let full = c >= o.trace_window.0 && c < o.trace_window.1;
+        let out = model.step(&pins);
+        let full = c >= lo && c < hi;
         if c >= 1 && (c == 1 || out != prev) {
             h = digest_event(h, [2, c, pack_pins(&out), out.rd_data]);
             count += 1;
