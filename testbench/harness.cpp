@@ -6,14 +6,15 @@
 // the register writes (which registers the pixel's write-enable vector `we` selects at the
 // edge, and their values after it) and the output pins; per digest window, a digest of both
 // (everywhere); per frame, the readout. It ends with exactly one line
-//   TOFPROBE-COSIM-DONE cycles=<n> frames=<n> mismatches=<n> seconds=<s>
-// preceded, on a mismatch, by
+//   TOFPROBE-COSIM-DONE cycles=<n> frames=<n> mismatches=<n> seconds=<s> cpu_seconds=<s>
+// (`seconds` wall time, `cpu_seconds` the process's CPU time, of the replay) preceded, on a mismatch, by
 //   TOFPROBE-MISMATCH cycle=<c> pulse=<p> signal=<name> expected=<hex|none> actual=<hex|none>
 // and/or
 //   TOFPROBE-DIGEST-MISMATCH window=<w> first_pulse=<p> cycle_from=<a> cycle_to=<b>
 // Compile-time settings (-D): PIX_WE, PIX_Y (expressions reaching the pixel's `we` and `y`
 // from `top->rootp`), TOP_HEADER, TOP_CLASS, optional TOFPROBE_TRACE (VCD support).
 #include <chrono>
+#include <ctime>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -177,6 +178,8 @@ int main(int argc, char** argv) {
 #endif
 
     auto t0 = std::chrono::steady_clock::now();
+    const std::clock_t cpu0 = std::clock();
+    auto cpu_secs = [&] { return static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC; };
     uint64_t mismatches = 0, frames = 0;
     bool reported = false;
     uint64_t next_pulse = 0, cur_pulse = 0;
@@ -205,8 +208,9 @@ int main(int argc, char** argv) {
             if (p) ++next_pulse;
         }
         double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::printf("TOFPROBE-BARE cycles=%llu pulses=%llu seconds=%.6f\n", static_cast<unsigned long long>(cycles),
-                    static_cast<unsigned long long>(next_pulse), secs);
+        std::printf("TOFPROBE-BARE cycles=%llu pulses=%llu seconds=%.6f cpu_seconds=%.6f\n",
+                    static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(next_pulse), secs,
+                    cpu_secs());
         top->final();
         return 0;
     }
@@ -373,8 +377,8 @@ int main(int argc, char** argv) {
     if (!cov_file.empty()) ctx->coveragep()->write(cov_file.c_str());
 #endif
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("TOFPROBE-COSIM-DONE cycles=%llu frames=%llu mismatches=%llu seconds=%.6f\n",
+    std::printf("TOFPROBE-COSIM-DONE cycles=%llu frames=%llu mismatches=%llu seconds=%.6f cpu_seconds=%.6f\n",
                 static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(frames),
-                static_cast<unsigned long long>(mismatches), secs);
+                static_cast<unsigned long long>(mismatches), secs, cpu_secs());
     return mismatches == 0 ? 0 : 1;
 }

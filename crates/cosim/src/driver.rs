@@ -10,6 +10,7 @@ use crate::icarus;
 use crate::verilator::{self, BuildProfile, HarnessBuild};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use tofprobe_pixel::bench::thread_cpu_seconds;
 use tofprobe_pixel::{DirectedOptions, Fault, Mode, PixelParams, directed_program};
 use tofprobe_rtlgen::render::RenderOptions;
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
@@ -131,6 +132,15 @@ pub struct CosimReport {
     /// Seconds of the Verilator harness run.
     pub verilator_seconds: f64,
     pub bare_seconds: Option<f64>,
+    /// CPU seconds of the same three (Linux; the harness's own report): the figures a
+    /// shared machine does not inflate by waiting for a core.
+    pub model_cpu_seconds: Option<f64>,
+    pub verilator_cpu_seconds: Option<f64>,
+    pub bare_cpu_seconds: Option<f64>,
+    /// With `measure_bare`: the cycle model stepped through the same sequence with nothing
+    /// recorded (the counterpart of the bare Verilator model), wall and CPU seconds.
+    pub bare_model_seconds: Option<f64>,
+    pub bare_model_cpu_seconds: Option<f64>,
     pub vcd: Option<PathBuf>,
     pub rtl_dir: PathBuf,
     pub vectors_dir: PathBuf,
@@ -191,6 +201,60 @@ pub fn render_with_rom(
     mutation: Option<Fault>,
 ) -> Result<(), CosimError> {
     render_driven(p, rom, dir, mutation, None)
+}
+
+impl CosimReport {
+    /// How many times faster the cycle model (the golden run: model, digests and the
+    /// recording) ran than the checking Verilator harness on the same sequence: the ratio
+    /// of CPU times where both were measured, else of wall times.
+    pub fn model_speedup(&self) -> f64 {
+        speedup(
+            (self.verilator_seconds, self.verilator_cpu_seconds),
+            (self.model_seconds, self.model_cpu_seconds),
+        )
+    }
+
+    /// The same for the bare pair (`measure_bare`): the Verilator model and the cycle model
+    /// stepped through the sequence with nothing observed.
+    pub fn bare_model_speedup(&self) -> Option<f64> {
+        Some(speedup(
+            (self.bare_seconds?, self.bare_cpu_seconds),
+            (self.bare_model_seconds?, self.bare_model_cpu_seconds),
+        ))
+    }
+}
+
+/// `reference` time over `fast` time, on CPU times when both are known.
+fn speedup(reference: (f64, Option<f64>), fast: (f64, Option<f64>)) -> f64 {
+    match (reference.1, fast.1) {
+        (Some(r), Some(f)) => r / f.max(1e-9),
+        _ => reference.0 / fast.0.max(1e-9),
+    }
+}
+
+/// Steps the cycle model through the run's sequence with nothing recorded: (wall, CPU)
+/// seconds.
+fn time_bare_model(
+    p: &PixelParams,
+    stim: &[Option<u32>],
+    rom: &[u64],
+    o: &VectorOptions,
+) -> Result<(f64, Option<f64>), CosimError> {
+    use tofprobe_rtlgen::golden;
+    let (stim, program) = golden::stimuli_and_program(p, stim, o.frames, o.directed.as_ref())?;
+    let image = golden::rom_image(p, rom);
+    let seq = golden::sequence_for(p, &stim, image.as_ref(), o.frames, program)?;
+    let mut model = tofprobe_pixel::CycleModel::new(p)?;
+    let c0 = thread_cpu_seconds();
+    let t0 = Instant::now();
+    let mut sink = 0u64;
+    for pins in seq {
+        let out = model.step(&pins);
+        sink = sink.wrapping_add(out.rd_data) ^ model.writes().len() as u64;
+    }
+    std::hint::black_box(sink);
+    let seconds = t0.elapsed().as_secs_f64();
+    Ok((seconds, c0.zip(thread_cpu_seconds()).map(|(a, b)| b - a)))
 }
 
 /// Runs one co-simulation.
@@ -275,9 +339,11 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         trace_window: o.digest_only.then_some((0, 0)),
         directed: o.directed,
     };
+    let c0 = thread_cpu_seconds();
     let t0 = Instant::now();
     let (golden, window) = golden_run(p, &stim, &rom, &vopts)?;
     let model_seconds = t0.elapsed().as_secs_f64();
+    let model_cpu_seconds = c0.zip(thread_cpu_seconds()).map(|(a, b)| b - a);
     let vec_dir = work_dir.join("vectors");
     write_vectors(&vec_dir, p, &stim, &rom, &golden, window, &vopts)?;
     let vec_dir = std::fs::canonicalize(&vec_dir).map_err(|e| CosimError::io(&vec_dir, e))?;
@@ -292,6 +358,7 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         return Ok(CosimReport {
             pass,
             verilator_seconds: seconds,
+            verilator_cpu_seconds: outcome.cpu_seconds,
             outcome,
             first,
             build: HarnessBuild {
@@ -304,6 +371,10 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
             frames,
             model_seconds,
             bare_seconds: None,
+            model_cpu_seconds,
+            bare_cpu_seconds: None,
+            bare_model_seconds: None,
+            bare_model_cpu_seconds: None,
             vcd: None,
             rtl_dir,
             vectors_dir: vec_dir,
@@ -369,14 +440,18 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
     } else {
         None
     };
-    let bare_seconds = if o.measure_bare {
-        Some(harness::run_bare(&build.exe, &rtl_dir, &vec_dir)?)
+    let (bare, bare_model) = if o.measure_bare {
+        (
+            Some(harness::run_bare(&build.exe, &rtl_dir, &vec_dir)?),
+            Some(time_bare_model(p, &stim, &rom, &vopts)?),
+        )
     } else {
-        None
+        (None, None)
     };
     Ok(CosimReport {
         pass,
         verilator_seconds: outcome.seconds,
+        verilator_cpu_seconds: outcome.cpu_seconds,
         outcome,
         first,
         build,
@@ -384,7 +459,11 @@ pub fn cosim(p: &PixelParams, o: &CosimOptions) -> Result<CosimReport, CosimErro
         cycles: golden.cycles,
         frames,
         model_seconds,
-        bare_seconds,
+        bare_seconds: bare.map(|b| b.seconds),
+        model_cpu_seconds,
+        bare_cpu_seconds: bare.and_then(|b| b.cpu_seconds),
+        bare_model_seconds: bare_model.map(|b| b.0),
+        bare_model_cpu_seconds: bare_model.and_then(|b| b.1),
         vcd,
         rtl_dir,
         vectors_dir: vec_dir,

@@ -29,7 +29,10 @@ pub struct RunOutcome {
     pub cycles: u64,
     pub frames: u64,
     pub mismatches: u64,
+    /// Wall time of the replay.
     pub seconds: f64,
+    /// CPU time of the replay (the Verilator harness reports it; the Icarus testbench not).
+    pub cpu_seconds: Option<f64>,
     pub first: Option<Mismatch>,
     pub digest: Option<DigestMismatch>,
 }
@@ -72,6 +75,7 @@ pub fn parse_output(tool: &'static str, text: &str) -> Result<RunOutcome, CosimE
             o.seconds = field(line, "seconds")
                 .and_then(|v| v.parse().ok())
                 .unwrap_or(0.0);
+            o.cpu_seconds = field(line, "cpu_seconds").and_then(|v| v.parse().ok());
         }
     }
     if done {
@@ -118,8 +122,15 @@ pub fn run(
     )
 }
 
-/// Runs the bare model (same inputs, no checking): its seconds, for the overhead figure.
-pub fn run_bare(exe: &Path, rtl_dir: &Path, vec_dir: &Path) -> Result<f64, CosimError> {
+/// The bare model's times (same inputs, no checking): wall and CPU seconds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BareRun {
+    pub seconds: f64,
+    pub cpu_seconds: Option<f64>,
+}
+
+/// Runs the bare model (same inputs, no checking), for the overhead figure.
+pub fn run_bare(exe: &Path, rtl_dir: &Path, vec_dir: &Path) -> Result<BareRun, CosimError> {
     let out = Command::new(exe)
         .current_dir(rtl_dir)
         .arg(vec_dir)
@@ -129,12 +140,38 @@ pub fn run_bare(exe: &Path, rtl_dir: &Path, vec_dir: &Path) -> Result<f64, Cosim
         .output()
         .map_err(|e| CosimError::io(exe, e))?;
     let text = String::from_utf8_lossy(&out.stdout);
-    text.lines()
-        .find(|l| l.starts_with("TOFPROBE-BARE"))
+    let line = text.lines().find(|l| l.starts_with("TOFPROBE-BARE"));
+    let seconds = line
         .and_then(|l| field(l, "seconds"))
         .and_then(|v| v.parse().ok())
         .ok_or(CosimError::NoCompletion {
             tool: "verilator harness --bare",
-            output: text.into_owned(),
-        })
+            output: text.clone().into_owned(),
+        })?;
+    Ok(BareRun {
+        seconds,
+        cpu_seconds: line
+            .and_then(|l| field(l, "cpu_seconds"))
+            .and_then(|v| v.parse().ok()),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `seconds=` is not read from `cpu_seconds=` (the key is matched whole), and a line
+    /// without `cpu_seconds` (the Icarus testbench's) leaves it unknown.
+    #[test]
+    fn completion_line_times_are_read_by_their_keys() {
+        let o = parse_output(
+            "t",
+            "TOFPROBE-COSIM-DONE cycles=10 frames=1 mismatches=0 seconds=0.5 cpu_seconds=0.25\n",
+        )
+        .unwrap();
+        assert_eq!((o.cycles, o.seconds, o.cpu_seconds), (10, 0.5, Some(0.25)));
+        let o = parse_output("t", "TOFPROBE-COSIM-DONE cycles=10 frames=1 mismatches=0 seconds=0.5\n")
+            .unwrap();
+        assert_eq!((o.seconds, o.cpu_seconds), (0.5, None));
+    }
 }

@@ -8,7 +8,10 @@
 //!
 //! The accumulate is pipelined (the contract's "Pipeline"): each adder's register operand,
 //! register and sign are read one edge ahead (`CycleModel::read_ahead`, after the edge's
-//! writes, which is the forward), and the write edge adds to that operand.
+//! writes, which is the forward), and the write edge adds to that operand. With the forward
+//! that operand is the register's value at the write edge, so the fault-free copy of the
+//! edge reads it there (`CycleModel::accumulate_slot`) and skips the stage; the faulty copy
+//! keeps it, since two faults (`MissingForward`, `ScheduleLate`) live in it.
 //!
 //! The arithmetic is the one [`Datapath`]'s, the slot order the one [`Schedule`]'s. The
 //! golden vectors are recorded from this model (tofprobe-rtlgen), and the mutation tests
@@ -84,8 +87,8 @@ pub struct CycleModel {
     rd_active: bool,
     rd_ptr: usize,
     y: Vec<i64>,
-    /// Read-ahead stage: per adder of the next slot, (register, add, `yin`); the first
-    /// `pre_len` entries are valid.
+    /// Read-ahead stage (the faulty copy's): per adder of the next slot, (register, add,
+    /// `yin`); the first `pre_len` entries are valid.
     pre: Vec<(usize, bool, i64)>,
     pre_len: usize,
     /// All-ones in the low W bits (the raw word of a register).
@@ -274,11 +277,14 @@ impl CycleModel {
         // were read ahead at the last edge; the datapath adds.
         if self.active {
             if self.acc_en {
-                let fault = if FAULTY { self.fault } else { None };
-                for i in 0..self.pre_len {
-                    let (reg, add, yin) = self.pre[i];
-                    let v = self.dp.accumulate(yin, self.op, add, fault);
-                    self.write::<FAULTY>(reg, v);
+                if FAULTY {
+                    for i in 0..self.pre_len {
+                        let (reg, add, yin) = self.pre[i];
+                        let v = self.dp.accumulate(yin, self.op, add, self.fault);
+                        self.write::<FAULTY>(reg, v);
+                    }
+                } else {
+                    self.accumulate_slot();
                 }
             }
             if self.slot == self.k - 1 {
@@ -309,7 +315,9 @@ impl CycleModel {
             self.rd_active = true;
             self.rd_ptr = 0;
         }
-        if self.active {
+        // The fault-free copy reads its operands at the write edge instead
+        // ([`CycleModel::accumulate_slot`]): the same values, without the stage.
+        if FAULTY && self.active {
             self.read_ahead::<FAULTY>();
         }
         if self.has::<FAULTY>(Fault::ScheduleLate) {
@@ -364,6 +372,25 @@ impl CycleModel {
             len += 1;
         }
         self.pre_len = len;
+    }
+
+    /// The fault-free accumulate of the current slot, its operands read at this edge: the
+    /// read-ahead stage's values exactly, since it reads after the last edge's writes (the
+    /// forward) and nothing writes the register file, the slot, the latched ROM word or
+    /// pulse index between that read and this edge's adds (a slot's operations touch
+    /// distinct registers). `MissingForward` and `ScheduleLate` break that equality, so the
+    /// faulty copy keeps the stage.
+    #[inline(always)]
+    fn accumulate_slot(&mut self) {
+        let (op, n_lat, log2_n) = (self.op, self.n_lat, self.log2_n);
+        for i in 0..self.p.adders {
+            let Some(operation) = self.schedule.at(self.slot, i) else {
+                break;
+            };
+            let (reg, add) = operation.target(n_lat, log2_n, &self.bits);
+            let v = self.dp.accumulate(self.y[reg], op, add, None);
+            self.write::<false>(reg, v);
+        }
     }
 
     /// A register write of this edge (a trace event).

@@ -139,9 +139,11 @@ impl Datapath {
     #[inline(always)]
     pub fn accumulate(&self, y: i64, op: i64, add: bool, fault: Option<Fault>) -> i64 {
         let add = add != (fault == Some(Fault::SignFlip));
-        // m = 0 (add) or −1 (subtract); (op ^ m) − m = ±op, without a branch.
-        let m = i64::from(add) - 1;
-        wrap(y.wrapping_add((op ^ m).wrapping_sub(m)), self.width)
+        // ±op without a branch: the sign is a ROM bit, as good as random, and a branch on
+        // it (what the compiler makes of `(op ^ m) − m` once op is hoisted out of a loop)
+        // mispredicts every other register.
+        let signed = std::hint::select_unpredictable(add, op, op.wrapping_neg());
+        wrap(y.wrapping_add(signed), self.width)
     }
 
     /// The primed Fourier front end as a [`FourierStream`], for a streaming driver to step

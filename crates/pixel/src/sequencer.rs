@@ -282,6 +282,7 @@ impl<'a> Sequencer<'a> {
 impl<'a> Iterator for Sequencer<'a> {
     type Item = PinsIn<'a>;
 
+    #[inline]
     fn next(&mut self) -> Option<PinsIn<'a>> {
         if self.cycle >= self.total {
             return None;

@@ -143,6 +143,19 @@ struct Json {
     harness_overhead_ratio: Option<f64>,
     cycle_model_seconds: f64,
     cycle_model_cycles_per_s: f64,
+    /// CPU times (Linux) and the rates on them: the cycle model's golden run on its thread,
+    /// the harness's replay in its process.
+    cycle_model_cpu_seconds: Option<f64>,
+    verilator_cpu_seconds: Option<f64>,
+    cycle_model_cycles_per_cpu_s: Option<f64>,
+    verilator_cycles_per_cpu_s: Option<f64>,
+    /// Cycle model ÷ Verilator on the same sequence in this run (CPU times where both are
+    /// measured, else wall), both checking: the golden run against the checking harness.
+    cycle_model_vs_verilator: f64,
+    /// With `--bare`: the cycle model stepped with nothing recorded, and its ratio to the
+    /// bare Verilator model.
+    bare_cycle_model_seconds: Option<f64>,
+    bare_cycle_model_vs_verilator: Option<f64>,
     transaction_model_seconds: f64,
     transaction_model_pulses_per_s: f64,
     build_seconds: f64,
@@ -266,6 +279,13 @@ pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
             .map(|b| r.verilator_seconds / b),
         cycle_model_seconds: r.model_seconds,
         cycle_model_cycles_per_s: rate(r.cycles, r.model_seconds),
+        cycle_model_cpu_seconds: r.model_cpu_seconds,
+        verilator_cpu_seconds: r.verilator_cpu_seconds,
+        cycle_model_cycles_per_cpu_s: r.model_cpu_seconds.map(|s| rate(r.cycles, s)),
+        verilator_cycles_per_cpu_s: r.verilator_cpu_seconds.map(|s| rate(r.cycles, s)),
+        cycle_model_vs_verilator: r.model_speedup(),
+        bare_cycle_model_seconds: r.bare_model_seconds,
+        bare_cycle_model_vs_verilator: r.bare_model_speedup(),
         transaction_model_seconds: if tx.is_finite() { tx } else { 0.0 },
         transaction_model_pulses_per_s: if tx.is_finite() {
             rate(r.pulses, tx)
@@ -289,7 +309,7 @@ pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
             ),
         };
         println!(
-            "cosim {verdict}: {} frame(s), {} pulses, {} cycles, {} mismatches | {} {:.2} Mcycles/s ({:.2} s{}, x-seed {}), cycle model {:.2} Mcycles/s ({:.2} s), transaction model {:.2} Mpulses/s ({:.3} s){}{}; {}",
+            "cosim {verdict}: {} frame(s), {} pulses, {} cycles, {} mismatches | {} {:.2} Mcycles/s ({:.2} s{}, x-seed {}), cycle model {:.2} Mcycles/s ({:.2} s), cycle model / {} {:.1}x{}{}, transaction model {:.2} Mpulses/s ({:.3} s){}{}; {}",
             j.frames,
             j.pulses,
             j.cycles,
@@ -303,6 +323,16 @@ pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
             j.x_seed,
             j.cycle_model_cycles_per_s / 1e6,
             j.cycle_model_seconds,
+            j.simulator,
+            j.cycle_model_vs_verilator,
+            if j.verilator_cpu_seconds.is_some() && j.cycle_model_cpu_seconds.is_some() {
+                " on CPU time"
+            } else {
+                " on wall time"
+            },
+            j.bare_cycle_model_vs_verilator
+                .map(|b| format!(" (bare models {b:.1}x)"))
+                .unwrap_or_default(),
             j.transaction_model_pulses_per_s / 1e6,
             j.transaction_model_seconds,
             if j.build_reused {
