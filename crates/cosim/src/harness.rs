@@ -170,8 +170,11 @@ mod tests {
         )
         .unwrap();
         assert_eq!((o.cycles, o.seconds, o.cpu_seconds), (10, 0.5, Some(0.25)));
-        let o = parse_output("t", "TOFPROBE-COSIM-DONE cycles=10 frames=1 mismatches=0 seconds=0.5\n")
-            .unwrap();
+        let o = parse_output(
+            "t",
+            "TOFPROBE-COSIM-DONE cycles=10 frames=1 mismatches=0 seconds=0.5\n",
+        )
+        .unwrap();
         assert_eq!((o.seconds, o.cpu_seconds), (0.5, None));
     }
 }

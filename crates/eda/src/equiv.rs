@@ -23,7 +23,7 @@
 //! proof covers the netlist's wiring of the cells, not the cells' transistors.
 
 use crate::error::{EdaError, Result};
-use crate::fsutil::write_atomic;
+use crate::fsutil::{Fnv64, write_atomic};
 use crate::tools::{Tool, tail};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -55,6 +55,10 @@ pub struct Equivalence {
     pub seconds: f64,
     /// The yosys log.
     pub log: PathBuf,
+    /// Served from the equivalence cache ([`check_equivalence_cached`]): `seconds` and
+    /// `log` are those of the run that proved it.
+    #[serde(default)]
+    pub cached: bool,
 }
 
 /// The yosys script comparing `spec`.
@@ -137,10 +141,58 @@ pub fn parse_status(log: &str) -> Option<(u64, u64, String)> {
     Some((points, unproven, first))
 }
 
+/// Where proven equivalences are cached: `equiv` beside the synthesis cache
+/// ([`crate::fsutil::synth_cache_dir`]), so one cache directory holds both.
+pub fn equiv_cache_dir() -> PathBuf {
+    let synth = crate::fsutil::synth_cache_dir(None);
+    synth
+        .parent()
+        .map_or_else(|| PathBuf::from("equiv"), |p| p.join("equiv"))
+}
+
+/// The cache key of `spec`: everything the proof's outcome depends on — the yosys version,
+/// the script (with the files named by role, their paths do not matter), and the bytes of
+/// the RTL sources, the netlist, the liberty and the clock-gate models read with it.
+fn cache_key(spec: &EquivSpec, yosys: &Path, models: Option<&str>) -> Result<String> {
+    let mut h = Fnv64::default();
+    h.feed(b"tofprobe-equiv-v1")
+        .feed(crate::synth::yosys_version(yosys).as_bytes());
+    let roles = EquivSpec {
+        rtl: (0..spec.rtl.len())
+            .map(|i| PathBuf::from(format!("rtl{i}.v")))
+            .collect(),
+        netlist: "netlist.v".into(),
+        liberty: "cells.lib".into(),
+        ..spec.clone()
+    };
+    let models_role = Path::new("icg_models.v");
+    h.feed(equiv_script_with(&roles, models.map(|_| models_role)).as_bytes());
+    for path in spec.rtl.iter().chain([&spec.netlist, &spec.liberty]) {
+        let bytes = std::fs::read(path).map_err(|e| EdaError::io("reading", path, e))?;
+        h.feed(&bytes);
+    }
+    h.feed(models.unwrap_or("").as_bytes());
+    Ok(h.hex())
+}
+
 /// Proves `spec`'s netlist equivalent to its RTL; `work` holds the script and the log.
 /// An unproven pair is [`EdaError::NotEquivalent`], naming the netlist and the first
-/// pair (`\\y[3]_gold [5] \\y[3]_gate [5]`: register 3, bit 5).
+/// pair (`\\y[3]_gold [5] \\y[3]_gate [5]`: register 3, bit 5). A proof already made
+/// of the same netlist, RTL, liberty and yosys is served from [`equiv_cache_dir`].
 pub fn check_equivalence(spec: &EquivSpec, work: &Path) -> Result<Equivalence> {
+    check_equivalence_cached(spec, work, Some(&equiv_cache_dir()))
+}
+
+/// [`check_equivalence`] with the cache in `cache` (`None`: no cache). Only a proof is
+/// cached (a failure is re-run, so its report is fresh): `cache/<key>/equiv.log` and then
+/// `result.json`, each written atomically, the result last, so an entry is whole or absent;
+/// an entry that does not read back whole (unparsable, not all points proven, its log
+/// missing) is proven again and replaced.
+pub fn check_equivalence_cached(
+    spec: &EquivSpec,
+    work: &Path,
+    cache: Option<&Path>,
+) -> Result<Equivalence> {
     let yosys = Tool::Yosys.locate()?;
     for src in &spec.rtl {
         if !src.is_file() {
@@ -156,18 +208,62 @@ pub fn check_equivalence(spec: &EquivSpec, work: &Path) -> Result<Equivalence> {
     let netlist = std::fs::read_to_string(&spec.netlist)
         .map_err(|e| EdaError::io("reading", &spec.netlist, e))?;
     let models = crate::clock_gate::icg_models(&lib, &netlist);
+    let entry = match cache {
+        Some(dir) => Some(dir.join(cache_key(spec, &yosys, models.as_deref())?)),
+        None => None,
+    };
+    if let Some(hit) = entry.as_deref().and_then(read_entry) {
+        return Ok(hit);
+    }
+    let proven = prove(spec, work, &yosys, models.as_deref())?;
+    if let Some(dir) = &entry {
+        store_entry(dir, &proven)?;
+    }
+    Ok(proven)
+}
+
+/// A whole cache entry, or `None` (absent, or not readable back whole).
+fn read_entry(dir: &Path) -> Option<Equivalence> {
+    let text = std::fs::read_to_string(dir.join("result.json")).ok()?;
+    let e: Equivalence = serde_json::from_str(&text).ok()?;
+    (e.points > 0 && e.proven == e.points && e.log.is_file()).then_some(Equivalence {
+        cached: true,
+        ..e
+    })
+}
+
+/// Stores a proof: its log, then the result naming it (each atomically).
+fn store_entry(dir: &Path, proven: &Equivalence) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| EdaError::io("creating", dir, e))?;
+    let log = dir.join("equiv.log");
+    let text = std::fs::read(&proven.log).map_err(|e| EdaError::io("reading", &proven.log, e))?;
+    write_atomic(&log, &text)?;
+    let entry = Equivalence {
+        log,
+        cached: false,
+        ..proven.clone()
+    };
+    let json = serde_json::to_vec_pretty(&entry).map_err(|e| EdaError::Json {
+        what: dir.join("result.json").display().to_string(),
+        source: e,
+    })?;
+    write_atomic(&dir.join("result.json"), &json)
+}
+
+/// Runs yosys's proof of `spec` in `work`.
+fn prove(spec: &EquivSpec, work: &Path, yosys: &Path, models: Option<&str>) -> Result<Equivalence> {
     let models_path = work.join("icg_models.v");
-    if let Some(m) = &models {
+    if let Some(m) = models {
         write_atomic(&models_path, m.as_bytes())?;
     }
     let script = work.join("equiv.ys");
     write_atomic(
         &script,
-        equiv_script_with(spec, models.as_ref().map(|_| models_path.as_path())).as_bytes(),
+        equiv_script_with(spec, models.map(|_| models_path.as_path())).as_bytes(),
     )?;
     let log_path = work.join("equiv.log");
     let start = std::time::Instant::now();
-    let out = Command::new(&yosys)
+    let out = Command::new(yosys)
         .arg("-q")
         .arg("-l")
         .arg(&log_path)
@@ -182,6 +278,7 @@ pub fn check_equivalence(spec: &EquivSpec, work: &Path) -> Result<Equivalence> {
             proven: points,
             seconds,
             log: log_path,
+            cached: false,
         }),
         Some((points, unproven, first)) if unproven > 0 => Err(EdaError::NotEquivalent(Box::new(
             crate::error::EquivFailure {

@@ -87,7 +87,7 @@ pub struct Synthesis {
     pub yosys_seconds: f64,
 }
 
-fn yosys_version(yosys: &Path) -> String {
+pub(crate) fn yosys_version(yosys: &Path) -> String {
     Command::new(yosys)
         .arg("-V")
         .output()

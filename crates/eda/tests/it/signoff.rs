@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use tofprobe_eda::EdaError;
 use tofprobe_eda::analysis::RtlProvider;
-use tofprobe_eda::equiv::{EquivSpec, check_equivalence};
+use tofprobe_eda::equiv::{EquivSpec, check_equivalence_cached};
 use tofprobe_eda::generated::GeneratedPixel;
 use tofprobe_eda::pdk::Sky130Pdk;
 use tofprobe_eda::signoff::{
@@ -160,12 +160,35 @@ fn broken_small_pixel_is_not_equivalent(liberty: &Path, inv: &str, name: &str) {
         liberty: liberty.to_path_buf(),
     };
     let work = cache(name).join("small-equiv");
-    let ok = check_equivalence(&spec(syn.netlist_verilog.clone()), &work).unwrap();
+    // A cache of this test's own (the default one is shared by every run on the machine).
+    let proofs = cache(name).join("equiv-cache");
+    let _ = std::fs::remove_dir_all(&proofs);
+    let prove = |netlist: PathBuf| check_equivalence_cached(&spec(netlist), &work, Some(&proofs));
+    let ok = prove(syn.netlist_verilog.clone()).unwrap();
     // 4 registers of 10 bits at least, all proven.
     assert!(ok.points >= 40 && ok.proven == ok.points, "{ok:?}");
+    assert!(!ok.cached, "a fresh cache served a proof");
+    if name == "osu018" {
+        // The same netlist again: served from the cache, the first run's figures.
+        let again = prove(syn.netlist_verilog.clone()).unwrap();
+        assert!(again.cached, "the proof was not cached");
+        assert_eq!((again.points, again.seconds), (ok.points, ok.seconds));
+        // A corrupted entry is proven again (not an error, not served) and replaced.
+        let entries: Vec<PathBuf> = std::fs::read_dir(&proofs)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        assert_eq!(entries.len(), 1, "{entries:?}");
+        std::fs::write(entries[0].join("result.json"), "{\"points\": 4").unwrap();
+        let redone = prove(syn.netlist_verilog.clone()).unwrap();
+        assert!(!redone.cached && redone.proven == redone.points && redone.points == ok.points);
+        assert!(prove(syn.netlist_verilog.clone()).unwrap().cached);
+    }
     let broken = cache(name).join("small-broken/netlist.v");
     break_netlist(&syn.netlist_verilog, "\\y[1] [5]", inv, &broken);
-    match check_equivalence(&spec(broken), &work) {
+    // A different netlist is a different key: the broken one is proven (and fails), never
+    // served the good one's proof.
+    match prove(broken) {
         Err(e @ EdaError::NotEquivalent(_)) => {
             let msg = e.to_string();
             assert!(
