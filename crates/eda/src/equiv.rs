@@ -226,10 +226,8 @@ pub fn check_equivalence_cached(
 fn read_entry(dir: &Path) -> Option<Equivalence> {
     let text = std::fs::read_to_string(dir.join("result.json")).ok()?;
     let e: Equivalence = serde_json::from_str(&text).ok()?;
-    (e.points > 0 && e.proven == e.points && e.log.is_file()).then_some(Equivalence {
-        cached: true,
-        ..e
-    })
+    (e.points > 0 && e.proven == e.points && e.log.is_file())
+        .then_some(Equivalence { cached: true, ..e })
 }
 
 /// Stores a proof: its log, then the result naming it (each atomically).

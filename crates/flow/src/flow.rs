@@ -212,12 +212,13 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
     let _ = writeln!(md, "## Verdict\n");
     let _ = writeln!(
         md,
-        "Co-simulation (Verilator vs the pixel crate's cycle model): **{}**, {} cycles, {} mismatches, Verilator {:.2} s, model {:.2} s.{}\n",
+        "Co-simulation (Verilator vs the pixel crate's cycle model): **{}**, {} cycles, {} mismatches, Verilator {:.2} s, model {:.2} s (the model {:.1}x Verilator).{}\n",
         if r.pass { "PASS" } else { "FAIL" },
         r.cycles,
         r.outcome.mismatches,
         r.verilator_seconds,
         r.model_seconds,
+        r.model_speedup(),
         r.first
             .as_ref()
             .map(|m| format!(

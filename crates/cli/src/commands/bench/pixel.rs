@@ -1,10 +1,15 @@
 //! `tofprobe bench pixel`: speed of the bit-true pixel at the configuration's `[pixel]`
-//! (`tofprobe_bench::pixel` measures; this prints).
+//! (`tofprobe_bench::pixel` measures; this prints). With `--verilator`, the cycle model
+//! and Verilator also run one frame of `--cycle-pulses` of the design's RTL side by side
+//! (a co-simulation: the same sequence, both checked), and the ratio is printed.
 
 use std::path::PathBuf;
 
 use clap::Args;
+use serde::Serialize;
 use tofprobe_bench::pixel::PixelReport;
+use tofprobe_cosim::{BuildProfile, CosimOptions, cosim};
+use tofprobe_design::{Chip, RomPurpose, RtlOverrides};
 
 use crate::error::CliError;
 
@@ -20,9 +25,65 @@ pub struct PixelBenchArgs {
     /// Pulses through the cycle model (one frame under the reference sequencer).
     #[arg(long, default_value_t = 200_000)]
     cycle_pulses: u64,
+    /// Also co-simulate a `--cycle-pulses` frame of the design's RTL in Verilator (builds
+    /// the harness once, cached) and print the cycle model's rate beside Verilator's.
+    #[arg(long)]
+    verilator: bool,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
+}
+
+/// The cycle model against Verilator on one frame of the design's RTL (`--verilator`).
+#[derive(Debug, Serialize)]
+struct VsVerilator {
+    cosim_cycles: u64,
+    cosim_pass: bool,
+    /// The golden run (cycle model, digests) and the checking harness, CPU time.
+    cycle_model_cycles_per_cpu_s: Option<f64>,
+    verilator_cycles_per_cpu_s: Option<f64>,
+    cycle_model_vs_verilator: f64,
+    /// The two models stepped with nothing observed.
+    bare_cycle_model_vs_verilator: Option<f64>,
+}
+
+#[derive(Debug, Serialize)]
+struct Json<'a> {
+    #[serde(flatten)]
+    report: &'a PixelReport,
+    #[serde(flatten)]
+    verilator: Option<VsVerilator>,
+}
+
+/// Co-simulates one `pulses`-pulse frame of the design's RTL (the ROM the simulating
+/// commands replay) in a temporary directory, with the bare models timed too.
+fn vs_verilator(args: &PixelBenchArgs, pulses: u64) -> Result<VsVerilator, CliError> {
+    let overrides = RtlOverrides {
+        frame_pulses: Some(pulses),
+        rom_depth: None,
+    };
+    let (design, _) = super::super::simulated_design(1, args.config.as_deref(), &overrides)?;
+    let chip = Chip::of(&design, &overrides, RomPurpose::Replayed)?;
+    let work = std::env::temp_dir().join(format!("tofprobe-bench-pixel-{}", std::process::id()));
+    let mut o = CosimOptions::new(&work);
+    o.frames = 1;
+    o.rom = Some(chip.rom.words);
+    o.profile = BuildProfile::Speed;
+    o.digest_pulses = 1024;
+    o.measure_bare = true;
+    o.vcd_on_mismatch = false;
+    let r = cosim(&chip.pixel, &o);
+    let _ = std::fs::remove_dir_all(&work);
+    let r = r?;
+    let rate = |s: f64| r.cycles as f64 / s.max(1e-9);
+    Ok(VsVerilator {
+        cosim_cycles: r.cycles,
+        cosim_pass: r.pass,
+        cycle_model_cycles_per_cpu_s: r.model_cpu_seconds.map(rate),
+        verilator_cycles_per_cpu_s: r.verilator_cpu_seconds.map(rate),
+        cycle_model_vs_verilator: r.model_speedup(),
+        bare_cycle_model_vs_verilator: r.bare_model_speedup(),
+    })
 }
 
 /// Runs the benchmark.
@@ -30,10 +91,44 @@ pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
     let design = tofprobe_design::load(args.config.as_deref())?;
     design.single_pixel("bench pixel")?;
     let report = tofprobe_bench::pixel::measure(&design, args.pulses, args.cycle_pulses)?;
+    let verilator = if args.verilator {
+        Some(vs_verilator(args, args.cycle_pulses)?)
+    } else {
+        None
+    };
+    let mismatch = verilator.as_ref().is_some_and(|v| !v.cosim_pass);
     if args.json {
-        println!("{}", serde_json::to_string(&report)?);
+        let j = Json {
+            report: &report,
+            verilator,
+        };
+        println!("{}", serde_json::to_string(&j)?);
     } else {
         print_text(&report);
+        if let Some(v) = &verilator {
+            let m = |r: Option<f64>| r.map_or("-".to_string(), |r| format!("{:.1}", r / 1e6));
+            println!(
+                "cycle model vs Verilator, {} cycles of the design's RTL ({}): cycle model {} M cycles per CPU-s, Verilator {} M: {:.1}x (bare models {})",
+                v.cosim_cycles,
+                if v.cosim_pass {
+                    "bit-exact"
+                } else {
+                    "MISMATCH"
+                },
+                m(v.cycle_model_cycles_per_cpu_s),
+                m(v.verilator_cycles_per_cpu_s),
+                v.cycle_model_vs_verilator,
+                v.bare_cycle_model_vs_verilator
+                    .map_or("-".to_string(), |b| format!("{b:.1}x"))
+            );
+        }
+    }
+    if mismatch {
+        return Err(CliError::option(
+            "verilator",
+            "a co-simulation mismatch",
+            "a bit-exact RTL (run `tofprobe cosim` for the first mismatch)",
+        ));
     }
     Ok(())
 }
