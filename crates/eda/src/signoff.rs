@@ -5,7 +5,7 @@
 //!
 //! The chip-level top and probe ROM (`$readmemh`) stay RTL: only the pixel is synthesised.
 
-use crate::equiv::{EquivSpec, Equivalence, check_equivalence};
+use crate::equiv::{EquivSpec, Equivalence, check_equivalence_cached};
 use crate::error::{EdaError, Result};
 use crate::pdk::{Sky130Pdk, plain_copy};
 use crate::synth::{SynthSpec, Synthesis, synthesise};
@@ -192,12 +192,14 @@ pub fn gate_level(req: &SignoffRequest<'_>, netlist: &Path) -> Result<GateLevel>
     })
 }
 
-/// Proves `netlist` equivalent to the RTL pixel of `req`.
+/// Proves `netlist` equivalent to the RTL pixel of `req`; a proof of the same netlist, RTL,
+/// liberty and yosys is served from `req.cache`'s `equiv-proofs` (the synthesis cache's
+/// neighbour: [`crate::equiv::check_equivalence_cached`]).
 pub fn equivalence(req: &SignoffRequest<'_>, netlist: &Path) -> Result<Equivalence> {
     let work = netlist
         .parent()
         .map_or_else(|| req.cache.join("equiv"), |d| d.join("equiv"));
-    check_equivalence(
+    check_equivalence_cached(
         &EquivSpec {
             rtl: vec![module_file(req.rtl_dir, req.pixel)?],
             top: req.pixel.to_string(),
@@ -206,6 +208,7 @@ pub fn equivalence(req: &SignoffRequest<'_>, netlist: &Path) -> Result<Equivalen
             liberty: req.library.liberty.clone(),
         },
         &work,
+        Some(&req.cache.join("equiv-proofs")),
     )
 }
 
