@@ -267,7 +267,7 @@ fn prove(spec: &EquivSpec, work: &Path, yosys: &Path, models: Option<&str>) -> R
         .arg(&log_path)
         .arg(&script)
         .output()
-        .map_err(|e| EdaError::io("running", &yosys, e))?;
+        .map_err(|e| EdaError::io("running", yosys, e))?;
     let seconds = start.elapsed().as_secs_f64();
     let log = std::fs::read_to_string(&log_path).unwrap_or_default();
     match parse_status(&log) {
