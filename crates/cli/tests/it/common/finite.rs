@@ -61,6 +61,13 @@ pub const NULLABLE: &[&str] = &[
     "coverage_percent",
     "bare_verilator_seconds",
     "harness_overhead_ratio",
+    "bare_cycle_model_seconds",
+    "bare_cycle_model_vs_verilator",
+    // cosim: CPU times where the platform has none (the Icarus testbench reports none).
+    "cycle_model_cpu_seconds",
+    "verilator_cpu_seconds",
+    "cycle_model_cycles_per_cpu_s",
+    "verilator_cycles_per_cpu_s",
     "first",
     "vcd",
     "first_mismatch_actual",
