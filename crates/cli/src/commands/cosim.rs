@@ -16,8 +16,8 @@ use crate::error::CliError;
 
 /// Runs longer than this many cycles compare digests of this many pulses instead of every
 /// pulse's (a 10^7-pulse frame then has ~10^4 digest lines).
-const LONG_RUN_CYCLES: u64 = 2_000_000;
-const LONG_RUN_DIGEST_PULSES: u64 = 1024;
+pub(crate) const LONG_RUN_CYCLES: u64 = 2_000_000;
+pub(crate) const LONG_RUN_DIGEST_PULSES: u64 = 1024;
 
 /// Arguments of `tofprobe cosim`.
 #[derive(Debug, Args)]

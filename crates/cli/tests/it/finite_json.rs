@@ -142,6 +142,29 @@ fn every_command_json_is_finite_on_extreme_configurations() {
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         tally(assert_finite_output("cosim, no detections", &o.stdout));
+        // The same design's RTL through `bench pixel --verilator` (its harness build shared
+        // with the cosim above): both rates and a positive ratio, bit-exact.
+        let c = tmp.path().join("x1.toml");
+        let args = ["bench", "pixel", "--config", c.to_str().unwrap()];
+        let more = [
+            "--pulses",
+            "4096",
+            "--cycle-pulses",
+            "1024",
+            "--verilator",
+            "--json",
+        ];
+        let o = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+            .args(args.iter().chain(&more))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        tally(assert_finite_output("bench pixel --verilator", &o.stdout));
+        let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(j["cosim_pass"], true, "{j}");
+        // 2 + (1024·C + R + 2) + 1 cycles of the x1 pixel (C = 4, R = 8).
+        assert_eq!(j["cosim_cycles"], 2 + (1024 * 4 + 8 + 2) + 1, "{j}");
+        assert!(j["cycle_model_vs_verilator"].as_f64().unwrap() > 0.0, "{j}");
     } else {
         eprintln!("skipped cosim: no verilator");
     }

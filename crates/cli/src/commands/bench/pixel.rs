@@ -68,8 +68,11 @@ fn vs_verilator(args: &PixelBenchArgs, pulses: u64) -> Result<VsVerilator, CliEr
     let mut o = CosimOptions::new(&work);
     o.frames = 1;
     o.rom = Some(chip.rom.words);
-    o.profile = BuildProfile::Speed;
-    o.digest_pulses = 1024;
+    // As `tofprobe cosim` sets a run of this length (so both share one harness build).
+    if pulses * chip.pixel.cycles_per_pulse as u64 > super::super::cosim::LONG_RUN_CYCLES {
+        o.profile = BuildProfile::Speed;
+        o.digest_pulses = super::super::cosim::LONG_RUN_DIGEST_PULSES;
+    }
     o.measure_bare = true;
     o.vcd_on_mismatch = false;
     let r = cosim(&chip.pixel, &o);
