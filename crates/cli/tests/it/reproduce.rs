@@ -179,12 +179,13 @@ fn render(path: &std::path::Path) -> Result<(), String> {
     if !tofprobe_testkit::tools::have(&["rsvg-convert"], "reproduce figures render") {
         return Ok(());
     }
+    // PNG to stdout (rsvg-convert refuses a non-regular --output such as /dev/null).
     let out = std::process::Command::new("rsvg-convert")
-        .args(["--format", "png", "--output", "/dev/null"])
+        .args(["--format", "png"])
         .arg(path)
         .output()
         .map_err(|e| format!("rsvg-convert: {e}"))?;
-    if !out.status.success() {
+    if !out.status.success() || !out.stdout.starts_with(b"\x89PNG") {
         return Err(format!(
             "{}: rsvg-convert failed: {}",
             path.display(),

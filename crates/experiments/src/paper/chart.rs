@@ -333,6 +333,9 @@ impl Chart {
             .y_desc(self.y_label.as_str())
             .label_style(("sans-serif", 14))
             .axis_desc_style(("sans-serif", 15))
+            // Grid lines at the labelled ticks only: plotters' light lines between them
+            // drew dense grey bands on log axes.
+            .light_line_style(TRANSPARENT)
             .draw()
             .map_err(|x| e(&x))?;
         let (y_lo, y_hi) = {
