@@ -15,6 +15,7 @@ mod common;
 mod core;
 mod cosim_directed;
 mod cosim_exact;
+mod docs_tables;
 mod exit_codes;
 mod extremes;
 mod finite_json;
