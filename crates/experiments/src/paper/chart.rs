@@ -9,6 +9,9 @@ use plotters::prelude::*;
 
 use crate::ExperimentError;
 
+/// (x, y) points of one curve.
+pub type Curve = Vec<(f64, f64)>;
+
 /// A named series of (x, y) points.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Series {

@@ -7,7 +7,7 @@ use tofprobe_dsp::closed_form::pileup_survival;
 
 use super::chart::{Chart, ErrorSeries, Series};
 use super::figures::QUICK_NOTE;
-use super::stats::{SEEDS, mean_sd, rician_mean};
+use super::stats::{mean_sd, rician_mean};
 use super::table2::{F0_HZ, RowResult};
 
 /// spectra.svg and noise_vs_sigma.svg.
@@ -53,8 +53,8 @@ pub fn charts(results: &[RowResult], quick: bool) -> Vec<Chart> {
     let mut noise = Chart {
         file: "noise_vs_sigma.svg".into(),
         title: format!(
-            "Table 2: noise floor vs σ_s (ρ_s = 1, no tone, Blackman, {} seeds)",
-            SEEDS.len()
+            "Table 2: noise floor vs σ_s (ρ_s = 1, no tone, Blackman, {})",
+            seeds_label(&chosen)
         ),
         x_label: "σ_s (mm)".into(),
         y_label: "noise floor (µm)".into(),
@@ -103,6 +103,17 @@ pub fn charts(results: &[RowResult], quick: bool) -> Vec<Chart> {
     vec![spectra, noise]
 }
 
+/// "5 seeds", or "5–34 seeds per row" where the rows' own seed counts differ.
+fn seeds_label(rows: &[&RowResult]) -> String {
+    let lo = rows.iter().map(|r| r.seeds.len()).min().unwrap_or(0);
+    let hi = rows.iter().map(|r| r.seeds.len()).max().unwrap_or(0);
+    if lo == hi {
+        format!("{lo} seeds")
+    } else {
+        format!("{lo}–{hi} seeds per row")
+    }
+}
+
 /// The largest bin within ±5 % of the tone's frequency (Hz, µm), from a row's group maxima.
 fn tone_peak(max: &[(f64, f64)]) -> Option<(f64, f64)> {
     max.iter()
@@ -145,8 +156,8 @@ pub fn fig5(results: &[RowResult], quick: bool) -> Chart {
     let mut c = Chart {
         file: "fig5_amplitude_vs_rho_b.svg".into(),
         title: format!(
-            "Fig. 5: amplitude vs ρ_b (σ_s = 7.5 mm, ρ_s = 0.3, 100 µm at 4.5 kHz, {} seeds)",
-            SEEDS.len()
+            "Fig. 5: amplitude vs ρ_b (σ_s = 7.5 mm, ρ_s = 0.3, 100 µm at 4.5 kHz, {})",
+            seeds_label(&rows)
         ),
         x_label: "ρ_b (background photons per pulse in the window)".into(),
         y_label: "measured amplitude / A".into(),
@@ -239,8 +250,8 @@ pub fn fig9(results: &[RowResult], quick: bool) -> Chart {
     let mut c = Chart {
         file: "fig9_rho_sweep.svg".into(),
         title: format!(
-            "Fig. 9: ρ_s sweep (σ_s = 7.5 mm, ρ_b = 0, 100 µm at 4.5 kHz, {} seeds)",
-            SEEDS.len()
+            "Fig. 9: ρ_s sweep (σ_s = 7.5 mm, ρ_b = 0, 100 µm at 4.5 kHz, {})",
+            seeds_label(&rows)
         ),
         x_label: "ρ_s".into(),
         y_label: "µm".into(),

@@ -297,7 +297,7 @@ pub fn rows(r: &RowResult) -> Vec<Row> {
             })
             .collect()
     };
-    let seeds = &super::stats::SEEDS[..per_seed.len()];
+    let seeds = &r.seeds[..per_seed.len().min(r.seeds.len())];
     let col = |i: usize| per_seed.iter().map(|v| v[i]).collect::<Vec<f64>>();
     let mean = |i: usize| super::stats::mean_sd(&col(i)).0;
     let (sd_noise, ref_noise, mean_err) = (mean(0), mean(1), mean(2));

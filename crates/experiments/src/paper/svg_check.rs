@@ -67,15 +67,14 @@ pub fn problems(svg: &str) -> Vec<String> {
             && l.starts_with("<rect")
             && l.contains("opacity=\"0.85\"")
             && l.contains("fill=\"#FFFFFF\"")
-        {
-            if let (Some(x), Some(y), Some(w), Some(h)) = (
+            && let (Some(x), Some(y), Some(w), Some(h)) = (
                 attr(l, "x"),
                 attr(l, "y"),
                 attr(l, "width"),
                 attr(l, "height"),
-            ) {
-                legend = Some((x, y, x + w, y + h));
-            }
+            )
+        {
+            legend = Some((x, y, x + w, y + h));
         }
     }
     if let Some((x0, y0, x1, y1)) = legend {
