@@ -7,12 +7,14 @@
 //! Errors are `ValueError`s carrying the library's message (it names the field, the value
 //! and what would work) or `TypeError`s naming the argument of a wrong dtype.
 
+mod analysis;
 mod convert;
+mod tiles;
 
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
-use numpy::ndarray::{Array2, Array3};
+use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -25,6 +27,8 @@ use convert::{CodeSlice, value_error};
 
 /// Origin of a design given as TOML text.
 const TEXT_ORIGIN: &str = "<TOML text>";
+/// Origin of a design given as a dict.
+const DICT_ORIGIN: &str = "<dict>";
 
 /// Pulses converted and run per step of `run_pixel` (64 k: the detections stay in cache).
 const CHUNK: usize = 1 << 16;
@@ -41,7 +45,7 @@ const CHUNK: usize = 1 << 16;
 #[pyclass(module = "tofprobe._native", name = "Design", frozen)]
 #[derive(Debug)]
 struct Design {
-    inner: ResolvedDesign,
+    pub(crate) inner: ResolvedDesign,
     /// The probe ROM (Fourier), generated on first use.
     rom: OnceLock<Option<ProbeRom>>,
 }
@@ -62,7 +66,7 @@ impl Design {
     }
 
     /// The probe ROM (`None` in Haar mode), generated once without the GIL.
-    fn rom(&self, py: Python<'_>) -> PyResult<Option<&ProbeRom>> {
+    pub(crate) fn rom(&self, py: Python<'_>) -> PyResult<Option<&ProbeRom>> {
         if let Some(r) = self.rom.get() {
             return Ok(r.as_ref());
         }
@@ -71,7 +75,7 @@ impl Design {
     }
 
     /// The probe ROM, refused in Haar mode (`what` names the call).
-    fn fourier_rom(&self, py: Python<'_>, what: &str) -> PyResult<&ProbeRom> {
+    pub(crate) fn fourier_rom(&self, py: Python<'_>, what: &str) -> PyResult<&ProbeRom> {
         self.rom(py)?.ok_or_else(|| {
             PyValueError::new_err(format!(
                 "{what} needs a Fourier pixel, and pixel.mode of `{}` resolved to \"{}\" \
@@ -84,6 +88,51 @@ impl Design {
     /// The largest TDC code the pixel takes: 2^T − 1.
     fn max_code(&self) -> u32 {
         ((1u64 << self.inner.pixel.tdc_bits.min(32)) - 1) as u32
+    }
+
+    /// The borrowed frame `(valid, tdc)`, checked: equal lengths, at most one frame.
+    fn checked_frame<'a>(
+        &self,
+        valid_a: &'a numpy::PyReadonlyArray1<'_, bool>,
+        tdc_a: &'a convert::Codes<'_>,
+    ) -> PyResult<(&'a [bool], CodeSlice<'a>)> {
+        let valid_s = convert::slice(valid_a, "valid")?;
+        let tdc_s: CodeSlice<'_> = tdc_a.slice("tdc")?;
+        if valid_s.len() != tdc_s.len() {
+            return Err(PyValueError::new_err(format!(
+                "`valid` has {} pulses and `tdc` {}: one code per pulse",
+                valid_s.len(),
+                tdc_s.len()
+            )));
+        }
+        let n = self.inner.pixel.frame_pulses;
+        if valid_s.len() as u64 > n {
+            return Err(PyValueError::new_err(format!(
+                "{} pulses exceed one frame of pixel.frame_pulses = {n}: pass at most {n} \
+                 (one frame; call once per frame)",
+                valid_s.len()
+            )));
+        }
+        Ok((valid_s, tdc_s))
+    }
+
+    /// The frame `(valid, tdc)` as the library's detections (`None` = no detection),
+    /// checked like `run_pixel`'s.
+    pub(crate) fn frame(
+        &self,
+        py: Python<'_>,
+        valid: &Bound<'_, PyAny>,
+        tdc: &Bound<'_, PyAny>,
+    ) -> PyResult<Vec<Option<u32>>> {
+        let valid_a = convert::bool_array("valid", valid)?;
+        let tdc_a = convert::codes("tdc", tdc)?;
+        let (valid_s, tdc_s) = self.checked_frame(&valid_a, &tdc_a)?;
+        let max_code = self.max_code();
+        py.detach(|| {
+            let mut out = Vec::with_capacity(valid_s.len());
+            convert::detections(valid_s, tdc_s, 0, max_code, &mut out).map(|()| out)
+        })
+        .map_err(PyValueError::new_err)
     }
 }
 
@@ -114,6 +163,35 @@ impl Design {
         tofprobe_design::load(Some(&path))
             .map(Design::new)
             .map_err(value_error)
+    }
+
+    /// A design from a dict shaped like the TOML document (``{"sensor": {...}, "scene":
+    /// {...}, "pixel": {...}, ...}``, e.g. ``tomllib.load`` of a configuration), resolved
+    /// by the same one resolution as ``from_toml``. ``ValueError`` naming the key for an
+    /// unknown key or a bad value; ``TypeError`` for a value JSON/TOML cannot hold.
+    #[staticmethod]
+    fn from_dict(d: &Bound<'_, PyAny>) -> PyResult<Self> {
+        if d.cast::<PyDict>().is_err() {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "`d` must be a dict of the configuration's tables, got {}",
+                d.get_type().name()?
+            )));
+        }
+        let json: String = d
+            .py()
+            .import("json")?
+            .call_method1("dumps", (d,))
+            .map_err(|e| {
+                pyo3::exceptions::PyTypeError::new_err(format!(
+                    "`d` holds a value a configuration cannot: {e}"
+                ))
+            })?
+            .extract()?;
+        let value: toml::Value = serde_json::from_str(&json).map_err(|e| {
+            PyValueError::new_err(format!("`d` is not a TOML document (no None values): {e}"))
+        })?;
+        let text = toml::to_string(&value).map_err(value_error)?;
+        Design::resolve(&text, DICT_ORIGIN)
     }
 
     /// A design serialised by ``to_json`` (no resolution runs again).
@@ -234,23 +312,7 @@ impl Design {
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let valid_a = convert::bool_array("valid", valid)?;
         let tdc_a = convert::codes("tdc", tdc)?;
-        let valid_s = convert::slice(&valid_a, "valid")?;
-        let tdc_s: CodeSlice<'_> = tdc_a.slice("tdc")?;
-        if valid_s.len() != tdc_s.len() {
-            return Err(PyValueError::new_err(format!(
-                "`valid` has {} pulses and `tdc` {}: one code per pulse",
-                valid_s.len(),
-                tdc_s.len()
-            )));
-        }
-        let n = self.inner.pixel.frame_pulses;
-        if valid_s.len() as u64 > n {
-            return Err(PyValueError::new_err(format!(
-                "{} pulses exceed one frame of pixel.frame_pulses = {n}: pass at most {n} \
-                 (one frame; call once per frame)",
-                valid_s.len()
-            )));
-        }
+        let (valid_s, tdc_s) = self.checked_frame(&valid_a, &tdc_a)?;
         let rom = self.rom(py)?.map(|r| &r.image);
         let params = &self.inner.pixel;
         let max_code = self.max_code();
@@ -319,26 +381,155 @@ impl Design {
     /// (uint64 [R, C]) and, for a Fourier pixel, ``frequencies_hz`` ([B]),
     /// ``amplitude_um`` and ``phase_deg`` (float64 [B, R, C]). Pixel (r, c)'s registers
     /// are ``run_pixel(*simulate_scene(pixel=(r, c)))``.
-    fn simulate_array<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let design = &self.inner;
-        let (frame, maps, _) = py
-            .detach(|| tofprobe_array::output::simulate(design))
-            .map_err(value_error)?;
-        let (r, c, k) = (frame.rows, frame.cols, frame.registers_per_pixel);
-        let out = PyDict::new(py);
-        let regs = Array3::from_shape_vec((r, c, k), frame.registers).map_err(value_error)?;
-        out.set_item("registers", regs.into_pyarray(py))?;
-        let det = Array2::from_shape_vec((r, c), frame.detections).map_err(value_error)?;
-        out.set_item("detections", det.into_pyarray(py))?;
-        if let Some(m) = maps {
-            let b = m.bins();
-            out.set_item("frequencies_hz", m.frequencies_hz.into_pyarray(py))?;
-            let amp = Array3::from_shape_vec((b, r, c), m.amplitude_um).map_err(value_error)?;
-            out.set_item("amplitude_um", amp.into_pyarray(py))?;
-            let ph = Array3::from_shape_vec((b, r, c), m.phase_deg).map_err(value_error)?;
-            out.set_item("phase_deg", ph.into_pyarray(py))?;
+    ///
+    /// ``tiles`` (1 ..= R·C) splits the array into that many tiles (``tile_rects``); with
+    /// ``client``, a ``dask.distributed.Client``, each tile is a task run in the workers
+    /// (``tofprobe.dask.simulate_array``; default tiles: twice the cluster's threads).
+    /// Any tiling, local or distributed, gives the same registers bit for bit.
+    #[pyo3(signature = (tiles=None, client=None))]
+    fn simulate_array<'py>(
+        slf: &Bound<'py, Self>,
+        py: Python<'py>,
+        tiles: Option<usize>,
+        client: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let d = slf.get();
+        if let Some(client) = client.filter(|c| !c.is_none()) {
+            let out = py
+                .import("tofprobe.dask")?
+                .call_method1("simulate_array", (slf, tiles, client))?;
+            return Ok(out.cast_into::<PyDict>()?);
         }
-        Ok(out)
+        let (frame, seconds) = tiles::run_local(d, py, tiles.unwrap_or(1))?;
+        tiles::array_dict(d, py, frame, seconds)
+    }
+
+    /// The partition of the array into ``tiles`` rectangles (``tofprobe simulate --shard
+    /// i/n``'s): a list of ``((row_start, row_end), (col_start, col_end))``, every pixel
+    /// in exactly one. ``ValueError`` unless 1 ≤ tiles ≤ R·C.
+    fn tile_rects(&self, tiles: usize) -> PyResult<Vec<((usize, usize), (usize, usize))>> {
+        Ok(tiles::rects(self, tiles)?
+            .into_iter()
+            .map(|(r, c)| ((r.start, r.end), (c.start, c.end)))
+            .collect())
+    }
+
+    /// Runs one tile of the array on a rayon pool of ``threads`` threads (default: all
+    /// cores): a dict ``rows``, ``cols`` (as given), ``registers`` (int64 [h, w, K]) and
+    /// ``detections`` (uint64 [h, w]); ``merge_tiles`` joins them.
+    #[pyo3(signature = (rows, cols, threads=None))]
+    fn run_tile<'py>(
+        &self,
+        py: Python<'py>,
+        rows: (usize, usize),
+        cols: (usize, usize),
+        threads: Option<usize>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let t = tiles::run_tile(self, py, rows.0..rows.1, cols.0..cols.1, threads)?;
+        tiles::tile_dict(py, t)
+    }
+
+    /// Joins ``run_tile``'s dicts covering the array exactly once into
+    /// ``simulate_array``'s dict (refusing a gap or an overlap, naming the pixel).
+    fn merge_tiles<'py>(
+        &self,
+        py: Python<'py>,
+        tiles: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let frame = tiles::merge(self, py, tiles)?;
+        tiles::array_dict(self, py, frame, 0.0)
+    }
+
+    /// The float reference: the windowed DFT (the ROM's window, 2/(N·G)) of the frame's
+    /// held depth at the design's bins — ``(frequencies_hz, amplitude_um, phase_deg)`` as
+    /// ``spectrum`` gives for the pixel (``tofprobe_experiments::references::dft``).
+    /// ``valid``/``tdc`` as for ``run_pixel``.
+    fn dft<'py>(
+        &self,
+        py: Python<'py>,
+        valid: &Bound<'py, PyAny>,
+        tdc: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        analysis::reference(self, py, valid, tdc, "dft")
+    }
+
+    /// Float ΣΔ probing of the frame (the pixel's float twin: the same ROM, hold, priming
+    /// and prefilter α = 2^−S): ``(frequencies_hz, amplitude_um, phase_deg)``.
+    fn float_sd<'py>(
+        &self,
+        py: Python<'py>,
+        valid: &Bound<'py, PyAny>,
+        tdc: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        analysis::reference(self, py, valid, tdc, "float_sd")
+    }
+
+    /// The closed-form noise floor E|Y| in µm at each bin for a frame of ``pulses``
+    /// (default N): eq. 12 with the TDC's a²/12, the 1NN hold and the first-arrival
+    /// mixture of the design's scene.
+    #[pyo3(signature = (pulses=None))]
+    fn noise_floor<'py>(&self, py: Python<'py>, pulses: Option<u64>) -> PyResult<Bound<'py, PyAny>> {
+        analysis::noise_floor(self, py, pulses)
+    }
+
+    /// The ΣΔ noise transfer function the probe ROM was modulated with: a dict of
+    /// ``zeros``, ``poles`` (complex128), ``frequencies_hz`` (``points`` from 0 to f_s/2)
+    /// and ``magnitude`` (|NTF(e^{j2πf/f_s})|), and ``order``, ``osr``, ``h_inf``.
+    #[pyo3(signature = (points=512))]
+    fn ntf<'py>(&self, py: Python<'py>, points: usize) -> PyResult<Bound<'py, PyDict>> {
+        analysis::ntf(self, py, points)
+    }
+
+    /// The resolved widths and the readout sizing (``tofprobe size``'s readout section):
+    /// ``width`` (W), ``tdc_bits`` (T), ``frac_bits`` (F), ``register_frac_bits`` (G),
+    /// ``operand_bits``, ``registers``, ``bits_per_frame`` (registers · W),
+    /// ``readout_bits`` (whole bytes), ``memory`` (every figure) and, for an array,
+    /// ``array_readout_bits``.
+    fn widths<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        analysis::widths(self, py)
+    }
+
+    /// ``tofprobe size``'s report as a dict (synthesis with yosys, timing with OpenSTA,
+    /// the B and W sweeps). ``RuntimeError`` naming the tool when yosys or OpenSTA is not
+    /// installed.
+    #[pyo3(signature = (liberty=None, sky130=false, sweep_bins=None, sweep_widths=None, node_nm=40.0))]
+    fn size<'py>(
+        &self,
+        py: Python<'py>,
+        liberty: Option<PathBuf>,
+        sky130: bool,
+        sweep_bins: Option<Vec<u64>>,
+        sweep_widths: Option<Vec<u32>>,
+        node_nm: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        analysis::size(self, py, liberty, sky130, sweep_bins, sweep_widths, node_nm)
+    }
+
+    /// Seconds the library's own pixel call takes on the frame (the frame converted to
+    /// detections first, untimed; then ``FrameDriver`` run and read out, best of
+    /// ``repeat``): the baseline of ``run_pixel``'s overhead (scripts/python-bench.py).
+    #[pyo3(signature = (valid, tdc, repeat=1))]
+    fn time_library_run_pixel(
+        &self,
+        py: Python<'_>,
+        valid: &Bound<'_, PyAny>,
+        tdc: &Bound<'_, PyAny>,
+        repeat: usize,
+    ) -> PyResult<f64> {
+        let detections = self.frame(py, valid, tdc)?;
+        let rom = self.rom(py)?.map(|r| &r.image);
+        let params = &self.inner.pixel;
+        py.detach(|| {
+            let mut best = f64::INFINITY;
+            for _ in 0..repeat.max(1) {
+                let t0 = std::time::Instant::now();
+                let mut driver = FrameDriver::new(params, rom).map_err(value_error)?;
+                driver.run(&detections, 0).map_err(value_error)?;
+                std::hint::black_box(driver.readout());
+                best = best.min(t0.elapsed().as_secs_f64());
+            }
+            Ok(best)
+        })
     }
 
     /// Pickling: the resolved design travels as its JSON.

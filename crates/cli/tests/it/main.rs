@@ -31,6 +31,7 @@ mod reliability;
 mod replay;
 mod reproduce;
 mod resolution;
+mod shard;
 mod signals;
 mod size;
 mod tradeoff;
