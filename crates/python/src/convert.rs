@@ -214,7 +214,10 @@ pub fn detections(
     }
 }
 
-/// [`detections`] for one integer type (one pass, no branch on the dtype per pulse).
+/// [`detections`] for one integer type, in two branch-free passes the compiler
+/// vectorises (the conversion is most of `run_pixel`'s overhead over the library call:
+/// scripts/python-bench.py): the detections (a code out of range wraps here), then the
+/// range check of the valid codes; only a failing check looks for the pulse to name.
 fn fill<T>(
     valid: &[bool],
     codes: &[T],
@@ -223,31 +226,27 @@ fn fill<T>(
     out: &mut Vec<Option<u32>>,
 ) -> Result<(), String>
 where
-    T: Copy + Into<i128>,
-    u32: TryFrom<T>,
+    T: Copy + Into<i128> + Code,
 {
     out.clear();
-    let mut ok = true;
-    out.extend(valid.iter().zip(codes).map(|(&v, &c)| {
-        if !v {
-            return None;
-        }
-        match u32::try_from(c) {
-            Ok(x) if x <= max_code => Some(x),
-            _ => {
-                ok = false;
-                None
-            }
-        }
-    }));
-    if ok {
+    out.extend(
+        valid
+            .iter()
+            .zip(codes)
+            .map(|(&v, &c)| if v { Some(c.wrapped()) } else { None }),
+    );
+    let bad = valid
+        .iter()
+        .zip(codes)
+        .fold(false, |bad, (&v, &c)| bad | (v & !c.within(max_code)));
+    if !bad {
         return Ok(());
     }
     let (i, c) = valid
         .iter()
         .zip(codes)
         .enumerate()
-        .find(|(_, (v, c))| **v && !(0..=i128::from(max_code)).contains(&(**c).into()))
+        .find(|(_, (v, c))| **v && !c.within(max_code))
         .map(|(i, (_, &c))| (first + i, c.into()))
         .unwrap_or((first, -1));
     Err(format!(
@@ -255,3 +254,28 @@ where
          (pixel.tdc_bits); a code in that range would work, or valid[{i}] = False"
     ))
 }
+
+/// An integer dtype of TDC codes.
+pub trait Code: Copy {
+    /// The code as u32 (wrapping: only used once [`Code::within`] holds).
+    fn wrapped(self) -> u32;
+    /// 0 ≤ code ≤ `max`.
+    fn within(self, max: u32) -> bool;
+}
+
+macro_rules! code {
+    ($($t:ty),*) => {$(
+        impl Code for $t {
+            #[inline]
+            fn wrapped(self) -> u32 {
+                self as u32
+            }
+            #[inline]
+            #[allow(unused_comparisons)]
+            fn within(self, max: u32) -> bool {
+                self >= 0 && (self as u64) <= u64::from(max)
+            }
+        }
+    )*};
+}
+code!(u8, u16, u32, u64, i8, i16, i32, i64);

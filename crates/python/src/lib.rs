@@ -30,8 +30,9 @@ const TEXT_ORIGIN: &str = "<TOML text>";
 /// Origin of a design given as a dict.
 const DICT_ORIGIN: &str = "<dict>";
 
-/// Pulses converted and run per step of `run_pixel` (64 k: the detections stay in cache).
-const CHUNK: usize = 1 << 16;
+/// Pulses converted and run per step of `run_pixel` (256 k: 2 MB of detections per
+/// buffer, in cache; 38 steps for 10^7 pulses).
+const CHUNK: usize = 1 << 18;
 
 /// A tofprobe design resolved once (``tofprobe config``'s resolution): sensor, scene,
 /// acquisition, the pixel's parameters and widths, the Fourier bins and the ΣΔ probe.
@@ -316,13 +317,28 @@ impl Design {
         let rom = self.rom(py)?.map(|r| &r.image);
         let params = &self.inner.pixel;
         let max_code = self.max_code();
+        // The conversion of chunk k + 1 overlaps the pixel's run of chunk k (two threads
+        // of rayon's pool): the Python call then costs the library call plus one chunk's
+        // conversion (scripts/python-bench.py, docs/performance.md).
         let words = py.detach(|| -> Result<Vec<i64>, String> {
             let mut driver = FrameDriver::new(params, rom).map_err(|e| e.to_string())?;
-            let mut buf = Vec::with_capacity(CHUNK);
-            for (k, v) in valid_s.chunks(CHUNK).enumerate() {
+            let (mut cur, mut next) = (Vec::with_capacity(CHUNK), Vec::with_capacity(CHUNK));
+            let chunks: Vec<&[bool]> = valid_s.chunks(CHUNK).collect();
+            if let Some(v) = chunks.first() {
+                convert::detections(v, tdc_s, 0, max_code, &mut cur)?;
+            }
+            for k in 0..chunks.len() {
                 let first = k * CHUNK;
-                convert::detections(v, tdc_s, first, max_code, &mut buf)?;
-                driver.run(&buf, first as u64).map_err(|e| e.to_string())?;
+                let (ran, converted) = rayon::join(
+                    || driver.run(&cur, first as u64).map_err(|e| e.to_string()),
+                    || match chunks.get(k + 1) {
+                        Some(v) => convert::detections(v, tdc_s, first + CHUNK, max_code, &mut next),
+                        None => Ok(()),
+                    },
+                );
+                ran?;
+                converted?;
+                std::mem::swap(&mut cur, &mut next);
             }
             Ok(driver.readout().words)
         });
