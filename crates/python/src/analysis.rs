@@ -6,8 +6,8 @@
 //! `tofprobe_eda::memory::memory`, `tofprobe size`'s readout section) and the EDA sizing
 //! report (`tofprobe_flow::sizing::size_report`), each run with the GIL released.
 
-use numpy::IntoPyArray;
 use numpy::Complex64;
+use numpy::IntoPyArray;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -119,12 +119,11 @@ fn to_python<'py>(py: Python<'py>, v: &impl serde::Serialize) -> PyResult<Bound<
 pub fn widths<'py>(d: &Design, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
     let design = &d.inner;
     let p = &design.pixel;
-    let (input, memory) = py
-        .detach(|| {
-            let input = tofprobe_flow::sizing::memory_input(design).map_err(value_error)?;
-            let m = tofprobe_eda::memory::memory(&input).map_err(value_error)?;
-            Ok::<_, PyErr>((input, m))
-        })?;
+    let (input, memory) = py.detach(|| {
+        let input = tofprobe_flow::sizing::memory_input(design).map_err(value_error)?;
+        let m = tofprobe_eda::memory::memory(&input).map_err(value_error)?;
+        Ok::<_, PyErr>((input, m))
+    })?;
     let out = PyDict::new(py);
     out.set_item("width", p.width)?;
     out.set_item("tdc_bits", p.tdc_bits)?;
@@ -138,7 +137,10 @@ pub fn widths<'py>(d: &Design, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> 
     out.set_item("readout_bits", memory.bytes_per_pixel * 8)?;
     out.set_item("memory", to_python(py, &memory)?)?;
     if let Some(chip) = &design.array {
-        out.set_item("array_readout_bits", memory.bytes_per_pixel * 8 * (chip.rows * chip.cols) as u64)?;
+        out.set_item(
+            "array_readout_bits",
+            memory.bytes_per_pixel * 8 * (chip.rows * chip.cols) as u64,
+        )?;
     }
     Ok(out)
 }

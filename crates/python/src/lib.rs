@@ -332,7 +332,9 @@ impl Design {
                 let (ran, converted) = rayon::join(
                     || driver.run(&cur, first as u64).map_err(|e| e.to_string()),
                     || match chunks.get(k + 1) {
-                        Some(v) => convert::detections(v, tdc_s, first + CHUNK, max_code, &mut next),
+                        Some(v) => {
+                            convert::detections(v, tdc_s, first + CHUNK, max_code, &mut next)
+                        }
                         None => Ok(()),
                     },
                 );
@@ -484,7 +486,11 @@ impl Design {
     /// (default N): eq. 12 with the TDC's a²/12, the 1NN hold and the first-arrival
     /// mixture of the design's scene.
     #[pyo3(signature = (pulses=None))]
-    fn noise_floor<'py>(&self, py: Python<'py>, pulses: Option<u64>) -> PyResult<Bound<'py, PyAny>> {
+    fn noise_floor<'py>(
+        &self,
+        py: Python<'py>,
+        pulses: Option<u64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         analysis::noise_floor(self, py, pulses)
     }
 

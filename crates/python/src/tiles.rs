@@ -19,12 +19,16 @@ use crate::convert::{self, value_error};
 
 /// The array shape, or a ValueError naming the missing `[array]`.
 fn shape(d: &Design) -> PyResult<(usize, usize)> {
-    d.inner.array.as_ref().map(|a| (a.rows, a.cols)).ok_or_else(|| {
-        PyValueError::new_err(format!(
-            "`{}` has no [array] section: simulate_array and tiles run an [array] design",
-            d.inner.origin
-        ))
-    })
+    d.inner
+        .array
+        .as_ref()
+        .map(|a| (a.rows, a.cols))
+        .ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "`{}` has no [array] section: simulate_array and tiles run an [array] design",
+                d.inner.origin
+            ))
+        })
 }
 
 /// The rectangles of `tiles` tiles, `((r0, r1), (c0, c1))` each.
@@ -72,8 +76,8 @@ pub fn tile_dict<'py>(py: Python<'py>, t: Tile) -> PyResult<Bound<'py, PyDict>> 
     let out = PyDict::new(py);
     out.set_item("rows", (t.rows.start, t.rows.end))?;
     out.set_item("cols", (t.cols.start, t.cols.end))?;
-    let regs = Array3::from_shape_vec((h, w, t.registers_per_pixel), t.registers)
-        .map_err(value_error)?;
+    let regs =
+        Array3::from_shape_vec((h, w, t.registers_per_pixel), t.registers).map_err(value_error)?;
     out.set_item("registers", regs.into_pyarray(py))?;
     let det = Array2::from_shape_vec((h, w), t.detections).map_err(value_error)?;
     out.set_item("detections", det.into_pyarray(py))?;
@@ -116,7 +120,9 @@ fn tile_from(py: Python<'_>, i: usize, obj: &Bound<'_, PyAny>, k: usize) -> PyRe
         .iter()
         .map(|&x| u64::try_from(x))
         .collect::<Result<_, _>>()
-        .map_err(|_| PyValueError::new_err(format!("`{name}['detections']` holds a negative count")))?;
+        .map_err(|_| {
+            PyValueError::new_err(format!("`{name}['detections']` holds a negative count"))
+        })?;
     Ok(Tile {
         rows: r0..r1,
         cols: c0..c1,

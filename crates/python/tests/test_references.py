@@ -168,3 +168,41 @@ def test_size_with_the_tools_reports_area(small):
     assert report["area"]["total_area_um2"] > 0 and report["area"]["cell_count"] > 100
     assert report["memory"] == small.widths()["memory"]
     assert (4, w) in {(r["bins"], r["width"]) for r in report["sweep"]}
+
+
+@pytest.mark.parametrize("call", ["dft", "float_sd", "time_library_run_pixel"])
+def test_the_references_refuse_bad_frames_like_run_pixel(small, call):
+    f = getattr(small, call)
+    valid, tdc = small.simulate_scene()
+    with pytest.raises(TypeError, match="`valid` must be a bool array"):
+        f(valid.astype(np.uint8), tdc)
+    with pytest.raises(TypeError, match="`tdc` must be an integer array"):
+        f(valid, tdc.astype(np.float32))
+    with pytest.raises(ValueError, match="one code per pulse"):
+        f(valid[:-1], tdc)
+    with pytest.raises(ValueError, match="one-dimensional"):
+        f(valid[None, :], tdc[None, :])
+    i = int(np.argmax(valid))
+    bad = tdc.astype(np.int64)
+    bad[i] = -3
+    with pytest.raises(ValueError, match=rf"`tdc\[{i}\]` = -3"):
+        f(valid, bad)
+    bad[i] = 1 << 40
+    with pytest.raises(ValueError, match=rf"`tdc\[{i}\]` = {1 << 40}"):
+        f(valid, bad)
+
+
+def test_an_empty_frame_and_haar_designs_are_refused(small):
+    with pytest.raises(ValueError, match="empty frame"):
+        small.dft(np.zeros(0, bool), np.zeros(0, np.int32))
+    text = (ROOT / "scenes" / "default.toml").read_text()
+    text = text.replace("duration_s = 1.0", f"pulses = {1 << 17}")
+    text = text.replace('mode = "fourier"', 'mode = "haar"').replace("rom_depth = 20000 ", "rom_depth = 16384 ")
+    haar = tofprobe.Design.from_toml(text)
+    v, t = haar.simulate_scene()
+    for call in (lambda: haar.dft(v, t), lambda: haar.float_sd(v, t), haar.noise_floor, haar.ntf):
+        with pytest.raises(ValueError, match="fourier"):
+            call()
+    # Haar widths still resolve: 2^(U+1) − 1 registers of W bits.
+    w = haar.widths()
+    assert w["bits_per_frame"] == w["registers"] * w["width"]
