@@ -67,14 +67,13 @@ pub fn share(total: u64, shard: Shard) -> Range<u64> {
     at(shard.index)..at(shard.index + 1)
 }
 
+/// A tile's rectangle: rows × cols.
+pub type Rect = (Range<usize>, Range<usize>);
+
 /// The partition of an R × C array into `n` rectangles (1 ≤ n ≤ R·C), in order: n ≤ R gives
 /// n bands of whole rows; n > R gives every row its own band, row r cut into n_r column
 /// pieces (the n_r share n over the rows). Deterministic, every pixel in exactly one tile.
-pub fn tiles(
-    rows: usize,
-    cols: usize,
-    n: usize,
-) -> Result<Vec<(Range<usize>, Range<usize>)>, ArrayError> {
+pub fn tiles(rows: usize, cols: usize, n: usize) -> Result<Vec<Rect>, ArrayError> {
     let pixels = rows * cols;
     if n == 0 || n > pixels {
         return Err(ArrayError::Shape(format!(

@@ -27,6 +27,9 @@ use convert::{CodeSlice, value_error};
 
 /// Origin of a design given as TOML text.
 const TEXT_ORIGIN: &str = "<TOML text>";
+/// A tile's rectangle for Python: `((row_start, row_end), (col_start, col_end))`.
+type PyRect = ((usize, usize), (usize, usize));
+
 /// Origin of a design given as a dict.
 const DICT_ORIGIN: &str = "<dict>";
 
@@ -425,7 +428,7 @@ impl Design {
     /// The partition of the array into ``tiles`` rectangles (``tofprobe simulate --shard
     /// i/n``'s): a list of ``((row_start, row_end), (col_start, col_end))``, every pixel
     /// in exactly one. ``ValueError`` unless 1 ≤ tiles ≤ R·C.
-    fn tile_rects(&self, tiles: usize) -> PyResult<Vec<((usize, usize), (usize, usize))>> {
+    fn tile_rects(&self, tiles: usize) -> PyResult<Vec<PyRect>> {
         Ok(tiles::rects(self, tiles)?
             .into_iter()
             .map(|(r, c)| ((r.start, r.end), (c.start, c.end)))

@@ -32,7 +32,7 @@ fn shape(d: &Design) -> PyResult<(usize, usize)> {
 }
 
 /// The rectangles of `tiles` tiles, `((r0, r1), (c0, c1))` each.
-pub fn rects(d: &Design, tiles: usize) -> PyResult<Vec<(Range<usize>, Range<usize>)>> {
+pub fn rects(d: &Design, tiles: usize) -> PyResult<Vec<tofprobe_array::shard::Rect>> {
     let (r, c) = shape(d)?;
     tofprobe_array::shard::tiles(r, c, tiles)
         .map_err(|e| PyValueError::new_err(format!("`tiles`: {e}")))
