@@ -23,7 +23,7 @@ use tofprobe_design::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, ResolvedDesign};
 use tofprobe_dsp::sd::ProbeRom;
 use tofprobe_pixel::FrameDriver;
 
-use convert::{CodeSlice, value_error};
+use convert::value_error;
 
 /// Origin of a design given as TOML text.
 const TEXT_ORIGIN: &str = "<TOML text>";
@@ -93,51 +93,6 @@ impl Design {
     fn max_code(&self) -> u32 {
         ((1u64 << self.inner.pixel.tdc_bits.min(32)) - 1) as u32
     }
-
-    /// The borrowed frame `(valid, tdc)`, checked: equal lengths, at most one frame.
-    fn checked_frame<'a>(
-        &self,
-        valid_a: &'a numpy::PyReadonlyArray1<'_, bool>,
-        tdc_a: &'a convert::Codes<'_>,
-    ) -> PyResult<(&'a [bool], CodeSlice<'a>)> {
-        let valid_s = convert::slice(valid_a, "valid")?;
-        let tdc_s: CodeSlice<'_> = tdc_a.slice("tdc")?;
-        if valid_s.len() != tdc_s.len() {
-            return Err(PyValueError::new_err(format!(
-                "`valid` has {} pulses and `tdc` {}: one code per pulse",
-                valid_s.len(),
-                tdc_s.len()
-            )));
-        }
-        let n = self.inner.pixel.frame_pulses;
-        if valid_s.len() as u64 > n {
-            return Err(PyValueError::new_err(format!(
-                "{} pulses exceed one frame of pixel.frame_pulses = {n}: pass at most {n} \
-                 (one frame; call once per frame)",
-                valid_s.len()
-            )));
-        }
-        Ok((valid_s, tdc_s))
-    }
-
-    /// The frame `(valid, tdc)` as the library's detections (`None` = no detection),
-    /// checked like `run_pixel`'s.
-    pub(crate) fn frame(
-        &self,
-        py: Python<'_>,
-        valid: &Bound<'_, PyAny>,
-        tdc: &Bound<'_, PyAny>,
-    ) -> PyResult<Vec<Option<u32>>> {
-        let valid_a = convert::bool_array("valid", valid)?;
-        let tdc_a = convert::codes("tdc", tdc)?;
-        let (valid_s, tdc_s) = self.checked_frame(&valid_a, &tdc_a)?;
-        let max_code = self.max_code();
-        py.detach(|| {
-            let mut out = Vec::with_capacity(valid_s.len());
-            convert::detections(valid_s, tdc_s, 0, max_code, &mut out).map(|()| out)
-        })
-        .map_err(PyValueError::new_err)
-    }
 }
 
 #[pymethods]
@@ -175,26 +130,7 @@ impl Design {
     /// unknown key or a bad value; ``TypeError`` for a value JSON/TOML cannot hold.
     #[staticmethod]
     fn from_dict(d: &Bound<'_, PyAny>) -> PyResult<Self> {
-        if d.cast::<PyDict>().is_err() {
-            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
-                "`d` must be a dict of the configuration's tables, got {}",
-                d.get_type().name()?
-            )));
-        }
-        let json: String = d
-            .py()
-            .import("json")?
-            .call_method1("dumps", (d,))
-            .map_err(|e| {
-                pyo3::exceptions::PyTypeError::new_err(format!(
-                    "`d` holds a value a configuration cannot: {e}"
-                ))
-            })?
-            .extract()?;
-        let value: toml::Value = serde_json::from_str(&json).map_err(|e| {
-            PyValueError::new_err(format!("`d` is not a TOML document (no None values): {e}"))
-        })?;
-        let text = toml::to_string(&value).map_err(value_error)?;
+        let text = convert::dict_to_toml(d)?;
         Design::resolve(&text, DICT_ORIGIN)
     }
 
