@@ -62,11 +62,14 @@ impl Design {
         }
     }
 
-    fn resolve(text: &str, origin: &str) -> PyResult<Self> {
-        let doc = Document::from_toml_str(text, origin).map_err(value_error)?;
-        tofprobe_design::resolve(doc, origin)
-            .map(Design::new)
-            .map_err(value_error)
+    /// The one resolution of TOML text, without the GIL (it designs the ΣΔ modulator).
+    fn resolve(py: Python<'_>, text: &str, origin: &str) -> PyResult<Self> {
+        py.detach(|| {
+            let doc = Document::from_toml_str(text, origin)?;
+            tofprobe_design::resolve(doc, origin)
+        })
+        .map(Design::new)
+        .map_err(value_error)
     }
 
     /// The probe ROM (`None` in Haar mode), generated once without the GIL.
@@ -100,8 +103,8 @@ impl Design {
     /// The embedded default design (the paper's Fig. 8: a 0.1 mm, 4.5 kHz sine; 10^7
     /// pulses; 16 bins), as ``tofprobe`` commands use without a configuration.
     #[staticmethod]
-    fn default() -> PyResult<Self> {
-        Design::resolve(DEFAULT_TOML, DEFAULT_ORIGIN)
+    fn default(py: Python<'_>) -> PyResult<Self> {
+        Design::resolve(py, DEFAULT_TOML, DEFAULT_ORIGIN)
     }
 
     /// A design from a TOML file or TOML text, resolved (validated and completed).
@@ -112,14 +115,15 @@ impl Design {
     /// resolve, and for a file that cannot be read.
     #[staticmethod]
     fn from_toml(source: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let py = source.py();
         if let Ok(s) = source.cast::<PyString>() {
             let s = s.to_cow()?;
             if s.contains('\n') || s.contains('=') {
-                return Design::resolve(&s, TEXT_ORIGIN);
+                return Design::resolve(py, &s, TEXT_ORIGIN);
             }
         }
         let path: PathBuf = source.extract()?;
-        tofprobe_design::load(Some(&path))
+        py.detach(|| tofprobe_design::load(Some(&path)))
             .map(Design::new)
             .map_err(value_error)
     }
@@ -131,13 +135,13 @@ impl Design {
     #[staticmethod]
     fn from_dict(d: &Bound<'_, PyAny>) -> PyResult<Self> {
         let text = convert::dict_to_toml(d)?;
-        Design::resolve(&text, DICT_ORIGIN)
+        Design::resolve(d.py(), &text, DICT_ORIGIN)
     }
 
     /// A design serialised by ``to_json`` (no resolution runs again).
     #[staticmethod]
-    fn from_json(text: &str) -> PyResult<Self> {
-        ResolvedDesign::from_json(text)
+    fn from_json(py: Python<'_>, text: &str) -> PyResult<Self> {
+        py.detach(|| ResolvedDesign::from_json(text))
             .map(Design::new)
             .map_err(value_error)
     }
@@ -302,7 +306,9 @@ impl Design {
         let rom = self.fourier_rom(py, "spectrum")?;
         let pulses = pulses.unwrap_or(self.inner.pixel.frame_pulses);
         let lsb_mm = self.inner.sensor().tdc_lsb_mm();
-        let bins = tofprobe_pixel::spectrum::phasors(&self.inner.pixel, rom, words, pulses, lsb_mm)
+        let params = &self.inner.pixel;
+        let bins = py
+            .detach(|| tofprobe_pixel::spectrum::phasors(params, rom, words, pulses, lsb_mm))
             .map_err(value_error)?;
         let f: Vec<f64> = bins.iter().map(|b| b.frequency_hz).collect();
         let a: Vec<f64> = bins.iter().map(|b| b.amplitude_um).collect();

@@ -219,7 +219,7 @@ fn cosim_shards_cover_exactly_the_soaks_configurations() {
         let mut a = vec![
             "cosim",
             "--random",
-            "3",
+            "2",
             "--seed",
             "5",
             "--json",
