@@ -69,8 +69,8 @@ pub fn float_sd(
 /// The closed-form noise floor E|Y| (µm) at each probe bin for a frame of `pulses` pulses
 /// of the design's scene: σ² of the first-arrival mixture plus the TDC's a²/12, the 1NN
 /// hold at the valid rate ρ_v, N_eff = N·G²/P of the ROM's window (eq. 12 and its
-/// extensions, `dsp::closed_form`). Without photons the floor is that of the jitter alone
-/// at ρ = 1 (no hold: eq. 12 itself).
+/// extensions, `dsp::closed_form`; the same terms as the trade-off's closed-form level).
+/// Without photons nothing is detected (ρ_v = 0) and the floor is 0.
 pub fn noise_floor_um(
     design: &ResolvedDesign,
     rom: &ProbeRom,
@@ -88,7 +88,7 @@ pub fn noise_floor_um(
         first_arrival(&mixture).map_err(dsp_err(design))?
     } else {
         FirstArrival {
-            valid_rate: 1.0,
+            valid_rate: 0.0,
             mean_mm: mixture.signal_depth_mm,
             variance_mm2: mixture.jitter_mm * mixture.jitter_mm,
             signal_fraction: 0.0,

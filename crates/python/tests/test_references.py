@@ -113,6 +113,16 @@ def test_noise_floor_is_eq12_and_matches_simulated_frames(small):
         small.noise_floor(pulses=0)
 
 
+def test_noise_floor_without_photons_is_zero(small_text):
+    # No photon, no detection: the pixel reads nothing (ρ_v = 0), and so does the floor.
+    doc = tomllib.loads(small_text)
+    doc["sensor"]["signal_rate"] = 0.0
+    dark = tofprobe.Design.from_dict(doc)
+    assert (dark.noise_floor() == 0).all()
+    valid, _ = dark.simulate_scene()
+    assert not valid.any()
+
+
 def test_ntf_has_its_zeros_poles_and_out_of_band_gain(small):
     text = (ROOT / "scenes" / "default.toml").read_text()
     order = int(text.split("order = ")[1].split()[0])
