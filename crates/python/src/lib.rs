@@ -358,6 +358,8 @@ impl Design {
     ) -> PyResult<Bound<'py, PyDict>> {
         let d = slf.get();
         if let Some(client) = client.filter(|c| !c.is_none()) {
+            // The ROM generated once here travels with the design to every task.
+            d.rom(py)?;
             let out = py
                 .import("tofprobe.dask")?
                 .call_method1("simulate_array", (slf, tiles, client))?;
@@ -499,10 +501,39 @@ impl Design {
         })
     }
 
-    /// Pickling: the resolved design travels as its JSON.
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
-        let ctor = slf.get_type().getattr("from_json")?;
-        Ok((ctor, (slf.get().to_json()?,)))
+    /// Pickling: the resolved design travels as its JSON, with its probe ROM once it has
+    /// been generated (a Dask worker then does not generate it again).
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (String, Option<String>))> {
+        let ctor = slf.get_type().getattr("_restore")?;
+        let d = slf.get();
+        let rom = match d.rom.get() {
+            Some(r) => Some(serde_json::to_string(r).map_err(value_error)?),
+            None => None,
+        };
+        Ok((ctor, (d.to_json()?, rom)))
+    }
+
+    /// Unpickling (`__reduce__`'s constructor): the design and, when it travelled, its ROM.
+    #[staticmethod]
+    #[pyo3(signature = (design, rom=None))]
+    fn _restore(py: Python<'_>, design: &str, rom: Option<&str>) -> PyResult<Self> {
+        let (inner, rom) = py
+            .detach(|| -> Result<_, String> {
+                let inner = ResolvedDesign::from_json(design).map_err(|e| e.to_string())?;
+                let rom = rom
+                    .map(serde_json::from_str::<Option<ProbeRom>>)
+                    .transpose()
+                    .map_err(|e| format!("the pickled probe ROM: {e}"))?;
+                Ok((inner, rom))
+            })
+            .map_err(PyValueError::new_err)?;
+        let d = Design::new(inner);
+        if let Some(r) = rom {
+            let _ = d.rom.set(r);
+        }
+        Ok(d)
     }
 
     fn __repr__(&self) -> String {

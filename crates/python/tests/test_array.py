@@ -61,6 +61,20 @@ def test_tiles_that_travelled_through_pickle_merge_even_misaligned(arr, whole):
     same(arr.merge_tiles(parts), whole)
 
 
+def test_a_pickled_design_carries_its_rom_once_generated(arr):
+    fresh = pickle.dumps(tofprobe.Design.from_json(arr.to_json()))
+    rom = arr.probe_rom()  # generated now: the pickle carries it
+    carried = pickle.dumps(arr)
+    assert len(carried) > len(fresh) + rom.size // 8
+    again = pickle.loads(carried)
+    np.testing.assert_array_equal(again.probe_rom(), rom)
+    assert again.to_json() == arr.to_json()
+    np.testing.assert_array_equal(again.run_tile((0, 1), (0, 3))["registers"],
+                                  arr.run_tile((0, 1), (0, 3))["registers"])
+    with pytest.raises(ValueError, match="pickled probe ROM"):
+        tofprobe.Design._restore(arr.to_json(), "{not json")
+
+
 def test_bad_tiles_are_refused_naming_the_argument(arr):
     for bad in (0, 13):
         with pytest.raises(ValueError, match="tiles"):
