@@ -27,6 +27,9 @@ use convert::value_error;
 
 /// Origin of a design given as TOML text.
 const TEXT_ORIGIN: &str = "<TOML text>";
+/// What a pickled Design carries: its resolved JSON and, once generated, its ROM's JSON.
+type PickleState = (String, Option<String>);
+
 /// A tile's rectangle for Python: `((row_start, row_end), (col_start, col_end))`.
 type PyRect = ((usize, usize), (usize, usize));
 
@@ -503,9 +506,7 @@ impl Design {
 
     /// Pickling: the resolved design travels as its JSON, with its probe ROM once it has
     /// been generated (a Dask worker then does not generate it again).
-    fn __reduce__<'py>(
-        slf: &Bound<'py, Self>,
-    ) -> PyResult<(Bound<'py, PyAny>, (String, Option<String>))> {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, PickleState)> {
         let ctor = slf.get_type().getattr("_restore")?;
         let d = slf.get();
         let rom = match d.rom.get() {
