@@ -32,6 +32,7 @@ mod reliability;
 mod replay;
 mod reproduce;
 mod resolution;
+mod shard;
 mod signals;
 mod size;
 mod tradeoff;
