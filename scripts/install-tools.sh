@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the EDA tools tofprobe drives (Verilator, Icarus Verilog, yosys, OpenSTA and the
-# OSU 0.18 um liberty) from Debian's packages, only where one is missing. Idempotent: a
+# OSU 0.18 um liberty) and rsvg-convert (the figures' rendering check) from Debian's
+# packages, only where one is missing. Idempotent: a
 # machine that already has them is left untouched, so CI and the main flow can call it on
 # every run.
 set -euo pipefail
@@ -11,6 +12,8 @@ command -v iverilog  >/dev/null 2>&1 || need+=(iverilog)
 command -v yosys     >/dev/null 2>&1 || need+=(yosys)
 command -v sta       >/dev/null 2>&1 || need+=(opensta)
 [ -d /usr/share/qflow/tech/osu018 ] || need+=(qflow-tech-osu018)
+# The figures' rendering check (cli reproduce test) renders every SVG as a viewer would.
+command -v rsvg-convert >/dev/null 2>&1 || need+=(librsvg2-bin)
 
 if [ ${#need[@]} -eq 0 ]; then
   exit 0

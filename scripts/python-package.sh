@@ -2,7 +2,8 @@
 # Builds the Python package `tofprobe` (crates/python: pyo3 + maturin, an abi3 wheel) in
 # release mode in the workspace's target dir (reusing the library crates `cargo test
 # --release` compiled), installs it into the scripts' venv (scripts/py-venv.sh) and runs
-# its pytest suite (crates/python/tests). Prints the build and test times.
+# its pytest suite (crates/python/tests), then runs examples/python_pixel.py headless.
+# Prints the build, test and example times.
 # A missing python3 fails under CI (TOFPROBE_REQUIRE_TOOLS=1 or CI set) and skips otherwise.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -28,4 +29,15 @@ built=$(date +%s)
 # The CLI binary the bit-identity test compares with (built by `cargo test --release`).
 export TOFPROBE_CLI="${TOFPROBE_CLI:-$target/release/tofprobe}"
 (cd "$root/crates/python" && "$venv/bin/python" -m pytest -q -p no:cacheprovider)
-echo "python-package: ok (build+install $(( built - start )) s, pytest $(( $(date +%s) - built )) s)"
+tested=$(date +%s)
+# The example, headless (matplotlib's Agg backend), on a short frame and a small array.
+example_out="$target/python-example"
+rm -rf "$example_out"
+MPLBACKEND=Agg "$venv/bin/python" "$root/examples/python_pixel.py" --quick --out "$example_out" >/dev/null
+for png in spectrum.png vibration_map.png; do
+  if [ ! -s "$example_out/$png" ]; then
+    echo "python-package: FAILED: examples/python_pixel.py wrote no $png" >&2
+    exit 1
+  fi
+done
+echo "python-package: ok (build+install $(( built - start )) s, pytest $(( tested - built )) s, example $(( $(date +%s) - tested )) s)"

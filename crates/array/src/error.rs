@@ -21,6 +21,9 @@ pub enum ArrayError {
     /// A tile, merge or map request that does not fit the array.
     #[error("{0}")]
     Shape(String),
+    /// A tile set that cannot be merged (not one, or not of the same run as the others).
+    #[error("tile set {}: {message}", path.display())]
+    TileSet { path: PathBuf, message: String },
     /// An output file that cannot be written.
     #[error("cannot write {}: {message}", path.display())]
     Output { path: PathBuf, message: String },

@@ -6,7 +6,8 @@
 //! [`maps`] turns the registers into vibration maps (amplitude and phase per bin through
 //! `pixel::spectrum::phasors`, the dominant bin, the deflection shape, the modal assurance
 //! criterion), [`plot`] draws them, [`uff`] writes them for modal-analysis tools and
-//! [`output`] writes the whole set.
+//! [`output`] writes the whole set; [`shard`] splits a run into tile sets across processes
+//! or machines and merges them back into the same set.
 
 mod error;
 pub mod events;
@@ -14,6 +15,7 @@ pub mod maps;
 pub mod model;
 pub mod output;
 pub mod plot;
+pub mod shard;
 pub mod uff;
 
 pub use error::ArrayError;

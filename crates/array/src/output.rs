@@ -13,6 +13,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 use tofprobe_design::ResolvedDesign;
+use tofprobe_dsp::sd::ProbeRom;
 use tofprobe_io::npy;
 
 use crate::error::ArrayError;
@@ -77,17 +78,41 @@ fn simulate_all(
     ),
     ArrayError,
 > {
+    let rom = design.probe_rom()?;
+    let t0 = Instant::now();
+    let frame = run_array(design, rom.as_ref().map(|r| &r.image))?;
+    finish(design, rom.as_ref(), frame, t0.elapsed().as_secs_f64())
+}
+
+/// The maps, the Haar events and the summary of a frame that took `model_seconds` to run
+/// (one run, or merged tiles); `rom` is the design's probe ROM (`None` in Haar mode).
+pub fn finish(
+    design: &ResolvedDesign,
+    rom: Option<&ProbeRom>,
+    frame: ArrayFrame,
+    model_seconds: f64,
+) -> Result<
+    (
+        ArrayFrame,
+        Option<VibrationMaps>,
+        Option<EventMap>,
+        ArraySummary,
+    ),
+    ArrayError,
+> {
     let Some(a) = &design.array else {
         return Err(ArrayError::Shape(format!(
             "`{}` has no [array] section",
             design.origin
         )));
     };
-    let rom = design.probe_rom()?;
-    let t0 = Instant::now();
-    let frame = run_array(design, rom.as_ref().map(|r| &r.image))?;
-    let model_seconds = t0.elapsed().as_secs_f64();
-    let maps = match &rom {
+    if (frame.rows, frame.cols) != (a.rows, a.cols) {
+        return Err(ArrayError::Shape(format!(
+            "a {} × {} frame for the {} × {} array of `{}`",
+            frame.rows, frame.cols, a.rows, a.cols, design.origin
+        )));
+    }
+    let maps = match rom {
         Some(rom) => Some(fourier_maps(design, rom, &frame)?),
         None => None,
     };
@@ -261,7 +286,22 @@ pub fn files(
 
 /// Runs the array and writes its set into `dir` (whole or absent); returns the summary.
 pub fn run_and_write(design: &ResolvedDesign, dir: &Path) -> Result<ArraySummary, ArrayError> {
-    let (frame, maps, events, mut summary) = simulate_all(design)?;
+    let rom = design.probe_rom()?;
+    let t0 = Instant::now();
+    let frame = run_array(design, rom.as_ref().map(|r| &r.image))?;
+    write_set(design, rom.as_ref(), frame, t0.elapsed().as_secs_f64(), dir)
+}
+
+/// Writes the set of a frame that took `model_seconds` to run (one run, or merged tiles:
+/// `shard::merge_sets`) into `dir` (whole or absent); returns the summary.
+pub fn write_set(
+    design: &ResolvedDesign,
+    rom: Option<&ProbeRom>,
+    frame: ArrayFrame,
+    model_seconds: f64,
+    dir: &Path,
+) -> Result<ArraySummary, ArrayError> {
+    let (frame, maps, events, mut summary) = finish(design, rom, frame, model_seconds)?;
     let files = files(design, &frame, maps.as_ref(), events.as_ref())?;
     let out_err = |e: std::io::Error| ArrayError::Output {
         path: dir.to_path_buf(),

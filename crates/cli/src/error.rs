@@ -21,6 +21,9 @@ pub enum CliError {
     /// `reproduce` could not run (not a missed row: that is the FAIL verdict).
     #[error("reproduce: {0}")]
     Reproduce(Box<tofprobe_experiments::ExperimentError>),
+    /// Tile sets that `merge` refuses (the message names the set).
+    #[error("merge: {0}")]
+    Merge(String),
     /// JSON serialisation failed (should not happen for plain numbers).
     #[error("cannot serialise JSON output: {0}")]
     Json(#[from] serde_json::Error),
@@ -78,6 +81,7 @@ impl From<tofprobe_array::ArrayError> for CliError {
         match e {
             tofprobe_array::ArrayError::Design(d) => CliError::Design(d),
             tofprobe_array::ArrayError::Output { path, message } => CliError::output(path, message),
+            e @ tofprobe_array::ArrayError::TileSet { .. } => CliError::Merge(e.to_string()),
             other => CliError::option("array", other.to_string(), "an array the model can run"),
         }
     }

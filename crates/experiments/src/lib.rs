@@ -13,6 +13,7 @@ pub mod options;
 pub mod paper;
 pub mod record_bounds;
 pub mod records;
+pub mod references;
 pub mod replay;
 pub mod scalogram;
 pub mod simulation;

@@ -65,16 +65,42 @@ pub fn scalogram_svg(
     title: &str,
     events: Option<&EventReport>,
 ) -> std::result::Result<String, String> {
+    scalogram_svg_with_notes(s, title, events, &[])
+}
+
+/// Height of one note line under the heat map (px; 14 px text).
+const NOTE_H: u32 = 20;
+
+/// [`scalogram_svg`] with text lines under the heat map (the paper's values beside the
+/// measured ones, in the reproduction's Fig. 3 and Fig. 12).
+pub fn scalogram_svg_with_notes(
+    s: &Scalogram,
+    title: &str,
+    events: Option<&EventReport>,
+    notes: &[String],
+) -> std::result::Result<String, String> {
     let vmax = check(s)?;
     let u_max = s.scales;
     let t_ms = s.duration_s() * 1e3;
     let e = |e: &dyn std::fmt::Display| e.to_string();
     let mut svg = String::new();
     {
+        let map_h = 80 + 50 * (u_max + 1);
         let root =
-            SVGBackend::with_string(&mut svg, (1000, 80 + 50 * (u_max + 1))).into_drawing_area();
+            SVGBackend::with_string(&mut svg, (1000, map_h + NOTE_H * notes.len() as u32 + 8))
+                .into_drawing_area();
         root.fill(&WHITE).map_err(|x| e(&x))?;
-        let (main, bar) = root.split_horizontally(880);
+        let (upper, lower) = root.split_vertically(map_h);
+        for (i, note) in notes.iter().enumerate() {
+            lower
+                .draw(&Text::new(
+                    note.clone(),
+                    (20, (NOTE_H * i as u32) as i32),
+                    ("sans-serif", 14).into_font().color(&BLACK),
+                ))
+                .map_err(|x| e(&x))?;
+        }
+        let (main, bar) = upper.split_horizontally(880);
         // Row u spans y ∈ [U − u − ½, U − u + ½]: integer ticks fall on the row centres.
         let y_top = f64::from(u_max) + 0.5;
         let mut chart = ChartBuilder::on(&main)
@@ -98,6 +124,8 @@ pub fn scalogram_svg(
             .disable_mesh()
             .x_desc("time (ms)")
             .y_desc("scale (wavelet duration)")
+            .label_style(("sans-serif", 14))
+            .axis_desc_style(("sans-serif", 15))
             .y_labels(u_max as usize + 2)
             .y_label_formatter(&row_label)
             .draw()
@@ -136,6 +164,10 @@ pub fn scalogram_svg(
             .disable_mesh()
             .disable_x_axis()
             .y_desc("w (mm)")
+            // Explicit sizes: plotters scales its default label font with the area, which
+            // made the narrow colour bar's labels 4 px.
+            .label_style(("sans-serif", 13))
+            .axis_desc_style(("sans-serif", 14))
             .y_labels(7)
             .y_label_formatter(&|y: &f64| format!("{y:+.3}"))
             .draw()

@@ -49,19 +49,11 @@ fn cache_dir(arg: Option<&Path>) -> PathBuf {
     tofprobe_eda::fsutil::synth_cache_dir(arg)
 }
 
-/// Builds the sizing report of `design`.
-pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeReport, FlowError> {
-    let pixel = design.pixel.clone();
-    if !(a.node_nm.is_finite() && a.node_nm > 0.0 && a.node_nm <= 1000.0) {
-        return Err(FlowError::option(
-            "node-nm",
-            a.node_nm,
-            "0 < node ≤ 1000 (nm)",
-        ));
-    }
-
-    // Memory: the codes the scene can produce, relative to the zoom, times 2^G (the
-    // registers' fraction bits).
+/// The memory request of `design` (`tofprobe size`'s readout section): the codes the
+/// scene can produce, relative to the zoom, times 2^G (the registers' fraction bits), the
+/// configured W, raw timestamps of T bits.
+pub fn memory_input(design: &ResolvedDesign) -> Result<MemoryInput, FlowError> {
+    let pixel = &design.pixel;
     let s = design.sensor();
     let scene = Scene::new(&design.document.scene)?;
     let (lo, hi) = scene_codes(
@@ -81,6 +73,22 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
         timestamp_bits: s.tdc_bits(),
         laser_rate_hz: s.laser_rate_hz,
     };
+    Ok(mem_in)
+}
+
+/// Builds the sizing report of `design`.
+pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeReport, FlowError> {
+    let pixel = design.pixel.clone();
+    if !(a.node_nm.is_finite() && a.node_nm > 0.0 && a.node_nm <= 1000.0) {
+        return Err(FlowError::option(
+            "node-nm",
+            a.node_nm,
+            "0 < node ≤ 1000 (nm)",
+        ));
+    }
+
+    let s = design.sensor();
+    let mem_in = memory_input(design)?;
     memory(&mem_in).map_err(|e| FlowError::option("config", &design.origin, &e.to_string()))?;
 
     let bins = pixel.bins as u64;

@@ -8,6 +8,7 @@
 use numpy::{Element, PyReadonlyArray1};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 /// A library error as a Python `ValueError` carrying its message.
 pub fn value_error(e: impl std::fmt::Display) -> PyErr {
@@ -214,7 +215,10 @@ pub fn detections(
     }
 }
 
-/// [`detections`] for one integer type (one pass, no branch on the dtype per pulse).
+/// [`detections`] for one integer type, in two branch-free passes the compiler
+/// vectorises (the conversion is most of `run_pixel`'s overhead over the library call:
+/// scripts/python-bench.py): the detections (a code out of range wraps here), then the
+/// range check of the valid codes; only a failing check looks for the pulse to name.
 fn fill<T>(
     valid: &[bool],
     codes: &[T],
@@ -223,35 +227,128 @@ fn fill<T>(
     out: &mut Vec<Option<u32>>,
 ) -> Result<(), String>
 where
-    T: Copy + Into<i128>,
-    u32: TryFrom<T>,
+    T: Copy + Into<i128> + Code,
 {
     out.clear();
-    let mut ok = true;
-    out.extend(valid.iter().zip(codes).map(|(&v, &c)| {
-        if !v {
-            return None;
-        }
-        match u32::try_from(c) {
-            Ok(x) if x <= max_code => Some(x),
-            _ => {
-                ok = false;
-                None
-            }
-        }
-    }));
-    if ok {
+    out.extend(
+        valid
+            .iter()
+            .zip(codes)
+            .map(|(&v, &c)| if v { Some(c.wrapped()) } else { None }),
+    );
+    let bad = valid
+        .iter()
+        .zip(codes)
+        .fold(false, |bad, (&v, &c)| bad | (v & !c.within(max_code)));
+    if !bad {
         return Ok(());
     }
     let (i, c) = valid
         .iter()
         .zip(codes)
         .enumerate()
-        .find(|(_, (v, c))| **v && !(0..=i128::from(max_code)).contains(&(**c).into()))
+        .find(|(_, (v, c))| **v && !c.within(max_code))
         .map(|(i, (_, &c))| (first + i, c.into()))
         .unwrap_or((first, -1));
     Err(format!(
         "`tdc[{i}]` = {c} is outside the pixel's TDC codes 0 ..= {max_code} \
          (pixel.tdc_bits); a code in that range would work, or valid[{i}] = False"
     ))
+}
+
+/// An integer dtype of TDC codes.
+pub trait Code: Copy {
+    /// The code as u32 (wrapping: only used once [`Code::within`] holds).
+    fn wrapped(self) -> u32;
+    /// 0 ≤ code ≤ `max`.
+    fn within(self, max: u32) -> bool;
+}
+
+macro_rules! code {
+    ($($t:ty),*) => {$(
+        impl Code for $t {
+            #[inline]
+            fn wrapped(self) -> u32 {
+                self as u32
+            }
+            #[inline]
+            #[allow(unused_comparisons)]
+            fn within(self, max: u32) -> bool {
+                self >= 0 && (self as u64) <= u64::from(max)
+            }
+        }
+    )*};
+}
+code!(u8, u16, u32, u64, i8, i16, i32, i64);
+
+/// A dict shaped like the configuration document as TOML text (through `json.dumps`: a
+/// value JSON cannot hold is a `TypeError` naming `d`; a `None` a `ValueError`).
+pub fn dict_to_toml(d: &Bound<'_, PyAny>) -> PyResult<String> {
+    if d.cast::<PyDict>().is_err() {
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "`d` must be a dict of the configuration's tables, got {}",
+            d.get_type().name()?
+        )));
+    }
+    let json: String = d
+        .py()
+        .import("json")?
+        .call_method1("dumps", (d,))
+        .map_err(|e| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "`d` holds a value a configuration cannot: {e}"
+            ))
+        })?
+        .extract()?;
+    let value: toml::Value = serde_json::from_str(&json).map_err(|e| {
+        PyValueError::new_err(format!("`d` is not a TOML document (no None values): {e}"))
+    })?;
+    toml::to_string(&value).map_err(value_error)
+}
+
+impl crate::Design {
+    /// The borrowed frame `(valid, tdc)`, checked: equal lengths, at most one frame.
+    pub(crate) fn checked_frame<'a>(
+        &self,
+        valid_a: &'a numpy::PyReadonlyArray1<'_, bool>,
+        tdc_a: &'a Codes<'_>,
+    ) -> PyResult<(&'a [bool], CodeSlice<'a>)> {
+        let valid_s = slice(valid_a, "valid")?;
+        let tdc_s: CodeSlice<'_> = tdc_a.slice("tdc")?;
+        if valid_s.len() != tdc_s.len() {
+            return Err(PyValueError::new_err(format!(
+                "`valid` has {} pulses and `tdc` {}: one code per pulse",
+                valid_s.len(),
+                tdc_s.len()
+            )));
+        }
+        let n = self.inner.pixel.frame_pulses;
+        if valid_s.len() as u64 > n {
+            return Err(PyValueError::new_err(format!(
+                "{} pulses exceed one frame of pixel.frame_pulses = {n}: pass at most {n} \
+                 (one frame; call once per frame)",
+                valid_s.len()
+            )));
+        }
+        Ok((valid_s, tdc_s))
+    }
+
+    /// The frame `(valid, tdc)` as the library's detections (`None` = no detection),
+    /// checked like `run_pixel`'s.
+    pub(crate) fn frame(
+        &self,
+        py: Python<'_>,
+        valid: &Bound<'_, PyAny>,
+        tdc: &Bound<'_, PyAny>,
+    ) -> PyResult<Vec<Option<u32>>> {
+        let valid_a = bool_array("valid", valid)?;
+        let tdc_a = codes("tdc", tdc)?;
+        let (valid_s, tdc_s) = self.checked_frame(&valid_a, &tdc_a)?;
+        let max_code = self.max_code();
+        py.detach(|| {
+            let mut out = Vec::with_capacity(valid_s.len());
+            detections(valid_s, tdc_s, 0, max_code, &mut out).map(|()| out)
+        })
+        .map_err(PyValueError::new_err)
+    }
 }

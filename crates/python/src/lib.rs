@@ -7,12 +7,14 @@
 //! Errors are `ValueError`s carrying the library's message (it names the field, the value
 //! and what would work) or `TypeError`s naming the argument of a wrong dtype.
 
+mod analysis;
 mod convert;
+mod tiles;
 
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
-use numpy::ndarray::{Array2, Array3};
+use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -21,13 +23,22 @@ use tofprobe_design::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, ResolvedDesign};
 use tofprobe_dsp::sd::ProbeRom;
 use tofprobe_pixel::FrameDriver;
 
-use convert::{CodeSlice, value_error};
+use convert::value_error;
 
 /// Origin of a design given as TOML text.
 const TEXT_ORIGIN: &str = "<TOML text>";
+/// What a pickled Design carries: its resolved JSON and, once generated, its ROM's JSON.
+type PickleState = (String, Option<String>);
 
-/// Pulses converted and run per step of `run_pixel` (64 k: the detections stay in cache).
-const CHUNK: usize = 1 << 16;
+/// A tile's rectangle for Python: `((row_start, row_end), (col_start, col_end))`.
+type PyRect = ((usize, usize), (usize, usize));
+
+/// Origin of a design given as a dict.
+const DICT_ORIGIN: &str = "<dict>";
+
+/// Pulses converted and run per step of `run_pixel` (256 k: 2 MB of detections per
+/// buffer, in cache; 38 steps for 10^7 pulses).
+const CHUNK: usize = 1 << 18;
 
 /// A tofprobe design resolved once (``tofprobe config``'s resolution): sensor, scene,
 /// acquisition, the pixel's parameters and widths, the Fourier bins and the ΣΔ probe.
@@ -41,7 +52,7 @@ const CHUNK: usize = 1 << 16;
 #[pyclass(module = "tofprobe._native", name = "Design", frozen)]
 #[derive(Debug)]
 struct Design {
-    inner: ResolvedDesign,
+    pub(crate) inner: ResolvedDesign,
     /// The probe ROM (Fourier), generated on first use.
     rom: OnceLock<Option<ProbeRom>>,
 }
@@ -54,15 +65,18 @@ impl Design {
         }
     }
 
-    fn resolve(text: &str, origin: &str) -> PyResult<Self> {
-        let doc = Document::from_toml_str(text, origin).map_err(value_error)?;
-        tofprobe_design::resolve(doc, origin)
-            .map(Design::new)
-            .map_err(value_error)
+    /// The one resolution of TOML text, without the GIL (it designs the ΣΔ modulator).
+    fn resolve(py: Python<'_>, text: &str, origin: &str) -> PyResult<Self> {
+        py.detach(|| {
+            let doc = Document::from_toml_str(text, origin)?;
+            tofprobe_design::resolve(doc, origin)
+        })
+        .map(Design::new)
+        .map_err(value_error)
     }
 
     /// The probe ROM (`None` in Haar mode), generated once without the GIL.
-    fn rom(&self, py: Python<'_>) -> PyResult<Option<&ProbeRom>> {
+    pub(crate) fn rom(&self, py: Python<'_>) -> PyResult<Option<&ProbeRom>> {
         if let Some(r) = self.rom.get() {
             return Ok(r.as_ref());
         }
@@ -71,7 +85,7 @@ impl Design {
     }
 
     /// The probe ROM, refused in Haar mode (`what` names the call).
-    fn fourier_rom(&self, py: Python<'_>, what: &str) -> PyResult<&ProbeRom> {
+    pub(crate) fn fourier_rom(&self, py: Python<'_>, what: &str) -> PyResult<&ProbeRom> {
         self.rom(py)?.ok_or_else(|| {
             PyValueError::new_err(format!(
                 "{what} needs a Fourier pixel, and pixel.mode of `{}` resolved to \"{}\" \
@@ -92,8 +106,8 @@ impl Design {
     /// The embedded default design (the paper's Fig. 8: a 0.1 mm, 4.5 kHz sine; 10^7
     /// pulses; 16 bins), as ``tofprobe`` commands use without a configuration.
     #[staticmethod]
-    fn default() -> PyResult<Self> {
-        Design::resolve(DEFAULT_TOML, DEFAULT_ORIGIN)
+    fn default(py: Python<'_>) -> PyResult<Self> {
+        Design::resolve(py, DEFAULT_TOML, DEFAULT_ORIGIN)
     }
 
     /// A design from a TOML file or TOML text, resolved (validated and completed).
@@ -104,22 +118,33 @@ impl Design {
     /// resolve, and for a file that cannot be read.
     #[staticmethod]
     fn from_toml(source: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let py = source.py();
         if let Ok(s) = source.cast::<PyString>() {
             let s = s.to_cow()?;
             if s.contains('\n') || s.contains('=') {
-                return Design::resolve(&s, TEXT_ORIGIN);
+                return Design::resolve(py, &s, TEXT_ORIGIN);
             }
         }
         let path: PathBuf = source.extract()?;
-        tofprobe_design::load(Some(&path))
+        py.detach(|| tofprobe_design::load(Some(&path)))
             .map(Design::new)
             .map_err(value_error)
     }
 
+    /// A design from a dict shaped like the TOML document (``{"sensor": {...}, "scene":
+    /// {...}, "pixel": {...}, ...}``, e.g. ``tomllib.load`` of a configuration), resolved
+    /// by the same one resolution as ``from_toml``. ``ValueError`` naming the key for an
+    /// unknown key or a bad value; ``TypeError`` for a value JSON/TOML cannot hold.
+    #[staticmethod]
+    fn from_dict(d: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let text = convert::dict_to_toml(d)?;
+        Design::resolve(d.py(), &text, DICT_ORIGIN)
+    }
+
     /// A design serialised by ``to_json`` (no resolution runs again).
     #[staticmethod]
-    fn from_json(text: &str) -> PyResult<Self> {
-        ResolvedDesign::from_json(text)
+    fn from_json(py: Python<'_>, text: &str) -> PyResult<Self> {
+        py.detach(|| ResolvedDesign::from_json(text))
             .map(Design::new)
             .map_err(value_error)
     }
@@ -234,33 +259,34 @@ impl Design {
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let valid_a = convert::bool_array("valid", valid)?;
         let tdc_a = convert::codes("tdc", tdc)?;
-        let valid_s = convert::slice(&valid_a, "valid")?;
-        let tdc_s: CodeSlice<'_> = tdc_a.slice("tdc")?;
-        if valid_s.len() != tdc_s.len() {
-            return Err(PyValueError::new_err(format!(
-                "`valid` has {} pulses and `tdc` {}: one code per pulse",
-                valid_s.len(),
-                tdc_s.len()
-            )));
-        }
-        let n = self.inner.pixel.frame_pulses;
-        if valid_s.len() as u64 > n {
-            return Err(PyValueError::new_err(format!(
-                "{} pulses exceed one frame of pixel.frame_pulses = {n}: pass at most {n} \
-                 (one frame; call once per frame)",
-                valid_s.len()
-            )));
-        }
+        let (valid_s, tdc_s) = self.checked_frame(&valid_a, &tdc_a)?;
         let rom = self.rom(py)?.map(|r| &r.image);
         let params = &self.inner.pixel;
         let max_code = self.max_code();
+        // The conversion of chunk k + 1 overlaps the pixel's run of chunk k (two threads
+        // of rayon's pool): the Python call then costs the library call plus one chunk's
+        // conversion (scripts/python-bench.py, docs/performance.md).
         let words = py.detach(|| -> Result<Vec<i64>, String> {
             let mut driver = FrameDriver::new(params, rom).map_err(|e| e.to_string())?;
-            let mut buf = Vec::with_capacity(CHUNK);
-            for (k, v) in valid_s.chunks(CHUNK).enumerate() {
+            let (mut cur, mut next) = (Vec::with_capacity(CHUNK), Vec::with_capacity(CHUNK));
+            let chunks: Vec<&[bool]> = valid_s.chunks(CHUNK).collect();
+            if let Some(v) = chunks.first() {
+                convert::detections(v, tdc_s, 0, max_code, &mut cur)?;
+            }
+            for k in 0..chunks.len() {
                 let first = k * CHUNK;
-                convert::detections(v, tdc_s, first, max_code, &mut buf)?;
-                driver.run(&buf, first as u64).map_err(|e| e.to_string())?;
+                let (ran, converted) = rayon::join(
+                    || driver.run(&cur, first as u64).map_err(|e| e.to_string()),
+                    || match chunks.get(k + 1) {
+                        Some(v) => {
+                            convert::detections(v, tdc_s, first + CHUNK, max_code, &mut next)
+                        }
+                        None => Ok(()),
+                    },
+                );
+                ran?;
+                converted?;
+                std::mem::swap(&mut cur, &mut next);
             }
             Ok(driver.readout().words)
         });
@@ -283,7 +309,9 @@ impl Design {
         let rom = self.fourier_rom(py, "spectrum")?;
         let pulses = pulses.unwrap_or(self.inner.pixel.frame_pulses);
         let lsb_mm = self.inner.sensor().tdc_lsb_mm();
-        let bins = tofprobe_pixel::spectrum::phasors(&self.inner.pixel, rom, words, pulses, lsb_mm)
+        let params = &self.inner.pixel;
+        let bins = py
+            .detach(|| tofprobe_pixel::spectrum::phasors(params, rom, words, pulses, lsb_mm))
             .map_err(value_error)?;
         let f: Vec<f64> = bins.iter().map(|b| b.frequency_hz).collect();
         let a: Vec<f64> = bins.iter().map(|b| b.amplitude_um).collect();
@@ -319,32 +347,194 @@ impl Design {
     /// (uint64 [R, C]) and, for a Fourier pixel, ``frequencies_hz`` ([B]),
     /// ``amplitude_um`` and ``phase_deg`` (float64 [B, R, C]). Pixel (r, c)'s registers
     /// are ``run_pixel(*simulate_scene(pixel=(r, c)))``.
-    fn simulate_array<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let design = &self.inner;
-        let (frame, maps, _) = py
-            .detach(|| tofprobe_array::output::simulate(design))
-            .map_err(value_error)?;
-        let (r, c, k) = (frame.rows, frame.cols, frame.registers_per_pixel);
-        let out = PyDict::new(py);
-        let regs = Array3::from_shape_vec((r, c, k), frame.registers).map_err(value_error)?;
-        out.set_item("registers", regs.into_pyarray(py))?;
-        let det = Array2::from_shape_vec((r, c), frame.detections).map_err(value_error)?;
-        out.set_item("detections", det.into_pyarray(py))?;
-        if let Some(m) = maps {
-            let b = m.bins();
-            out.set_item("frequencies_hz", m.frequencies_hz.into_pyarray(py))?;
-            let amp = Array3::from_shape_vec((b, r, c), m.amplitude_um).map_err(value_error)?;
-            out.set_item("amplitude_um", amp.into_pyarray(py))?;
-            let ph = Array3::from_shape_vec((b, r, c), m.phase_deg).map_err(value_error)?;
-            out.set_item("phase_deg", ph.into_pyarray(py))?;
+    ///
+    /// ``tiles`` (1 ..= R·C) splits the array into that many tiles (``tile_rects``); with
+    /// ``client``, a ``dask.distributed.Client``, each tile is a task run in the workers
+    /// (``tofprobe.dask.simulate_array``; default tiles: twice the cluster's threads).
+    /// Any tiling, local or distributed, gives the same registers bit for bit.
+    #[pyo3(signature = (tiles=None, client=None))]
+    fn simulate_array<'py>(
+        slf: &Bound<'py, Self>,
+        py: Python<'py>,
+        tiles: Option<usize>,
+        client: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let d = slf.get();
+        if let Some(client) = client.filter(|c| !c.is_none()) {
+            // The ROM generated once here travels with the design to every task.
+            d.rom(py)?;
+            let out = py
+                .import("tofprobe.dask")?
+                .call_method1("simulate_array", (slf, tiles, client))?;
+            return Ok(out.cast_into::<PyDict>()?);
         }
-        Ok(out)
+        let (frame, seconds) = tiles::run_local(d, py, tiles.unwrap_or(1))?;
+        tiles::array_dict(d, py, frame, seconds)
     }
 
-    /// Pickling: the resolved design travels as its JSON.
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
-        let ctor = slf.get_type().getattr("from_json")?;
-        Ok((ctor, (slf.get().to_json()?,)))
+    /// The partition of the array into ``tiles`` rectangles (``tofprobe simulate --shard
+    /// i/n``'s): a list of ``((row_start, row_end), (col_start, col_end))``, every pixel
+    /// in exactly one. ``ValueError`` unless 1 ≤ tiles ≤ R·C.
+    fn tile_rects(&self, tiles: usize) -> PyResult<Vec<PyRect>> {
+        Ok(tiles::rects(self, tiles)?
+            .into_iter()
+            .map(|(r, c)| ((r.start, r.end), (c.start, c.end)))
+            .collect())
+    }
+
+    /// Runs one tile of the array on a rayon pool of ``threads`` threads (default: all
+    /// cores): a dict ``rows``, ``cols`` (as given), ``registers`` (int64 [h, w, K]) and
+    /// ``detections`` (uint64 [h, w]); ``merge_tiles`` joins them.
+    #[pyo3(signature = (rows, cols, threads=None))]
+    fn run_tile<'py>(
+        &self,
+        py: Python<'py>,
+        rows: (usize, usize),
+        cols: (usize, usize),
+        threads: Option<usize>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let t = tiles::run_tile(self, py, rows.0..rows.1, cols.0..cols.1, threads)?;
+        tiles::tile_dict(py, t)
+    }
+
+    /// Joins ``run_tile``'s dicts covering the array exactly once into
+    /// ``simulate_array``'s dict (refusing a gap or an overlap, naming the pixel).
+    fn merge_tiles<'py>(
+        &self,
+        py: Python<'py>,
+        tiles: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let frame = tiles::merge(self, py, tiles)?;
+        tiles::array_dict(self, py, frame, 0.0)
+    }
+
+    /// The float reference: the windowed DFT (the ROM's window, 2/(N·G)) of the frame's
+    /// held depth at the design's bins — ``(frequencies_hz, amplitude_um, phase_deg)`` as
+    /// ``spectrum`` gives for the pixel (``tofprobe_experiments::references::dft``).
+    /// ``valid``/``tdc`` as for ``run_pixel``.
+    fn dft<'py>(
+        &self,
+        py: Python<'py>,
+        valid: &Bound<'py, PyAny>,
+        tdc: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        analysis::reference(self, py, valid, tdc, "dft")
+    }
+
+    /// Float ΣΔ probing of the frame (the pixel's float twin: the same ROM, hold, priming
+    /// and prefilter α = 2^−S): ``(frequencies_hz, amplitude_um, phase_deg)``.
+    fn float_sd<'py>(
+        &self,
+        py: Python<'py>,
+        valid: &Bound<'py, PyAny>,
+        tdc: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        analysis::reference(self, py, valid, tdc, "float_sd")
+    }
+
+    /// The closed-form noise floor E|Y| in µm at each bin for a frame of ``pulses``
+    /// (default N): eq. 12 with the TDC's a²/12, the 1NN hold and the first-arrival
+    /// mixture of the design's scene.
+    #[pyo3(signature = (pulses=None))]
+    fn noise_floor<'py>(
+        &self,
+        py: Python<'py>,
+        pulses: Option<u64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        analysis::noise_floor(self, py, pulses)
+    }
+
+    /// The ΣΔ noise transfer function the probe ROM was modulated with: a dict of
+    /// ``zeros``, ``poles`` (complex128), ``frequencies_hz`` (``points`` from 0 to f_s/2)
+    /// and ``magnitude`` (|NTF(e^{j2πf/f_s})|), and ``order``, ``osr``, ``h_inf``.
+    #[pyo3(signature = (points=512))]
+    fn ntf<'py>(&self, py: Python<'py>, points: usize) -> PyResult<Bound<'py, PyDict>> {
+        analysis::ntf(self, py, points)
+    }
+
+    /// The resolved widths and the readout sizing (``tofprobe size``'s readout section):
+    /// ``width`` (W), ``tdc_bits`` (T), ``frac_bits`` (F), ``register_frac_bits`` (G),
+    /// ``operand_bits``, ``registers``, ``bits_per_frame`` (registers · W),
+    /// ``readout_bits`` (whole bytes), ``memory`` (every figure) and, for an array,
+    /// ``array_readout_bits``.
+    fn widths<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        analysis::widths(self, py)
+    }
+
+    /// ``tofprobe size``'s report as a dict (synthesis with yosys, timing with OpenSTA,
+    /// the B and W sweeps). ``RuntimeError`` naming the tool when yosys or OpenSTA is not
+    /// installed.
+    #[pyo3(signature = (liberty=None, sky130=false, sweep_bins=None, sweep_widths=None, node_nm=40.0))]
+    fn size<'py>(
+        &self,
+        py: Python<'py>,
+        liberty: Option<PathBuf>,
+        sky130: bool,
+        sweep_bins: Option<Vec<u64>>,
+        sweep_widths: Option<Vec<u32>>,
+        node_nm: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        analysis::size(self, py, liberty, sky130, sweep_bins, sweep_widths, node_nm)
+    }
+
+    /// Seconds the library's own pixel call takes on the frame (the frame converted to
+    /// detections first, untimed; then ``FrameDriver`` run and read out, best of
+    /// ``repeat``): the baseline of ``run_pixel``'s overhead (scripts/python-bench.py).
+    #[pyo3(signature = (valid, tdc, repeat=1))]
+    fn time_library_run_pixel(
+        &self,
+        py: Python<'_>,
+        valid: &Bound<'_, PyAny>,
+        tdc: &Bound<'_, PyAny>,
+        repeat: usize,
+    ) -> PyResult<f64> {
+        let detections = self.frame(py, valid, tdc)?;
+        let rom = self.rom(py)?.map(|r| &r.image);
+        let params = &self.inner.pixel;
+        py.detach(|| {
+            let mut best = f64::INFINITY;
+            for _ in 0..repeat.max(1) {
+                let t0 = std::time::Instant::now();
+                let mut driver = FrameDriver::new(params, rom).map_err(value_error)?;
+                driver.run(&detections, 0).map_err(value_error)?;
+                std::hint::black_box(driver.readout());
+                best = best.min(t0.elapsed().as_secs_f64());
+            }
+            Ok(best)
+        })
+    }
+
+    /// Pickling: the resolved design travels as its JSON, with its probe ROM once it has
+    /// been generated (a Dask worker then does not generate it again).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, PickleState)> {
+        let ctor = slf.get_type().getattr("_restore")?;
+        let d = slf.get();
+        let rom = match d.rom.get() {
+            Some(r) => Some(serde_json::to_string(r).map_err(value_error)?),
+            None => None,
+        };
+        Ok((ctor, (d.to_json()?, rom)))
+    }
+
+    /// Unpickling (`__reduce__`'s constructor): the design and, when it travelled, its ROM.
+    #[staticmethod]
+    #[pyo3(signature = (design, rom=None))]
+    fn _restore(py: Python<'_>, design: &str, rom: Option<&str>) -> PyResult<Self> {
+        let (inner, rom) = py
+            .detach(|| -> Result<_, String> {
+                let inner = ResolvedDesign::from_json(design).map_err(|e| e.to_string())?;
+                let rom = rom
+                    .map(serde_json::from_str::<Option<ProbeRom>>)
+                    .transpose()
+                    .map_err(|e| format!("the pickled probe ROM: {e}"))?;
+                Ok((inner, rom))
+            })
+            .map_err(PyValueError::new_err)?;
+        let d = Design::new(inner);
+        if let Some(r) = rom {
+            let _ = d.rom.set(r);
+        }
+        Ok(d)
     }
 
     fn __repr__(&self) -> String {

@@ -94,8 +94,10 @@ def test_a_missing_file_is_refused_naming_the_path(tmp_path):
 def test_help_documents_every_call():
     doc = tofprobe.Design.__doc__
     assert "resolved once" in doc
-    for name in ["default", "from_toml", "to_toml", "summary", "simulate_scene", "run_pixel",
-                 "spectrum", "probe_rom", "simulate_array"]:
+    for name in ["default", "from_toml", "from_dict", "from_json", "to_toml", "to_json",
+                 "summary", "simulate_scene", "run_pixel", "spectrum", "probe_rom",
+                 "simulate_array", "tile_rects", "run_tile", "merge_tiles", "dft", "float_sd",
+                 "noise_floor", "ntf", "widths", "size", "time_library_run_pixel"]:
         method = getattr(tofprobe.Design, name)
         assert method.__doc__ and len(method.__doc__) > 40, name
     assert "valid, tdc" in tofprobe.Design.run_pixel.__text_signature__
@@ -110,7 +112,8 @@ def test_the_installed_stubs_list_exactly_the_native_calls():
     tree = ast.parse((package / "_native.pyi").read_text())
     (cls,) = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Design"]
     stubbed = {n.name for n in cls.body if isinstance(n, ast.FunctionDef)}
-    native = {n for n in dir(tofprobe.Design) if not n.startswith("_")} | {"__reduce__"}
+    native = {n for n in dir(tofprobe.Design) if not n.startswith("_")} | {"__reduce__",
+                                                                             "_restore"}
     assert stubbed == native
     summary = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Summary"][0]
     keys = {n.target.id for n in summary.body if isinstance(n, ast.AnnAssign)}

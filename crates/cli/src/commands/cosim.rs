@@ -77,6 +77,10 @@ pub struct CosimArgs {
     /// or "auto"), drawn from --seed, instead of CONFIG.
     #[arg(long)]
     pub random: Option<u64>,
+    /// With --random N: run only share i of n (0-based) of the N configurations, so the n
+    /// tasks of a job array cover exactly the configurations of one run.
+    #[arg(long, value_name = "I/N", requires = "random")]
+    pub shard: Option<String>,
     /// Also write a JUnit XML report: one test case per frame and configuration, the first
     /// mismatch as the failure message (written whole; an existing file is replaced only if
     /// tofprobe wrote it).
@@ -393,7 +397,15 @@ fn run_random(a: &CosimArgs, n: u64) -> Result<super::Verdict, CliError> {
         out: &a.out,
     };
     let mut printed: Result<(), CliError> = Ok(());
-    let report = tofprobe_cosim::soak::run(0..n, &o, |c| {
+    let cases = match &a.shard {
+        Some(s) => tofprobe_array::shard::share(
+            n,
+            tofprobe_array::shard::Shard::parse(s).map_err(|e| CliError::option("shard", s, e))?,
+        ),
+        None => 0..n,
+    };
+    let ran = cases.end - cases.start;
+    let report = tofprobe_cosim::soak::run(cases, &o, |c| {
         let p = &c.case.params;
         let line = SoakCase {
             case: c.index,
@@ -431,8 +443,8 @@ fn run_random(a: &CosimArgs, n: u64) -> Result<super::Verdict, CliError> {
     printed?;
     let (failed, suites) = (report.failed, report.suites);
     println!(
-        "cosim soak: {} of {n} configuration(s) passed ({}, --seed {}, {} frame(s) each) in {:.1} s",
-        n - failed,
+        "cosim soak: {} of {ran} configuration(s) passed ({}, --seed {}, {} frame(s) each) in {:.1} s",
+        ran - failed,
         a.simulator
             .to_possible_value()
             .map(|v| v.get_name().to_string())

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod config;
 pub mod cosim;
 pub mod flow;
+pub mod merge;
 pub mod replay;
 pub mod reproduce;
 pub mod rtl;
@@ -22,6 +23,8 @@ use crate::error::CliError;
 pub enum Command {
     /// Run the photon/TDC Monte Carlo on a configuration and print a summary.
     Simulate(simulate::SimulateArgs),
+    /// Join the tile sets of `simulate --shard i/n` into the array's output set.
+    Merge(merge::MergeArgs),
     /// Print or check a configuration.
     Config(config::ConfigArgs),
     /// Measure the speed of one part of tofprobe.
@@ -85,6 +88,7 @@ pub fn run(command: Command) -> Result<Verdict, CliError> {
     let done = |r: Result<(), CliError>| r.map(|()| Verdict::Done);
     match command {
         Command::Simulate(a) => done(simulate::run(&a)),
+        Command::Merge(a) => done(merge::run(&a)),
         Command::Config(a) => done(config::run(&a)),
         Command::Bench(a) => done(bench::run(a)),
         Command::Reproduce(a) => reproduce::run(&a),

@@ -32,6 +32,10 @@ pub struct SimulateArgs {
     /// .npy, heat maps, the deflection animation, the UFF file, summary.json last).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// An `[array]` configuration with --out: run only tile i of n (0-based) and write its
+    /// tile set (`tofprobe merge` joins the sets into the --out set of one run).
+    #[arg(long, value_name = "I/N", requires = "out")]
+    shard: Option<String>,
 }
 
 /// Runs the command.
@@ -39,6 +43,13 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let design = tofprobe_design::load(args.config.as_deref())?;
     if design.array.is_some() {
         return run_array(args, &design);
+    }
+    if let Some(shard) = &args.shard {
+        return Err(CliError::option(
+            "shard",
+            shard,
+            "an [array] configuration (a single pixel is one task)",
+        ));
     }
     if let Some(out) = &args.out {
         return Err(CliError::option(
@@ -159,11 +170,48 @@ fn run_array(
             "no --svg for an [array] configuration: its maps are written with --out DIR",
         ));
     }
+    if let (Some(shard), Some(dir)) = (&args.shard, &args.out) {
+        let shard = tofprobe_array::shard::Shard::parse(shard)
+            .map_err(|e| CliError::option("shard", shard, e))?;
+        let m = tofprobe_array::shard::run_shard(design, shard, dir)?;
+        if args.json {
+            println!(
+                "{}",
+                serde_json::json!({
+                    "shard": shard.to_string(), "rows": m.rows, "cols": m.cols,
+                    "config_hash": m.config_hash, "seed": m.seed,
+                    "model_seconds": m.model_seconds, "tile_set": dir,
+                })
+            );
+        } else {
+            println!(
+                "tile set           {} (shard {shard}: rows {:?} × cols {:?} of {} × {}, seed {}, configuration {}; model {:.3} s)",
+                dir.display(),
+                m.rows,
+                m.cols,
+                m.array_rows,
+                m.array_cols,
+                m.seed,
+                m.config_hash,
+                m.model_seconds
+            );
+        }
+        return Ok(());
+    }
     let summary = match &args.out {
         Some(dir) => tofprobe_array::output::run_and_write(design, dir)?,
         None => tofprobe_array::output::simulate(design)?.2,
     };
-    if args.json {
+    print_array(&summary, args.out.as_deref(), args.json)
+}
+
+/// Prints an array run's summary (`simulate` of an array, `merge`).
+pub fn print_array(
+    summary: &tofprobe_array::output::ArraySummary,
+    out: Option<&std::path::Path>,
+    json: bool,
+) -> Result<(), CliError> {
+    if json {
         println!("{}", serde_json::to_string(&summary)?);
         return Ok(());
     }
@@ -193,7 +241,7 @@ fn run_array(
     if let (Some(b), Some(f)) = (summary.dominant_bin, summary.dominant_frequency_hz) {
         println!("dominant bin       {b} ({f:.2} Hz)");
     }
-    if let Some(dir) = &args.out {
+    if let Some(dir) = out {
         println!(
             "output set         {} ({} files)",
             dir.display(),

@@ -106,7 +106,9 @@ const FIGURES: &[(&str, &str, &[&str])] = &[
         &[
             "frequency (Hz)",
             "|Y| (µm)",
-            "amplitude 102.3 µm, noise floor 5.52 µm",
+            "σ_s = 3 mm, ρ_s = 1, ρ_b = 0, no tone",
+            "prints an average noise of 2.5 µm",
+            "gives 2.25 µm (DFT)",
         ],
     ),
     (
@@ -164,6 +166,32 @@ fn check_svg(name: &str, svg: &str, title: &str, texts: &[&str]) -> Result<(), S
     if let Some(t) = non_finite_token(svg) {
         return Err(format!("{name}: holds `{t}`"));
     }
+    // Readable as drawn: texts ≥ 8 px, no legend over a data marker.
+    if let Some(p) = tofprobe_experiments::paper::svg_check::problems(svg).first() {
+        return Err(format!("{name}: {p}"));
+    }
+    Ok(())
+}
+
+/// The figure renders in librsvg (what GNOME's viewers and many converters use) without an
+/// error: a malformed element fails here even where the text checks pass.
+fn render(path: &std::path::Path) -> Result<(), String> {
+    if !tofprobe_testkit::tools::have(&["rsvg-convert"], "reproduce figures render") {
+        return Ok(());
+    }
+    // PNG to stdout (rsvg-convert refuses a non-regular --output such as /dev/null).
+    let out = std::process::Command::new("rsvg-convert")
+        .args(["--format", "png"])
+        .arg(path)
+        .output()
+        .map_err(|e| format!("rsvg-convert: {e}"))?;
+    if !out.status.success() || !out.stdout.starts_with(b"\x89PNG") {
+        return Err(format!(
+            "{}: rsvg-convert failed: {}",
+            path.display(),
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
     Ok(())
 }
 
@@ -182,6 +210,7 @@ fn check_figures(dir: &std::path::Path, v: &serde_json::Value) -> Result<(), Str
         }
         let svg = std::fs::read_to_string(&path).map_err(|e| format!("{file}: {e}"))?;
         check_svg(file, &svg, &format!("{figure}:"), texts)?;
+        render(&path)?;
     }
     // The set is whole: no stage directory or temporary left beside it.
     for e in std::fs::read_dir(dir).map_err(|e| e.to_string())? {

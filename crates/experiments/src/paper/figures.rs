@@ -37,7 +37,8 @@ pub fn probe_spectrum(m: &Modulator, amplitude: f64) -> Result<ToneSpectrum, Exp
 pub fn fig2(m: &Modulator, amplitude: f64) -> Result<Chart, ExperimentError> {
     let t = probe_spectrum(m, amplitude)?;
     let df = FS_HZ / t.n as f64;
-    // Log-spaced maxima (≈ 300 points) of the power per bin, in dB.
+    // Log-spaced maxima (≈ 300 points) of the power per bin, in dB (the noise-shaped
+    // floor's envelope: Fig. 2 is read for its slope and the tone, both maxima).
     let mut pts = Vec::new();
     let mut k = 1usize;
     while k < t.power.len() {
@@ -45,7 +46,11 @@ pub fn fig2(m: &Modulator, amplitude: f64) -> Result<Chart, ExperimentError> {
             .max(k + 1)
             .min(t.power.len());
         let p = t.power[k..next].iter().copied().fold(0.0, f64::max);
-        pts.push((k as f64 * df, 10.0 * p.max(1e-20).log10()));
+        // A group of exactly-zero bins has no level in dB: it is left out, not drawn at a
+        // clamp (a −200 dB floor read as data).
+        if p > 0.0 {
+            pts.push((k as f64 * df, 10.0 * p.log10()));
+        }
         k = next;
     }
     let band = 0.5 / m.osr;
@@ -293,7 +298,18 @@ mod tests {
         eprintln!("in-band {in_band} dB, full band {full} dB");
         assert!(in_band > full + 30.0, "{in_band} vs {full}");
         assert!(in_band < eq4_snr_db(3, 32.0, 0.5));
-        let svg = fig2(&m, 0.5).unwrap().render().unwrap();
+        let chart = fig2(&m, 0.5).unwrap();
+        // No clamp drawn as data: the old figure drew every group below 1e-20 at exactly
+        // −200 dB (a flat line the shaping does not make). The shaped floor near DC goes
+        // below that, so real points lie under −200 dB and none sits at the clamp.
+        let ys: Vec<f64> = chart.lines[0].points.iter().map(|p| p.1).collect();
+        assert!(ys.iter().all(|&y| y != -200.0 && y.is_finite()));
+        assert!(ys.iter().any(|&y| y < -200.0), "{:?}", &ys[..8]);
+        let svg = chart.render().unwrap();
         assert!(svg.contains("156.25 kHz") && svg.contains("297 kHz"));
+        assert_eq!(
+            super::super::svg_check::problems(&svg),
+            Vec::<String>::new()
+        );
     }
 }

@@ -18,6 +18,7 @@ pub mod reproduce;
 pub mod setup;
 pub mod sigma_delta;
 pub mod stats;
+pub mod svg_check;
 pub mod table2;
 pub mod transients;
 

@@ -7,26 +7,42 @@ use tofprobe_dsp::closed_form::pileup_survival;
 
 use super::chart::{Chart, ErrorSeries, Series};
 use super::figures::QUICK_NOTE;
-use super::stats::{SEEDS, mean_sd, rician_mean};
-use super::table2::RowResult;
+use super::stats::{mean_sd, rician_mean};
+use super::table2::{F0_HZ, RowResult};
 
 /// spectra.svg and noise_vs_sigma.svg.
 pub fn charts(results: &[RowResult], quick: bool) -> Vec<Chart> {
-    // Spectra of the σ_s = 7.5 mm tone rows without background (ρ_s = 1, 0.3, 0.1, 0.03).
-    let spectra: Vec<Series> = results
-        .iter()
-        .filter(|r| r.spec.sigma_s_mm == 7.5 && r.spec.rho_b == 0.0 && r.spec.amp_um.is_some())
-        .map(|r| Series::new(format!("ρ_s = {}", r.spec.rho_s), r.spectrum.clone()))
-        .collect();
+    // Spectra of the σ_s = 7.5 mm tone rows without background (ρ_s = 1, 0.3, 0.1, 0.03):
+    // the mean of each 2 % group of bins as the line, the tone's largest bin as a marker.
+    let rows = rho_rows(results);
     let spectra = Chart {
         file: "spectra.svg".into(),
         title: "Table 2: Blackman DFT of the held depth, 100 µm at 4.5 kHz, σ_s = 7.5 mm (seed 0)"
             .into(),
         x_label: "frequency (Hz)".into(),
-        y_label: "|Y| (µm)".into(),
+        y_label: "|Y| (µm), mean of each 2 % group of bins".into(),
         x_log: true,
         y_log: true,
-        lines: spectra,
+        lines: rows
+            .iter()
+            .map(|r| {
+                Series::new(
+                    format!("ρ_s = {} (group mean)", r.spec.rho_s),
+                    r.spectrum.clone(),
+                )
+            })
+            .collect(),
+        points: vec![Series::new(
+            "the tone's largest bin (each ρ_s)",
+            rows.iter()
+                .filter_map(|r| tone_peak(&r.spectrum_max))
+                .collect(),
+        )],
+        notes: vec![
+            "lines: mean |Y| of each log-spaced group of bins (2 % wide); markers: the \
+             largest bin of the group holding the tone"
+                .into(),
+        ],
         ..Chart::default()
     };
     let mut chosen: Vec<&RowResult> = results
@@ -37,11 +53,12 @@ pub fn charts(results: &[RowResult], quick: bool) -> Vec<Chart> {
     let mut noise = Chart {
         file: "noise_vs_sigma.svg".into(),
         title: format!(
-            "Table 2: noise floor vs σ_s (ρ_s = 1, no tone, Blackman, {} seeds)",
-            SEEDS.len()
+            "Table 2: noise floor vs σ_s (ρ_s = 1, no tone, Blackman, {})",
+            seeds_label(&chosen)
         ),
         x_label: "σ_s (mm)".into(),
         y_label: "noise floor (µm)".into(),
+        x_ticks: chosen.iter().map(|r| r.spec.sigma_s_mm).collect(),
         x_log: true,
         y_log: true,
         lines: vec![Series::new(
@@ -86,6 +103,25 @@ pub fn charts(results: &[RowResult], quick: bool) -> Vec<Chart> {
     vec![spectra, noise]
 }
 
+/// "5 seeds", or "5–34 seeds per row" where the rows' own seed counts differ.
+fn seeds_label(rows: &[&RowResult]) -> String {
+    let lo = rows.iter().map(|r| r.seeds.len()).min().unwrap_or(0);
+    let hi = rows.iter().map(|r| r.seeds.len()).max().unwrap_or(0);
+    if lo == hi {
+        format!("{lo} seeds")
+    } else {
+        format!("{lo}–{hi} seeds per row")
+    }
+}
+
+/// The largest bin within ±5 % of the tone's frequency (Hz, µm), from a row's group maxima.
+fn tone_peak(max: &[(f64, f64)]) -> Option<(f64, f64)> {
+    max.iter()
+        .copied()
+        .filter(|&(f, _)| (f / F0_HZ - 1.0).abs() <= 0.05)
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
 /// Fig. 5's closed form: the fraction of signal photons that arrive before every
 /// background photon with the signal mid-window, e^(−ρ_b/2) (pile-up, ρ_s* = ρ_s·e^(−ρ_b/2)).
 pub fn background_survival(rho_b: f64) -> f64 {
@@ -120,8 +156,8 @@ pub fn fig5(results: &[RowResult], quick: bool) -> Chart {
     let mut c = Chart {
         file: "fig5_amplitude_vs_rho_b.svg".into(),
         title: format!(
-            "Fig. 5: amplitude vs ρ_b (σ_s = 7.5 mm, ρ_s = 0.3, 100 µm at 4.5 kHz, {} seeds)",
-            SEEDS.len()
+            "Fig. 5: amplitude vs ρ_b (σ_s = 7.5 mm, ρ_s = 0.3, 100 µm at 4.5 kHz, {})",
+            seeds_label(&rows)
         ),
         x_label: "ρ_b (background photons per pulse in the window)".into(),
         y_label: "measured amplitude / A".into(),
@@ -166,7 +202,8 @@ pub fn fig5(results: &[RowResult], quick: bool) -> Chart {
         }],
         ..Chart::default()
     };
-    let printed: Vec<&&RowResult> = rows.iter().filter(|r| r.spec.rho_b > 0.0).collect();
+    // Every printed row, ρ_b = 0 included (the paper's reference point the others fall from).
+    let printed: Vec<&&RowResult> = rows.iter().collect();
     c.points.push(Series::new(
         "paper (Table 2)",
         printed
@@ -213,11 +250,12 @@ pub fn fig9(results: &[RowResult], quick: bool) -> Chart {
     let mut c = Chart {
         file: "fig9_rho_sweep.svg".into(),
         title: format!(
-            "Fig. 9: ρ_s sweep (σ_s = 7.5 mm, ρ_b = 0, 100 µm at 4.5 kHz, {} seeds)",
-            SEEDS.len()
+            "Fig. 9: ρ_s sweep (σ_s = 7.5 mm, ρ_b = 0, 100 µm at 4.5 kHz, {})",
+            seeds_label(&rows)
         ),
         x_label: "ρ_s".into(),
         y_label: "µm".into(),
+        x_ticks: rows.iter().map(|r| r.spec.rho_s).collect(),
         x_log: true,
         y_log: true,
         lines: vec![

@@ -62,6 +62,7 @@ pub fn reproduce(quick: bool, out: &Path) -> Result<Reproduction, ExperimentErro
         band_spectra::STEP_HZ
     };
     let band = band_spectra::measure(&probe, step)?;
+    let band7 = band_spectra::measure_scene(&band_spectra::fig7_scene(), &probe, step)?;
     let band_seconds = t_band.elapsed().as_secs_f64();
     let design = probe.design.clone();
     drop(probe);
@@ -83,7 +84,8 @@ pub fn reproduce(quick: bool, out: &Path) -> Result<Reproduction, ExperimentErro
         plots::fig5(&results, quick),
         figures::fig6(&corners, quick),
     ];
-    charts.extend(band_spectra::charts(&band, n_t2, quick)?);
+    charts.push(band_spectra::fig7(&band7, n_t2, quick)?);
+    charts.push(band_spectra::fig8(&band, n_t2, quick)?);
     charts.push(plots::fig9(&results, quick));
     charts.extend(plots::charts(&results, quick));
     let mut files: Vec<(String, String)> = Vec::new();

@@ -2,7 +2,7 @@
 //! of every row, against the paper and the closed form (eq. 12 extended for the hold and
 //! the background mixture, `tofprobe_dsp::closed_form`).
 //!
-//! Per row and per seed of [`SEEDS`]: a full record → 1NN hold (raw held depth, no
+//! Per row and per seed of the row's own seeds ([`seeds_for`]): a full record → 1NN hold (raw held depth, no
 //! prefilter) → full Blackman FFT → noise floor (mean |Y| over 1–10 kHz, DC and ±8 bins
 //! around the tone excluded) and the interpolated peak; the rows show mean ± sd over the
 //! seeds and are judged by `super::stats` (tolerance from the spread and the number of
@@ -21,6 +21,7 @@ use tofprobe_dsp::dft::{amplitude_scale, amplitude_spectrum, windowed_dft_half};
 use tofprobe_dsp::stats::{NoiseBand, interpolate_peak, noise_floor};
 use tofprobe_scene::PhotonSource;
 
+use super::chart::Curve;
 use super::setup::{FS_HZ, LSB_MM, Setup};
 use super::sigma_delta::{self, Phasor, ProbeSetup};
 use super::stats::{self, K};
@@ -33,8 +34,44 @@ pub const WINDOW: Window = Window::Blackman;
 pub const BAND: (f64, f64) = (1_000.0, 10_000.0);
 /// The tone frequency of the amplitude rows.
 pub const F0_HZ: f64 = 4_500.0;
-/// Seeds of every row (≥ 5): noise floor and amplitude are means over them.
+/// The seeds of a row not in [`ROWS`] (tests' own specs), and the count every row has at
+/// least: noise floor and amplitude are means over a row's seeds ([`seeds_for`]).
 pub const SEEDS: &[u64] = stats::SEEDS;
+/// The amplitude bias a full-length tested amplitude row must catch (µm): its seed count
+/// makes K·se ≤ this ([`seeds_for`]).
+pub const AMP_BIAS_UM: f64 = 10.0;
+/// The most seeds a row gets (a full record costs ≈ 1 s of CPU per seed).
+pub const MAX_SEEDS: usize = 64;
+/// Record length from which rows get their powered seed counts (shorter `--quick`
+/// records keep [`SEEDS`]'s count: their floors are too high for a 10 µm test anyway).
+pub const FULL_N: u64 = 10_000_000;
+/// The float ΣΔ column runs on this many of a row's seeds (its rows compare ΣΔ with the
+/// DFT of the same records, a paired difference that needs no more).
+pub const SD_SEEDS: usize = 5;
+
+/// A row's own seeds: rows share none (row i of [`ROWS`] draws from 1000·(i + 1) on, so
+/// their statistics are independent), and a tested amplitude row of a full record has
+/// enough that a [`AMP_BIAS_UM`] bias fails its K·se test: S = ⌈(K·sd/bias)²⌉ with sd the
+/// predicted sd of one seed's amplitude, floor·sqrt(2/π) (`amplitude_row`), between
+/// [`SEEDS`]'s count and [`MAX_SEEDS`]. A spec outside [`ROWS`] gets [`SEEDS`].
+pub fn seeds_for(spec: &Spec, n: u64) -> Result<Vec<u64>, ExperimentError> {
+    let Some(i) = ROWS.iter().position(|r| r == spec) else {
+        return Ok(SEEDS.to_vec());
+    };
+    let mut count = SEEDS.len();
+    if n >= FULL_N
+        && let Some(amp) = closed_form_amp_um(spec)?
+    {
+        let floor = closed_form_noise_um(spec, n as usize)?;
+        if amp / floor >= AMP_MIN_SNR {
+            let sd = floor * (2.0 / std::f64::consts::PI).sqrt();
+            let want = (K * sd / AMP_BIAS_UM).powi(2).ceil() as usize;
+            count = want.clamp(SEEDS.len(), MAX_SEEDS);
+        }
+    }
+    let base = 1000 * (i as u64 + 1);
+    Ok((base..base + count as u64).collect())
+}
 /// Relative tolerance of the noise rows.
 pub const NOISE_REL: f64 = 0.05;
 
@@ -412,7 +449,9 @@ pub struct RowResult {
     pub spec: Spec,
     /// Per column, the seed-0 measurement.
     pub columns: Vec<(&'static str, Measurement)>,
-    /// DFT noise floors of all seeds ([`SEEDS`] order), µm.
+    /// The row's seeds ([`seeds_for`]).
+    pub seeds: Vec<u64>,
+    /// DFT noise floors of all seeds (`seeds` order), µm.
     pub noises_um: Vec<f64>,
     /// Band bins the floor averages.
     pub band_bins: usize,
@@ -421,16 +460,19 @@ pub struct RowResult {
     pub closed_form_um: f64,
     /// Closed-form expected amplitude g·|H(ρ_v, ω0)|·A (µm), tone rows.
     pub amp_closed_um: Option<f64>,
-    /// Seed-0 spectrum, decimated for plotting: (Hz, µm).
+    /// Seed-0 spectrum, decimated for plotting: the mean |Y| of each log-spaced group of
+    /// bins (Hz, µm) — the level a reader reads as the spectrum.
     pub spectrum: Vec<(f64, f64)>,
-    /// Per seed of [`SEEDS`] (when the ΣΔ column ran): the DFT and the float ΣΔ (with the
+    /// The same groups' largest bin (Hz, µm): where a tone is, its height.
+    pub spectrum_max: Vec<(f64, f64)>,
+    /// Per seed of the first [`SD_SEEDS`] of `seeds` (when the ΣΔ column ran): the DFT and the float ΣΔ (with the
     /// prefilter) of that seed's record at the shared probe bins.
     pub probe_seeds: Vec<(Measurement, Measurement)>,
 }
 
 /// Runs one row with the given columns ([`COLUMNS`] for the full table; the first must be
 /// the DFT column, which the seed statistics use): seed 0 in full, the other seeds of
-/// [`SEEDS`] through the DFT column (noise floor and amplitude) and, if the ΣΔ column is
+/// the row's seeds ([`seeds_for`]) through the DFT column (noise floor and amplitude) and, if the ΣΔ column is
 /// among `columns_to_run`, the float ΣΔ column too (the ΣΔ rows are means over the seeds;
 /// the unprefiltered and bit-true columns stay seed 0). `bench dsp` times the DFT rows
 /// alone this way.
@@ -441,7 +483,8 @@ pub fn run_row_with(
     columns_to_run: &[Column],
 ) -> Result<RowResult, ExperimentError> {
     let setup = spec.setup();
-    let source = setup.source(SEEDS[0])?;
+    let seeds = seeds_for(spec, n)?;
+    let source = setup.source(seeds[0])?;
     let detections = source.record(n);
     let rec = RowRecord {
         spec,
@@ -461,11 +504,12 @@ pub fn run_row_with(
     drop(detections);
     let spectrum = amplitude_spectrum(&held, WINDOW)?;
     drop(held);
-    let plot = decimate(&spectrum, n as usize);
+    let (plot, plot_max) = decimate(&spectrum, n as usize);
     let probe_sd = probe.filter(|_| columns_to_run.iter().any(|c| c.name == SD));
-    let rest: Result<Vec<(Measurement, Option<Measurement>)>, ExperimentError> = SEEDS[1..]
+    let rest: Result<Vec<(Measurement, Option<Measurement>)>, ExperimentError> = seeds[1..]
         .par_iter()
-        .map(|&s| seed_measurement(spec, n, s, probe_sd))
+        .enumerate()
+        .map(|(i, &s)| seed_measurement(spec, n, s, probe_sd.filter(|_| i + 1 < SD_SEEDS)))
         .collect();
     let rest = rest?;
     let seed_ms: Vec<&Measurement> = std::iter::once(&columns[0].1)
@@ -485,6 +529,7 @@ pub fn run_row_with(
     let amps_um: Vec<f64> = seed_ms.iter().filter_map(|m| m.amp_um).collect();
     Ok(RowResult {
         spec: *spec,
+        seeds,
         columns,
         noises_um,
         band_bins: band_bins(spec, n as usize)?,
@@ -492,23 +537,33 @@ pub fn run_row_with(
         closed_form_um: closed_form_noise_um(spec, n as usize)?,
         amp_closed_um: closed_form_amp_um(spec)?,
         spectrum: plot,
+        spectrum_max: plot_max,
         probe_seeds,
     })
 }
 
-/// Log-spaced maxima of the spectrum up to 50 kHz (for SVG plots, ~400 points), µm.
-fn decimate(spectrum: &[f64], n: usize) -> Vec<(f64, f64)> {
+/// The spectrum up to 50 kHz in log-spaced groups of bins (2 % wide, ~400 points for an
+/// SVG plot), µm: each group's mean |Y| at its first bin's frequency, and its largest bin.
+/// The mean is the spectrum's level (a group of M bins of a flat floor averages to the
+/// floor); the maximum of M Rayleigh bins grows like sqrt(ln M) and drew a flat 5.5 µm
+/// floor rising to 16.7 µm, so it is kept for the tone's height only.
+pub fn decimate(spectrum: &[f64], n: usize) -> (Curve, Curve) {
     let df = FS_HZ / n as f64;
-    let kmax = ((50_000.0 / df) as usize).min(spectrum.len() - 1);
-    let mut out = Vec::new();
+    let kmax = ((50_000.0 / df) as usize).min(spectrum.len().saturating_sub(1));
+    let (mut mean, mut max) = (Vec::new(), Vec::new());
     let mut k = 1usize;
     while k <= kmax {
         let next = ((k as f64 * 1.02).ceil() as usize).max(k + 1).min(kmax + 1);
-        let m = spectrum[k..next].iter().cloned().fold(0.0, f64::max);
-        out.push((k as f64 * df, m * 1e3));
+        let group = &spectrum[k..next];
+        let m = group.iter().sum::<f64>() / group.len() as f64;
+        mean.push((k as f64 * df, m * 1e3));
+        max.push((
+            k as f64 * df,
+            group.iter().copied().fold(0.0, f64::max) * 1e3,
+        ));
         k = next;
     }
-    out
+    (mean, max)
 }
 
 /// "The paper is off": |z_paper| > K, with the difference in % of the mean.
@@ -547,7 +602,7 @@ pub fn noise_row(r: &RowResult, quick: bool) -> Row {
             r.spec.setup().jitter_mm().unwrap_or(f64::NAN)
         ),
     )
-    .with_seeds(SEEDS, &st, Some(BAND))
+    .with_seeds(&r.seeds, &st, Some(BAND))
 }
 
 /// The amplitude row: mean over the seeds against the closed form, tolerance K·se.
@@ -594,7 +649,7 @@ pub fn amplitude_row(r: &RowResult) -> Option<Row> {
                 r.amps_um.iter().map(|a| (a * 100.0).round() / 100.0).collect::<Vec<_>>()
             ),
         )
-        .with_seeds(SEEDS, &st, None),
+        .with_seeds(&r.seeds, &st, None),
     )
 }
 
@@ -652,6 +707,40 @@ pub fn eq12_row(results: &[RowResult], n: u64, quick: bool) -> Option<Row> {
 mod tests {
     use super::*;
 
+    /// The plotted spectrum is the level of the spectrum: on a flat Rayleigh floor (mean
+    /// sqrt(π/2) = 1.2533 mm, drawn from a fixed LCG) the median group mean above 10 kHz
+    /// is within 4 % of it (81 groups of 20–100 bins, each mean within ≈ 8 % sd: the
+    /// median's standard error ≈ 1.1 %, so 4 % is > 3.5σ), while the group maxima — what spectra.svg used to draw — sit ≥ 1.5×
+    /// above it (the maximum of M ≥ 20 Rayleigh bins exceeds the mean by ≈ sqrt(2 ln M)).
+    #[test]
+    fn decimated_spectrum_is_the_group_mean() {
+        let n = 1_000_000usize;
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let spectrum: Vec<f64> = (0..n / 2)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1);
+                let u = ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
+                (-2.0 * u.ln()).sqrt() * 1e-3
+            })
+            .collect();
+        let (mean, max) = decimate(&spectrum, n);
+        assert_eq!(mean.len(), max.len());
+        let median = |v: &[(f64, f64)]| {
+            let mut y: Vec<f64> = v.iter().filter(|p| p.0 >= 10_000.0).map(|p| p.1).collect();
+            y.sort_by(f64::total_cmp);
+            y[y.len() / 2]
+        };
+        let level = (std::f64::consts::PI / 2.0).sqrt();
+        assert!(
+            (median(&mean) / level - 1.0).abs() < 0.04,
+            "{}",
+            median(&mean)
+        );
+        assert!(median(&max) > 1.5 * level, "{}", median(&max));
+    }
+
     /// A short record (2^18 pulses, 38 Hz bins) of the σ_s = 7.5 mm, ρ_s = 0.3 row: the
     /// band holds ≈ 220 bins, ≈ 110 independent ones under Blackman, so the mean Rayleigh
     /// magnitude has a standard error ≈ 0.52/sqrt(110) ≈ 5%; 15% is 3σ. The ΣΔ column runs
@@ -674,14 +763,95 @@ mod tests {
         // The ΣΔ noise and amplitude rows are means over every seed, each seed's ΣΔ read
         // against the DFT of its own record (the 3% / 3ē tolerances of `sigma_delta`).
         assert_eq!(r.probe_seeds.len(), SEEDS.len());
+        // The row's own seeds (row 9 of ROWS: 10000..10005), shared with no other row.
+        assert_eq!(r.seeds, (10_000..10_005).collect::<Vec<u64>>());
         let sd_rows = crate::paper::sigma_delta::rows(&r);
         for fam in ["Table 2 ΣΔ noise", "Table 2 ΣΔ amplitude"] {
             let row = sd_rows.iter().find(|x| x.family == fam).expect(fam);
-            assert_eq!(row.seeds, SEEDS, "{row:?}");
+            assert_eq!(row.seeds, r.seeds, "{row:?}");
             assert!(row.pass && row.seed_sd.is_some_and(|s| s > 0.0), "{row:?}");
         }
         let dft_only = run_row_with(&spec, n, Some(&probe), &COLUMNS[..1]).unwrap();
         assert!(dft_only.probe_seeds.is_empty());
+    }
+
+    /// Statistical power: at N = 10^7 every tested amplitude row has seeds enough that a
+    /// 10 µm bias fails its test, and no two rows share a seed. Shown on seed amplitudes
+    /// built to have exactly the predicted sd about the closed form (normal quantiles,
+    /// rescaled): unbiased they pass, shifted by ±10 µm they fail — while with the old
+    /// five shared seeds the same shift passes at least one row (the defect).
+    #[test]
+    fn a_ten_micron_amplitude_bias_fails_every_tested_row() {
+        let n = FULL_N;
+        let mut all: Vec<u64> = Vec::new();
+        let mut tested = 0;
+        for spec in ROWS {
+            let seeds = seeds_for(spec, n).unwrap();
+            eprintln!("{}: {} seeds from {}", spec.label(), seeds.len(), seeds[0]);
+            all.extend(&seeds);
+            let Some(amp) = closed_form_amp_um(spec).unwrap() else {
+                continue;
+            };
+            let floor = closed_form_noise_um(spec, n as usize).unwrap();
+            let expected = stats::rician_mean(amp, floor);
+            let sd = floor * (2.0 / std::f64::consts::PI).sqrt();
+            let draws = |count: usize, shift: f64| -> Vec<f64> {
+                // A symmetric spread (logits of (i + ½)/count) rescaled to sample sd 1:
+                // mean 0 and sd 1 exactly, which is all the row's test reads.
+                let z: Vec<f64> = (0..count)
+                    .map(|i| {
+                        let p = (i as f64 + 0.5) / count as f64;
+                        (p / (1.0 - p)).ln()
+                    })
+                    .collect();
+                let (_, zs) = stats::mean_sd(&z);
+                z.iter().map(|v| expected + shift + sd * v / zs).collect()
+            };
+            let row_with = |amps: Vec<f64>| {
+                let r = RowResult {
+                    spec: *spec,
+                    seeds: (0..amps.len() as u64).collect(),
+                    columns: Vec::new(),
+                    noises_um: vec![floor; amps.len()],
+                    band_bins: 100,
+                    amps_um: amps,
+                    closed_form_um: floor,
+                    amp_closed_um: Some(amp),
+                    spectrum: Vec::new(),
+                    spectrum_max: Vec::new(),
+                    probe_seeds: Vec::new(),
+                };
+                amplitude_row(&r).unwrap()
+            };
+            let row = row_with(draws(seeds.len(), 0.0));
+            if matches!(row.tolerance, Tolerance::Untested) {
+                continue;
+            }
+            tested += 1;
+            assert!(row.pass, "{}: unbiased must pass: {row:?}", spec.label());
+            for shift in [AMP_BIAS_UM, -AMP_BIAS_UM] {
+                let biased = row_with(draws(seeds.len(), shift));
+                assert!(!biased.pass, "{} with {shift} µm passes", spec.label());
+            }
+        }
+        assert!(tested >= 10, "{tested}");
+        let unique: std::collections::BTreeSet<u64> = all.iter().copied().collect();
+        assert_eq!(unique.len(), all.len(), "rows share seeds");
+        // The old five seeds: some tested row lets a 10 µm bias through.
+        let weak = ROWS.iter().any(|spec| {
+            let (Some(amp), Ok(floor)) = (
+                closed_form_amp_um(spec).unwrap(),
+                closed_form_noise_um(spec, n as usize),
+            ) else {
+                return false;
+            };
+            let sd = floor * (2.0 / std::f64::consts::PI).sqrt();
+            amp / floor >= AMP_MIN_SNR && AMP_BIAS_UM < K * sd / (SEEDS.len() as f64).sqrt()
+        });
+        assert!(
+            weak,
+            "five seeds were already enough: the seed counts buy nothing"
+        );
     }
 
     /// Deliberately wrong pipelines fail the noise row (2^16 pulses, DFT column only, the

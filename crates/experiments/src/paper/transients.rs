@@ -91,12 +91,32 @@ pub fn svgs(figs: &[TransientFigure]) -> Result<Vec<(String, String)>, Experimen
             f.scalogram.pulses,
             f.scalogram.scales
         );
-        let svg = crate::scalogram::scalogram_svg(&f.scalogram, &title, Some(&f.events)).map_err(
-            |message| ExperimentError::Plot {
-                path: name.to_string(),
-                message,
-            },
-        )?;
+        // The paper's value beside each measured one (event time, scale, rate, counts).
+        let notes: Vec<String> = f
+            .rows
+            .iter()
+            .map(|r| {
+                let paper = r.paper.map_or("the paper prints none".to_string(), |p| {
+                    format!("paper {p} {}", r.unit).trim_end().to_string()
+                });
+                let measured = if r.measured.fract() == 0.0 {
+                    format!("{:.0}", r.measured)
+                } else {
+                    format!("{:.4}", r.measured)
+                };
+                format!("{}: measured {measured} {} ({paper})", r.label, r.unit).replace("  ", " ")
+            })
+            .collect();
+        let svg = crate::scalogram::scalogram_svg_with_notes(
+            &f.scalogram,
+            &title,
+            Some(&f.events),
+            &notes,
+        )
+        .map_err(|message| ExperimentError::Plot {
+            path: name.to_string(),
+            message,
+        })?;
         out.push((name.to_string(), svg));
     }
     Ok(out)
