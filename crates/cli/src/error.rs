@@ -21,6 +21,10 @@ pub enum CliError {
     /// `reproduce` could not run (not a missed row: that is the FAIL verdict).
     #[error("reproduce: {0}")]
     Reproduce(Box<tofprobe_experiments::ExperimentError>),
+    /// An output set read (`cosim --rtl`, `check-set`) is not whole: killed mid-commit or
+    /// changed since (the message names the missing marker or the file that fails).
+    #[error("{0}")]
+    IncompleteSet(std::io::Error),
     /// JSON serialisation failed (should not happen for plain numbers).
     #[error("cannot serialise JSON output: {0}")]
     Json(#[from] serde_json::Error),

@@ -82,31 +82,44 @@ pub fn hash_file(path: &Path) -> std::io::Result<u64> {
     }
 }
 
-/// Checks that `dir` holds a whole set completed by `marker`: the marker is there, lists at
-/// least one file, and every listed file exists with its recorded hash. Returns the listed
-/// paths. The error (kind `NotFound` for a missing marker or file, `InvalidData` otherwise)
-/// says which file failed and that the set is incomplete.
-pub fn check_set(dir: &Path, marker: &str) -> std::io::Result<Vec<String>> {
-    let incomplete = |kind: ErrorKind, what: String| {
-        Error::new(
-            kind,
-            format!(
-                "{} is not a whole output set: {what}; it was interrupted or changed after it was written: write it again",
-                dir.display()
-            ),
-        )
-    };
+/// What [`inspect_set`] found of a set that has its marker and every listed file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SetStatus {
+    /// The listed paths.
+    pub files: Vec<String>,
+    /// The listed paths whose bytes no longer have the recorded hash (changed since the
+    /// commit), each as `path (hash H, the marker records M)`.
+    pub changed: Vec<String>,
+}
+
+fn incomplete(dir: &Path, kind: ErrorKind, what: String) -> Error {
+    Error::new(
+        kind,
+        format!(
+            "{} is not a whole output set: {what}; it was interrupted or changed after it was written: write it again",
+            dir.display()
+        ),
+    )
+}
+
+/// Reads the marker `marker` of the set in `dir` and checks that every file it lists is
+/// there; a missing marker or file is an error (kind `NotFound`; `InvalidData` for a
+/// marker that is not one or lists a path outside the set), a changed file is reported in
+/// [`SetStatus::changed`] (a reader that co-simulates deliberately edited RTL may go on).
+pub fn inspect_set(dir: &Path, marker: &str) -> std::io::Result<SetStatus> {
     let mpath = dir.join(marker);
     let text = match crate::read_bounded_text(&mpath, MAX_MARKER_BYTES) {
         Ok(t) => t,
         Err(e) if e.kind() == ErrorKind::NotFound => {
             return Err(incomplete(
+                dir,
                 ErrorKind::NotFound,
                 format!("its completion marker {marker} is missing"),
             ));
         }
         Err(e) => {
             return Err(incomplete(
+                dir,
                 ErrorKind::InvalidData,
                 format!("its completion marker {marker} cannot be read: {e}"),
             ));
@@ -116,34 +129,54 @@ pub fn check_set(dir: &Path, marker: &str) -> std::io::Result<Vec<String>> {
         .filter(|f| !f.is_empty())
         .ok_or_else(|| {
             incomplete(
+                dir,
                 ErrorKind::InvalidData,
                 format!("{marker} has no [files] table of path = \"16-hex-digit hash\""),
             )
         })?;
+    let mut changed = Vec::new();
     for (name, want) in &files {
         if !safe_relative(name) || name == marker {
             return Err(incomplete(
+                dir,
                 ErrorKind::InvalidData,
                 format!("{marker} lists `{name}`, not a plain relative path inside the set"),
             ));
         }
         match hash_file(&dir.join(name)) {
             Ok(h) if h == *want => {}
-            Ok(h) => {
-                return Err(incomplete(
-                    ErrorKind::InvalidData,
-                    format!("{name} has hash {h:016x}, {marker} records {want:016x}"),
-                ));
-            }
+            Ok(h) => changed.push(format!(
+                "{name} (hash {h:016x}, {marker} records {want:016x})"
+            )),
             Err(e) => {
                 return Err(incomplete(
+                    dir,
                     e.kind(),
                     format!("{name}, listed in {marker}, cannot be read: {e}"),
                 ));
             }
         }
     }
-    Ok(files.into_keys().collect())
+    Ok(SetStatus {
+        files: files.into_keys().collect(),
+        changed,
+    })
+}
+
+/// Checks that `dir` holds a whole set completed by `marker`, unchanged: the marker is
+/// there, lists at least one file, and every listed file exists with its recorded hash.
+/// Returns the listed paths; the error says which file failed and that the set is not
+/// whole.
+pub fn check_set(dir: &Path, marker: &str) -> std::io::Result<Vec<String>> {
+    let s = inspect_set(dir, marker)?;
+    if let Some(first) = s.changed.first() {
+        return Err(incomplete(
+            dir,
+            ErrorKind::InvalidData,
+            format!("{first} was changed"),
+        ));
+    }
+    Ok(s.files)
 }
 
 #[cfg(test)]
@@ -163,7 +196,8 @@ mod tests {
         // A changed file, a missing file and a missing marker are each refused.
         std::fs::write(dir.path().join("a.v"), b"module b;").unwrap();
         let e = check_set(dir.path(), SET_MARKER).unwrap_err().to_string();
-        assert!(e.contains("a.v has hash"), "{e}");
+        assert!(e.contains("a.v (hash"), "{e}");
+        assert_eq!(inspect_set(dir.path(), SET_MARKER).unwrap().changed.len(), 1);
         std::fs::remove_file(dir.path().join("a.v")).unwrap();
         assert!(check_set(dir.path(), SET_MARKER).is_err());
         std::fs::remove_file(dir.path().join(SET_MARKER)).unwrap();
