@@ -64,7 +64,10 @@ pub fn seal(out: &Path) -> Result<(), FlowError> {
     for (sub, marker) in [("rtl", SET_MARKER), ("vectors", "manifest.toml")] {
         let dir = out.join(sub);
         let listed = tofprobe_io::check_set(&dir, marker).map_err(|e| out_err(&dir, e))?;
-        for name in listed.into_iter().chain(std::iter::once(marker.to_string())) {
+        for name in listed
+            .into_iter()
+            .chain(std::iter::once(marker.to_string()))
+        {
             add(format!("{sub}/{name}"))?;
         }
     }

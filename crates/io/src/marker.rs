@@ -197,12 +197,18 @@ mod tests {
         std::fs::write(dir.path().join("a.v"), b"module b;").unwrap();
         let e = check_set(dir.path(), SET_MARKER).unwrap_err().to_string();
         assert!(e.contains("a.v (hash"), "{e}");
-        assert_eq!(inspect_set(dir.path(), SET_MARKER).unwrap().changed.len(), 1);
+        assert_eq!(
+            inspect_set(dir.path(), SET_MARKER).unwrap().changed.len(),
+            1
+        );
         std::fs::remove_file(dir.path().join("a.v")).unwrap();
         assert!(check_set(dir.path(), SET_MARKER).is_err());
         std::fs::remove_file(dir.path().join(SET_MARKER)).unwrap();
         let e = check_set(dir.path(), SET_MARKER).unwrap_err().to_string();
-        assert!(e.contains("completion marker tofprobe-set.toml is missing"), "{e}");
+        assert!(
+            e.contains("completion marker tofprobe-set.toml is missing"),
+            "{e}"
+        );
     }
 
     #[test]

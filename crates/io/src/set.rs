@@ -225,7 +225,12 @@ fn kill_hook() -> Option<usize> {
 
 /// Step 3 of the protocol for a stage whose `COMMIT` list is `list`: files already moved
 /// or removed are skipped, so this also completes an interrupted commit.
-fn finish(target: &Path, stage: &Path, list: &str, kill_after: Option<usize>) -> std::io::Result<()> {
+fn finish(
+    target: &Path,
+    stage: &Path,
+    list: &str,
+    kill_after: Option<usize>,
+) -> std::io::Result<()> {
     let mut order: Vec<String> = Vec::new();
     let mut removals: Vec<&str> = Vec::new();
     for line in list.lines() {

@@ -23,6 +23,7 @@ mod fuzz_binary;
 mod haar;
 mod junit;
 mod options;
+mod output_sets;
 mod prefilter_rounding;
 mod probe_convention;
 mod register_file;
