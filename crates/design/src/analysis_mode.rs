@@ -133,10 +133,11 @@ pub fn check_haar(
     tofprobe_dsp::haar::HaarNoise::for_static_scene(&d.sensor, d.scene.depth_mm).map_err(|e| {
         err(
             format!(
-                "Haar mode{how} needs detections to judge its coefficients: its noise model \
-                 (sensor.signal_rate, sensor.background_rate, sensor.jitter_ps and the window \
-                 sensor.window_start_ps/window_length_ps around scene.depth_mm = {} mm) fails; \
-                 make sensor.signal_rate > 0 with the target in the window, or set pixel.mode = \"fourier\"",
+                "Haar mode{how} judges its coefficients against the noise of the static scene, \
+                 and that noise model (from sensor.signal_rate, sensor.background_rate, \
+                 sensor.jitter_ps and the window around scene.depth_mm = {} mm) fails: it needs \
+                 detections (sensor.signal_rate > 0 with the target in the window) and jitter \
+                 (sensor.jitter_ps > 0); or set pixel.mode = \"fourier\"",
                 d.scene.depth_mm
             ),
             e,

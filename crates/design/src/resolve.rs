@@ -317,7 +317,9 @@ impl ResolvedDesign {
     /// (a `[probe]` section in Haar mode): the file-loading entries ([`load`] and the
     /// hardware commands' `tofprobe_flow::adders::load`) call it once per command.
     pub fn warn_ignored(&self) {
-        if let Some(w) = crate::analysis_mode::ignored_probe_warning(&self.document, self.pixel.mode) {
+        if let Some(w) =
+            crate::analysis_mode::ignored_probe_warning(&self.document, self.pixel.mode)
+        {
             eprintln!("warning: {}: {w}", self.origin);
         }
     }

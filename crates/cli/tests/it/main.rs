@@ -22,6 +22,7 @@ mod flow;
 mod fuzz_binary;
 mod haar;
 mod junit;
+mod one_resolution;
 mod options;
 mod output_sets;
 mod prefilter_rounding;
