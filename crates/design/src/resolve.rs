@@ -405,9 +405,9 @@ impl ResolvedDesign {
             Some(a) => Err(DesignError::array(
                 &self.origin,
                 format!(
-                    "`{command}` runs one pixel, and [array] makes this a {} × {} sensor: \
+                    "`{command}` runs one pixel, and [array] (array.rows = {}, array.cols = {}) makes this a {} × {} sensor: \
                      `tofprobe simulate CONFIG --out DIR` runs the array (remove [array] to {command} its pixel)",
-                    a.rows, a.cols
+                    a.rows, a.cols, a.rows, a.cols
                 ),
             )),
         }

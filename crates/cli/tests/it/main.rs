@@ -20,6 +20,7 @@ mod extremes;
 mod finite_json;
 mod flow;
 mod fuzz_binary;
+mod fuzz_records;
 mod haar;
 mod junit;
 mod one_resolution;
