@@ -184,7 +184,7 @@ fn mutate(rng: &mut Rng) -> (String, Vec<(String, String)>) {
     let mut doc: toml::Table = toml::from_str(&base).unwrap();
     let mut muts = Vec::new();
     for _ in 0..1 + rng.next() % 3 {
-        let (table, key, lit) = if rng.next() % 2 == 0 {
+        let (table, key, lit) = if rng.next().is_multiple_of(2) {
             let (table, keys) = rng.pick(KEYS);
             (
                 *table,
