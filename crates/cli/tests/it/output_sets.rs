@@ -319,3 +319,24 @@ fn an_interrupted_flow_leaves_no_previous_report() {
     assert!(e.contains("tofprobe-set.toml is missing"), "{e}");
     let _ = std::fs::remove_dir_all(&tmp);
 }
+
+/// `reproduce --out DIR` (the run the test binary shares) is a marked set: `check-set`
+/// finds it whole and its marker lists every figure it wrote.
+#[test]
+fn reproduce_writes_a_marked_set() {
+    let (o, dir) = common::reproduce_quick();
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{}", text(o));
+    check_set(dir).expect("reproduce's set is whole");
+    let marker = std::fs::read_to_string(dir.join("tofprobe-set.toml")).unwrap();
+    let svgs: Vec<String> = listing(dir)
+        .into_iter()
+        .filter(|n| n.ends_with(".svg"))
+        .collect();
+    assert!(svgs.len() >= 10, "{svgs:?}");
+    for n in &svgs {
+        assert!(
+            marker.contains(&format!("\"{n}\" = ")),
+            "{n} not in the marker"
+        );
+    }
+}
