@@ -14,6 +14,14 @@ work="$root/target/fusesoc"
 mkdir -p "$work"
 cd "$work"
 core=tofprobe:tofprobe:tofprobe_pixel
+# A core's users first check that its directory is a whole set (a `tofprobe rtl` killed
+# mid-commit leaves no completion marker): `tofprobe check-set DIR`.
+bin="${CARGO_TARGET_DIR:-$root/target}/release/tofprobe"
+if [[ -x "$bin" ]]; then
+  for d in "$root/rtl" "$root/testbench/default-short/rtl" "$root/testbench/default-short/vectors"; do
+    "$bin" check-set "$d" >/dev/null || { echo "fusesoc-check: $d is not a whole output set" >&2; exit 1; }
+  done
+fi
 # Each directory holds one core of that name (the default's and the short frame's): one
 # cores root at a time.
 run() { # cores-root target log

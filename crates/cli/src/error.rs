@@ -24,6 +24,10 @@ pub enum CliError {
     /// Tile sets that `merge` refuses (the message names the set).
     #[error("merge: {0}")]
     Merge(String),
+    /// An output set read (`cosim --rtl`, `check-set`) is not whole: killed mid-commit or
+    /// changed since (the message names the missing marker or the file that fails).
+    #[error("{0}")]
+    IncompleteSet(std::io::Error),
     /// JSON serialisation failed (should not happen for plain numbers).
     #[error("cannot serialise JSON output: {0}")]
     Json(#[from] serde_json::Error),

@@ -58,6 +58,16 @@ pub fn decide_mode(d: &Document, px: &mut PixelConfig, frame: u64) -> ModeDecisi
     ModeDecision { mode, auto }
 }
 
+/// The warning for a `[probe]` section in a Haar design: Haar mode reads no ΣΔ probe ROM, so
+/// the section is accepted, not validated against the frame, and ignored (README). `None`
+/// in Fourier mode or without the section. The commands print it on stderr
+/// ([`crate::load`]).
+pub fn ignored_probe_warning(d: &Document, mode: Mode) -> Option<String> {
+    (mode == Mode::Haar && d.probe != ProbeConfig::default()).then(|| {
+        "[probe] is set but pixel.mode is Haar, which reads no ΣΔ probe ROM: the probe section is ignored".to_string()
+    })
+}
+
 /// Where N comes from, for the messages.
 fn frame_field(d: &Document) -> &'static str {
     if d.pixel.frame_pulses.is_some() {
@@ -68,8 +78,9 @@ fn frame_field(d: &Document) -> &'static str {
 }
 
 /// The Haar frame's checks: errors for N not a power of two (the nearest powers), U beyond
-/// log₂N − 1 (the largest U that works) and Fourier bin frequencies given; notes for a
-/// `[probe]` section that Haar does not read and for transients outside the frame.
+/// log₂N − 1 (the largest U that works), Fourier bin frequencies given and a scene without
+/// detections (its noise model fails, naming the keys); notes for transients outside the
+/// frame. A `[probe]` section is ignored in Haar mode ([`ignored_probe_warning`]).
 pub fn check_haar(
     d: &Document,
     px: &PixelConfig,
@@ -115,12 +126,24 @@ pub fn check_haar(
             ),
         ));
     }
+    // The Haar analysis judges its coefficients against the noise of the static scene: a
+    // scene that yields no detections (or no jitter) has none, and `simulate` could not run
+    // it, so every command refuses it here, naming the keys (it used to pass `config`, `rtl`
+    // and `vectors` and fail in `simulate` naming none).
+    tofprobe_dsp::haar::HaarNoise::for_static_scene(&d.sensor, d.scene.depth_mm).map_err(|e| {
+        err(
+            format!(
+                "Haar mode{how} judges its coefficients against the noise of the static scene, \
+                 and that noise model (from sensor.signal_rate, sensor.background_rate, \
+                 sensor.jitter_ps and the window around scene.depth_mm = {} mm) fails: it needs \
+                 detections (sensor.signal_rate > 0 with the target in the window) and jitter \
+                 (sensor.jitter_ps > 0); or set pixel.mode = \"fourier\"",
+                d.scene.depth_mm
+            ),
+            e,
+        )
+    })?;
     let mut notes = Vec::new();
-    if d.probe != ProbeConfig::default() {
-        notes.push(
-            "[probe] is set but Haar mode reads no ΣΔ probe ROM: the section is ignored".into(),
-        );
-    }
     let frame_s = frame as f64 / d.sensor.laser_rate_hz;
     notes.extend(transients_outside_frame(&d.scene, frame_s));
     Ok(notes)

@@ -201,11 +201,25 @@ pub fn resolve_array(
             2.0 * d * (fov.to_radians() / 2.0).tan() / f64::from(a.cols)
         }
         _ => {
-            return Err(err(
-                "[array] maps pixels onto the scene plane with either `mm_per_pixel` or both \
-                 `field_of_view_deg` and `distance_mm` (one of the two ways, not both)"
-                    .into(),
-            ));
+            // Name the keys written (their dotted paths), not only the section.
+            let given: Vec<&str> = [
+                ("array.mm_per_pixel", a.mm_per_pixel.is_some()),
+                ("array.field_of_view_deg", a.field_of_view_deg.is_some()),
+                ("array.distance_mm", a.distance_mm.is_some()),
+            ]
+            .iter()
+            .filter(|(_, set)| *set)
+            .map(|(k, _)| *k)
+            .collect();
+            return Err(err(format!(
+                "[array] maps pixels onto the scene plane with either array.mm_per_pixel or both \
+                 array.field_of_view_deg and array.distance_mm (exactly one of the two ways); given: {}",
+                if given.is_empty() {
+                    "none".to_string()
+                } else {
+                    given.join(", ")
+                }
+            )));
         }
     };
     let (rows, cols) = (a.rows as usize, a.cols as usize);

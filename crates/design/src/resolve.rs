@@ -54,7 +54,9 @@ pub struct ResolvedDesign {
 /// Reads `path` (or the embedded default) and resolves it.
 pub fn load(path: Option<&Path>) -> Result<ResolvedDesign, DesignError> {
     let (document, origin) = Document::read(path)?;
-    resolve(document, &origin)
+    let design = resolve(document, &origin)?;
+    design.warn_ignored();
+    Ok(design)
 }
 
 /// Resolves a document; `origin` names it in every error. Pure: no tool runs
@@ -98,7 +100,6 @@ pub fn resolve_timed(
             PhotonSource::new(&d.sensor, &scene, d.acquisition.seed).map_err(scene_err)?;
         }
     }
-    d.probe.validate().map_err(probe_err)?;
     let frame = d.pixel.frame_pulses.unwrap_or(d.pulses());
     // A frame is part of the acquisition (docs: "N: pulses per frame; default: the whole
     // acquisition"): a longer one would read pulses that were never simulated.
@@ -114,7 +115,6 @@ pub fn resolve_timed(
             format!("{} (or leave pixel.frame_pulses out)", d.pulses()),
         )));
     }
-    d.probe.check_frame(frame).map_err(probe_err)?;
     // The pixel reads the ROM the probe design generates: its depth defaults to the
     // `[probe]` design's (L = N windowed, `probe.rom_depth` periodic).
     // A Fourier pixel addresses exactly that ROM: another `pixel.rom_depth` would read the
@@ -122,6 +122,13 @@ pub fn resolve_timed(
     let context = d.pixel_context();
     let mut px = d.pixel.clone();
     let mode = decide_mode(d, &mut px, frame);
+    // Haar mode reads no ΣΔ probe ROM: a `[probe]` section is ignored (with a warning,
+    // `ignored_probe_warning`), neither validated nor checked against the frame.
+    let fourier = mode.mode == Mode::Fourier;
+    if fourier {
+        d.probe.validate().map_err(probe_err)?;
+        d.probe.check_frame(frame).map_err(probe_err)?;
+    }
     // A windowed ROM is one frame deep, and `simulate` builds it whole (≈ 24 bytes per
     // pulse): bounded here, once, as `rtl` and `vectors` bound theirs.
     if mode.mode == Mode::Fourier
@@ -147,7 +154,11 @@ pub fn resolve_timed(
     if mode.mode == Mode::Haar {
         notes.extend(check_haar(d, &px, &mode, frame, origin)?);
     }
-    let probe_depth = d.probe.depth(frame);
+    let probe_depth = if fourier {
+        d.probe.depth(frame)
+    } else {
+        tofprobe_dsp::sd::ProbeConfig::default().depth(frame)
+    };
     match px.rom_depth {
         None => px.rom_depth = Some(probe_depth),
         Some(l) if l != probe_depth && mode.mode == Mode::Fourier => {
@@ -187,6 +198,21 @@ pub fn resolve_timed(
     // `adders = "auto"`: A and C from measured timing when an oracle is given
     // (crate::adders), else a provisional A, open; then the pixel resolves with them like any
     // explicit value.
+    // `timing_liberty` is read only to time the candidates of `adders = "auto"`: beside an
+    // explicit A it would be ignored silently, so it is refused, naming both keys.
+    if let (Some(lib), tofprobe_pixel::config::Choice::Value(a)) =
+        (&d.pixel.timing_liberty, &d.pixel.adders)
+    {
+        return Err(pixel_err(PixelError::invalid(
+            "timing_liberty",
+            format!("\"{}\"", tofprobe_io::text::clip(lib, 60)),
+            format!(
+                "it is read only by pixel.adders = \"auto\" (the liberty its candidates are timed on); \
+                 pixel.adders = {a} is explicit, so it would be ignored"
+            ),
+            "remove pixel.timing_liberty, or set pixel.adders = \"auto\"",
+        )));
+    }
     let adders = if matches!(px.adders, tofprobe_pixel::config::Choice::Auto(_)) {
         let (status, a, c) = match timing {
             Some(t) => {
@@ -287,6 +313,17 @@ fn derived_from(e: PixelError, d: &Document) -> PixelError {
 }
 
 impl ResolvedDesign {
+    /// Prints on stderr, as `warning: …`, what the document sets that this design ignores
+    /// (a `[probe]` section in Haar mode): the file-loading entries ([`load`] and the
+    /// hardware commands' `tofprobe_flow::adders::load`) call it once per command.
+    pub fn warn_ignored(&self) {
+        if let Some(w) =
+            crate::analysis_mode::ignored_probe_warning(&self.document, self.pixel.mode)
+        {
+            eprintln!("warning: {}: {w}", self.origin);
+        }
+    }
+
     /// The document with a decided `adders = "auto"` written out as the chosen A and C, so
     /// a variant re-resolved from it (an architecture option, a knob) keeps the measured
     /// choice instead of reopening it; the document as written otherwise.
@@ -368,9 +405,9 @@ impl ResolvedDesign {
             Some(a) => Err(DesignError::array(
                 &self.origin,
                 format!(
-                    "`{command}` runs one pixel, and [array] makes this a {} × {} sensor: \
+                    "`{command}` runs one pixel, and [array] (array.rows = {}, array.cols = {}) makes this a {} × {} sensor: \
                      `tofprobe simulate CONFIG --out DIR` runs the array (remove [array] to {command} its pixel)",
-                    a.rows, a.cols
+                    a.rows, a.cols, a.rows, a.cols
                 ),
             )),
         }

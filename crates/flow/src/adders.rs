@@ -28,7 +28,9 @@ use crate::error::FlowError;
 /// "auto"` is decided by synthesis and static timing (cached).
 pub fn load(path: Option<&Path>) -> Result<ResolvedDesign, FlowError> {
     let (document, origin) = Document::read(path)?;
-    resolve(document, &origin, &mut ProbeCache::default())
+    let design = resolve(document, &origin, &mut ProbeCache::default())?;
+    design.warn_ignored();
+    Ok(design)
 }
 
 /// [`load`] for a document in hand.

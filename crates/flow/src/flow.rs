@@ -135,13 +135,24 @@ pub fn recommended(
     Ok((crate::adders::decide(chosen)?, report))
 }
 
-/// Runs the flow on `design` and writes its report into `a.out`.
+/// Runs the flow on `design` and writes its report into `a.out`, the directory one output
+/// set ([`crate::flowset`]): the old report and marker go first, the new marker last, and a
+/// failed flow removes the directory if it created it.
 pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome, FlowError> {
     if a.frames == 0 || a.frames > 100 {
         return Err(FlowError::option("frames", a.frames, "1..=100"));
     }
     // Before minutes of co-simulation, not after: a hand-written report.md stays.
     refuse_foreign_report(&a.out.join("report.md"))?;
+    let created = crate::flowset::open(&a.out)?;
+    let r = run_flow_in(design, a);
+    if r.is_err() {
+        crate::flowset::discard(&a.out, created);
+    }
+    r
+}
+
+fn run_flow_in(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome, FlowError> {
     let t_start = std::time::Instant::now();
     let config = &design.document;
     let fs = config.sensor.laser_rate_hz;
@@ -312,6 +323,7 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
     let path = a.out.join("report.md");
     refuse_foreign_report(&path)?;
     write_atomic(&path, md.as_bytes())?;
+    crate::flowset::seal(&a.out)?;
     Ok(FlowOutcome {
         pass: r.pass && signoff.iter().all(|l| l.pass()),
         frame_pulses: p.frame_pulses,

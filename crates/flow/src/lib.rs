@@ -8,6 +8,7 @@
 pub mod adders;
 pub mod error;
 pub mod flow;
+pub mod flowset;
 pub mod rtl;
 pub mod signoff;
 pub mod sizing;

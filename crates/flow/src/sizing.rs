@@ -159,6 +159,8 @@ pub fn options_request(
     seeds: Vec<u64>,
     target_error_um: f64,
 ) -> Result<tofprobe_experiments::options::OptionsRequest, FlowError> {
+    // Before any liberty is prepared: a Haar design has no options study.
+    tofprobe_experiments::options::require_fourier(design)?;
     let cache = cache_dir(a.cache.as_deref());
     let mut liberties = vec![a.liberty.clone().unwrap_or_else(|| OSU018.into())];
     if !a.no_sky130

@@ -12,6 +12,7 @@
 mod atomic;
 pub mod bounded;
 pub mod live;
+pub mod marker;
 pub mod npy;
 mod set;
 pub mod stale;
@@ -19,6 +20,7 @@ pub mod text;
 
 pub use atomic::{write_atomic, write_svg_atomic};
 pub use bounded::{read_bounded, read_bounded_text};
+pub use marker::{SET_MARKER, SetStatus, check_set, inspect_set};
 pub use set::{OutputSet, STAGE_PREFIX, recover};
 
 /// FNV-1a 64-bit offset basis: the hash of no bytes.

@@ -5,8 +5,11 @@
 //!    `DIR/.output-set.tofprobe-PID.stage/`, and flushed to disk;
 //! 2. a `COMMIT` list (the names, in order, the completion file last) is written there:
 //!    from now on the new set is whole on disk;
-//! 3. the target's completion file (e.g. `manifest.toml`) is removed, each staged file is
-//!    renamed into place, the completion file last, and the stage directory is removed.
+//! 3. the target's completion file (e.g. `manifest.toml`) is removed, then the files of the
+//!    old set that the new one does not write (those the old completion marker lists with
+//!    the hash they still have: never a file the old set did not write,
+//!    [`crate::marker`]), then each staged file is renamed into place, the completion file
+//!    last, and the stage directory is removed.
 //!
 //! A run killed before step 2 leaves the old set untouched and a stage directory that the
 //! next run removes; killed during step 3, it leaves a set without its completion file
@@ -36,6 +39,8 @@ pub struct OutputSet {
     target: PathBuf,
     stage: PathBuf,
     names: Vec<String>,
+    /// FNV-1a-64 of each staged file, for the completion marker.
+    hashes: std::collections::BTreeMap<String, u64>,
     created_target: bool,
     done: bool,
     /// The stage (and the target if this run made it) in the registry of live
@@ -71,6 +76,7 @@ impl OutputSet {
             target: target.to_path_buf(),
             stage: stage.clone(),
             names: Vec::new(),
+            hashes: Default::default(),
             created_target,
             done: false,
             live: registered,
@@ -111,7 +117,20 @@ impl OutputSet {
         f.sync_all()?;
         self.names.retain(|n| n != name);
         self.names.push(name.to_string());
+        self.hashes
+            .insert(name.to_string(), crate::fnv1a64(contents));
         Ok(())
+    }
+
+    /// Stages the completion marker `marker` (`preamble`, then the `[files]` table of every
+    /// file staged so far with its hash, [`crate::marker::marker_text`]) and commits with
+    /// it last: readers check the set with [`crate::check_set`]`(dir, marker)`.
+    pub fn commit_marked(mut self, marker: &str, preamble: &str) -> std::io::Result<()> {
+        self.hashes.remove(marker);
+        self.names.retain(|n| n != marker);
+        let text = crate::marker::marker_text(preamble, &self.hashes);
+        self.add(marker, text.as_bytes())?;
+        self.commit(Some(marker))
     }
 
     /// Moves the staged files into place, `last` (the set's completion file, e.g. its
@@ -126,17 +145,27 @@ impl OutputSet {
         if let Some(l) = last.filter(|l| self.names.iter().any(|n| n == l)) {
             order.push(l.to_string());
         }
-        let list = order.join("\n") + "\n";
+        // The old set's files that the new one drops: only those its completion marker
+        // lists and that still have the listed hash (a file changed since is not ours).
+        let mut list = String::new();
+        if let Some(l) = last {
+            for name in dropped_files(&self.target, l, &self.names) {
+                list.push_str(REMOVE);
+                list.push_str(&name);
+                list.push('\n');
+            }
+        }
+        list.push_str(&(order.join("\n") + "\n"));
         let commit = self.stage.join(COMMIT);
         // An interrupt waits for the commit: it finds the set staged (and removes the
         // stage: the old set stays) or moved into place, never half moved.
         // If the COMMIT list cannot be written, `done` stays false and dropping the set
         // removes the stage.
         live::critical(|| {
-            std::fs::write(&commit, list)?;
+            std::fs::write(&commit, &list)?;
             std::fs::File::open(&commit)?.sync_all()?;
             self.done = true;
-            finish(&self.target, &self.stage, &order)
+            finish(&self.target, &self.stage, &list, kill_hook())
         })
     }
 
@@ -157,9 +186,60 @@ impl Drop for OutputSet {
     }
 }
 
-/// Step 3 of the protocol for a stage whose `COMMIT` list is `order`: files already moved
-/// are skipped, so this also completes an interrupted commit.
-fn finish(target: &Path, stage: &Path, order: &[String]) -> std::io::Result<()> {
+/// Prefix of a `COMMIT` line naming a file of the old set to remove (a staged name never
+/// holds `/`, so no name reads as one).
+const REMOVE: &str = "remove/";
+
+/// The files of the set completed by `target/marker` that are not in `keep`, still as the
+/// marker lists them (plain names whose bytes have the listed hash).
+fn dropped_files(target: &Path, marker: &str, keep: &[String]) -> Vec<String> {
+    let Ok(text) = crate::read_bounded_text(&target.join(marker), 1 << 20) else {
+        return Vec::new();
+    };
+    let Some(files) = crate::marker::marker_files(&text) else {
+        return Vec::new();
+    };
+    files
+        .into_iter()
+        .filter(|(name, hash)| {
+            !keep.contains(name)
+                && name.as_str() != marker
+                && !name.is_empty()
+                && !name.contains(['/', '\\'])
+                && !name.starts_with('.')
+                && crate::marker::hash_file(&target.join(name)).is_ok_and(|h| h == *hash)
+        })
+        .map(|(name, _)| name)
+        .collect()
+}
+
+/// Tests only: `TOFPROBE_TEST_KILL_AFTER_RENAMES=k` aborts the process (no handler, no
+/// destructor runs: a SIGKILL's effect) right after the k-th rename of a commit, so tests
+/// through the binary can stop a commit at every point.
+fn kill_hook() -> Option<usize> {
+    std::env::var("TOFPROBE_TEST_KILL_AFTER_RENAMES")
+        .ok()?
+        .parse()
+        .ok()
+}
+
+/// Step 3 of the protocol for a stage whose `COMMIT` list is `list`: files already moved
+/// or removed are skipped, so this also completes an interrupted commit.
+fn finish(
+    target: &Path,
+    stage: &Path,
+    list: &str,
+    kill_after: Option<usize>,
+) -> std::io::Result<()> {
+    let mut order: Vec<String> = Vec::new();
+    let mut removals: Vec<&str> = Vec::new();
+    for line in list.lines() {
+        match line.strip_prefix(REMOVE) {
+            Some(name) => removals.push(name),
+            None => order.push(line.to_string()),
+        }
+    }
+    let mut renamed = 0;
     if let Some(last) = order.last() {
         let staged_last = stage.join(last);
         if staged_last.exists() && order.len() > 1 {
@@ -169,10 +249,20 @@ fn finish(target: &Path, stage: &Path, order: &[String]) -> std::io::Result<()> 
             }
         }
     }
-    for name in order {
+    for name in removals {
+        match std::fs::remove_file(target.join(name)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
+            _ => {}
+        }
+    }
+    for name in &order {
         let from = stage.join(name);
         if from.exists() {
             std::fs::rename(&from, target.join(name))?;
+            renamed += 1;
+            if kill_after == Some(renamed) {
+                std::process::abort();
+            }
         }
     }
     std::fs::remove_dir_all(stage)
@@ -194,10 +284,7 @@ pub fn recover(target: &Path) -> std::io::Result<()> {
             }
             let stage = e.path();
             match std::fs::read_to_string(stage.join(COMMIT)) {
-                Ok(list) => {
-                    let order: Vec<String> = list.lines().map(str::to_string).collect();
-                    finish(target, &stage, &order)?;
-                }
+                Ok(list) => finish(target, &stage, &list, None)?,
                 Err(_) => {
                     let _ = std::fs::remove_dir_all(&stage);
                 }
@@ -233,6 +320,28 @@ mod tests {
         assert!(s.add("../escape", b"x").is_err());
         s.commit(Some("manifest.toml")).unwrap();
         assert_eq!(listing(&t), ["a.hex", "b.hex", "manifest.toml"]);
+    }
+
+    #[test]
+    fn a_shrinking_set_drops_only_the_old_markers_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let t = dir.path().join("out");
+        let mut s = OutputSet::begin(&t).unwrap();
+        for n in ["a.v", "rom.hex", "rom.toml", "mine.txt"] {
+            s.add(n, n.as_bytes()).unwrap();
+        }
+        s.commit_marked(crate::SET_MARKER, "# old").unwrap();
+        // The user edits one file of the old set and adds one of their own.
+        std::fs::write(t.join("mine.txt"), b"edited").unwrap();
+        std::fs::write(t.join("notes.md"), b"user").unwrap();
+        let mut s = OutputSet::begin(&t).unwrap();
+        s.add("a.v", b"new a").unwrap();
+        s.commit_marked(crate::SET_MARKER, "# new").unwrap();
+        assert_eq!(
+            listing(&t),
+            ["a.v", "mine.txt", "notes.md", crate::SET_MARKER]
+        );
+        assert_eq!(crate::check_set(&t, crate::SET_MARKER).unwrap(), ["a.v"]);
     }
 
     #[test]

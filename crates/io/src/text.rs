@@ -53,6 +53,47 @@ pub fn canonical_path(path: &Path) -> String {
     sanitize(&text)
 }
 
+/// A path as the user would type it from the working directory `cwd`, for a header's
+/// regeneration command: an absolute path is made relative to `cwd` (lexically: `/w/d`
+/// from `/w` is `d`, `/tmp/d` from `/w/x` is `../../tmp/d`), so `--out d` and `--out
+/// /w/d` give the same bytes and no machine's absolute path reaches a generated file; a
+/// relative path is kept relative; then [`canonical_path`].
+pub fn path_from(cwd: &Path, path: &Path) -> String {
+    if !path.is_absolute() || !cwd.is_absolute() {
+        return canonical_path(path);
+    }
+    let parts = |p: &Path| -> Vec<String> {
+        let mut v: Vec<String> = Vec::new();
+        for c in p.components() {
+            match c {
+                Component::Normal(n) => v.push(n.to_string_lossy().into_owned()),
+                Component::ParentDir => {
+                    v.pop();
+                }
+                _ => {}
+            }
+        }
+        v
+    };
+    let (a, b) = (parts(cwd), parts(path));
+    let common = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut rel: Vec<String> = vec!["..".to_string(); a.len() - common];
+    rel.extend(b[common..].iter().cloned());
+    canonical_path(Path::new(&rel.join("/")))
+}
+
+/// [`path_from`] the process's working directory (an absolute path when there is none
+/// is replaced by its file name alone: still never the machine's path).
+pub fn path_as_typed(path: &Path) -> String {
+    match std::env::current_dir() {
+        Ok(cwd) => path_from(&cwd, path),
+        Err(_) if path.is_absolute() => {
+            canonical_path(Path::new(path.file_name().unwrap_or_default()))
+        }
+        Err(_) => canonical_path(path),
+    }
+}
+
 /// `text` cut to at most `max` characters (with `...` when cut): what an error message
 /// echoes of a value, so a megabyte string does not become a megabyte message.
 pub fn clip(text: &str, max: usize) -> String {
@@ -97,6 +138,16 @@ mod tests {
         assert_eq!(canonical_path(Path::new("/tmp//a/./b/")), "/tmp/a/b");
         assert_eq!(canonical_path(Path::new("a/../b")), "a/../b");
         assert_eq!(canonical_path(Path::new("x\ny")), "x_y");
+    }
+
+    #[test]
+    fn absolute_paths_become_what_the_user_would_type() {
+        let w = Path::new("/w/x");
+        assert_eq!(path_from(w, Path::new("/w/x/d")), "d");
+        assert_eq!(path_from(w, Path::new("/w/x/d/")), "d");
+        assert_eq!(path_from(w, Path::new("d")), "d");
+        assert_eq!(path_from(w, Path::new("/tmp/d")), "../../tmp/d");
+        assert_eq!(path_from(w, Path::new("/w/x")), ".");
     }
 
     #[test]

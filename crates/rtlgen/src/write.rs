@@ -38,12 +38,23 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), RtlError> {
 }
 
 /// Writes generated files into `dir` as one set: every target is checked first (a foreign
-/// one refuses the whole set), then all are staged and moved into place together, the last
-/// of `files` (a vector set's `manifest.toml`) last, so a set without its last file is an
-/// interrupted one that the next write into `dir` completes ([`tofprobe_io::recover`]).
-/// On any error nothing of the new set is left behind.
+/// one refuses the whole set), then all are staged and moved into place together with a
+/// completion marker last ([`tofprobe_io::marker`]): the last of `files` when it is one (a
+/// vector set's `manifest.toml`, whose `[files]` table lists the others with their hashes),
+/// else [`tofprobe_io::SET_MARKER`] written here. A set without its marker is an interrupted
+/// one that every reader refuses ([`tofprobe_io::check_set`]) and the next write into `dir`
+/// completes ([`tofprobe_io::recover`]); files of the old set that the new one drops (a Haar
+/// set over a Fourier one) are removed in the same commit. On any error nothing of the new
+/// set is left behind.
 pub fn write_generated(dir: &Path, files: &[(String, String)]) -> Result<(), RtlError> {
-    for (name, _) in files {
+    let own_marker = files
+        .last()
+        .filter(|(_, c)| tofprobe_io::marker::marker_files(c).is_some())
+        .map(|(n, _)| n.clone());
+    let marker = own_marker
+        .clone()
+        .unwrap_or_else(|| tofprobe_io::SET_MARKER.to_string());
+    for name in files.iter().map(|(n, _)| n).chain(std::iter::once(&marker)) {
         let path = dir.join(name);
         if !is_ours_or_absent(&path)? {
             return Err(RtlError::Foreign { path });
@@ -54,6 +65,16 @@ pub fn write_generated(dir: &Path, files: &[(String, String)]) -> Result<(), Rtl
         set.add(name, contents.as_bytes())
             .map_err(|e| RtlError::io(dir.join(name), e))?;
     }
-    let last = files.last().map(|(n, _)| n.as_str());
-    set.commit(last).map_err(|e| RtlError::io(dir, e))
+    let committed = match own_marker {
+        Some(m) => set.commit(Some(&m)),
+        None => set.commit_marked(
+            &marker,
+            &format!(
+                "#{} {}: this set's completion marker (each file's FNV-1a-64), written last; check with `tofprobe check-set`.\n",
+                &HEADER_MARK[2..],
+                env!("CARGO_PKG_VERSION")
+            ),
+        ),
+    };
+    committed.map_err(|e| RtlError::io(dir, e))
 }

@@ -226,6 +226,10 @@ pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
     if let Some(n) = a.random {
         return run_random(a, n);
     }
+    if let Some(dir) = &a.rtl {
+        // A set killed mid-commit is refused; edited files are named (and co-simulated).
+        super::check_set::check_reader(dir)?;
+    }
     let (design, _) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
     // With --rtl, the chip `tofprobe rtl` renders for this configuration (the image in DIR
     // must be its ROM); else the chip the simulating commands replay.

@@ -2,6 +2,7 @@
 //! [`run`].
 
 pub mod bench;
+pub mod check_set;
 pub mod config;
 pub mod cosim;
 pub mod flow;
@@ -47,6 +48,8 @@ pub enum Command {
     Flow(flow::FlowArgs),
     /// The speed/accuracy trade: every fidelity level timed and scored per scene.
     Tradeoff(tradeoff::TradeoffArgs),
+    /// Check that a directory holds a whole output set (rtl, vectors, reproduce, flow).
+    CheckSet(check_set::CheckSetArgs),
 }
 
 /// The simulating RTL commands' start (`vectors`, `cosim`): `frames` checked (1..=1000),
@@ -99,5 +102,6 @@ pub fn run(command: Command) -> Result<Verdict, CliError> {
         Command::Cosim(a) => cosim::run(&a),
         Command::Flow(a) => flow::run(&a),
         Command::Tradeoff(a) => done(tradeoff::run(&a)),
+        Command::CheckSet(a) => done(check_set::run(&a)),
     }
 }

@@ -40,11 +40,13 @@ pub struct RtlArgs {
     pub core_testbench: Option<PathBuf>,
 }
 
-/// The command line that regenerates `out` (recorded in every header): paths in their
-/// canonical, sanitised form (`tofprobe_io::text::canonical_path`), so no text of the
-/// command line reaches a header raw and `X` and `./X/` give the same bytes.
+/// The command line that regenerates `out` (recorded in every header): paths as the user
+/// would type them from the working directory, canonical and sanitised
+/// (`tofprobe_io::text::path_as_typed`), so no text of the command line reaches a header
+/// raw, `X`, `./X/` and `/abs/X` give the same bytes, and no machine's absolute path is
+/// recorded.
 pub fn regen_command(a: &RtlArgs) -> String {
-    use tofprobe_io::text::canonical_path;
+    use tofprobe_io::text::path_as_typed as canonical_path;
     let mut s = String::from("tofprobe rtl");
     if let Some(c) = &a.config {
         s.push_str(&format!(" {}", canonical_path(c)));

@@ -100,6 +100,15 @@ fn mismatched_rtl_is_refused_naming_the_parameter() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("= 10000000"));
     // A one-bit ROM edit (manifest removed, so only the comparison can catch it).
     std::fs::remove_file(Path::new(rtl).join("tofprobe_probe_rom.toml")).expect("rm");
+    // The set's marker lists the manifest: without that line the set is still whole (a
+    // listed file missing is an interrupted set, refused before anything runs).
+    let marker = Path::new(rtl).join("tofprobe-set.toml");
+    let listed = std::fs::read_to_string(&marker).expect("marker");
+    let kept: Vec<&str> = listed
+        .lines()
+        .filter(|l| !l.starts_with("\"tofprobe_probe_rom.toml\""))
+        .collect();
+    std::fs::write(&marker, kept.join("\n") + "\n").expect("marker");
     let hex = Path::new(rtl).join("tofprobe_probe_rom.hex");
     let text = std::fs::read_to_string(&hex).expect("hex");
     let first_data = text

@@ -4,7 +4,8 @@
 //! run exits 0 or 2 within a time limit, prints no panic, and a refusal names a key of the
 //! document together with the value given (or, for a cross-field refusal, another key of
 //! the document by its dotted path). Deterministic: a fixed seed walks the same cases.
-//! `TOFPROBE_BINARY_MUTATIONS=N` runs N cases.
+//! `TOFPROBE_BINARY_MUTATIONS=N` runs N cases. Half the mutations draw the newer keys with
+//! their real types ([`TYPED`]: strings, `"auto"`, paths, lists, `[array]`).
 
 use crate::common;
 
@@ -112,8 +113,64 @@ const VALUES: &[&str] = &[
     "\"periodic\"",
 ];
 
+/// The newer keys with values of their real types (strings, `"auto"`, paths, lists) beside
+/// wrong ones: half of the mutations draw from here, so a key whose type the error table
+/// forgets, or a string key blamed for another key's fault, shows up (issue 31).
+const TYPED: &[(&str, &str, &[&str])] = &[
+    ("pixel", "adders", &["\"auto\"", "\"AUTO\"", "1", "4"]),
+    (
+        "pixel",
+        "register_file",
+        &["\"flops\"", "\"clock_gated\"", "\"latch\"", "1"],
+    ),
+    (
+        "pixel",
+        "prefilter_rounding",
+        &["\"floor\"", "\"nearest\"", "\"up\"", "0"],
+    ),
+    (
+        "pixel",
+        "timing_liberty",
+        &[
+            "\"osu018\"",
+            "\"sky130\"",
+            "\"/dev/zero\"",
+            "\"/nonexistent/x.lib\"",
+            "\"\"",
+            "130",
+        ],
+    ),
+    (
+        "pixel",
+        "register_frac_bits",
+        &["0", "4", "8", "64", "\"auto\""],
+    ),
+    ("pixel", "haar_scales", &["0", "4", "6", "31", "\"auto\""]),
+    (
+        "pixel",
+        "frequencies_hz",
+        &["[4500.0]", "[0.0]", "[-1.0]", "[4500.0, 4500.0]", "[\"x\"]"],
+    ),
+    (
+        "pixel",
+        "mode",
+        &["\"auto\"", "\"haar\"", "\"fourier\"", "\"x\""],
+    ),
+    ("array", "rows", &["1", "2", "0", "4097", "-1", "\"2\""]),
+    ("array", "cols", &["1", "3", "0", "4097", "1.5"]),
+    (
+        "array",
+        "pitch_um",
+        &["30.0", "0.0", "-1.0", "nan", "\"x\""],
+    ),
+    ("array", "mm_per_pixel", &["1.0", "0.0", "1e300", "inf"]),
+    ("array", "field_of_view_deg", &["30.0", "0.0", "180.0"]),
+    ("array", "distance_mm", &["1000.0", "0.0", "-5.0"]),
+];
+
 /// The short windowed frame (N = 4096, B = 4; fast through `simulate`) with one to three
-/// keys set from [`VALUES`]; the text and the mutations (key, literal).
+/// keys set from [`VALUES`] or [`TYPED`]; the text and the mutations (key, literal). A
+/// mutation of `[array]` starts from a valid 2 × 2 array.
 fn mutate(rng: &mut Rng) -> (String, Vec<(String, String)>) {
     let base = edit(
         default_text(),
@@ -127,14 +184,27 @@ fn mutate(rng: &mut Rng) -> (String, Vec<(String, String)>) {
     let mut doc: toml::Table = toml::from_str(&base).unwrap();
     let mut muts = Vec::new();
     for _ in 0..1 + rng.next() % 3 {
-        let (table, keys) = rng.pick(KEYS);
-        let key = rng.pick(keys).to_string();
-        let lit = rng.pick(VALUES).to_string();
+        let (table, key, lit) = if rng.next().is_multiple_of(2) {
+            let (table, keys) = rng.pick(KEYS);
+            (
+                *table,
+                rng.pick(keys).to_string(),
+                rng.pick(VALUES).to_string(),
+            )
+        } else {
+            let (table, key, values) = rng.pick(TYPED);
+            (*table, key.to_string(), rng.pick(values).to_string())
+        };
+        if table == "array" && !doc.contains_key("array") {
+            let array: toml::Table =
+                toml::from_str("rows = 2\ncols = 2\npitch_um = 30.0\nmm_per_pixel = 1.0").unwrap();
+            doc.insert("array".into(), toml::Value::Table(array));
+        }
         let value = toml::from_str::<toml::Table>(&format!("v = {lit}"))
             .unwrap()
             .remove("v")
             .unwrap();
-        let target = if *table == "motion" {
+        let target = if table == "motion" {
             let scene = doc.get_mut("scene").unwrap().as_table_mut().unwrap();
             scene.get_mut("motion").unwrap().as_array_mut().unwrap()[0]
                 .as_table_mut()
@@ -189,9 +259,12 @@ fn dotted_paths(doc: &toml::Table) -> Vec<String> {
 /// Runs the binary with a time limit; (exit code, stderr). A run past the limit is killed
 /// and reported as a hang.
 fn run(args: &[&str], cfg: &Path, limit: Duration) -> Result<(Option<i32>, String), String> {
+    // No EDA tool on the PATH: `rtl` with `adders = "auto"` is refused at once (naming
+    // pixel.adders and the missing tool) instead of synthesising for minutes per case.
     let mut child = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
         .args(args)
         .arg(cfg)
+        .env("PATH", "")
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()

@@ -106,6 +106,7 @@ pub fn check(
     design: &ResolvedDesign,
     req: &OptionsRequest,
 ) -> Result<Vec<ArchOption>, ExperimentError> {
+    require_fourier(design)?;
     if !(req.target_error_um.is_finite() && req.target_error_um > 0.0) {
         return Err(ExperimentError::option(
             "target-error-um",
@@ -136,6 +137,26 @@ pub fn check(
         &only,
     )
     .map_err(|e| ExperimentError::option("option", only.join(","), &e))
+}
+
+/// The study measures each option's tone error against the float DFT: a Fourier pixel's.
+/// A Haar design is refused before anything runs, naming `pixel.mode` (it used to run for
+/// minutes and then blame an `--option` the user never gave).
+pub fn require_fourier(design: &ResolvedDesign) -> Result<(), ExperimentError> {
+    if design.pixel.mode == tofprobe_pixel::Mode::Fourier {
+        return Ok(());
+    }
+    Err(tofprobe_design::DesignError::pixel(
+        &design.origin,
+        tofprobe_pixel::PixelError::invalid(
+            "mode",
+            "\"haar\"",
+            "the architecture options study (size --options, flow --recommended) compares \
+             the tone errors of Fourier pixels; a Haar pixel has no tones to compare",
+            "pixel.mode = \"fourier\", or size / flow without --options / --recommended",
+        ),
+    )
+    .into())
 }
 
 /// Runs the study on `design`.
