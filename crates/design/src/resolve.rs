@@ -54,9 +54,7 @@ pub struct ResolvedDesign {
 /// Reads `path` (or the embedded default) and resolves it.
 pub fn load(path: Option<&Path>) -> Result<ResolvedDesign, DesignError> {
     let (document, origin) = Document::read(path)?;
-    let design = resolve(document, &origin)?;
-    design.warn_ignored();
-    Ok(design)
+    resolve(document, &origin)
 }
 
 /// Resolves a document; `origin` names it in every error. Pure: no tool runs
@@ -313,15 +311,12 @@ fn derived_from(e: PixelError, d: &Document) -> PixelError {
 }
 
 impl ResolvedDesign {
-    /// Prints on stderr, as `warning: …`, what the document sets that this design ignores
-    /// (a `[probe]` section in Haar mode): the file-loading entries ([`load`] and the
-    /// hardware commands' `tofprobe_flow::adders::load`) call it once per command.
-    pub fn warn_ignored(&self) {
-        if let Some(w) =
-            crate::analysis_mode::ignored_probe_warning(&self.document, self.pixel.mode)
-        {
-            eprintln!("warning: {}: {w}", self.origin);
-        }
+    /// What the document sets that this design ignores (a `[probe]` section in Haar
+    /// mode), as `ORIGIN: …`: the front ends show it (the CLI on stderr as `warning: …`,
+    /// Python as a `UserWarning`); the library only decides it.
+    pub fn ignored_warning(&self) -> Option<String> {
+        crate::analysis_mode::ignored_probe_warning(&self.document, self.pixel.mode)
+            .map(|w| format!("{}: {w}", self.origin))
     }
 
     /// The document with a decided `adders = "auto"` written out as the chosen A and C, so

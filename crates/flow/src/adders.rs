@@ -28,9 +28,7 @@ use crate::error::FlowError;
 /// "auto"` is decided by synthesis and static timing (cached).
 pub fn load(path: Option<&Path>) -> Result<ResolvedDesign, FlowError> {
     let (document, origin) = Document::read(path)?;
-    let design = resolve(document, &origin, &mut ProbeCache::default())?;
-    design.warn_ignored();
-    Ok(design)
+    resolve(document, &origin, &mut ProbeCache::default())
 }
 
 /// [`load`] for a document in hand.

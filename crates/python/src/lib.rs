@@ -67,12 +67,24 @@ impl Design {
 
     /// The one resolution of TOML text, without the GIL (it designs the ΣΔ modulator).
     fn resolve(py: Python<'_>, text: &str, origin: &str) -> PyResult<Self> {
-        py.detach(|| {
-            let doc = Document::from_toml_str(text, origin)?;
-            tofprobe_design::resolve(doc, origin)
-        })
-        .map(Design::new)
-        .map_err(value_error)
+        let inner = py
+            .detach(|| {
+                let doc = Document::from_toml_str(text, origin)?;
+                tofprobe_design::resolve(doc, origin)
+            })
+            .map_err(value_error)?;
+        Design::loaded(py, inner)
+    }
+
+    /// A resolved design, with what it ignores (`ignored_warning`: a `[probe]` in Haar
+    /// mode) shown as a Python `UserWarning`, as the CLI shows it on stderr.
+    fn loaded(py: Python<'_>, inner: ResolvedDesign) -> PyResult<Self> {
+        if let Some(w) = inner.ignored_warning() {
+            let message = std::ffi::CString::new(w.replace('\0', " ")).map_err(value_error)?;
+            let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+            PyErr::warn(py, &category, &message, 1)?;
+        }
+        Ok(Design::new(inner))
     }
 
     /// The probe ROM (`None` in Haar mode), generated once without the GIL.
@@ -126,9 +138,10 @@ impl Design {
             }
         }
         let path: PathBuf = source.extract()?;
-        py.detach(|| tofprobe_design::load(Some(&path)))
-            .map(Design::new)
-            .map_err(value_error)
+        let inner = py
+            .detach(|| tofprobe_design::load(Some(&path)))
+            .map_err(value_error)?;
+        Design::loaded(py, inner)
     }
 
     /// A design from a dict shaped like the TOML document (``{"sensor": {...}, "scene":

@@ -33,9 +33,9 @@ pub fn run(args: &ConfigArgs) -> Result<(), CliError> {
         return Ok(());
     }
     let design = if args.time_adders {
-        tofprobe_flow::adders::load(args.config.as_deref())?
+        crate::commands::load_for_hardware(args.config.as_deref())?
     } else {
-        tofprobe_design::load(args.config.as_deref())?
+        crate::commands::load_design(args.config.as_deref())?
     };
     let c = &design.document;
     println!(

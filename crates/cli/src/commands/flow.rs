@@ -61,7 +61,7 @@ pub fn run(a: &FlowArgs) -> Result<super::Verdict, CliError> {
     if a.frames == 0 || a.frames > 100 {
         return Err(CliError::option("frames", a.frames.to_string(), "1..=100"));
     }
-    let mut design = tofprobe_flow::adders::load(a.config.as_deref())?;
+    let mut design = crate::commands::load_for_hardware(a.config.as_deref())?;
     design.single_pixel("flow")?;
     let options = if a.recommended {
         let (chosen, report) =

@@ -52,6 +52,33 @@ pub enum Command {
     CheckSet(check_set::CheckSetArgs),
 }
 
+/// Shows what a design ignores (`ResolvedDesign::ignored_warning`) on stderr: the CLI's
+/// one place for it, so every command that loads a file warns alike.
+fn warn_ignored(design: &tofprobe_design::ResolvedDesign) {
+    if let Some(w) = design.ignored_warning() {
+        eprintln!("warning: {w}");
+    }
+}
+
+/// `tofprobe_design::load` (the pure resolution) with its warning shown.
+pub fn load_design(
+    path: Option<&std::path::Path>,
+) -> Result<tofprobe_design::ResolvedDesign, tofprobe_design::DesignError> {
+    let design = tofprobe_design::load(path)?;
+    warn_ignored(&design);
+    Ok(design)
+}
+
+/// `tofprobe_flow::adders::load` (the resolution with `adders = "auto"` decided) with its
+/// warning shown.
+pub fn load_for_hardware(
+    path: Option<&std::path::Path>,
+) -> Result<tofprobe_design::ResolvedDesign, tofprobe_flow::FlowError> {
+    let design = tofprobe_flow::adders::load(path)?;
+    warn_ignored(&design);
+    Ok(design)
+}
+
 /// The simulating RTL commands' start (`vectors`, `cosim`): `frames` checked (1..=1000),
 /// the configuration resolved, the generator's parameters for the overrides.
 pub fn simulated_design(
@@ -62,7 +89,7 @@ pub fn simulated_design(
     if frames == 0 || frames > 1000 {
         return Err(CliError::option("frames", frames, "1..=1000"));
     }
-    let design = tofprobe_flow::adders::load(config)?;
+    let design = crate::commands::load_for_hardware(config)?;
     design.single_pixel("vectors and cosim")?;
     let p = tofprobe_design::rtl_params(&design, overrides)?;
     Ok((design, p))

@@ -47,7 +47,7 @@ pub fn run(a: &ReplayArgs) -> Result<(), CliError> {
     }
     let design = match &a.config {
         Some(c) => {
-            let d = tofprobe_design::load(Some(c))?;
+            let d = crate::commands::load_design(Some(c))?;
             d.single_pixel("replay")?;
             Some(d)
         }

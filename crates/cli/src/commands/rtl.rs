@@ -70,7 +70,7 @@ pub fn regen_command(a: &RtlArgs) -> String {
 
 /// Runs `tofprobe rtl`.
 pub fn run(a: &RtlArgs) -> Result<(), CliError> {
-    let design = tofprobe_flow::adders::load(a.config.as_deref())?;
+    let design = crate::commands::load_for_hardware(a.config.as_deref())?;
     design.single_pixel("rtl")?;
     let overrides = RtlOverrides {
         frame_pulses: a.frame_pulses,

@@ -40,7 +40,7 @@ pub struct SimulateArgs {
 
 /// Runs the command.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
-    let design = tofprobe_design::load(args.config.as_deref())?;
+    let design = crate::commands::load_design(args.config.as_deref())?;
     if design.array.is_some() {
         return run_array(args, &design);
     }

@@ -85,7 +85,7 @@ pub struct FullReport {
 
 /// Builds the report for the arguments (no printing).
 pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
-    let design = tofprobe_flow::adders::load(a.config.as_deref())?;
+    let design = crate::commands::load_for_hardware(a.config.as_deref())?;
     design.single_pixel("size")?;
     let options = size_options(a);
     let req = if a.options {

@@ -91,7 +91,7 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     let mut skip_reports = Vec::new();
     let mut tables = Vec::new();
     for p in paths {
-        let design = tofprobe_flow::adders::load(p)?;
+        let design = crate::commands::load_for_hardware(p)?;
         design.single_pixel("tradeoff")?;
         if design.pixel.mode == tofprobe_pixel::Mode::Haar {
             let h = measure_haar(&design, args.verilator)?;

@@ -30,7 +30,7 @@ pub struct ArrayBenchArgs {
 
 /// Runs the benchmark.
 pub fn run(args: &ArrayBenchArgs) -> Result<(), CliError> {
-    let base = tofprobe_design::load(args.config.as_deref())?;
+    let base = crate::commands::load_design(args.config.as_deref())?;
     let report = tofprobe_bench::array::measure(&base, args.rows, args.cols, &args.pulses)?;
     if args.json {
         println!("{}", serde_json::to_string(&report)?);

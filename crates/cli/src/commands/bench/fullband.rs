@@ -47,7 +47,7 @@ pub struct FullBandArgs {
 
 /// Runs the benchmark.
 pub fn run(args: &FullBandArgs) -> Result<(), CliError> {
-    let loaded = tofprobe_design::load(args.config.as_deref())?;
+    let loaded = crate::commands::load_design(args.config.as_deref())?;
     loaded.single_pixel("bench fullband")?;
     let precision = match args.precision.as_str() {
         "f32" => LanePrecision::F32,

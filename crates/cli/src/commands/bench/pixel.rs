@@ -91,7 +91,7 @@ fn vs_verilator(args: &PixelBenchArgs, pulses: u64) -> Result<VsVerilator, CliEr
 
 /// Runs the benchmark.
 pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
-    let design = tofprobe_design::load(args.config.as_deref())?;
+    let design = crate::commands::load_design(args.config.as_deref())?;
     design.single_pixel("bench pixel")?;
     let report = tofprobe_bench::pixel::measure(&design, args.pulses, args.cycle_pulses)?;
     let verilator = if args.verilator {

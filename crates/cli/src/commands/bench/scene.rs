@@ -24,7 +24,7 @@ pub struct SceneBenchArgs {
 
 /// Runs the benchmark.
 pub fn run(args: &SceneBenchArgs) -> Result<(), CliError> {
-    let design = tofprobe_design::load(args.config.as_deref())?;
+    let design = crate::commands::load_design(args.config.as_deref())?;
     design.single_pixel("bench scene")?;
     let report = tofprobe_bench::scene::measure(&design.document, args.pulses)?;
     if args.json {
