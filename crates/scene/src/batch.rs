@@ -12,7 +12,7 @@
 //!   sub-blocks of [`SUB`] pulses from a table of (cos kΔ, sin kΔ) (no serial recurrence
 //!   per pulse); other motions use the scene's own evaluation.
 //! - **Laws**: signal with probability ρ_s at δ/c·2 + σ_I·z; background first arrival
-//!   −ln(u)·W/ρ_b with u ∈ (0, 1], inside the window iff u > e^(−ρ_b); earliest in-window
+//!   −ln(u)·W/ρ_b with u ∈ (0, 1] (52 bits), inside the window iff u > e^(−ρ_b); earliest in-window
 //!   arrival wins; code = ⌊t / lsb⌋ (computed in code units, ≤ 1 ulp from the division).
 //!   Every pulse draws its words whether or not it uses them: no per-pulse branches.
 
@@ -49,25 +49,30 @@ impl Lanes {
     }
 
     /// Fills `out` (a multiple of `LANES` long) with the streams' next words.
+    #[inline(always)]
     fn fill(&mut self, out: &mut [u64]) {
         let [mut s0, mut s1, mut s2, mut s3] = self.s;
         for chunk in out.chunks_exact_mut(LANES) {
             for l in 0..LANES {
-                chunk[l] = s0[l]
-                    .wrapping_add(s3[l])
-                    .rotate_left(23)
-                    .wrapping_add(s0[l]);
+                chunk[l] = rotl(s0[l].wrapping_add(s3[l]), 23).wrapping_add(s0[l]);
                 let t = s1[l] << 17;
                 s2[l] ^= s0[l];
                 s3[l] ^= s1[l];
                 s1[l] ^= s2[l];
                 s0[l] ^= s3[l];
                 s2[l] ^= t;
-                s3[l] = s3[l].rotate_left(45);
+                s3[l] = rotl(s3[l], 45);
             }
         }
         self.s = [s0, s1, s2, s3];
     }
+}
+
+/// x rotated left by k, as two shifts and an or: AVX2 has no 64-bit rotate, and LLVM's
+/// rotate of a vector is lowered lane by lane there.
+#[inline(always)]
+fn rotl(x: u64, k: u32) -> u64 {
+    (x << k) | (x >> (64 - k))
 }
 
 /// A sine motion's per-sub-block tables.
@@ -121,6 +126,7 @@ impl Depths {
     }
 
     /// δ (mm) of pulses `first_pulse ..` into `out`.
+    #[inline(always)]
     fn fill(&self, scene: &Scene, first_pulse: u64, period_s: f64, out: &mut [f64]) {
         let Some(sines) = &self.sines else {
             scene.fill_depths_mm(first_pulse, period_s, out);
@@ -207,8 +213,48 @@ mod tests {
     }
 }
 
-/// Generates pulses 0 .. n of a block (n ≤ the block length) into `sc.best` / `sc.from_bg`.
+/// Generates pulses 0 .. n of a block (n ≤ the block length) into `sc.best` / `sc.from_bg`:
+/// the AVX2 copy of the kernel where the CPU has it (the same IEEE operations, no fused
+/// multiply-adds: bit-identical to the baseline copy), the baseline copy elsewhere.
 pub(crate) fn generate(
+    p: &Params,
+    scene: &Scene,
+    depths: &Depths,
+    block_seed: u64,
+    first_pulse: u64,
+    n: usize,
+    sc: &mut Scratch,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked on the line above), the one requirement of
+        // `generate_avx2`; the workspace's second allowed unsafe call (see Cargo.toml).
+        #[allow(unsafe_code)]
+        unsafe {
+            generate_avx2(p, scene, depths, block_seed, first_pulse, n, sc);
+        }
+        return;
+    }
+    generate_body(p, scene, depths, block_seed, first_pulse, n, sc);
+}
+
+/// [`generate_body`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn generate_avx2(
+    p: &Params,
+    scene: &Scene,
+    depths: &Depths,
+    block_seed: u64,
+    first_pulse: u64,
+    n: usize,
+    sc: &mut Scratch,
+) {
+    generate_body(p, scene, depths, block_seed, first_pulse, n, sc);
+}
+
+#[inline(always)]
+fn generate_body(
     p: &Params,
     scene: &Scene,
     depths: &Depths,
@@ -251,11 +297,14 @@ pub(crate) fn generate(
     }
     if p.signal_rate < 1.0 {
         signal.fill(&mut sc.words);
-        let thr = p.signal_threshold;
+        // Both sides < 2^53: the signed compare (the one AVX2 has) is exact.
+        let thr = p.signal_threshold.min(1 << 53) as i64;
         for (b, &w) in sc.best.iter_mut().zip(&sc.words) {
-            if (w >> 11) >= thr {
-                *b = f64::INFINITY;
-            }
+            *b = if ((w >> 11) as i64) < thr {
+                *b
+            } else {
+                f64::INFINITY
+            };
         }
     }
     sc.from_bg.fill(false);
@@ -264,7 +313,9 @@ pub(crate) fn generate(
         let scale = len / p.background_rate;
         let nb = p.no_background;
         for ((b, bg), &w) in sc.best.iter_mut().zip(sc.from_bg.iter_mut()).zip(&sc.words) {
-            let u = ((w >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64);
+            // u ∈ (0, 1] on the 2^−52 grid, by the exponent trick (no integer-to-float
+            // conversion, which AVX2 lacks for 64-bit lanes).
+            let u = 2.0 - f64::from_bits((w >> 12) | 0x3FF0_0000_0000_0000);
             let tb = -ln(u) * scale;
             let wins = u > nb && tb < *b;
             *b = if wins { tb } else { *b };
@@ -314,15 +365,13 @@ pub(crate) fn codes(
 ) -> (u64, u64) {
     let mut detections = 0u64;
     let mut wins = 0u64;
+    let last_f = f64::from(last);
     for ((o, &b), &g) in out.iter_mut().zip(best).zip(from_bg) {
-        // b ∈ [0, length) when hit (length ≤ 2^16 codes), ∞ otherwise: i32 holds both.
-        let c = b as i32;
-        let hit = c != i32::MAX;
-        *o = if hit {
-            Some((c as u32).min(last))
-        } else {
-            None
-        };
+        // b ∈ [0, length) when hit, ∞ otherwise; the clamp is a float min (an integer min
+        // compiles to a branch that a 50 % detection rate would mispredict).
+        let hit = b < f64::INFINITY;
+        let c = b.min(last_f) as u32;
+        *o = [None, Some(c)][usize::from(hit)];
         detections += u64::from(hit);
         wins += u64::from(g);
     }
