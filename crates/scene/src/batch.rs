@@ -72,7 +72,7 @@ impl Lanes {
 /// rotate of a vector is lowered lane by lane there.
 #[inline(always)]
 fn rotl(x: u64, k: u32) -> u64 {
-    (x << k) | (x >> (64 - k))
+    (x << k) ^ (x >> (64 - k))
 }
 
 /// A sine motion's per-sub-block tables.
@@ -178,6 +178,7 @@ pub(crate) struct Scratch {
     depth: Vec<f64>,
     z: Vec<f64>,
     words: Vec<u64>,
+    flags: Vec<u8>,
     rejects: Vec<u32>,
     /// The earliest in-window arrival of each pulse, code units (∞ when none).
     pub best: Vec<f64>,
@@ -187,6 +188,75 @@ pub(crate) struct Scratch {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::{SceneConfig, SensorConfig};
+
+    /// The dispatched copy (AVX-512 or AVX2 where the CPU has them) and the baseline copy
+    /// give the same codes, detections and background wins, bit for bit, on a moving
+    /// scene at mixed rates (a reordered or fused operation would move some codes).
+    #[test]
+    fn every_copy_of_the_kernel_is_bit_identical() {
+        let scene = Scene::new(&SceneConfig {
+            depth_mm: 30.0,
+            motions: vec![MotionConfig::Sine {
+                amplitude_mm: 5.0,
+                frequency_hz: 4500.0,
+                phase_deg: 10.0,
+            }],
+        })
+        .expect("valid");
+        let sensor = SensorConfig {
+            laser_rate_hz: 10e6,
+            jitter_ps: 50.0,
+            tdc_lsb_ps: 5.0,
+            window_start_ps: 0.0,
+            window_length_ps: 400.0,
+            signal_rate: 0.7,
+            background_rate: 0.4,
+        };
+        let lsb = sensor.tdc_lsb_ps;
+        let p = Params {
+            period_s: 1e-7,
+            code_per_mm: 1.0 / (crate::MM_PER_PS * lsb),
+            start: 0.0,
+            length: 400.0 / lsb,
+            sigma: 50.0 / lsb,
+            signal_threshold: (0.7 * (1u64 << 53) as f64) as u64,
+            signal_rate: 0.7,
+            background_rate: 0.4,
+            no_background: (-0.4f64).exp(),
+        };
+        let depths = Depths::new(&scene, p.period_s);
+        for block in 0..8u64 {
+            let (mut a, mut b) = (vec![None; 4096], vec![None; 4096]);
+            let (mut sa, mut sb) = (Scratch::default(), Scratch::default());
+            let first = block * 4096;
+            let ca = generate(
+                &p,
+                &scene,
+                &depths,
+                block,
+                first,
+                4096,
+                &mut sa,
+                (0, 79, &mut a),
+            );
+            let cb = generate_body(
+                &p,
+                &scene,
+                &depths,
+                block,
+                first,
+                4096,
+                &mut sb,
+                (0, 79, &mut b),
+            );
+            assert_eq!(ca, cb, "block {block}");
+            assert_eq!(a, b, "block {block}");
+            assert!(ca.0 > 3000 && ca.1 > 500, "block {block}: {ca:?}");
+        }
+    }
+
     /// The branch-free ln against the platform's over (0, 1]: within 2 ulps everywhere
     /// tried (a wrong fdlibm coefficient shows at ~1e-10).
     #[test]
@@ -213,7 +283,9 @@ mod tests {
     }
 }
 
-/// Generates pulses 0 .. n of a block (n ≤ the block length) into `sc.best` / `sc.from_bg`:
+/// Generates pulses 0 .. n of a block (n ≤ the block length) into `sc.best` / `sc.from_bg`,
+/// and writes pulses `offset .. offset + out.len()` of them as codes into `out` (returns
+/// its detections and background wins):
 /// the AVX2 copy of the kernel where the CPU has it (the same IEEE operations, no fused
 /// multiply-adds: bit-identical to the baseline copy), the baseline copy elsewhere.
 pub(crate) fn generate(
@@ -224,18 +296,83 @@ pub(crate) fn generate(
     first_pulse: u64,
     n: usize,
     sc: &mut Scratch,
-) {
+    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+) -> (u64, u64) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+    {
+        // SAFETY: the CPU has the three features (checked above), the one requirement
+        // of `generate_avx512`.
+        #[allow(unsafe_code)]
+        unsafe {
+            return generate_avx512(
+                p,
+                scene,
+                depths,
+                block_seed,
+                first_pulse,
+                n,
+                sc,
+                (offset, last, out),
+            );
+        }
+    }
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (checked on the line above), the one requirement of
         // `generate_avx2`; the workspace's second allowed unsafe call (see Cargo.toml).
         #[allow(unsafe_code)]
         unsafe {
-            generate_avx2(p, scene, depths, block_seed, first_pulse, n, sc);
+            return generate_avx2(
+                p,
+                scene,
+                depths,
+                block_seed,
+                first_pulse,
+                n,
+                sc,
+                (offset, last, out),
+            );
         }
-        return;
     }
-    generate_body(p, scene, depths, block_seed, first_pulse, n, sc);
+    generate_body(
+        p,
+        scene,
+        depths,
+        block_seed,
+        first_pulse,
+        n,
+        sc,
+        (offset, last, out),
+    )
+}
+
+/// [`generate_body`] compiled for AVX-512 (64-bit rotates, gathers and integer-to-float
+/// conversions in vectors).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq")]
+fn generate_avx512(
+    p: &Params,
+    scene: &Scene,
+    depths: &Depths,
+    block_seed: u64,
+    first_pulse: u64,
+    n: usize,
+    sc: &mut Scratch,
+    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+) -> (u64, u64) {
+    generate_body(
+        p,
+        scene,
+        depths,
+        block_seed,
+        first_pulse,
+        n,
+        sc,
+        (offset, last, out),
+    )
 }
 
 /// [`generate_body`] compiled for AVX2.
@@ -249,8 +386,18 @@ fn generate_avx2(
     first_pulse: u64,
     n: usize,
     sc: &mut Scratch,
-) {
-    generate_body(p, scene, depths, block_seed, first_pulse, n, sc);
+    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+) -> (u64, u64) {
+    generate_body(
+        p,
+        scene,
+        depths,
+        block_seed,
+        first_pulse,
+        n,
+        sc,
+        (offset, last, out),
+    )
 }
 
 #[inline(always)]
@@ -262,7 +409,8 @@ fn generate_body(
     first_pulse: u64,
     n: usize,
     sc: &mut Scratch,
-) {
+    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+) -> (u64, u64) {
     let padded = n.div_ceil(LANES) * LANES;
     sc.depth.resize(padded, 0.0);
     sc.z.resize(padded, 0.0);
@@ -280,7 +428,7 @@ fn generate_body(
 
     let t: &Tables = tables();
     jitter.fill(&mut sc.words);
-    fast_pass(t, &sc.words, &mut sc.z, &mut sc.rejects);
+    fast_pass(t, &sc.words, &mut sc.z, &mut sc.flags, &mut sc.rejects);
     for &k in &sc.rejects {
         sc.z[k as usize] = finish(t, sc.words[k as usize], &mut slow);
     }
@@ -322,6 +470,8 @@ fn generate_body(
             *bg = wins;
         }
     }
+    let r = offset..offset + out.len();
+    codes(&sc.best[r.clone()], &sc.from_bg[r], last, out)
 }
 
 /// ln(u) for u ∈ [2^−53, 1] (normal, positive), branch-free so a batch vectorises: the
@@ -355,14 +505,10 @@ pub(crate) fn ln(u: f64) -> f64 {
     k * LN2_HI - ((hfsq - (s * (hfsq + r) + k * LN2_LO)) - f)
 }
 
-/// Writes `best[range]` as TDC codes into `out` (`None` outside the window); returns the
+/// Writes `best` as TDC codes into `out` (`None` outside the window); returns the
 /// detections and the background wins among them.
-pub(crate) fn codes(
-    best: &[f64],
-    from_bg: &[bool],
-    last: u32,
-    out: &mut [Option<u32>],
-) -> (u64, u64) {
+#[inline(always)]
+fn codes(best: &[f64], from_bg: &[bool], last: u32, out: &mut [Option<u32>]) -> (u64, u64) {
     let mut detections = 0u64;
     let mut wins = 0u64;
     let last_f = f64::from(last);

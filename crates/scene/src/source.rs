@@ -166,7 +166,7 @@ impl PhotonSource {
             let take = (BLOCK_PULSES - offset).min(out.len() - done);
             // A request starting mid-block regenerates the block's prefix: the result does
             // not depend on where chunks start.
-            batch::generate(
+            let (d, w) = batch::generate(
                 &self.params,
                 &self.scene,
                 &self.depths,
@@ -174,13 +174,7 @@ impl PhotonSource {
                 block * BLOCK_PULSES as u64,
                 offset + take,
                 &mut sc,
-            );
-            let r = offset..offset + take;
-            let (d, w) = batch::codes(
-                &sc.best[r.clone()],
-                &sc.from_bg[r],
-                last,
-                &mut out[done..done + take],
+                (offset, last, &mut out[done..done + take]),
             );
             counts += FillCounts {
                 detections: d,
