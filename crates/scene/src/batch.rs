@@ -172,6 +172,14 @@ pub(crate) struct Params {
     pub no_background: f64,
 }
 
+/// The block to generate: its streams' seed, its first pulse, and how many of its pulses.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Block {
+    pub seed: u64,
+    pub first_pulse: u64,
+    pub n: usize,
+}
+
 /// Per-thread scratch of one block.
 #[derive(Debug, Default)]
 pub(crate) struct Scratch {
@@ -230,27 +238,13 @@ mod tests {
         for block in 0..8u64 {
             let (mut a, mut b) = (vec![None; 4096], vec![None; 4096]);
             let (mut sa, mut sb) = (Scratch::default(), Scratch::default());
-            let first = block * 4096;
-            let ca = generate(
-                &p,
-                &scene,
-                &depths,
-                block,
-                first,
-                4096,
-                &mut sa,
-                (0, 79, &mut a),
-            );
-            let cb = generate_body(
-                &p,
-                &scene,
-                &depths,
-                block,
-                first,
-                4096,
-                &mut sb,
-                (0, 79, &mut b),
-            );
+            let blk = Block {
+                seed: block,
+                first_pulse: block * 4096,
+                n: 4096,
+            };
+            let ca = generate(&p, &scene, &depths, blk, &mut sa, (0, 79, &mut a));
+            let cb = generate_body(&p, &scene, &depths, blk, &mut sb, (0, 79, &mut b));
             assert_eq!(ca, cb, "block {block}");
             assert_eq!(a, b, "block {block}");
             assert!(ca.0 > 3000 && ca.1 > 500, "block {block}: {ca:?}");
@@ -292,9 +286,7 @@ pub(crate) fn generate(
     p: &Params,
     scene: &Scene,
     depths: &Depths,
-    block_seed: u64,
-    first_pulse: u64,
-    n: usize,
+    block: Block,
     sc: &mut Scratch,
     (offset, last, out): (usize, u32, &mut [Option<u32>]),
 ) -> (u64, u64) {
@@ -307,16 +299,7 @@ pub(crate) fn generate(
         // of `generate_avx512`.
         #[allow(unsafe_code)]
         unsafe {
-            return generate_avx512(
-                p,
-                scene,
-                depths,
-                block_seed,
-                first_pulse,
-                n,
-                sc,
-                (offset, last, out),
-            );
+            return generate_avx512(p, scene, depths, block, sc, (offset, last, out));
         }
     }
     #[cfg(target_arch = "x86_64")]
@@ -325,28 +308,10 @@ pub(crate) fn generate(
         // `generate_avx2`; the workspace's second allowed unsafe call (see Cargo.toml).
         #[allow(unsafe_code)]
         unsafe {
-            return generate_avx2(
-                p,
-                scene,
-                depths,
-                block_seed,
-                first_pulse,
-                n,
-                sc,
-                (offset, last, out),
-            );
+            return generate_avx2(p, scene, depths, block, sc, (offset, last, out));
         }
     }
-    generate_body(
-        p,
-        scene,
-        depths,
-        block_seed,
-        first_pulse,
-        n,
-        sc,
-        (offset, last, out),
-    )
+    generate_body(p, scene, depths, block, sc, (offset, last, out))
 }
 
 /// [`generate_body`] compiled for AVX-512 (64-bit rotates, gathers and integer-to-float
@@ -357,22 +322,11 @@ fn generate_avx512(
     p: &Params,
     scene: &Scene,
     depths: &Depths,
-    block_seed: u64,
-    first_pulse: u64,
-    n: usize,
+    block: Block,
     sc: &mut Scratch,
     (offset, last, out): (usize, u32, &mut [Option<u32>]),
 ) -> (u64, u64) {
-    generate_body(
-        p,
-        scene,
-        depths,
-        block_seed,
-        first_pulse,
-        n,
-        sc,
-        (offset, last, out),
-    )
+    generate_body(p, scene, depths, block, sc, (offset, last, out))
 }
 
 /// [`generate_body`] compiled for AVX2.
@@ -382,22 +336,11 @@ fn generate_avx2(
     p: &Params,
     scene: &Scene,
     depths: &Depths,
-    block_seed: u64,
-    first_pulse: u64,
-    n: usize,
+    block: Block,
     sc: &mut Scratch,
     (offset, last, out): (usize, u32, &mut [Option<u32>]),
 ) -> (u64, u64) {
-    generate_body(
-        p,
-        scene,
-        depths,
-        block_seed,
-        first_pulse,
-        n,
-        sc,
-        (offset, last, out),
-    )
+    generate_body(p, scene, depths, block, sc, (offset, last, out))
 }
 
 #[inline(always)]
@@ -405,12 +348,15 @@ fn generate_body(
     p: &Params,
     scene: &Scene,
     depths: &Depths,
-    block_seed: u64,
-    first_pulse: u64,
-    n: usize,
+    block: Block,
     sc: &mut Scratch,
     (offset, last, out): (usize, u32, &mut [Option<u32>]),
 ) -> (u64, u64) {
+    let Block {
+        seed: block_seed,
+        first_pulse,
+        n,
+    } = block;
     let padded = n.div_ceil(LANES) * LANES;
     sc.depth.resize(padded, 0.0);
     sc.z.resize(padded, 0.0);
@@ -476,7 +422,8 @@ fn generate_body(
 
 /// ln(u) for u ∈ [2^−53, 1] (normal, positive), branch-free so a batch vectorises: the
 /// fdlibm algorithm (e_log.c: u = 2^k·m with m ∈ [√½, √2), s = (m − 1)/(m + 1), a degree-14
-/// polynomial in s), error < 1 ulp as fdlibm's.
+/// polynomial in s), error < 1 ulp as fdlibm's. The constants as fdlibm publishes them.
+#[allow(clippy::excessive_precision)]
 #[inline(always)]
 pub(crate) fn ln(u: f64) -> f64 {
     const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;

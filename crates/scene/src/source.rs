@@ -15,11 +15,18 @@
 //! - **TDC**: `code = floor((t − window_start) / lsb)`, 0 ≤ code < `tdc_codes()`; a pulse
 //!   with no arrival in the window is `None`.
 //!
+//! Two kernels draw these laws. [`PhotonSource::fill`] (every command's path) is the batched
+//! kernel of crates/scene/src/batch.rs: a block at a time, in vectorised passes (lanes of
+//! xoshiro256++, a split ziggurat normal, branch-free selects; AVX-512 and AVX2 copies
+//! chosen at run time, bit-identical to the baseline copy). [`PhotonSource::fill_reference`]
+//! is the original per-pulse kernel, kept as the naive reference that judges it (the
+//! scene crate's KS tests, tests/it/ks.rs) and that `tofprobe bench scene` times beside it.
+//! The two draw the same laws from unrelated streams, so their seeded records differ.
+//!
 //! Determinism: pulses are grouped in fixed blocks of [`BLOCK_PULSES`]; block b draws from
-//! its own xoshiro256++ generator seeded by a hash of (seed, b), and the motion δ(t) is
-//! evaluated from the block's start. Any request is served by regenerating the blocks it
-//! touches from their start, so every chunking and every thread count gives the same
-//! stream.
+//! its own generators seeded by a hash of (seed, b), and the motion δ(t) is evaluated from
+//! the block's start. Any request is served by regenerating the blocks it touches from
+//! their start, so every chunking and every thread count gives the same stream.
 
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{Rng, SeedableRng};
@@ -27,7 +34,7 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
 use crate::MM_PER_PS;
-use crate::batch::{self, Depths, Params, Scratch};
+use crate::batch::{self, Block, Depths, Params, Scratch};
 use crate::error::SceneError;
 use crate::scene::Scene;
 use crate::sensor::SensorConfig;
@@ -170,9 +177,11 @@ impl PhotonSource {
                 &self.params,
                 &self.scene,
                 &self.depths,
-                batch_seed(self.seed, block),
-                block * BLOCK_PULSES as u64,
-                offset + take,
+                Block {
+                    seed: batch_seed(self.seed, block),
+                    first_pulse: block * BLOCK_PULSES as u64,
+                    n: offset + take,
+                },
                 &mut sc,
                 (offset, last, &mut out[done..done + take]),
             );

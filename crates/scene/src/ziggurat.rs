@@ -17,7 +17,7 @@ use rand::{Rng, RngExt};
 /// Layers of the ziggurat.
 const LAYERS: usize = 256;
 /// The right edge of the base layer's rectangle (where the tail begins).
-const R: f64 = 3.654_152_885_361_008_8;
+const R: f64 = 3.654_152_885_361_009;
 /// The area of every layer (base layer: its rectangle plus the tail) under e^(−x²/2).
 const V: f64 = 0.004_928_673_233_99;
 
