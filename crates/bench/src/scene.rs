@@ -1,8 +1,12 @@
 //! The photon/TDC Monte Carlo's single-thread throughput on a configuration's scene, at
 //! (ρ_s, ρ_b) = (1, 0) and (0.3, 0.3), against the targets of 50 M and 20 M pulses/s.
 //!
-//! Rates are reported against wall-clock time and, where Linux exposes it, against the
-//! thread's own CPU time: `pass` uses the CPU-time rates when available.
+//! Each case times the batched kernel (`PhotonSource::fill_counted`, what every command
+//! uses) beside the per-pulse reference kernel (`fill_counted_reference`) in the same run,
+//! alternating halves of the pulses so both see the same machine load, and reports the
+//! ratio (issue 28's target: ≥ 3× per CPU-second). Rates are reported against wall-clock
+//! time and, where Linux exposes it, against the thread's own CPU time: `pass` and the
+//! ratios use the CPU-time rates when available.
 
 use std::time::Instant;
 
@@ -17,6 +21,8 @@ use crate::cpu::thread_cpu_ns;
 pub const TARGET_SIGNAL_ONLY: f64 = 50e6;
 /// Target throughput at ρ_s = 0.3, ρ_b = 0.3 (pulses/s).
 pub const TARGET_MIXED: f64 = 20e6;
+/// Target speed-up of the batched kernel over the per-pulse reference (CPU time).
+pub const TARGET_SPEEDUP: f64 = 3.0;
 /// Pulses per fill call (a multiple of the source's block); also the fewest pulses a case
 /// may time.
 pub const CHUNK: usize = 1 << 16;
@@ -29,20 +35,74 @@ pub struct SceneReport {
     pub mixed_pulses_per_s: f64,
     pub signal_only_pulses_per_cpu_s: Option<f64>,
     pub mixed_pulses_per_cpu_s: Option<f64>,
+    /// The per-pulse reference kernel, same run.
+    pub signal_only_reference_pulses_per_s: f64,
+    pub mixed_reference_pulses_per_s: f64,
+    pub signal_only_reference_pulses_per_cpu_s: Option<f64>,
+    pub mixed_reference_pulses_per_cpu_s: Option<f64>,
+    /// Batched ÷ reference pulses per CPU-second (wall where CPU time is not measured).
+    pub signal_only_speedup_vs_reference: f64,
+    pub mixed_speedup_vs_reference: f64,
+    pub speedup_target: f64,
     pub signal_only_target_pulses_per_s: f64,
     pub mixed_target_pulses_per_s: f64,
     pub threads: u32,
+    /// Both absolute targets met.
     pub pass: bool,
+    /// Both speed-ups ≥ [`TARGET_SPEEDUP`].
+    pub speedup_pass: bool,
 }
 
-/// Rates of one case: pulses per wall-clock second and per CPU second of this thread.
+/// Rates of one kernel: pulses per wall-clock second and per CPU second of this thread.
 struct Rates {
     wall: f64,
     cpu: Option<f64>,
 }
 
-/// Times `pulses` pulses through one thread.
-fn time_case(config: &Document, rho_s: f64, rho_b: f64, pulses: u64) -> Result<Rates, BenchError> {
+impl Rates {
+    fn judged(&self) -> f64 {
+        self.cpu.unwrap_or(self.wall)
+    }
+}
+
+/// Wall and CPU seconds of one kernel over pulses `first .. first + pulses`.
+fn run(
+    source: &PhotonSource,
+    reference: bool,
+    first: u64,
+    pulses: u64,
+    buf: &mut [Option<u32>],
+) -> (f64, Option<f64>) {
+    let cpu0 = thread_cpu_ns();
+    let start = Instant::now();
+    let mut detections = 0u64;
+    let mut p = first;
+    while p < first + pulses {
+        let n = (first + pulses - p).min(buf.len() as u64) as usize;
+        detections += if reference {
+            source.fill_counted_reference(p, &mut buf[..n])
+        } else {
+            source.fill_counted(p, &mut buf[..n])
+        }
+        .detections;
+        p += n as u64;
+    }
+    let s = start.elapsed().as_secs_f64();
+    std::hint::black_box(detections);
+    let cpu = match (cpu0, thread_cpu_ns()) {
+        (Some(a), Some(b)) if b > a => Some((b - a) as f64 * 1e-9),
+        _ => None,
+    };
+    (s, cpu)
+}
+
+/// Times `pulses` pulses of each kernel through one thread: (batched, reference).
+fn time_case(
+    config: &Document,
+    rho_s: f64,
+    rho_b: f64,
+    pulses: u64,
+) -> Result<(Rates, Rates), BenchError> {
     let mut c = config.clone();
     c.sensor.signal_rate = rho_s;
     c.sensor.background_rate = rho_b;
@@ -50,27 +110,23 @@ fn time_case(config: &Document, rho_s: f64, rho_b: f64, pulses: u64) -> Result<R
         .photon_source()
         .map_err(|source| tofprobe_design::DesignError::scene("bench scene", source))?;
     let mut buf = vec![None; CHUNK];
-    // Warm-up, then the timed run; the detection count keeps the work observable.
+    // Warm-up, then alternating halves of batched and reference over the same pulses.
     source.fill(0, &mut buf);
-    let cpu0 = thread_cpu_ns();
-    let start = Instant::now();
-    let mut detections = 0u64;
-    let mut first = 0u64;
-    while first < pulses {
-        let n = (pulses - first).min(CHUNK as u64) as usize;
-        detections += source.fill_counted(first, &mut buf[..n]).detections;
-        first += n as u64;
+    source.fill_reference(0, &mut buf);
+    let half = pulses / 2;
+    let mut acc = [(0.0, Some(0.0)); 2];
+    for (first, n) in [(0, half), (half, pulses - half)] {
+        for (k, reference) in [(0, false), (1, true)] {
+            let (w, c) = run(&source, reference, first, n, &mut buf);
+            acc[k].0 += w;
+            acc[k].1 = acc[k].1.zip(c).map(|(a, b)| a + b);
+        }
     }
-    let s = start.elapsed().as_secs_f64();
-    let cpu = match (cpu0, thread_cpu_ns()) {
-        (Some(a), Some(b)) if b > a => Some(pulses as f64 / ((b - a) as f64 * 1e-9)),
-        _ => None,
+    let rates = |(w, c): (f64, Option<f64>)| Rates {
+        wall: pulses as f64 / w.max(1e-9),
+        cpu: c.map(|c| pulses as f64 / c.max(1e-9)),
     };
-    std::hint::black_box(detections);
-    Ok(Rates {
-        wall: pulses as f64 / s.max(1e-9),
-        cpu,
-    })
+    Ok((rates(acc[0]), rates(acc[1])))
 }
 
 /// Times both cases on the document's scene, `pulses` pulses each (≥ [`CHUNK`]).
@@ -82,18 +138,26 @@ pub fn measure(document: &Document, pulses: u64) -> Result<SceneReport, BenchErr
             format!("pulses >= {CHUNK}"),
         ));
     }
-    let a = time_case(document, 1.0, 0.0, pulses)?;
-    let b = time_case(document, 0.3, 0.3, pulses)?;
-    let judged = (a.cpu.unwrap_or(a.wall), b.cpu.unwrap_or(b.wall));
+    let (a, ar) = time_case(document, 1.0, 0.0, pulses)?;
+    let (b, br) = time_case(document, 0.3, 0.3, pulses)?;
+    let speedup = (a.judged() / ar.judged(), b.judged() / br.judged());
     Ok(SceneReport {
         pulses,
         signal_only_pulses_per_s: a.wall,
         mixed_pulses_per_s: b.wall,
         signal_only_pulses_per_cpu_s: a.cpu,
         mixed_pulses_per_cpu_s: b.cpu,
+        signal_only_reference_pulses_per_s: ar.wall,
+        mixed_reference_pulses_per_s: br.wall,
+        signal_only_reference_pulses_per_cpu_s: ar.cpu,
+        mixed_reference_pulses_per_cpu_s: br.cpu,
+        signal_only_speedup_vs_reference: speedup.0,
+        mixed_speedup_vs_reference: speedup.1,
+        speedup_target: TARGET_SPEEDUP,
         signal_only_target_pulses_per_s: TARGET_SIGNAL_ONLY,
         mixed_target_pulses_per_s: TARGET_MIXED,
         threads: 1,
-        pass: judged.0 >= TARGET_SIGNAL_ONLY && judged.1 >= TARGET_MIXED,
+        pass: a.judged() >= TARGET_SIGNAL_ONLY && b.judged() >= TARGET_MIXED,
+        speedup_pass: speedup.0 >= TARGET_SPEEDUP && speedup.1 >= TARGET_SPEEDUP,
     })
 }

@@ -6,6 +6,7 @@
 //! no detection. See [`PhotonSource`] for the exact Monte Carlo semantics.
 
 mod acquisition;
+mod batch;
 mod error;
 mod motion;
 mod scene;
@@ -14,6 +15,7 @@ mod source;
 pub mod spatial;
 pub mod splitmix;
 pub mod tttr;
+mod ziggurat;
 
 pub use acquisition::AcquisitionConfig;
 pub use error::SceneError;

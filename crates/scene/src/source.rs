@@ -15,11 +15,18 @@
 //! - **TDC**: `code = floor((t − window_start) / lsb)`, 0 ≤ code < `tdc_codes()`; a pulse
 //!   with no arrival in the window is `None`.
 //!
+//! Two kernels draw these laws. [`PhotonSource::fill`] (every command's path) is the batched
+//! kernel of crates/scene/src/batch.rs: a block at a time, in vectorised passes (lanes of
+//! xoshiro256++, a split ziggurat normal, branch-free selects; AVX-512 and AVX2 copies
+//! chosen at run time, bit-identical to the baseline copy). [`PhotonSource::fill_reference`]
+//! is the original per-pulse kernel, kept as the naive reference that judges it (the
+//! scene crate's KS tests, tests/it/ks.rs) and that `tofprobe bench scene` times beside it.
+//! The two draw the same laws from unrelated streams, so their seeded records differ.
+//!
 //! Determinism: pulses are grouped in fixed blocks of [`BLOCK_PULSES`]; block b draws from
-//! its own xoshiro256++ generator seeded by a hash of (seed, b), and the motion δ(t) is
-//! evaluated from the block's start. Any request is served by regenerating the blocks it
-//! touches from their start, so every chunking and every thread count gives the same
-//! stream.
+//! its own generators seeded by a hash of (seed, b), and the motion δ(t) is evaluated from
+//! the block's start. Any request is served by regenerating the blocks it touches from
+//! their start, so every chunking and every thread count gives the same stream.
 
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{Rng, SeedableRng};
@@ -27,6 +34,7 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
 use crate::MM_PER_PS;
+use crate::batch::{self, Block, Depths, Params, Scratch};
 use crate::error::SceneError;
 use crate::scene::Scene;
 use crate::sensor::SensorConfig;
@@ -72,6 +80,9 @@ pub struct PhotonSource {
     background_rate: f64,
     /// e^(−ρ_b): a uniform u ∈ (0, 1] above it means at least one background arrival.
     no_background: f64,
+    /// The batched kernel's parameters (code units) and depth evaluation.
+    params: Params,
+    depths: Depths,
 }
 
 impl PhotonSource {
@@ -92,7 +103,22 @@ impl PhotonSource {
             ));
         }
         check_scene(sensor, scene)?;
+        let period_s = 1.0 / sensor.laser_rate_hz;
+        let lsb = sensor.tdc_lsb_ps;
+        let params = Params {
+            period_s,
+            code_per_mm: PS_PER_MM / lsb,
+            start: sensor.window_start_ps / lsb,
+            length: sensor.window_length_ps / lsb,
+            sigma: sensor.jitter_ps / lsb,
+            signal_threshold: (sensor.signal_rate * (1u64 << 53) as f64) as u64,
+            signal_rate: sensor.signal_rate,
+            background_rate: sensor.background_rate,
+            no_background: (-sensor.background_rate).exp(),
+        };
         Ok(PhotonSource {
+            params,
+            depths: Depths::new(scene, period_s),
             scene: scene.clone(),
             seed,
             period_s: 1.0 / sensor.laser_rate_hz,
@@ -133,8 +159,49 @@ impl PhotonSource {
     }
 
     /// Like [`Self::fill`], and returns how many detections there were and how many of them
-    /// a background photon won.
+    /// a background photon won. The batched kernel (crates/scene/src/batch.rs): the same
+    /// laws as [`Self::fill_counted_reference`], other draws.
     pub fn fill_counted(&self, first_pulse: u64, out: &mut [Option<u32>]) -> FillCounts {
+        let mut counts = FillCounts::default();
+        let mut sc = Scratch::default();
+        let last = self.codes - 1;
+        let mut done = 0usize;
+        while done < out.len() {
+            let pulse = first_pulse + done as u64;
+            let block = pulse / BLOCK_PULSES as u64;
+            let offset = (pulse % BLOCK_PULSES as u64) as usize;
+            let take = (BLOCK_PULSES - offset).min(out.len() - done);
+            // A request starting mid-block regenerates the block's prefix: the result does
+            // not depend on where chunks start.
+            let (d, w) = batch::generate(
+                &self.params,
+                &self.scene,
+                &self.depths,
+                Block {
+                    seed: batch_seed(self.seed, block),
+                    first_pulse: block * BLOCK_PULSES as u64,
+                    n: offset + take,
+                },
+                &mut sc,
+                (offset, last, &mut out[done..done + take]),
+            );
+            counts += FillCounts {
+                detections: d,
+                background_wins: w,
+            };
+            done += take;
+        }
+        counts
+    }
+
+    /// The per-pulse reference kernel (one pulse at a time, the draws of the original
+    /// Monte Carlo): the naive path the batched [`Self::fill`] is judged against.
+    pub fn fill_reference(&self, first_pulse: u64, out: &mut [Option<u32>]) {
+        self.fill_counted_reference(first_pulse, out);
+    }
+
+    /// Like [`Self::fill_reference`], with the counts of [`Self::fill_counted`].
+    pub fn fill_counted_reference(&self, first_pulse: u64, out: &mut [Option<u32>]) -> FillCounts {
         let mut counts = FillCounts::default();
         let mut depths = vec![0.0; BLOCK_PULSES];
         let mut scratch: Vec<Option<u32>> = Vec::new();
@@ -355,6 +422,12 @@ pub(crate) fn check_window(sensor: &SensorConfig, scene: &Scene) -> Result<(), S
         ),
         allowed,
     })
+}
+
+/// The seed of a block's batched streams: unrelated to the reference's stream of the same
+/// block (a further mix), so the two paths are independent samples of one law.
+fn batch_seed(seed: u64, block: u64) -> u64 {
+    mix(block_seed(seed, block) ^ 0x6A09_E667_F3BC_C909)
 }
 
 /// The counter-based seed of a block: distinct (seed, block) pairs give unrelated streams.

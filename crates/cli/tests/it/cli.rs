@@ -143,6 +143,13 @@ fn bench_scene_json_has_unit_named_keys() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
     assert!(v["signal_only_pulses_per_s"].as_f64().expect("rate") > 0.0);
     assert!(v["mixed_pulses_per_s"].as_f64().expect("rate") > 0.0);
+    for k in [
+        "signal_only_speedup_vs_reference",
+        "mixed_speedup_vs_reference",
+    ] {
+        assert!(v[k].as_f64().expect("ratio") > 0.0, "{k}");
+    }
+    assert!(v["speedup_pass"].is_boolean());
     assert!(v["pass"].is_boolean());
     fails_with(
         &["bench", "scene", "--pulses", "10"],

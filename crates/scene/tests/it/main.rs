@@ -4,6 +4,7 @@
 
 mod common;
 mod determinism;
+mod ks;
 mod mixture;
 mod motion;
 mod pileup;

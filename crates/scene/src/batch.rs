@@ -1,0 +1,472 @@
+//! The batched Monte Carlo kernel: the same photon laws as the per-pulse reference
+//! ([`crate::PhotonSource::fill_reference`]), drawn a block at a time in passes the
+//! compiler vectorises.
+//!
+//! - **Random words**: [`LANES`] interleaved xoshiro256++ generators (struct of arrays, one
+//!   step gives `LANES` words), one set per stream (jitter, signal Bernoulli, background).
+//!   Pulse k of a block takes word k of each stream, whatever the request's length.
+//! - **Jitter**: the ziggurat's branch-free fast pass over the block, the ≈ 0.7 % rejects
+//!   finished exactly by the scalar slow path from a fourth, scalar stream
+//!   ([`crate::ziggurat`]).
+//! - **Depth**: a sine motion is evaluated as sin(θ_j + kΔ) = s_j cos kΔ + c_j sin kΔ over
+//!   sub-blocks of [`SUB`] pulses from a table of (cos kΔ, sin kΔ) (no serial recurrence
+//!   per pulse); other motions use the scene's own evaluation.
+//! - **Laws**: signal with probability ρ_s at δ/c·2 + σ_I·z; background first arrival
+//!   −ln(u)·W/ρ_b with u ∈ (0, 1] (52 bits), inside the window iff u > e^(−ρ_b); earliest in-window
+//!   arrival wins; code = ⌊t / lsb⌋ (computed in code units, ≤ 1 ulp from the division).
+//!   Every pulse draws its words whether or not it uses them: no per-pulse branches.
+
+use std::f64::consts::TAU;
+
+use rand::SeedableRng;
+use rand::rngs::Xoshiro256PlusPlus;
+
+use crate::MotionConfig;
+use crate::scene::Scene;
+use crate::splitmix::SplitMix64;
+use crate::ziggurat::{Tables, fast_pass, finish, tables};
+
+/// Interleaved generators per stream.
+pub(crate) const LANES: usize = 4;
+/// Pulses per sine sub-block (one table of cos kΔ, sin kΔ).
+pub(crate) const SUB: usize = 64;
+
+/// `LANES` xoshiro256++ generators side by side (state word j of lane l is `s[j][l]`).
+#[derive(Debug, Clone)]
+struct Lanes {
+    s: [[u64; LANES]; 4],
+}
+
+impl Lanes {
+    fn new(seeder: &mut SplitMix64) -> Lanes {
+        let mut s = [[0u64; LANES]; 4];
+        for l in 0..LANES {
+            for w in &mut s {
+                w[l] = seeder.next_u64();
+            }
+        }
+        Lanes { s }
+    }
+
+    /// Fills `out` (a multiple of `LANES` long) with the streams' next words.
+    #[inline(always)]
+    fn fill(&mut self, out: &mut [u64]) {
+        let [mut s0, mut s1, mut s2, mut s3] = self.s;
+        for chunk in out.chunks_exact_mut(LANES) {
+            for l in 0..LANES {
+                chunk[l] = rotl(s0[l].wrapping_add(s3[l]), 23).wrapping_add(s0[l]);
+                let t = s1[l] << 17;
+                s2[l] ^= s0[l];
+                s3[l] ^= s1[l];
+                s1[l] ^= s2[l];
+                s0[l] ^= s3[l];
+                s2[l] ^= t;
+                s3[l] = rotl(s3[l], 45);
+            }
+        }
+        self.s = [s0, s1, s2, s3];
+    }
+}
+
+/// x rotated left by k, as two shifts and an or: AVX2 has no 64-bit rotate, and LLVM's
+/// rotate of a vector is lowered lane by lane there.
+#[inline(always)]
+fn rotl(x: u64, k: u32) -> u64 {
+    (x << k) ^ (x >> (64 - k))
+}
+
+/// A sine motion's per-sub-block tables.
+#[derive(Debug, Clone)]
+pub(crate) struct SineTable {
+    amplitude_mm: f64,
+    frequency_hz: f64,
+    phase_deg: f64,
+    cos_k: [f64; SUB],
+    sin_k: [f64; SUB],
+    /// (sin, cos) of SUB·Δ: the step from one sub-block's anchor to the next.
+    step: (f64, f64),
+}
+
+/// How the batched kernel evaluates δ(t): the sine tables when every motion is a sine.
+#[derive(Debug, Clone)]
+pub(crate) struct Depths {
+    sines: Option<Vec<SineTable>>,
+}
+
+impl Depths {
+    pub(crate) fn new(scene: &Scene, period_s: f64) -> Depths {
+        let sines = scene
+            .motions()
+            .iter()
+            .map(|m| match *m {
+                MotionConfig::Sine {
+                    amplitude_mm,
+                    frequency_hz,
+                    phase_deg,
+                } => {
+                    let d = TAU * frequency_hz * period_s;
+                    let mut cos_k = [0.0; SUB];
+                    let mut sin_k = [0.0; SUB];
+                    for k in 0..SUB {
+                        (sin_k[k], cos_k[k]) = (d * k as f64).sin_cos();
+                    }
+                    Some(SineTable {
+                        amplitude_mm,
+                        frequency_hz,
+                        phase_deg,
+                        cos_k,
+                        sin_k,
+                        step: (d * SUB as f64).sin_cos(),
+                    })
+                }
+                _ => None,
+            })
+            .collect();
+        Depths { sines }
+    }
+
+    /// δ (mm) of pulses `first_pulse ..` into `out`.
+    #[inline(always)]
+    fn fill(&self, scene: &Scene, first_pulse: u64, period_s: f64, out: &mut [f64]) {
+        let Some(sines) = &self.sines else {
+            scene.fill_depths_mm(first_pulse, period_s, out);
+            return;
+        };
+        out.fill(scene.static_depth_mm());
+        for t in sines {
+            // The anchor's phase reduced modulo one period first (as the reference does).
+            let cycles =
+                (t.frequency_hz * period_s * first_pulse as f64).fract() + t.phase_deg / 360.0;
+            let (mut s, mut c) = (TAU * cycles).sin_cos();
+            let (ds, dc) = t.step;
+            for sub in out.chunks_mut(SUB) {
+                let (a_s, a_c) = (t.amplitude_mm * s, t.amplitude_mm * c);
+                for ((d, &ck), &sk) in sub.iter_mut().zip(&t.cos_k).zip(&t.sin_k) {
+                    *d += a_s * ck + a_c * sk;
+                }
+                let s1 = s * dc + c * ds;
+                c = c * dc - s * ds;
+                s = s1;
+            }
+        }
+    }
+}
+
+/// The parameters of the kernel, in TDC code units (time / lsb).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Params {
+    pub period_s: f64,
+    /// Code units per mm of depth: 1 / (MM_PER_PS · lsb).
+    pub code_per_mm: f64,
+    /// Window start in code units.
+    pub start: f64,
+    /// Window length in code units.
+    pub length: f64,
+    /// σ_I in code units.
+    pub sigma: f64,
+    /// ρ_s as a threshold on 53-bit integers (≥ 2^53 when ρ_s = 1).
+    pub signal_threshold: u64,
+    pub signal_rate: f64,
+    pub background_rate: f64,
+    /// e^(−ρ_b).
+    pub no_background: f64,
+}
+
+/// The block to generate: its streams' seed, its first pulse, and how many of its pulses.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Block {
+    pub seed: u64,
+    pub first_pulse: u64,
+    pub n: usize,
+}
+
+/// Per-thread scratch of one block.
+#[derive(Debug, Default)]
+pub(crate) struct Scratch {
+    depth: Vec<f64>,
+    z: Vec<f64>,
+    words: Vec<u64>,
+    flags: Vec<u8>,
+    rejects: Vec<u32>,
+    /// The earliest in-window arrival of each pulse, code units (∞ when none).
+    pub best: Vec<f64>,
+    /// Whether a background photon won the pulse.
+    pub from_bg: Vec<bool>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{SceneConfig, SensorConfig};
+
+    /// The dispatched copy (AVX-512 or AVX2 where the CPU has them) and the baseline copy
+    /// give the same codes, detections and background wins, bit for bit, on a moving
+    /// scene at mixed rates (a reordered or fused operation would move some codes).
+    #[test]
+    fn every_copy_of_the_kernel_is_bit_identical() {
+        let scene = Scene::new(&SceneConfig {
+            depth_mm: 30.0,
+            motions: vec![MotionConfig::Sine {
+                amplitude_mm: 5.0,
+                frequency_hz: 4500.0,
+                phase_deg: 10.0,
+            }],
+        })
+        .expect("valid");
+        let sensor = SensorConfig {
+            laser_rate_hz: 10e6,
+            jitter_ps: 50.0,
+            tdc_lsb_ps: 5.0,
+            window_start_ps: 0.0,
+            window_length_ps: 400.0,
+            signal_rate: 0.7,
+            background_rate: 0.4,
+        };
+        let lsb = sensor.tdc_lsb_ps;
+        let p = Params {
+            period_s: 1e-7,
+            code_per_mm: 1.0 / (crate::MM_PER_PS * lsb),
+            start: 0.0,
+            length: 400.0 / lsb,
+            sigma: 50.0 / lsb,
+            signal_threshold: (0.7 * (1u64 << 53) as f64) as u64,
+            signal_rate: 0.7,
+            background_rate: 0.4,
+            no_background: (-0.4f64).exp(),
+        };
+        let depths = Depths::new(&scene, p.period_s);
+        for block in 0..8u64 {
+            let (mut a, mut b) = (vec![None; 4096], vec![None; 4096]);
+            let (mut sa, mut sb) = (Scratch::default(), Scratch::default());
+            let blk = Block {
+                seed: block,
+                first_pulse: block * 4096,
+                n: 4096,
+            };
+            let ca = generate(&p, &scene, &depths, blk, &mut sa, (0, 79, &mut a));
+            let cb = generate_body(&p, &scene, &depths, blk, &mut sb, (0, 79, &mut b));
+            assert_eq!(ca, cb, "block {block}");
+            assert_eq!(a, b, "block {block}");
+            assert!(ca.0 > 3000 && ca.1 > 500, "block {block}: {ca:?}");
+        }
+    }
+
+    /// The branch-free ln against the platform's over (0, 1]: within 2 ulps everywhere
+    /// tried (a wrong fdlibm coefficient shows at ~1e-10).
+    #[test]
+    fn ln_matches_std() {
+        let mut g = crate::SplitMix64::new(7);
+        let mut worst = 0.0f64;
+        for i in 0..200_000 {
+            let u = if i < 64 {
+                0.5f64.powi(i) * 0.999
+            } else {
+                ((g.next_u64() >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64)
+            };
+            let (a, b) = (super::ln(u), u.ln());
+            if b != 0.0 {
+                worst = worst.max(((a - b) / b).abs());
+            } else {
+                assert_eq!(a, 0.0);
+            }
+        }
+        assert!(
+            worst <= 2.0 * f64::EPSILON,
+            "worst relative error {worst:e}"
+        );
+    }
+}
+
+/// Generates pulses 0 .. n of a block (n ≤ the block length) into `sc.best` / `sc.from_bg`,
+/// and writes pulses `offset .. offset + out.len()` of them as codes into `out` (returns
+/// its detections and background wins):
+/// the AVX2 copy of the kernel where the CPU has it (the same IEEE operations, no fused
+/// multiply-adds: bit-identical to the baseline copy), the baseline copy elsewhere.
+pub(crate) fn generate(
+    p: &Params,
+    scene: &Scene,
+    depths: &Depths,
+    block: Block,
+    sc: &mut Scratch,
+    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+) -> (u64, u64) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+    {
+        // SAFETY: the CPU has the three features (checked above), the one requirement
+        // of `generate_avx512`.
+        #[allow(unsafe_code)]
+        unsafe {
+            return generate_avx512(p, scene, depths, block, sc, (offset, last, out));
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked on the line above), the one requirement of
+        // `generate_avx2`; the workspace's second allowed unsafe call (see Cargo.toml).
+        #[allow(unsafe_code)]
+        unsafe {
+            return generate_avx2(p, scene, depths, block, sc, (offset, last, out));
+        }
+    }
+    generate_body(p, scene, depths, block, sc, (offset, last, out))
+}
+
+/// [`generate_body`] compiled for AVX-512 (64-bit rotates, gathers and integer-to-float
+/// conversions in vectors).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq")]
+fn generate_avx512(
+    p: &Params,
+    scene: &Scene,
+    depths: &Depths,
+    block: Block,
+    sc: &mut Scratch,
+    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+) -> (u64, u64) {
+    generate_body(p, scene, depths, block, sc, (offset, last, out))
+}
+
+/// [`generate_body`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn generate_avx2(
+    p: &Params,
+    scene: &Scene,
+    depths: &Depths,
+    block: Block,
+    sc: &mut Scratch,
+    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+) -> (u64, u64) {
+    generate_body(p, scene, depths, block, sc, (offset, last, out))
+}
+
+#[inline(always)]
+fn generate_body(
+    p: &Params,
+    scene: &Scene,
+    depths: &Depths,
+    block: Block,
+    sc: &mut Scratch,
+    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+) -> (u64, u64) {
+    let Block {
+        seed: block_seed,
+        first_pulse,
+        n,
+    } = block;
+    let padded = n.div_ceil(LANES) * LANES;
+    sc.depth.resize(padded, 0.0);
+    sc.z.resize(padded, 0.0);
+    sc.words.resize(padded, 0);
+    sc.best.resize(padded, 0.0);
+    sc.from_bg.resize(padded, false);
+    sc.rejects.clear();
+    depths.fill(scene, first_pulse, p.period_s, &mut sc.depth[..n]);
+
+    let mut seeder = SplitMix64::new(block_seed);
+    let mut jitter = Lanes::new(&mut seeder);
+    let mut signal = Lanes::new(&mut seeder);
+    let mut background = Lanes::new(&mut seeder);
+    let mut slow = Xoshiro256PlusPlus::seed_from_u64(seeder.next_u64());
+
+    let t: &Tables = tables();
+    jitter.fill(&mut sc.words);
+    fast_pass(t, &sc.words, &mut sc.z, &mut sc.flags, &mut sc.rejects);
+    for &k in &sc.rejects {
+        sc.z[k as usize] = finish(t, sc.words[k as usize], &mut slow);
+    }
+
+    // Signal: t = δ·code_per_mm + σ z − start, kept when inside [0, length).
+    let (cpm, sigma, start, len) = (p.code_per_mm, p.sigma, p.start, p.length);
+    for ((b, &d), &z) in sc.best.iter_mut().zip(&sc.depth).zip(&sc.z) {
+        let x = d * cpm + sigma * z - start;
+        *b = if x >= 0.0 && x < len {
+            x
+        } else {
+            f64::INFINITY
+        };
+    }
+    if p.signal_rate < 1.0 {
+        signal.fill(&mut sc.words);
+        // Both sides < 2^53: the signed compare (the one AVX2 has) is exact.
+        let thr = p.signal_threshold.min(1 << 53) as i64;
+        for (b, &w) in sc.best.iter_mut().zip(&sc.words) {
+            *b = if ((w >> 11) as i64) < thr {
+                *b
+            } else {
+                f64::INFINITY
+            };
+        }
+    }
+    sc.from_bg.fill(false);
+    if p.background_rate > 0.0 {
+        background.fill(&mut sc.words);
+        let scale = len / p.background_rate;
+        let nb = p.no_background;
+        for ((b, bg), &w) in sc.best.iter_mut().zip(sc.from_bg.iter_mut()).zip(&sc.words) {
+            // u ∈ (0, 1] on the 2^−52 grid, by the exponent trick (no integer-to-float
+            // conversion, which AVX2 lacks for 64-bit lanes).
+            let u = 2.0 - f64::from_bits((w >> 12) | 0x3FF0_0000_0000_0000);
+            let tb = -ln(u) * scale;
+            let wins = u > nb && tb < *b;
+            *b = if wins { tb } else { *b };
+            *bg = wins;
+        }
+    }
+    let r = offset..offset + out.len();
+    codes(&sc.best[r.clone()], &sc.from_bg[r], last, out)
+}
+
+/// ln(u) for u ∈ [2^−53, 1] (normal, positive), branch-free so a batch vectorises: the
+/// fdlibm algorithm (e_log.c: u = 2^k·m with m ∈ [√½, √2), s = (m − 1)/(m + 1), a degree-14
+/// polynomial in s), error < 1 ulp as fdlibm's. The constants as fdlibm publishes them.
+#[allow(clippy::excessive_precision)]
+#[inline(always)]
+pub(crate) fn ln(u: f64) -> f64 {
+    const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
+    const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+    const LG1: f64 = 6.666_666_666_666_735_130e-1;
+    const LG2: f64 = 3.999_999_999_940_941_908e-1;
+    const LG3: f64 = 2.857_142_874_366_239_149e-1;
+    const LG4: f64 = 2.222_219_843_214_978_396e-1;
+    const LG5: f64 = 1.818_357_216_161_805_012e-1;
+    const LG6: f64 = 1.531_383_769_920_937_332e-1;
+    const LG7: f64 = 1.479_819_860_511_658_591e-1;
+    let bits = u.to_bits();
+    let e = ((bits >> 52) as i64 - 1023) as f64;
+    let m = f64::from_bits((bits & 0x000F_FFFF_FFFF_FFFF) | 0x3FF0_0000_0000_0000);
+    let big = m > std::f64::consts::SQRT_2;
+    let m = if big { 0.5 * m } else { m };
+    let k = if big { e + 1.0 } else { e };
+    let f = m - 1.0;
+    let s = f / (2.0 + f);
+    let z = s * s;
+    let w = z * z;
+    let t1 = w * (LG2 + w * (LG4 + w * LG6));
+    let t2 = z * (LG1 + w * (LG3 + w * (LG5 + w * LG7)));
+    let r = t2 + t1;
+    let hfsq = 0.5 * f * f;
+    k * LN2_HI - ((hfsq - (s * (hfsq + r) + k * LN2_LO)) - f)
+}
+
+/// Writes `best` as TDC codes into `out` (`None` outside the window); returns the
+/// detections and the background wins among them.
+#[inline(always)]
+fn codes(best: &[f64], from_bg: &[bool], last: u32, out: &mut [Option<u32>]) -> (u64, u64) {
+    let mut detections = 0u64;
+    let mut wins = 0u64;
+    let last_f = f64::from(last);
+    for ((o, &b), &g) in out.iter_mut().zip(best).zip(from_bg) {
+        // b ∈ [0, length) when hit, ∞ otherwise; the clamp is a float min (an integer min
+        // compiles to a branch that a 50 % detection rate would mispredict).
+        let hit = b < f64::INFINITY;
+        let c = b.min(last_f) as u32;
+        *o = [None, Some(c)][usize::from(hit)];
+        detections += u64::from(hit);
+        wins += u64::from(g);
+    }
+    (detections, wins)
+}
