@@ -247,6 +247,18 @@ mod tests {
             let cb = generate_body(&p, &scene, &depths, blk, &mut sb, (0, 79, &mut b));
             assert_eq!(ca, cb, "block {block}");
             assert_eq!(a, b, "block {block}");
+            // The AVX2 copy too where the CPU has it (on an AVX-512 machine the dispatch
+            // above ran the AVX-512 copy, so this is the only check of the AVX2 one).
+            #[cfg(target_arch = "x86_64")]
+            if std::arch::is_x86_feature_detected!("avx2") {
+                let (mut c, mut sc) = (vec![None; 4096], Scratch::default());
+                // SAFETY: the CPU has AVX2 (checked on the line above), the one requirement
+                // of `generate_avx2`.
+                #[allow(unsafe_code)]
+                let cc =
+                    unsafe { generate_avx2(&p, &scene, &depths, blk, &mut sc, (0, 79, &mut c)) };
+                assert_eq!((cc, &c), (cb, &b), "AVX2 copy, block {block}");
+            }
             assert!(ca.0 > 3000 && ca.1 > 500, "block {block}: {ca:?}");
         }
     }
