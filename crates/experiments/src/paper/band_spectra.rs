@@ -250,14 +250,17 @@ mod tests {
         }
     }
 
-    /// A short record (2^18 pulses, floor ≈ 5.5·sqrt(10^7/2^18) ≈ 34 µm): the ΣΔ-probed
+    /// A short record (2^20 pulses, floor ≈ 5.5·sqrt(10^7/2^20) ≈ 17 µm: the 100 µm tone
+    /// stands 6 floors up, and a noise bin of the 20 on the grid passes it with probability
+    /// ≈ 20·e^(−(100/13.5)²/2) ≈ 10^-11 — at 2^18 (3 floors) that was ≈ 2 %, and one seed
+    /// of the batched Monte Carlo drew it: the peak landed on 8 kHz): the ΣΔ-probed
     /// tone differs from the DFT's on the same record by the ΣΔ error only, ≈ 0.2 floor
     /// per bin; its projection on the tone has sd ≈ ē/1.13 (ē the mean error over the noise
     /// bins, `sigma_delta::rows`), so 3ē bounds it at ≈ 3.4σ. The error itself stays well
     /// under one floor (a broken prefilter correction would make it several floors).
     #[test]
     fn short_band_tracks_the_dft() {
-        let n = 1u64 << 18;
+        let n = 1u64 << 20;
         let probe = super::super::sigma_delta::tests::setup_for_tests(n);
         let s = measure(&probe, 1000.0).unwrap();
         let sum = BandSummary::of(&s, n).unwrap();
