@@ -66,6 +66,46 @@ pub fn float_sd(
     Ok(normalise(rom, &sums, detections.len() as u64, Some(alpha)))
 }
 
+/// What the closed forms read of a design's detected depth: the first-arrival mixture of
+/// signal and background, the depth's σ (the mixture's variance plus the TDC's a²/12) and
+/// the valid rate ρ_v the 1NN hold sees. A scene without photons has no mixture: nothing
+/// is detected (ρ_v = 0). One computation for [`noise_floor_um`] and the trade-off's
+/// closed-form level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DetectionNoise {
+    pub mixture: MixtureParams,
+    pub sigma_mm: f64,
+    pub valid_rate: f64,
+}
+
+/// [`DetectionNoise`] of the design's scene and sensor.
+pub fn detection_noise(design: &ResolvedDesign) -> Result<DetectionNoise, tofprobe_dsp::DspError> {
+    let s = &design.document.sensor;
+    let mixture = MixtureParams {
+        signal_rate: s.signal_rate,
+        background_rate: s.background_rate,
+        signal_depth_mm: design.document.scene.depth_mm - s.window_start_mm(),
+        jitter_mm: s.jitter_mm(),
+        window_mm: s.window_end_mm() - s.window_start_mm(),
+    };
+    let arrival = if mixture.signal_rate + mixture.background_rate > 0.0 {
+        first_arrival(&mixture)?
+    } else {
+        FirstArrival {
+            valid_rate: 0.0,
+            mean_mm: mixture.signal_depth_mm,
+            variance_mm2: mixture.jitter_mm * mixture.jitter_mm,
+            signal_fraction: 0.0,
+        }
+    };
+    let lsb_mm = design.sensor().tdc_lsb_mm();
+    Ok(DetectionNoise {
+        mixture,
+        sigma_mm: (arrival.variance_mm2 + lsb_mm * lsb_mm / 12.0).sqrt(),
+        valid_rate: arrival.valid_rate.min(1.0),
+    })
+}
+
 /// The closed-form noise floor E|Y| (µm) at each probe bin for a frame of `pulses` pulses
 /// of the design's scene: σ² of the first-arrival mixture plus the TDC's a²/12, the 1NN
 /// hold at the valid rate ρ_v, N_eff = N·G²/P of the ROM's window (eq. 12 and its
@@ -76,27 +116,8 @@ pub fn noise_floor_um(
     rom: &ProbeRom,
     pulses: u64,
 ) -> Result<Vec<f64>, ExperimentError> {
-    let s = &design.document.sensor;
-    let mixture = MixtureParams {
-        signal_rate: s.signal_rate,
-        background_rate: s.background_rate,
-        signal_depth_mm: design.document.scene.depth_mm - s.window_start_mm(),
-        jitter_mm: s.jitter_mm(),
-        window_mm: s.window_end_mm() - s.window_start_mm(),
-    };
-    let arrival = if mixture.signal_rate + mixture.background_rate > 0.0 {
-        first_arrival(&mixture).map_err(dsp_err(design))?
-    } else {
-        FirstArrival {
-            valid_rate: 0.0,
-            mean_mm: mixture.signal_depth_mm,
-            variance_mm2: mixture.jitter_mm * mixture.jitter_mm,
-            signal_fraction: 0.0,
-        }
-    };
-    let lsb_mm = design.sensor().tdc_lsb_mm();
-    let sigma = (arrival.variance_mm2 + lsb_mm * lsb_mm / 12.0).sqrt();
-    let rho = arrival.valid_rate.min(1.0);
+    let noise = detection_noise(design).map_err(dsp_err(design))?;
+    let (sigma, rho) = (noise.sigma_mm, noise.valid_rate);
     let n_eff = pulses as f64 * rom.window.effective_length_factor();
     let fs = design.sensor().laser_rate_hz;
     Ok(rom

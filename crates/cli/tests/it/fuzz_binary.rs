@@ -10,8 +10,8 @@
 use crate::common;
 
 use std::path::Path;
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 use common::{default_text, edit};
 
@@ -261,35 +261,9 @@ fn dotted_paths(doc: &toml::Table) -> Vec<String> {
 fn run(args: &[&str], cfg: &Path, limit: Duration) -> Result<(Option<i32>, String), String> {
     // No EDA tool on the PATH: `rtl` with `adders = "auto"` is refused at once (naming
     // pixel.adders and the missing tool) instead of synthesising for minutes per case.
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .args(args)
-        .arg(cfg)
-        .env("PATH", "")
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let t0 = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if t0.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Err(format!("{args:?} still running after {limit:?}"));
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
-    let mut err = String::new();
-    use std::io::Read;
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
-    Ok((status.code(), err))
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_tofprobe"));
+    cmd.args(args).arg(cfg).env("PATH", "");
+    common::run_limited(cmd, limit).map(|(code, err, _)| (code, err))
 }
 
 #[test]

@@ -10,8 +10,8 @@
 //! `TOFPROBE_RECORD_MUTATIONS=N` runs N cases (default 12, about ten seconds) for a soak.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 /// SplitMix64, as in fuzz_binary.rs.
 struct Rng(u64);
@@ -195,35 +195,9 @@ fn mutate(
 
 /// Runs `replay FILE ARGS` with [`LIMIT`]: (exit code, stderr, seconds) or a hang.
 fn replay(file: &Path, args: &[String]) -> Result<(Option<i32>, String, f64), String> {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .arg("replay")
-        .arg(file)
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let t0 = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if t0.elapsed() > LIMIT {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Err(format!("still running after {LIMIT:?}"));
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
-    let mut err = String::new();
-    use std::io::Read;
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
-    Ok((status.code(), err, t0.elapsed().as_secs_f64()))
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_tofprobe"));
+    cmd.arg("replay").arg(file).args(args);
+    crate::common::run_limited(cmd, LIMIT)
 }
 
 #[test]

@@ -17,8 +17,7 @@ use std::time::Instant;
 use serde::Serialize;
 use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::closed_form::{
-    FirstArrival, MixtureParams, first_arrival, hold_response_sq, mixture_gain,
-    noise_floor_hold_mm, noise_floor_mm,
+    hold_response_sq, mixture_gain, noise_floor_hold_mm, noise_floor_mm,
 };
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_detections};
@@ -393,28 +392,10 @@ impl<'a> Ladder<'a> {
         let config = &self.design.document;
         // The ROM's window (rectangular in periodic mode), so every level weighs alike.
         let window = self.su.rom.window;
-        let mixture = MixtureParams {
-            signal_rate: config.sensor.signal_rate,
-            background_rate: config.sensor.background_rate,
-            signal_depth_mm: config.scene.depth_mm - config.sensor.window_start_mm(),
-            jitter_mm: config.sensor.jitter_mm(),
-            window_mm: config.sensor.window_end_mm() - config.sensor.window_start_mm(),
-        };
         let dsp_err = self.dsp_err();
-        // A scene without photons has no mixture: no detections, so the closed form reads 0.
-        let arrival = if mixture.signal_rate + mixture.background_rate > 0.0 {
-            first_arrival(&mixture).map_err(&dsp_err)?
-        } else {
-            FirstArrival {
-                valid_rate: 0.0,
-                mean_mm: mixture.signal_depth_mm,
-                variance_mm2: mixture.jitter_mm * mixture.jitter_mm,
-                signal_fraction: 0.0,
-            }
-        };
-        let lsb_mm = self.lsb_mm;
-        let sigma = (arrival.variance_mm2 + lsb_mm * lsb_mm / 12.0).sqrt();
-        let rho = arrival.valid_rate.min(1.0);
+        // The mixture, σ (a²/12 included) and ρ_v: one computation with the references'.
+        let noise = crate::references::detection_noise(self.design).map_err(&dsp_err)?;
+        let (mixture, sigma, rho) = (noise.mixture, noise.sigma_mm, noise.valid_rate);
         let n_eff = self.n as f64 * window.effective_length_factor();
         let omega = |i: usize| 2.0 * std::f64::consts::PI * self.su.rom.bins[i] / self.fs;
         let cf_noise = if self.noise_idx.is_empty() {

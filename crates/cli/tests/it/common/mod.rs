@@ -125,3 +125,35 @@ pub fn whole_set_seed(dir: &Path) -> Option<u64> {
     expected.sort();
     (visible == expected).then(|| m.get("seed")?.as_integer().map(|s| s as u64))?
 }
+
+/// Runs `cmd` (stdout discarded, stderr captured) with a time limit: (exit code, stderr,
+/// seconds), or an error naming the hang when it runs past `limit` (killed then). The
+/// fuzz tests' one runner: a hang fails the test instead of stalling CI.
+pub fn run_limited(
+    mut cmd: Command,
+    limit: std::time::Duration,
+) -> Result<(Option<i32>, String, f64), String> {
+    use std::io::Read;
+    let mut child = cmd
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cannot start {cmd:?}: {e}"))?;
+    let t0 = std::time::Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().map_err(|e| e.to_string())? {
+            break s;
+        }
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(format!("{cmd:?} still running after {limit:?}"));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    };
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        e.read_to_string(&mut err).map_err(|e| e.to_string())?;
+    }
+    Ok((status.code(), err, t0.elapsed().as_secs_f64()))
+}
