@@ -66,18 +66,17 @@ pub fn simulate(
     simulate_all(design).map(|(f, m, _, s)| (f, m, s))
 }
 
+/// A simulated frame with what is read from it: the registers, the vibration maps
+/// (Fourier), the Haar event map and the summary.
+pub type Simulated = (
+    ArrayFrame,
+    Option<VibrationMaps>,
+    Option<EventMap>,
+    ArraySummary,
+);
+
 /// [`simulate`] with the Haar event map.
-fn simulate_all(
-    design: &ResolvedDesign,
-) -> Result<
-    (
-        ArrayFrame,
-        Option<VibrationMaps>,
-        Option<EventMap>,
-        ArraySummary,
-    ),
-    ArrayError,
-> {
+fn simulate_all(design: &ResolvedDesign) -> Result<Simulated, ArrayError> {
     let rom = design.probe_rom()?;
     let t0 = Instant::now();
     let frame = run_array(design, rom.as_ref().map(|r| &r.image))?;
@@ -91,15 +90,7 @@ pub fn finish(
     rom: Option<&ProbeRom>,
     frame: ArrayFrame,
     model_seconds: f64,
-) -> Result<
-    (
-        ArrayFrame,
-        Option<VibrationMaps>,
-        Option<EventMap>,
-        ArraySummary,
-    ),
-    ArrayError,
-> {
+) -> Result<Simulated, ArrayError> {
     let Some(a) = &design.array else {
         return Err(ArrayError::Shape(format!(
             "`{}` has no [array] section",

@@ -15,20 +15,7 @@ use std::time::Duration;
 
 use common::{default_text, edit};
 
-/// SplitMix64 (as in the library's test: the case list must not depend on a crate).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn pick<'a, T>(&mut self, v: &'a [T]) -> &'a T {
-        &v[(self.next() % v.len() as u64) as usize]
-    }
-}
+use tofprobe_testkit::params::Rng;
 
 /// The keys mutated, by table (`motion` = `scene.motion[0]`).
 const KEYS: &[(&str, &[&str])] = &[
@@ -183,8 +170,8 @@ fn mutate(rng: &mut Rng) -> (String, Vec<(String, String)>) {
     );
     let mut doc: toml::Table = toml::from_str(&base).unwrap();
     let mut muts = Vec::new();
-    for _ in 0..1 + rng.next() % 3 {
-        let (table, key, lit) = if rng.next().is_multiple_of(2) {
+    for _ in 0..1 + rng.next_u64() % 3 {
+        let (table, key, lit) = if rng.next_u64().is_multiple_of(2) {
             let (table, keys) = rng.pick(KEYS);
             (
                 *table,

@@ -13,20 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
-/// SplitMix64, as in fuzz_binary.rs.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
+use tofprobe_testkit::params::Rng;
 
 /// Records kept of each real file.
 const KEEP_RECORDS: usize = 4000;
@@ -90,7 +77,7 @@ fn cut_ptu(name: &str) -> Option<Vec<u8>> {
 fn spc(rng: &mut Rng, n: usize) -> Vec<u8> {
     let mut words = vec![500u32];
     for k in 0..n {
-        let adc = 100 + (rng.next() % 16) as u32;
+        let adc = 100 + (rng.next_u64() % 16) as u32;
         words.push((adc << 16) | (k as u32 % 4096));
     }
     words.iter().flat_map(|w| w.to_le_bytes()).collect()
@@ -110,22 +97,22 @@ fn tag_value(rng: &mut Rng, typ: u32) -> [u8; 8] {
         f64::INFINITY,
     ];
     let ints = [0i64, 1, -1, 2, i64::MAX, i64::MIN, 1 << 40, 4096];
-    match (typ, rng.below(5)) {
-        (_, 4) => rng.next().to_le_bytes(),
-        (0x2000_0008, _) => floats[rng.below(floats.len())].to_le_bytes(),
-        _ => ints[rng.below(ints.len())].to_le_bytes(),
+    match (typ, rng.index(5)) {
+        (_, 4) => rng.next_u64().to_le_bytes(),
+        (0x2000_0008, _) => floats[rng.index(floats.len())].to_le_bytes(),
+        _ => ints[rng.index(ints.len())].to_le_bytes(),
     }
 }
 
 /// Record words: all ones (T3: an overflow of 1023 wraps), an overflow marker with a huge
 /// count (SPC's multiple macro-time overflow), a T2/T3 special with random bits, anything.
 fn record_word(rng: &mut Rng) -> u32 {
-    match rng.below(5) {
+    match rng.index(5) {
         0 => u32::MAX,
-        1 => 0xC000_0000 | (rng.next() as u32 & 0x0FFF_FFFF),
-        2 => 0xFE00_0000 | (rng.next() as u32 & 0x01FF_FFFF),
+        1 => 0xC000_0000 | (rng.next_u64() as u32 & 0x0FFF_FFFF),
+        2 => 0xFE00_0000 | (rng.next_u64() as u32 & 0x01FF_FFFF),
         3 => 0,
-        _ => rng.next() as u32,
+        _ => rng.next_u64() as u32,
     }
 }
 
@@ -135,33 +122,33 @@ fn mutate(
     bases: &[(String, Vec<u8>)],
 ) -> (Vec<u8>, &'static str, Vec<String>, String) {
     let mut what = Vec::new();
-    let spc_case = rng.below(4) == 0;
+    let spc_case = rng.index(4) == 0;
     let (mut d, ext, start, tag_list) = if spc_case {
         let d = spc(rng, 2000);
         what.push("spc".to_string());
         (d, "spc", 4, Vec::new())
     } else {
-        let (name, d) = &bases[rng.below(bases.len())];
+        let (name, d) = &bases[rng.index(bases.len())];
         what.push(name.clone());
         let (t, start) = tags(d);
         (d.clone(), "ptu", start, t)
     };
-    for _ in 0..1 + rng.below(3) {
-        match rng.below(if tag_list.is_empty() { 3 } else { 4 }) {
+    for _ in 0..1 + rng.index(3) {
+        match rng.index(if tag_list.is_empty() { 3 } else { 4 }) {
             0 | 1 => {
-                for _ in 0..1 + rng.below(8) {
+                for _ in 0..1 + rng.index(8) {
                     let records = d.len().saturating_sub(start) / 4;
                     if records == 0 {
                         break;
                     }
-                    let at = start + 4 * rng.below(records);
+                    let at = start + 4 * rng.index(records);
                     let w = record_word(rng);
                     d[at..at + 4].copy_from_slice(&w.to_le_bytes());
                     what.push(format!("record {} = {w:#010x}", (at - start) / 4));
                 }
             }
             2 => {
-                let at = rng.below(d.len() + 1);
+                let at = rng.index(d.len() + 1);
                 d.truncate(at);
                 what.push(format!("cut at {at}"));
             }
@@ -173,7 +160,7 @@ fn mutate(
                     })
                     .filter(|t| t.name != "Header_End")
                     .collect();
-                let t = scalars[rng.below(scalars.len())];
+                let t = scalars[rng.index(scalars.len())];
                 let v = tag_value(rng, t.typ);
                 if t.value_at + 8 <= d.len() {
                     d[t.value_at..t.value_at + 8].copy_from_slice(&v);
@@ -184,9 +171,9 @@ fn mutate(
     }
     let mut args = Vec::new();
     let resolutions = ["1.2e-11", "1e-21", "0", "-1e-12", "nan", "1e3", "4e-12"];
-    if spc_case || rng.below(4) == 0 {
+    if spc_case || rng.index(4) == 0 {
         // SPC files need it; a PTU's header value is overridden now and then.
-        let r = resolutions[rng.below(resolutions.len())];
+        let r = resolutions[rng.index(resolutions.len())];
         args.extend(["--resolution-s".to_string(), r.to_string()]);
         what.push(format!("--resolution-s {r}"));
     }

@@ -9,21 +9,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use tofprobe_design::{DEFAULT_TOML, Document, ProbeCache, RtlOverrides, resolve_with, rtl_params};
 
-/// SplitMix64: a tiny deterministic generator (the case list must not depend on a crate's
-/// version).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn pick<'a, T>(&mut self, v: &'a [T]) -> &'a T {
-        &v[(self.next() % v.len() as u64) as usize]
-    }
-}
+use tofprobe_testkit::params::Rng;
 
 /// Every key a document can hold (those the default leaves out included), by table.
 const KEYS: &[(&str, &[&str])] = &[
@@ -141,7 +127,7 @@ fn values() -> Vec<String> {
 fn mutate(rng: &mut Rng, vals: &[String]) -> (String, Vec<(String, String, String)>) {
     let mut doc: toml::Table = toml::from_str(DEFAULT_TOML).unwrap();
     let mut muts = Vec::new();
-    for _ in 0..1 + rng.next() % 3 {
+    for _ in 0..1 + rng.next_u64() % 3 {
         let (table, keys) = rng.pick(KEYS);
         let key = rng.pick(keys).to_string();
         let lit = rng.pick(vals).clone();
@@ -159,7 +145,7 @@ fn mutate(rng: &mut Rng, vals: &[String]) -> (String, Vec<(String, String, Strin
                 .as_table_mut()
                 .unwrap()
         };
-        if rng.next().is_multiple_of(8) {
+        if rng.next_u64().is_multiple_of(8) {
             if target.remove(&key).is_some() {
                 muts.push((table.to_string(), key, "<removed>".to_string()));
             }
