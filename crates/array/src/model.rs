@@ -16,7 +16,7 @@ use tofprobe_pixel::FrameDriver;
 
 use crate::error::ArrayError;
 
-/// Pulses per streamed chunk of one pixel (64 k pulses: 512 kB of detections per thread).
+/// Pulses per streamed chunk of one pixel (64 k pulses: 256 kB of codes per thread).
 const CHUNK: usize = 1 << 16;
 
 /// The registers of a rectangle of pixels after one frame.
@@ -71,11 +71,12 @@ pub fn run_pixel(
     let mut tm = FrameDriver::new(&design.pixel, rom).map_err(err)?;
     // The source counts the detections as it draws them: no second pass over the pulses.
     let n = design.pixel.frame_pulses;
-    let mut buf = vec![None; CHUNK.min(n as usize)];
+    // The compact codes (4 bytes a pulse), read by the driver without conversion.
+    let mut buf = vec![0u32; CHUNK.min(n as usize)];
     let (mut first, mut detections) = (0u64, 0u64);
     while first < n {
         let k = (n - first).min(buf.len() as u64) as usize;
-        detections += source.fill_counted(first, &mut buf[..k]).detections;
+        detections += source.fill_counted_codes(first, &mut buf[..k]).detections;
         tm.run(&buf[..k], first).map_err(err)?;
         first += k as u64;
     }

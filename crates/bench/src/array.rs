@@ -109,13 +109,14 @@ pub fn measure(
         drop(frame);
         // The Monte Carlo alone: pixel (0, 0)'s source over the same N on this thread.
         let src = d.pixel_source(0, 0)?;
-        let mut buf = vec![None; 1 << 16];
+        // The compact codes, the form the array streams (`PhotonSource::fill_codes`).
+        let mut buf = vec![0u32; 1 << 16];
         let c0 = thread_cpu_ns();
         let t1 = Instant::now();
         let mut first = 0u64;
         while first < n {
             let k = (n - first).min(buf.len() as u64) as usize;
-            src.fill(first, &mut buf[..k]);
+            src.fill_codes(first, &mut buf[..k]);
             first += k as u64;
         }
         let mc_wall = t1.elapsed().as_secs_f64();

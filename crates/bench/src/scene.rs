@@ -1,8 +1,9 @@
 //! The photon/TDC Monte Carlo's single-thread throughput on a configuration's scene, at
 //! (ρ_s, ρ_b) = (1, 0) and (0.3, 0.3), against the targets of 50 M and 20 M pulses/s.
 //!
-//! Each case times the batched kernel (`PhotonSource::fill_counted`, what every command
-//! uses) beside the per-pulse reference kernel (`fill_counted_reference`) in the same run,
+//! Each case times the batched kernel writing the compact codes the pixel's drivers read
+//! (`PhotonSource::fill_counted_codes`, what the array and `run_pixel` stream) beside the
+//! per-pulse reference kernel (`fill_counted_reference`, its `Option`s) in the same run,
 //! alternating halves of the pulses so both see the same machine load, and reports the
 //! ratio (issue 28's target: ≥ 3× per CPU-second). Rates are reported against wall-clock
 //! time and, where Linux exposes it, against the thread's own CPU time: `pass` and the
@@ -71,7 +72,7 @@ fn run(
     reference: bool,
     first: u64,
     pulses: u64,
-    buf: &mut [Option<u32>],
+    (buf, codes): (&mut [Option<u32>], &mut [u32]),
 ) -> (f64, Option<f64>) {
     let cpu0 = thread_cpu_ns();
     let start = Instant::now();
@@ -82,7 +83,7 @@ fn run(
         detections += if reference {
             source.fill_counted_reference(p, &mut buf[..n])
         } else {
-            source.fill_counted(p, &mut buf[..n])
+            source.fill_counted_codes(p, &mut codes[..n])
         }
         .detections;
         p += n as u64;
@@ -110,14 +111,15 @@ fn time_case(
         .photon_source()
         .map_err(|source| tofprobe_design::DesignError::scene("bench scene", source))?;
     let mut buf = vec![None; CHUNK];
+    let mut codes = vec![0u32; CHUNK];
     // Warm-up, then alternating halves of batched and reference over the same pulses.
-    source.fill(0, &mut buf);
+    source.fill_codes(0, &mut codes);
     source.fill_reference(0, &mut buf);
     let half = pulses / 2;
     let mut acc = [(0.0, Some(0.0)); 2];
     for (first, n) in [(0, half), (half, pulses - half)] {
         for (k, reference) in [(0, false), (1, true)] {
-            let (w, c) = run(&source, reference, first, n, &mut buf);
+            let (w, c) = run(&source, reference, first, n, (&mut buf, &mut codes));
             acc[k].0 += w;
             acc[k].1 = acc[k].1.zip(c).map(|(a, b)| a + b);
         }

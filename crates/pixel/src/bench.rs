@@ -2,7 +2,8 @@
 //! transaction model's pulses per second at B = 16 with the ROM read for every pulse, the
 //! folded driver's on the same frame (issue 28; [`bench_fold`], checked bit-identical to
 //! the transaction driver's readout), and the cycle model's clock edges per second under
-//! the reference sequencer.
+//! the reference sequencer. Both transaction-level drivers read the compact codes
+//! ([`synthetic_codes`]), the form the Monte Carlo writes.
 
 use std::time::Instant;
 
@@ -14,6 +15,15 @@ use crate::fold::FoldModel;
 use crate::params::PixelParams;
 use crate::sequencer::Sequencer;
 use crate::transaction::TransactionModel;
+
+/// [`synthetic_stimuli`] in the drivers' compact form ([`crate::NO_DETECTION`] for none):
+/// what the benchmarks stream, as the Monte Carlo hands it to the array.
+pub fn synthetic_codes(pulses: usize, codes: u32) -> Vec<u32> {
+    synthetic_stimuli(pulses, codes)
+        .into_iter()
+        .map(crate::detections::compact)
+        .collect()
+}
 
 /// Stimuli the benchmark feeds: a deterministic mix of detections (≈ 90 %) spread over the
 /// 80-code window and misses, so the hold and the prefilter do real work.
@@ -73,7 +83,7 @@ pub fn bench_transaction(
     rom: &RomImage,
     laser_rate_hz: f64,
 ) -> Result<TransactionBench, PixelError> {
-    let stimuli = synthetic_stimuli(pulses, 80);
+    let stimuli = synthetic_codes(pulses, 80);
     let mut tm = TransactionModel::new(params)?;
     let c0 = thread_cpu_seconds();
     let t0 = Instant::now();
@@ -89,7 +99,10 @@ pub fn bench_transaction(
     let depth = rom.depth();
     let t1 = Instant::now();
     for (n, &d) in stimuli.iter().enumerate() {
-        one.pulse(d, rom.entry(n % depth));
+        one.pulse(
+            (d != crate::NO_DETECTION).then_some(d),
+            rom.entry(n % depth),
+        );
     }
     let slow = one.readout();
     let per_pulse_seconds = t1.elapsed().as_secs_f64();
@@ -149,7 +162,7 @@ pub fn bench_fold(
     rom: &RomImage,
     laser_rate_hz: f64,
 ) -> Result<FoldBench, PixelError> {
-    let stimuli = synthetic_stimuli(pulses, 80);
+    let stimuli = synthetic_codes(pulses, 80);
     let mut fm = FoldModel::new(params, rom)?;
     let c0 = thread_cpu_seconds();
     let t0 = Instant::now();

@@ -9,10 +9,12 @@
 //! Fault hooks (`Option<Fault>`, for the mutation tests) sit on the same lines as the
 //! behaviour they break; the transaction model passes `None`, which compiles them away.
 //!
-//! The streaming drivers (`TransactionModel::run`, the folded driver) run the primed
-//! Fourier front end through [`FourierStream`]: [`Datapath::fourier_pulse`]'s arithmetic
-//! without faults, regrouped so that the loop-carried chain is two operations (see there).
+//! The streaming drivers (the folded driver, the lane driver) run the primed Fourier front
+//! end through [`FourierStream`]: [`Datapath::fourier_pulse`]'s arithmetic without faults,
+//! regrouped so that the loop-carried chain is two operations (see there). The transaction
+//! driver, their judge, calls [`Datapath::fourier_pulse`] itself.
 
+use crate::detections::{Detections, NO_DETECTION};
 use crate::fault::Fault;
 use crate::fixed::{mask, prefilter_step_rounded, sign_extend, wrap, zoomed};
 use crate::params::{Mode, PixelParams, Rounding};
@@ -183,24 +185,24 @@ impl Datapath {
     }
 }
 
-/// Pulses per block of [`FourierStream::run`] (a block's decoding, prefilter and sums stay
-/// within the processor's reorder window, so they overlap).
-pub const STREAM_BLOCK: usize = 32;
-/// The decoded code of a pulse without a detection (codes are masked to T ≤ 16 bits).
-const NO_CODE: u32 = u32::MAX;
+/// Pulses per block of [`FourierStream::accumulate`] (the codes of a stream not stored in
+/// the compact form are decoded a block at a time into a buffer on the stack).
+pub const STREAM_BLOCK: usize = 256;
 
-/// The primed Fourier front end over runs of pulses ([`FourierStream::run`]): exactly
-/// [`Datapath::fourier_pulse`] of a primed pixel without faults (tested against it through
-/// the drivers, crates/pixel/tests/it/fold.rs), in another grouping.
+/// The primed Fourier front end over runs of pulses ([`FourierStream::accumulate`]):
+/// exactly [`Datapath::fourier_pulse`] of a primed pixel without faults (tested against it
+/// through the drivers, crates/pixel/tests/it/fold.rs), in another grouping.
 ///
-/// - The detections are decoded to their T-bit codes a block at a time without a branch
-///   (whether a pulse has one is the scene's coin flip; see `decode`).
+/// - The pulses are read in the compact form ([`Detections::codes`]: a code, or
+///   [`NO_DETECTION`]), borrowed where the stream is stored that way.
 /// - The hold is a select of the rounded target t = ((tdc − Z) << F) + r (t of the pulse,
 ///   or the held one), and the prefilter x ← x + ((t − x) >>> S) is carried as the
 ///   distance u = t − x: with s = u >>> S, x ← x + s and u ← u + (t' − t) − s, t' the
 ///   target after this pulse's hold. The chain from one pulse to the next is `>>>` and `−`
 ///   (the target difference is added beside it), where the direct form has `−`, `>>>`
 ///   and `+`.
+/// - Each pulse's operand is added into its own cell in the same loop (the folded driver's
+///   phase sums): no buffer of operands between the front end and the sums.
 /// - The held depth itself is the last detection's, looked up at the end of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FourierStream {
@@ -216,113 +218,98 @@ pub struct FourierStream {
     u: i64,
 }
 
+/// The constants of the stream's per-pulse step.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepConsts {
+    /// The T-bit code mask.
+    pub mask: u32,
+    /// F.
+    pub frac_bits: u32,
+    /// r − (Z << F): the target of code c is (c << F) + offset.
+    pub offset: i64,
+    /// S.
+    pub shift: u32,
+    /// F − G.
+    pub register_shift: u32,
+}
+
 impl FourierStream {
-    /// Runs `detections` (the TDC code of a detected photon, or `None`) through the front
-    /// end: per pulse the prefilter steps towards the held depth, then the hold takes the
-    /// detection. Hands the operands x >>> (F − G) to `sink` in pulse order, in slices of
-    /// at most [`STREAM_BLOCK`].
+    /// The per-pulse constants.
+    pub(crate) fn consts(&self) -> StepConsts {
+        StepConsts {
+            mask: self.mask,
+            frac_bits: self.frac_bits,
+            offset: self.half - (self.zoom << self.frac_bits),
+            shift: self.shift,
+            register_shift: self.register_shift,
+        }
+    }
+
+    /// The loop-carried state (t, x, u).
+    pub(crate) fn state(&self) -> (i64, i64, i64) {
+        (self.target, self.x, self.u)
+    }
+
+    /// Takes back the loop-carried state and the held depth of the last detection (if
+    /// the pulses run since [`FourierStream::state`] had one; its code).
+    pub(crate) fn set_state(&mut self, state: (i64, i64, i64), last: Option<u32>) {
+        (self.target, self.x, self.u) = state;
+        if let Some(c) = last {
+            self.held = i64::from(c & self.mask) - self.zoom;
+        }
+    }
+
+    /// Runs pulses `start .. start + cells.len()` of `detections` through the front end
+    /// (per pulse the prefilter steps towards the held depth, then the hold takes the
+    /// detection) and adds the operand x >>> (F − G) of pulse `start + i` into `cells[i]`
+    /// (wrapping).
     #[inline(always)]
-    pub fn run(&mut self, detections: &[Option<u32>], mut sink: impl FnMut(&[i64])) {
-        let mut codes = [0u32; STREAM_BLOCK];
-        let mut targets = [0i64; STREAM_BLOCK];
-        let mut ops = [0i64; STREAM_BLOCK];
-        let (mask, frac_bits) = (self.mask, self.frac_bits);
-        // t = ((code − Z) << F) + r = (code << F) + offset; NO_CODE (2^32 − 1 > any T-bit
-        // code) maps to a target above every detection's, `none`.
-        let offset = self.half - (self.zoom << frac_bits);
-        let none = (i64::from(NO_CODE) << frac_bits) + offset;
-        let (shift, register_shift) = (self.shift, self.register_shift);
-        let (mut target, mut x, mut u) = (self.target, self.x, self.u);
-        let (whole, tail) = detections.as_chunks::<STREAM_BLOCK>();
-        let tail_codes = tail.iter().map(|d| d.map_or(NO_CODE, |c| c & mask));
-        for block in whole.iter().map(Some).chain(std::iter::once(None)) {
-            let n = match block {
-                Some(block) => {
-                    decode(block, mask, &mut codes);
-                    STREAM_BLOCK
-                }
-                None => {
-                    codes
-                        .iter_mut()
-                        .zip(tail_codes.clone())
-                        .for_each(|(c, t)| *c = t);
-                    tail.len()
-                }
-            };
-            for (t, &c) in targets.iter_mut().zip(&codes) {
-                *t = (i64::from(c) << frac_bits) + offset;
-            }
-            let mut state = (target, x, u);
-            if register_shift == 0 {
+    pub fn accumulate<D: Detections + ?Sized>(
+        &mut self,
+        detections: &D,
+        start: usize,
+        cells: &mut [i64],
+    ) {
+        let k = self.consts();
+        let mut state = self.state();
+        let mut buf = [0u32; STREAM_BLOCK];
+        for (b, block) in cells.chunks_mut(STREAM_BLOCK).enumerate() {
+            let codes = detections.codes(start + b * STREAM_BLOCK, block.len(), &mut buf);
+            if k.register_shift == 0 {
                 // G = F (the default): the operand is x itself.
-                prefilter::<false>(&targets[..n], &mut ops[..n], none, shift, 0, &mut state);
+                step::<false>(codes, block, &k, &mut state);
             } else {
-                prefilter::<true>(
-                    &targets[..n],
-                    &mut ops[..n],
-                    none,
-                    shift,
-                    register_shift,
-                    &mut state,
-                );
-            }
-            (target, x, u) = state;
-            if n > 0 {
-                sink(&ops[..n]);
+                step::<true>(codes, block, &k, &mut state);
             }
         }
-        (self.target, self.x, self.u) = (target, x, u);
-        if let Some(c) = detections.iter().rev().find_map(|d| *d) {
-            self.held = i64::from(c & mask) - self.zoom;
-        }
+        let last = detections.last_detection(start, start + cells.len());
+        self.set_state(state, last);
     }
 }
 
-/// The prefilter and hold of [`FourierStream::run`] over a block of targets (`none`: no
-/// detection): the operands into `ops`, the state (t, x, u) carried in `state`. `SHIFTS`:
-/// whether the operand drops fraction bits (F > G).
+/// The prefilter and hold of [`FourierStream::accumulate`] over a block of compact codes,
+/// each pulse's operand added into its cell, the state (t, x, u) carried in `state`.
+/// `SHIFTS`: whether the operand drops fraction bits (F > G).
 #[inline(always)]
-fn prefilter<const SHIFTS: bool>(
-    targets: &[i64],
-    ops: &mut [i64],
-    none: i64,
-    shift: u32,
-    register_shift: u32,
+pub(crate) fn step<const SHIFTS: bool>(
+    codes: &[u32],
+    cells: &mut [i64],
+    k: &StepConsts,
     state: &mut (i64, i64, i64),
 ) {
     let (mut target, mut x, mut u) = *state;
-    for (op, &t) in ops.iter_mut().zip(targets) {
-        let next = std::hint::select_unpredictable(t != none, t, target);
-        let s = u >> shift;
+    for (cell, &c) in cells.iter_mut().zip(codes) {
+        let t = (i64::from(c & k.mask) << k.frac_bits) + k.offset;
+        let next = std::hint::select_unpredictable(c != NO_DETECTION, t, target);
+        let s = u >> k.shift;
         // v = u + (t' − t) is used twice, so the compiler keeps it whole and the chain
         // u → u' stays `>>>` beside `+`, then `−`.
         let v = u + (next - target);
         u = v - s;
         x = (next - v) + s;
-        *op = if SHIFTS { x >> register_shift } else { x };
+        let op = if SHIFTS { x >> k.register_shift } else { x };
+        *cell = cell.wrapping_add(op);
         target = next;
     }
     *state = (target, x, u);
-}
-
-/// The codes of `STREAM_BLOCK` pulses masked to T bits, [`NO_CODE`] where there is no
-/// detection. Not inlined on purpose: behind a reference to a whole array the compiler may
-/// read every payload, so the select needs no branch (it vectorises); inlined into a loop
-/// over a slice, it would branch on each pulse's detection.
-#[inline(never)]
-fn decode(detections: &[Option<u32>; STREAM_BLOCK], mask: u32, codes: &mut [u32; STREAM_BLOCK]) {
-    let (ds, cs) = (detections.as_chunks::<8>().0, codes.as_chunks_mut::<8>().0);
-    for (d, c) in ds.iter().zip(cs) {
-        decode8(d, mask, c);
-    }
-}
-
-/// The codes of 8 pulses masked to T bits, [`NO_CODE`] without a detection (fully unrolled:
-/// constant offsets from the array).
-#[inline(always)]
-fn decode8(detections: &[Option<u32>; 8], mask: u32, codes: &mut [u32; 8]) {
-    for (d, c) in detections.iter().zip(codes) {
-        let code = d.unwrap_or(0) & mask;
-        *c = if d.is_some() { code } else { NO_CODE };
-    }
 }

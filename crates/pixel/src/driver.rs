@@ -6,6 +6,7 @@
 
 use tofprobe_dsp::RomImage;
 
+use crate::detections::{Detections, Window};
 use crate::error::PixelError;
 use crate::fold::{FoldModel, fold_pays};
 use crate::params::PixelParams;
@@ -52,9 +53,9 @@ impl<'rom> FrameDriver<'rom> {
 
     /// Runs many pulses: pulse i reads ROM address (`first_address` + i) mod L (see
     /// [`TransactionModel::run`]).
-    pub fn run(
+    pub fn run<D: Detections + ?Sized>(
         &mut self,
-        detections: &[Option<u32>],
+        detections: &D,
         first_address: u64,
     ) -> Result<(), PixelError> {
         match self {
@@ -87,16 +88,16 @@ impl<'rom> FrameDriver<'rom> {
 /// pulses, pulse n of a frame reading ROM address n mod L, a readout after each), with the
 /// driver [`FrameDriver::new`] picks: the same readouts as
 /// [`TransactionModel::run_frames`].
-pub fn run_frames(
+pub fn run_frames<D: Detections + ?Sized>(
     params: &PixelParams,
-    stimuli: &[Option<u32>],
+    stimuli: &D,
     rom: Option<&RomImage>,
 ) -> Result<Vec<Readout>, PixelError> {
     let n = frame_len(params, stimuli.len())?;
     let mut driver = FrameDriver::new(params, rom)?;
     let mut out = Vec::with_capacity(stimuli.len() / n.max(1));
-    for frame in stimuli.chunks(n) {
-        driver.run(frame, 0)?;
+    for start in (0..stimuli.len()).step_by(n.max(1)) {
+        driver.run(&Window::new(stimuli, start..start + n), 0)?;
         out.push(driver.readout());
     }
     Ok(out)

@@ -21,6 +21,7 @@
 use tofprobe_dsp::RomImage;
 
 use crate::datapath::Datapath;
+use crate::detections::Detections;
 use crate::error::PixelError;
 use crate::params::{Mode, PixelParams};
 use crate::readout::Readout;
@@ -128,16 +129,17 @@ impl<'rom> FoldModel<'rom> {
 
     /// Runs many pulses: pulse i reads ROM address (`first_address` + i) mod L, as
     /// [`crate::TransactionModel::run`] (same registers at the next readout).
-    pub fn run(&mut self, detections: &[Option<u32>], first_address: u64) {
+    pub fn run<D: Detections + ?Sized>(&mut self, detections: &D, first_address: u64) {
         let depth = self.phases.len();
+        let total = detections.len();
         // L_v is a multiple of L: address mod L_v names the same ROM entry.
         let mut addr = (first_address % depth as u64) as usize;
         // Until the first detection nothing accumulates (the priming rule): step singly.
-        let mut rest = detections;
-        while !self.dp.primed() && !rest.is_empty() {
-            let det = rest[0];
+        let mut pos = 0usize;
+        while !self.dp.primed() && pos < total {
+            let det = detections.get(pos);
             self.dp.pulse(det.is_some(), det.unwrap_or(0), None);
-            rest = &rest[1..];
+            pos += 1;
             addr += 1;
             if addr == depth {
                 addr = 0;
@@ -145,29 +147,21 @@ impl<'rom> FoldModel<'rom> {
         }
         let Some(mut stream) = self.dp.stream() else {
             // Every pulse went into priming and none primed.
-            self.pcount += detections.len() as u64;
+            self.pcount += total as u64;
             return;
         };
-        while !rest.is_empty() {
-            let len = (depth - addr).min(rest.len());
-            let (now, later) = rest.split_at(len);
-            // Primed: every pulse contributes its operand, in phase order.
-            let mut cells = &mut self.phases[addr..addr + len];
-            stream.run(now, |ops| {
-                let (these, others) = std::mem::take(&mut cells).split_at_mut(ops.len());
-                for (cell, &op) in these.iter_mut().zip(ops) {
-                    *cell = cell.wrapping_add(op);
-                }
-                cells = others;
-            });
-            rest = later;
+        while pos < total {
+            let len = (depth - addr).min(total - pos);
+            // Primed: every pulse adds its operand into its phase sum, in phase order.
+            stream.accumulate(detections, pos, &mut self.phases[addr..addr + len]);
+            pos += len;
             addr += len;
             if addr == depth {
                 addr = 0;
             }
         }
         self.dp.end_stream(stream);
-        self.pcount += detections.len() as u64;
+        self.pcount += total as u64;
     }
 
     /// The register file as it stands (each value sign-extended from W bits): the phase

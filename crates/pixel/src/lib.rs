@@ -5,6 +5,8 @@
 //! - [`params`]: the validated parameters ([`PixelParams`]) and their derived sizes;
 //! - [`config`]: the `[pixel]` TOML section ([`PixelConfig`]) and its validation;
 //! - [`datapath`]: the one datapath (zoom, hold, prefilter, accumulate) both models drive;
+//! - [`detections`]: the drivers' one input, a pulse stream ([`Detections`]: compact codes
+//!   with [`NO_DETECTION`], `Option`s, or any other shape);
 //! - [`fold`]: the folded driver of a Fourier frame (phase sums of the periodic ROM), and
 //!   [`driver`]: [`FrameDriver`], which runs it when it pays and the transaction driver
 //!   otherwise;
@@ -21,6 +23,7 @@ pub mod bench;
 pub mod config;
 pub mod cycle;
 pub mod datapath;
+pub mod detections;
 pub mod directed;
 pub mod driver;
 pub mod error;
@@ -45,6 +48,7 @@ pub mod contract {}
 pub use config::{PixelConfig, PixelContext};
 pub use cycle::{CycleModel, PinsIn, PinsOut, RegWrite};
 pub use datapath::Datapath;
+pub use detections::{Detections, NO_DETECTION, Window};
 pub use directed::{DirectedOptions, Program, directed_program};
 pub use driver::FrameDriver;
 pub use error::PixelError;

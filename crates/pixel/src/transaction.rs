@@ -16,6 +16,7 @@
 use tofprobe_dsp::RomImage;
 
 use crate::datapath::Datapath;
+use crate::detections::{Detections, Window};
 use crate::error::PixelError;
 use crate::fixed::wrap;
 use crate::params::{Mode, PixelParams};
@@ -140,15 +141,16 @@ impl TransactionModel {
     /// Runs many pulses: pulse i reads ROM address (`first_address` + i) mod L. Same result
     /// as calling [`TransactionModel::pulse`] for each, faster (see the module notes).
     /// Fails if the ROM's depth or width does not match the parameters (Fourier).
-    pub fn run(
+    pub fn run<D: Detections + ?Sized>(
         &mut self,
-        detections: &[Option<u32>],
+        detections: &D,
         rom: Option<&RomImage>,
         first_address: u64,
     ) -> Result<(), PixelError> {
+        let total = detections.len();
         if self.params.mode == Mode::Haar {
-            for &d in detections {
-                self.pulse_haar(d);
+            for i in 0..total {
+                self.pulse_haar(detections.get(i));
             }
             return Ok(());
         }
@@ -160,10 +162,10 @@ impl TransactionModel {
         let depth = rom.depth();
         let mut addr = (first_address % depth as u64) as usize;
         // Until the first detection nothing accumulates (the priming rule): step singly.
-        let mut rest = detections;
-        while !self.dp.primed() && !rest.is_empty() {
-            self.advance(rest[0]);
-            rest = &rest[1..];
+        let mut pos = 0usize;
+        while !self.dp.primed() && pos < total {
+            self.advance(detections.get(pos));
+            pos += 1;
             addr += 1;
             if addr == depth {
                 addr = 0;
@@ -176,7 +178,8 @@ impl TransactionModel {
         tables.resize(2 * nbytes, [0; 256]);
         let (even, odd) = tables.split_at_mut(nbytes);
         let mut dp = self.dp;
-        for (i, &det) in rest.iter().enumerate() {
+        for i in 0..total - pos {
+            let det = detections.get(pos + i);
             // Primed: every pulse contributes its operand.
             let x = dp
                 .fourier_pulse(det.is_some(), det.unwrap_or(0), None)
@@ -211,7 +214,7 @@ impl TransactionModel {
             }
         }
         tables.truncate(nbytes);
-        self.pcount += detections.len() as u64;
+        self.pcount += total as u64;
         distribute(&mut tables, &mut self.regs, self.params.width);
         self.tables = tables;
         Ok(())
@@ -229,15 +232,15 @@ impl TransactionModel {
 
     /// Runs whole frames the way the reference sequencer drives them: frame after frame of
     /// N pulses, pulse n of a frame reading ROM address n mod L, a readout after each.
-    pub fn run_frames(
+    pub fn run_frames<D: Detections + ?Sized>(
         &mut self,
-        stimuli: &[Option<u32>],
+        stimuli: &D,
         rom: Option<&RomImage>,
     ) -> Result<Vec<Readout>, PixelError> {
         let n = frame_len(&self.params, stimuli.len())?;
         let mut out = Vec::with_capacity(stimuli.len() / n.max(1));
-        for frame in stimuli.chunks(n) {
-            self.run(frame, rom, 0)?;
+        for start in (0..stimuli.len()).step_by(n.max(1)) {
+            self.run(&Window::new(stimuli, start..start + n), rom, 0)?;
             out.push(self.readout());
         }
         Ok(out)

@@ -26,6 +26,42 @@ use crate::scene::Scene;
 use crate::splitmix::SplitMix64;
 use crate::ziggurat::{Tables, fast_pass, finish, tables};
 
+/// One pulse of the Monte Carlo's output, in either form the kernels write: `Option<u32>`
+/// (`None`: no detection) or the compact code (`u32`, [`NO_DETECTION`] for none, 4 bytes a
+/// pulse: what the pixel's drivers read without conversion).
+pub trait Slot: Copy + Default + Send + Sync + 'static {
+    /// The pulse: a detection of `code` if `hit`, else none (branch-free).
+    fn detection(hit: bool, code: u32) -> Self;
+    /// The pulse as an `Option`.
+    fn get(self) -> Option<u32>;
+}
+
+impl Slot for Option<u32> {
+    #[inline(always)]
+    fn detection(hit: bool, code: u32) -> Self {
+        [None, Some(code)][usize::from(hit)]
+    }
+    #[inline(always)]
+    fn get(self) -> Option<u32> {
+        self
+    }
+}
+
+impl Slot for u32 {
+    #[inline(always)]
+    fn detection(hit: bool, code: u32) -> Self {
+        if hit { code } else { NO_DETECTION }
+    }
+    #[inline(always)]
+    fn get(self) -> Option<u32> {
+        (self != NO_DETECTION).then_some(self)
+    }
+}
+
+/// The compact form's code of a pulse without a detection (TDC codes have at most 16
+/// bits); the pixel's drivers read the same sentinel (`tofprobe_pixel::NO_DETECTION`).
+pub const NO_DETECTION: u32 = u32::MAX;
+
 /// Interleaved generators per stream.
 pub(crate) const LANES: usize = 4;
 /// Pulses per sine sub-block (one table of cos kΔ, sin kΔ).
@@ -294,13 +330,13 @@ mod tests {
 /// its detections and background wins):
 /// the AVX2 copy of the kernel where the CPU has it (the same IEEE operations, no fused
 /// multiply-adds: bit-identical to the baseline copy), the baseline copy elsewhere.
-pub(crate) fn generate(
+pub(crate) fn generate<O: Slot>(
     p: &Params,
     scene: &Scene,
     depths: &Depths,
     block: Block,
     sc: &mut Scratch,
-    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+    (offset, last, out): (usize, u32, &mut [O]),
 ) -> (u64, u64) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx512f")
@@ -330,13 +366,13 @@ pub(crate) fn generate(
 /// conversions in vectors).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512dq")]
-fn generate_avx512(
+fn generate_avx512<O: Slot>(
     p: &Params,
     scene: &Scene,
     depths: &Depths,
     block: Block,
     sc: &mut Scratch,
-    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+    (offset, last, out): (usize, u32, &mut [O]),
 ) -> (u64, u64) {
     generate_body(p, scene, depths, block, sc, (offset, last, out))
 }
@@ -344,25 +380,25 @@ fn generate_avx512(
 /// [`generate_body`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn generate_avx2(
+fn generate_avx2<O: Slot>(
     p: &Params,
     scene: &Scene,
     depths: &Depths,
     block: Block,
     sc: &mut Scratch,
-    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+    (offset, last, out): (usize, u32, &mut [O]),
 ) -> (u64, u64) {
     generate_body(p, scene, depths, block, sc, (offset, last, out))
 }
 
 #[inline(always)]
-fn generate_body(
+fn generate_body<O: Slot>(
     p: &Params,
     scene: &Scene,
     depths: &Depths,
     block: Block,
     sc: &mut Scratch,
-    (offset, last, out): (usize, u32, &mut [Option<u32>]),
+    (offset, last, out): (usize, u32, &mut [O]),
 ) -> (u64, u64) {
     let Block {
         seed: block_seed,
@@ -464,10 +500,10 @@ pub(crate) fn ln(u: f64) -> f64 {
     k * LN2_HI - ((hfsq - (s * (hfsq + r) + k * LN2_LO)) - f)
 }
 
-/// Writes `best` as TDC codes into `out` (`None` outside the window); returns the
+/// Writes `best` as TDC codes into `out` (no detection outside the window); returns the
 /// detections and the background wins among them.
 #[inline(always)]
-fn codes(best: &[f64], from_bg: &[bool], last: u32, out: &mut [Option<u32>]) -> (u64, u64) {
+fn codes<O: Slot>(best: &[f64], from_bg: &[bool], last: u32, out: &mut [O]) -> (u64, u64) {
     let mut detections = 0u64;
     let mut wins = 0u64;
     let last_f = f64::from(last);
@@ -476,7 +512,7 @@ fn codes(best: &[f64], from_bg: &[bool], last: u32, out: &mut [Option<u32>]) -> 
         // compiles to a branch that a 50 % detection rate would mispredict).
         let hit = b < f64::INFINITY;
         let c = b.min(last_f) as u32;
-        *o = [None, Some(c)][usize::from(hit)];
+        *o = O::detection(hit, c);
         detections += u64::from(hit);
         wins += u64::from(g);
     }

@@ -18,6 +18,7 @@ pub mod tttr;
 mod ziggurat;
 
 pub use acquisition::AcquisitionConfig;
+pub use batch::{NO_DETECTION, Slot};
 pub use error::SceneError;
 pub use motion::MotionConfig;
 pub use scene::{Scene, SceneConfig};

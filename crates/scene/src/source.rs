@@ -34,7 +34,7 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
 use crate::MM_PER_PS;
-use crate::batch::{self, Block, Depths, Params, Scratch};
+use crate::batch::{self, Block, Depths, Params, Scratch, Slot};
 use crate::error::SceneError;
 use crate::scene::Scene;
 use crate::sensor::SensorConfig;
@@ -162,6 +162,23 @@ impl PhotonSource {
     /// a background photon won. The batched kernel (crates/scene/src/batch.rs): the same
     /// laws as [`Self::fill_counted_reference`], other draws.
     pub fn fill_counted(&self, first_pulse: u64, out: &mut [Option<u32>]) -> FillCounts {
+        self.fill_counted_slots(first_pulse, out)
+    }
+
+    /// Like [`Self::fill`] in the compact form: pulse i's TDC code, or [`NO_DETECTION`](crate::NO_DETECTION)
+    /// (4 bytes a pulse instead of 8; what the pixel's drivers read directly). The same
+    /// pulses as [`Self::fill`].
+    pub fn fill_codes(&self, first_pulse: u64, out: &mut [u32]) {
+        self.fill_counted_slots(first_pulse, out);
+    }
+
+    /// Like [`Self::fill_codes`], with the counts of [`Self::fill_counted`].
+    pub fn fill_counted_codes(&self, first_pulse: u64, out: &mut [u32]) -> FillCounts {
+        self.fill_counted_slots(first_pulse, out)
+    }
+
+    /// The batched kernel into either output form.
+    fn fill_counted_slots<O: Slot>(&self, first_pulse: u64, out: &mut [O]) -> FillCounts {
         let mut counts = FillCounts::default();
         let mut sc = Scratch::default();
         let last = self.codes - 1;
