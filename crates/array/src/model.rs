@@ -2,9 +2,12 @@
 //! photon stream (`ResolvedDesign::pixel_source`: its rates, the scene at its centre, the
 //! seed of (seed, r, c)) through the pixel's `FrameDriver` (the folded driver of a
 //! periodic ROM, or the transaction driver), streamed in chunks, with the
-//! chip's one probe ROM broadcast to all (Fourier) or the Haar signs of its counter. A
-//! tile is a rectangle of pixels run in parallel on the current rayon pool; tiles merge
-//! into the array byte for byte whatever the tiling, the threads or the process.
+//! chip's one probe ROM broadcast to all (Fourier) or the Haar signs of its counter. Where
+//! the fold pays, the pixels run in groups of `LANES` through the pixel's lane driver
+//! (`FoldLanes`: each pixel's folded driver, in lockstep; [`run_group`]), with the same
+//! registers as one pixel at a time ([`run_pixel`]). A tile is a rectangle of pixels run
+//! in parallel on the current rayon pool; tiles merge into the array byte for byte
+//! whatever the tiling, the threads or the process.
 
 use std::ops::Range;
 
@@ -12,12 +15,16 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use tofprobe_design::ResolvedDesign;
 use tofprobe_dsp::rom::RomImage;
-use tofprobe_pixel::FrameDriver;
+use tofprobe_pixel::{FoldLanes, FrameDriver, LANES, fold_pays};
 
 use crate::error::ArrayError;
 
 /// Pulses per streamed chunk of one pixel (64 k pulses: 256 kB of codes per thread).
 const CHUNK: usize = 1 << 16;
+
+/// Pulses per streamed chunk of a lane group (16 k pulses: 64 kB of codes per pixel, 512
+/// kB per group of eight).
+const LANE_CHUNK: usize = 1 << 14;
 
 /// The registers of a rectangle of pixels after one frame.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -83,6 +90,46 @@ pub fn run_pixel(
     Ok((tm.readout().words, detections))
 }
 
+/// One frame of the pixels `group` (at most [`LANES`], each (r, c)) through the lane
+/// driver (`FoldLanes`, the folded driver of each pixel run in lockstep): each pixel's
+/// register words and detections, exactly [`run_pixel`]'s. Each pixel reads its own
+/// stream, so the result does not depend on which pixels share a group.
+pub fn run_group(
+    design: &ResolvedDesign,
+    rom: &RomImage,
+    group: &[(usize, usize)],
+) -> Result<Vec<(Vec<i64>, u64)>, ArrayError> {
+    let err = |(row, col): (usize, usize)| move |source| ArrayError::Pixel { row, col, source };
+    let first = *group
+        .first()
+        .ok_or_else(|| ArrayError::Shape("a lane group of no pixels".into()))?;
+    let sources = group
+        .iter()
+        .map(|&(r, c)| design.pixel_source(r, c))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut lanes = FoldLanes::new(&design.pixel, rom, group.len()).map_err(err(first))?;
+    let n = design.pixel.frame_pulses;
+    let len = LANE_CHUNK.min(n as usize);
+    let mut bufs = vec![vec![0u32; len]; group.len()];
+    let mut detections = vec![0u64; group.len()];
+    let mut start = 0u64;
+    while start < n {
+        let k = (n - start).min(len as u64) as usize;
+        for ((src, buf), d) in sources.iter().zip(&mut bufs).zip(&mut detections) {
+            *d += src.fill_counted_codes(start, &mut buf[..k]).detections;
+        }
+        let chunk: Vec<&[u32]> = bufs.iter().map(|b| &b[..k]).collect();
+        lanes.run(&chunk, start).map_err(err(first))?;
+        start += k as u64;
+    }
+    Ok(lanes
+        .readout()
+        .into_iter()
+        .map(|r| r.words)
+        .zip(detections)
+        .collect())
+}
+
 /// The array shape of a design, or an error naming the missing `[array]`.
 fn shape(design: &ResolvedDesign) -> Result<(usize, usize), ArrayError> {
     design
@@ -107,10 +154,25 @@ pub fn run_tile(
         )));
     }
     let w = cols.len();
-    let pixels: Vec<(Vec<i64>, u64)> = (0..rows.len() * w)
-        .into_par_iter()
-        .map(|i| run_pixel(design, rom, rows.start + i / w, cols.start + i % w))
-        .collect::<Result<_, _>>()?;
+    let at = |i: usize| (rows.start + i / w, cols.start + i % w);
+    let count = rows.len() * w;
+    let pixels: Vec<(Vec<i64>, u64)> = match rom {
+        // A folded pixel: groups of LANES pixels (row-major over the tile) in lockstep.
+        Some(rom) if fold_pays(&design.pixel) => (0..count.div_ceil(LANES))
+            .into_par_iter()
+            .map(|g| {
+                let group: Vec<_> = (g * LANES..((g + 1) * LANES).min(count)).map(at).collect();
+                run_group(design, rom, &group)
+            })
+            .collect::<Result<Vec<_>, _>>()?
+            .into_iter()
+            .flatten()
+            .collect(),
+        _ => (0..count)
+            .into_par_iter()
+            .map(|i| run_pixel(design, rom, at(i).0, at(i).1))
+            .collect::<Result<_, _>>()?,
+    };
     let registers_per_pixel = design.pixel.registers();
     let mut registers = Vec::with_capacity(pixels.len() * registers_per_pixel);
     let mut detections = Vec::with_capacity(pixels.len());

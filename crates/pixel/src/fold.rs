@@ -48,8 +48,65 @@ pub fn fold_pays(params: &PixelParams) -> bool {
     n + l * nbytes < n * nbytes
 }
 
+/// Checks what a folded pixel needs (valid parameters, Fourier, L ≤ [`MAX_FOLD_DEPTH`], a
+/// ROM that fits) and returns the ROM.
+pub(crate) fn check_fold<'rom>(
+    params: &PixelParams,
+    rom: &'rom RomImage,
+) -> Result<&'rom RomImage, PixelError> {
+    params.validate()?;
+    if params.mode != Mode::Fourier {
+        return Err(PixelError::mismatch(
+            "folded driver's pixel mode",
+            params.mode,
+            "fourier (Haar has no periodic ROM: use the transaction driver)",
+        ));
+    }
+    if params.rom_depth > MAX_FOLD_DEPTH {
+        return Err(PixelError::mismatch(
+            "folded driver's ROM depth",
+            params.rom_depth,
+            format!("L ≤ {MAX_FOLD_DEPTH} (use the transaction driver)"),
+        ));
+    }
+    check_rom(params, Some(rom))
+}
+
+/// The registers (sign-extended from W bits) of phase sums `phases` (phase p reads ROM
+/// address p mod L): each sum added into the byte tables of its ROM entry, then
+/// distributed with the ± signs of the entry's bits. Shared by the folded and lane drivers.
+pub(crate) fn fold_registers(
+    params: &PixelParams,
+    rom: &RomImage,
+    phases: impl Iterator<Item = i64>,
+) -> Vec<i64> {
+    let r = params.registers();
+    let mut tables = vec![[0i64; 256]; r.div_ceil(8)];
+    let wpe = rom.words_per_entry();
+    let words = rom.words();
+    let depth = rom.depth();
+    let mut a = 0usize;
+    for s in phases {
+        if s != 0 {
+            let entry = &words[a * wpe..a * wpe + wpe];
+            for (j, table) in tables.iter_mut().enumerate() {
+                let byte = (entry[j / 8] >> ((j % 8) * 8)) as u8;
+                let cell = &mut table[byte as usize];
+                *cell = cell.wrapping_add(s);
+            }
+        }
+        a += 1;
+        if a == depth {
+            a = 0;
+        }
+    }
+    let mut regs = vec![0; r];
+    distribute(&mut tables, &mut regs, params.width);
+    regs
+}
+
 /// The smallest multiple of `depth` that is at least [`MIN_SEGMENT`] (`depth` ≥ 1).
-fn virtual_depth(depth: usize) -> usize {
+pub(crate) fn virtual_depth(depth: usize) -> usize {
     depth * MIN_SEGMENT.div_ceil(depth).max(1)
 }
 
@@ -70,22 +127,7 @@ impl<'rom> FoldModel<'rom> {
     /// A pixel just out of reset. Fails if the parameters do not validate, if the mode is
     /// not Fourier, if L exceeds [`MAX_FOLD_DEPTH`] or if `rom` does not fit the parameters.
     pub fn new(params: &PixelParams, rom: &'rom RomImage) -> Result<Self, PixelError> {
-        params.validate()?;
-        if params.mode != Mode::Fourier {
-            return Err(PixelError::mismatch(
-                "folded driver's pixel mode",
-                params.mode,
-                "fourier (Haar has no periodic ROM: use the transaction driver)",
-            ));
-        }
-        if params.rom_depth > MAX_FOLD_DEPTH {
-            return Err(PixelError::mismatch(
-                "folded driver's ROM depth",
-                params.rom_depth,
-                format!("L ≤ {MAX_FOLD_DEPTH} (use the transaction driver)"),
-            ));
-        }
-        let rom = check_rom(params, Some(rom))?;
+        let rom = check_fold(params, rom)?;
         Ok(FoldModel {
             params: params.clone(),
             rom,
@@ -167,29 +209,7 @@ impl<'rom> FoldModel<'rom> {
     /// The register file as it stands (each value sign-extended from W bits): the phase
     /// sums distributed, without reading out.
     pub fn registers(&self) -> Vec<i64> {
-        let r = self.params.registers();
-        let mut tables = vec![[0i64; 256]; r.div_ceil(8)];
-        let wpe = self.rom.words_per_entry();
-        let words = self.rom.words();
-        let depth = self.rom.depth();
-        let mut a = 0usize;
-        for &s in &self.phases {
-            if s != 0 {
-                let entry = &words[a * wpe..a * wpe + wpe];
-                for (j, table) in tables.iter_mut().enumerate() {
-                    let byte = (entry[j / 8] >> ((j % 8) * 8)) as u8;
-                    let cell = &mut table[byte as usize];
-                    *cell = cell.wrapping_add(s);
-                }
-            }
-            a += 1;
-            if a == depth {
-                a = 0;
-            }
-        }
-        let mut regs = vec![0; r];
-        distribute(&mut tables, &mut regs, self.params.width);
-        regs
+        fold_registers(&self.params, self.rom, self.phases.iter().copied())
     }
 
     /// Reads the frame out and clears the registers and the frame counters. The depth

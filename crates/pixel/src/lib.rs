@@ -9,7 +9,8 @@
 //!   with [`NO_DETECTION`], `Option`s, or any other shape);
 //! - [`fold`]: the folded driver of a Fourier frame (phase sums of the periodic ROM), and
 //!   [`driver`]: [`FrameDriver`], which runs it when it pays and the transaction driver
-//!   otherwise;
+//!   otherwise; [`lanes`]: [`FoldLanes`], up to [`LANES`] folded pixels of an array in
+//!   lockstep;
 //! - [`schedule`]: the adder schedule, which register each adder touches in which slot;
 //! - [`fault`]: deliberate faults the cycle model carries for the mutation tests;
 //! - [`fixed`]: the fixed-width arithmetic of the datapath;
@@ -30,6 +31,7 @@ pub mod error;
 pub mod fault;
 pub mod fixed;
 pub mod fold;
+pub mod lanes;
 pub mod params;
 pub mod readout;
 pub mod schedule;
@@ -54,6 +56,7 @@ pub use driver::FrameDriver;
 pub use error::PixelError;
 pub use fault::Fault;
 pub use fold::{FoldModel, fold_pays};
+pub use lanes::{FoldLanes, LANES};
 pub use params::{Mode, PixelParams, RegisterFile, Rounding};
 pub use readout::{Readout, ReadoutCollector};
 pub use schedule::{Operation, Schedule};

@@ -90,3 +90,25 @@ fn every_sampled_pixel_is_the_single_pixel_model_on_its_stream() {
         );
     }
 }
+
+/// A lane group (the pixels of the array run in lockstep by the pixel's lane driver) gives
+/// each pixel the registers and detections it has alone, whichever pixels share the group
+/// and in which order.
+#[test]
+fn a_lane_group_is_each_pixel_alone() {
+    use tofprobe_array::model::{run_group, run_pixel};
+    let d = design(&plate(1, 2), 40_000, ARRAY);
+    let rom = d.probe_rom().unwrap().unwrap();
+    let group = [(4, 3), (0, 0), (2, 1)];
+    let lanes = run_group(&d, &rom.image, &group).unwrap();
+    for (&(r, c), got) in group.iter().zip(&lanes) {
+        assert_eq!(
+            got,
+            &run_pixel(&d, Some(&rom.image), r, c).unwrap(),
+            "({r}, {c})"
+        );
+    }
+    let alone = run_group(&d, &rom.image, &group[1..2]).unwrap();
+    assert_eq!(alone[0], lanes[1]);
+    assert_ne!(lanes[0], lanes[1], "pixels differ, so the test can fail");
+}

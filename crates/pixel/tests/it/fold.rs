@@ -3,8 +3,9 @@
 //! wrap), random frame lengths N and ROM depths L (below and above the fold's minimum
 //! segment), random ROM bits and random detections (misses, codes wider than the T pins),
 //! streamed in random chunks over several frames, the fold's readouts, held depth and
-//! prefilter state equal `TransactionModel::run`'s and the pulse-by-pulse reference's. A
-//! fold whose phases are off by one fails the same property.
+//! prefilter state equal `TransactionModel::run`'s and the pulse-by-pulse reference's, on
+//! the `Option` stream and on its compact form (`u32` codes). A fold whose phases are off
+//! by one fails the same property.
 
 use crate::common;
 
@@ -12,6 +13,7 @@ use common::{Rng, random_detection, random_params, random_rom};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use tofprobe_dsp::RomImage;
+use tofprobe_pixel::detections::compact;
 use tofprobe_pixel::driver::run_frames;
 use tofprobe_pixel::fold::{MAX_FOLD_DEPTH, MIN_SEGMENT};
 use tofprobe_pixel::{
@@ -132,6 +134,21 @@ fn fold_trace(c: &Case, phase_error: u64) -> Trace {
         .collect()
 }
 
+/// The fold's trace on the compact form of the same pulses (`u32` codes, NO_DETECTION).
+fn fold_trace_codes(c: &Case) -> Trace {
+    let codes: Vec<u32> = c.detections.iter().map(|&d| compact(d)).collect();
+    let mut fm = FoldModel::new(&c.params, &c.rom).unwrap();
+    let n = c.params.frame_pulses as usize;
+    runs(c)
+        .into_iter()
+        .map(|(at, len, ends)| {
+            fm.run(&codes[at..at + len], (at % n) as u64);
+            let r = ends.then(|| fm.readout());
+            (r, fm.held(), fm.prefilter_state(), fm.primed())
+        })
+        .collect()
+}
+
 fn fold_agrees(seed: u64, phase_error: u64) -> Result<(), TestCaseError> {
     let c = case(seed);
     let reference = transaction_trace(&c);
@@ -141,6 +158,9 @@ fn fold_agrees(seed: u64, phase_error: u64) -> Result<(), TestCaseError> {
         &reference,
         "fold against run()"
     );
+    if phase_error == 0 {
+        prop_assert_eq!(&fold_trace_codes(&c), &reference, "fold on codes");
+    }
     Ok(())
 }
 

@@ -8,6 +8,7 @@ mod equivalence;
 mod float_sd;
 mod fold;
 mod haar;
+mod lanes;
 mod numerics;
 mod refusal;
 mod register_frac_bits;
