@@ -87,3 +87,29 @@ fn seeds_give_different_streams() {
     // (0.7·e^-0.3)² = 0.27, equal codes rarely (σ = 10 codes wide). 0.35 is > 20 SE away.
     assert!(same < 7_000, "{same} of 20000 equal");
 }
+
+/// The compact form (`fill_codes`: the code, or NO_DETECTION) is the same stream as the
+/// `Option` form, with the same counts, in any chunking and from mid-block starts.
+#[test]
+fn the_compact_codes_are_the_same_stream() {
+    use tofprobe_scene::NO_DETECTION;
+    let s = src(7);
+    let whole = chunked(&s, 0, 40_000, 40_000);
+    let mut codes = vec![0u32; 40_000];
+    for (i, c) in codes.chunks_mut(3001).enumerate() {
+        s.fill_codes((i * 3001) as u64, c);
+    }
+    let as_options: Vec<Option<u32>> = codes
+        .iter()
+        .map(|&c| (c != NO_DETECTION).then_some(c))
+        .collect();
+    assert_eq!(as_options, whole);
+    assert!(whole.iter().any(Option::is_none) && whole.iter().any(Option::is_some));
+    let mut opts = vec![None; 9000];
+    let mut tail = vec![0u32; 9000];
+    assert_eq!(
+        s.fill_counted_codes(12_345, &mut tail),
+        s.fill_counted(12_345, &mut opts)
+    );
+    assert_eq!(&codes[12_345..21_345], &tail[..]);
+}
