@@ -9,6 +9,7 @@ use numpy::{Element, PyReadonlyArray1};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use tofprobe_pixel::NO_DETECTION;
 
 /// A library error as a Python `ValueError` carrying its message.
 pub fn value_error(e: impl std::fmt::Display) -> PyErr {
@@ -191,6 +192,67 @@ impl CodeSlice<'_> {
     }
 }
 
+impl CodeSlice<'_> {
+    /// Writes pulses `first .. first + valid.len()` of the frame (`valid`, these codes) into
+    /// `out` in the drivers' compact form: the code where valid, `NO_DETECTION` elsewhere
+    /// (the code of an invalid pulse is ignored). One branch-free pass the compiler
+    /// vectorises ([`compact_codes`]); a valid code outside 0 ..= `max_code` is refused,
+    /// naming the pulse and the range.
+    pub fn compact_into(
+        &self,
+        valid: &[bool],
+        first: usize,
+        max_code: u32,
+        out: &mut Vec<u32>,
+    ) -> Result<(), String> {
+        let end = first + valid.len();
+        match *self {
+            CodeSlice::U8(s) => compact_codes(valid, &s[first..end], first, max_code, out),
+            CodeSlice::U16(s) => compact_codes(valid, &s[first..end], first, max_code, out),
+            CodeSlice::U32(s) => compact_codes(valid, &s[first..end], first, max_code, out),
+            CodeSlice::U64(s) => compact_codes(valid, &s[first..end], first, max_code, out),
+            CodeSlice::I8(s) => compact_codes(valid, &s[first..end], first, max_code, out),
+            CodeSlice::I16(s) => compact_codes(valid, &s[first..end], first, max_code, out),
+            CodeSlice::I32(s) => compact_codes(valid, &s[first..end], first, max_code, out),
+            CodeSlice::I64(s) => compact_codes(valid, &s[first..end], first, max_code, out),
+        }
+    }
+}
+
+/// [`CodeSlice::compact_into`] for one integer type: masks instead of selects (a valid
+/// pulse's mask is all ones, an in-range code's too; the code OR the complement of both
+/// masks is the code or all ones, `NO_DETECTION`), so the pass has no branch; only a
+/// failing range check looks for the pulse to name.
+fn compact_codes<T: Code>(
+    valid: &[bool],
+    codes: &[T],
+    first: usize,
+    max_code: u32,
+    out: &mut Vec<u32>,
+) -> Result<(), String> {
+    out.clear();
+    out.resize(valid.len(), NO_DETECTION);
+    let mut bad = 0u32;
+    for ((o, &v), &c) in out.iter_mut().zip(valid).zip(codes) {
+        let valid_mask = u32::from(v).wrapping_neg();
+        let ok_mask = u32::from(c.within(max_code)).wrapping_neg();
+        bad |= valid_mask & !ok_mask;
+        *o = c.wrapped() | !(valid_mask & ok_mask);
+    }
+    const _: () = assert!(NO_DETECTION == u32::MAX, "the masks make all ones");
+    if bad == 0 {
+        return Ok(());
+    }
+    let (i, c) = valid
+        .iter()
+        .zip(codes)
+        .enumerate()
+        .find(|(_, (v, c))| **v && !c.within(max_code))
+        .map(|(i, (_, &c))| (first + i, c.into()))
+        .unwrap_or((first, -1));
+    Err(range_error(i, c, max_code))
+}
+
 /// Fills `out` with the detections of pulses `first .. first + valid.len()` of (`valid`,
 /// `tdc`): `Some(code)` where valid, `None` elsewhere (the code of an invalid pulse is
 /// ignored). A valid code outside 0 ..= `max_code` is refused, naming the pulse and the
@@ -250,14 +312,19 @@ where
         .find(|(_, (v, c))| **v && !c.within(max_code))
         .map(|(i, (_, &c))| (first + i, c.into()))
         .unwrap_or((first, -1));
-    Err(format!(
+    Err(range_error(i, c, max_code))
+}
+
+/// The message of a valid pulse `i` whose code `c` is out of 0 ..= `max_code`.
+fn range_error(i: usize, c: i128, max_code: u32) -> String {
+    format!(
         "`tdc[{i}]` = {c} is outside the pixel's TDC codes 0 ..= {max_code} \
          (pixel.tdc_bits); a code in that range would work, or valid[{i}] = False"
-    ))
+    )
 }
 
 /// An integer dtype of TDC codes.
-pub trait Code: Copy {
+pub trait Code: Copy + Into<i128> + Send + Sync {
     /// The code as u32 (wrapping: only used once [`Code::within`] holds).
     fn wrapped(self) -> u32;
     /// 0 ≤ code ≤ `max`.
@@ -272,9 +339,9 @@ macro_rules! code {
                 self as u32
             }
             #[inline]
-            #[allow(unused_comparisons)]
             fn within(self, max: u32) -> bool {
-                self >= 0 && (self as u64) <= u64::from(max)
+                // One unsigned compare: a negative code sign-extends to above any max.
+                (self as i64 as u64) <= u64::from(max)
             }
         }
     )*};

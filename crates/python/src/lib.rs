@@ -36,9 +36,9 @@ type PyRect = ((usize, usize), (usize, usize));
 /// Origin of a design given as a dict.
 const DICT_ORIGIN: &str = "<dict>";
 
-/// Pulses converted and run per step of `run_pixel` (256 k: 2 MB of detections per
-/// buffer, in cache; 38 steps for 10^7 pulses).
-const CHUNK: usize = 1 << 18;
+/// Pulses converted and run per step of `run_pixel` (64 k: 256 kB of compact codes per
+/// buffer, in cache; 153 steps for 10^7 pulses).
+const CHUNK: usize = 1 << 16;
 
 /// A tofprobe design resolved once (``tofprobe config``'s resolution): sensor, scene,
 /// acquisition, the pixel's parameters and widths, the Fourier bins and the ΣΔ probe.
@@ -276,24 +276,27 @@ impl Design {
         let rom = self.rom(py)?.map(|r| &r.image);
         let params = &self.inner.pixel;
         let max_code = self.max_code();
-        // The conversion of chunk k + 1 overlaps the pixel's run of chunk k (two threads
-        // of rayon's pool): the Python call then costs the library call plus one chunk's
-        // conversion (scripts/python-bench.py, docs/performance.md).
+        // The frame goes to the driver in its compact form (4 bytes a pulse, what the Monte
+        // Carlo hands the array), a chunk at a time: the conversion of chunk k + 1 (one
+        // branch-free pass, with the range check) overlaps the pixel's run of chunk k on
+        // a second thread of rayon's pool (scripts/python-bench.py, docs/performance.md).
         let words = py.detach(|| -> Result<Vec<i64>, String> {
             let mut driver = FrameDriver::new(params, rom).map_err(|e| e.to_string())?;
             let (mut cur, mut next) = (Vec::with_capacity(CHUNK), Vec::with_capacity(CHUNK));
             let chunks: Vec<&[bool]> = valid_s.chunks(CHUNK).collect();
             if let Some(v) = chunks.first() {
-                convert::detections(v, tdc_s, 0, max_code, &mut cur)?;
+                tdc_s.compact_into(v, 0, max_code, &mut cur)?;
             }
             for k in 0..chunks.len() {
                 let first = k * CHUNK;
                 let (ran, converted) = rayon::join(
-                    || driver.run(&cur, first as u64).map_err(|e| e.to_string()),
+                    || {
+                        driver
+                            .run(&cur[..], first as u64)
+                            .map_err(|e| e.to_string())
+                    },
                     || match chunks.get(k + 1) {
-                        Some(v) => {
-                            convert::detections(v, tdc_s, first + CHUNK, max_code, &mut next)
-                        }
+                        Some(v) => tdc_s.compact_into(v, first + CHUNK, max_code, &mut next),
                         None => Ok(()),
                     },
                 );
@@ -490,9 +493,10 @@ impl Design {
         analysis::size(self, py, liberty, sky130, sweep_bins, sweep_widths, node_nm)
     }
 
-    /// Seconds the library's own pixel call takes on the frame (the frame converted to
-    /// detections first, untimed; then ``FrameDriver`` run and read out, best of
-    /// ``repeat``): the baseline of ``run_pixel``'s overhead (scripts/python-bench.py).
+    /// Seconds the library's own pixel call takes on the frame (the frame converted to the
+    /// drivers' compact codes first, untimed — what the Monte Carlo hands the array; then
+    /// ``FrameDriver`` run and read out, best of ``repeat``): the baseline of
+    /// ``run_pixel``'s overhead (scripts/python-bench.py).
     #[pyo3(signature = (valid, tdc, repeat=1))]
     fn time_library_run_pixel(
         &self,
@@ -501,7 +505,18 @@ impl Design {
         tdc: &Bound<'_, PyAny>,
         repeat: usize,
     ) -> PyResult<f64> {
-        let detections = self.frame(py, valid, tdc)?;
+        let valid_a = convert::bool_array("valid", valid)?;
+        let tdc_a = convert::codes("tdc", tdc)?;
+        let (valid_s, tdc_s) = self.checked_frame(&valid_a, &tdc_a)?;
+        let max_code = self.max_code();
+        let detections = py
+            .detach(|| {
+                let mut out = Vec::new();
+                tdc_s
+                    .compact_into(valid_s, 0, max_code, &mut out)
+                    .map(|()| out)
+            })
+            .map_err(PyValueError::new_err)?;
         let rom = self.rom(py)?.map(|r| &r.image);
         let params = &self.inner.pixel;
         py.detach(|| {
