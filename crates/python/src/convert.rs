@@ -5,11 +5,13 @@
 //! borrowed). Library errors become `ValueError` with the library's message, which names
 //! the field, the value and the allowed range.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use numpy::{Element, PyReadonlyArray1};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use tofprobe_pixel::NO_DETECTION;
+use tofprobe_pixel::{Detections, FrameDriver, NO_DETECTION};
 
 /// A library error as a Python `ValueError` carrying its message.
 pub fn value_error(e: impl std::fmt::Display) -> PyErr {
@@ -192,7 +194,127 @@ impl CodeSlice<'_> {
     }
 }
 
+/// The frame `(valid, tdc)` as the pixel drivers' input, read in place (no conversion
+/// pass of its own): pulse i is a detection of code `tdc[i]` where `valid[i]`, none
+/// elsewhere, decoded a block at a time into the compact form as the driver reads it. A
+/// valid code outside 0 ..= `max_code` reads as no detection and is remembered; the caller
+/// then refuses the frame ([`ValidTdc::check`]), so the range check rides along too.
+#[derive(Debug)]
+pub struct ValidTdc<'a, T> {
+    valid: &'a [bool],
+    tdc: &'a [T],
+    max_code: u32,
+    bad: AtomicBool,
+}
+
+impl<'a, T: Code> ValidTdc<'a, T> {
+    /// The frame; `valid` and `tdc` of the same length (checked by the caller).
+    pub fn new(valid: &'a [bool], tdc: &'a [T], max_code: u32) -> Self {
+        ValidTdc {
+            valid,
+            tdc,
+            max_code,
+            bad: AtomicBool::new(false),
+        }
+    }
+
+    /// `Ok` unless a valid code read so far was out of range: then the error naming the
+    /// first such pulse, its code and the range.
+    pub fn check(&self) -> Result<(), String> {
+        if !self.bad.load(Ordering::Relaxed) {
+            return Ok(());
+        }
+        let (i, c) = self
+            .valid
+            .iter()
+            .zip(self.tdc)
+            .enumerate()
+            .find(|(_, (v, c))| **v && !c.within(self.max_code))
+            .map(|(i, (_, &c))| (i, c.into()))
+            .unwrap_or((0, -1));
+        Err(range_error(i, c, self.max_code))
+    }
+}
+
+impl<T: Code> Detections for ValidTdc<'_, T> {
+    fn len(&self) -> usize {
+        self.valid.len()
+    }
+
+    fn get(&self, i: usize) -> Option<u32> {
+        let (v, c) = (self.valid[i], self.tdc[i]);
+        let ok = c.within(self.max_code);
+        if v && !ok {
+            self.bad.store(true, Ordering::Relaxed);
+        }
+        (v && ok).then(|| c.wrapped())
+    }
+
+    #[inline]
+    fn codes<'b>(&'b self, start: usize, n: usize, buf: &'b mut [u32]) -> &'b [u32] {
+        let out = &mut buf[..n];
+        let bad = mask_codes(
+            &self.valid[start..start + n],
+            &self.tdc[start..start + n],
+            self.max_code,
+            out,
+        );
+        if bad {
+            self.bad.store(true, Ordering::Relaxed);
+        }
+        out
+    }
+}
+
+/// The compact codes of (`valid`, `codes`) into `out` (same lengths): masks instead of
+/// selects (a valid pulse's mask is all ones, an in-range code's too; the code OR the
+/// complement of both masks is the code or all ones, `NO_DETECTION`), so the pass has no
+/// branch and vectorises. Returns whether a valid code was out of 0 ..= `max_code`.
+#[inline(always)]
+fn mask_codes<T: Code>(valid: &[bool], codes: &[T], max_code: u32, out: &mut [u32]) -> bool {
+    const _: () = assert!(NO_DETECTION == u32::MAX, "the masks make all ones");
+    let mut bad = 0u32;
+    for ((o, &v), &c) in out.iter_mut().zip(valid).zip(codes) {
+        let valid_mask = u32::from(v).wrapping_neg();
+        let ok_mask = u32::from(c.within(max_code)).wrapping_neg();
+        bad |= valid_mask & !ok_mask;
+        *o = c.wrapped() | !(valid_mask & ok_mask);
+    }
+    bad != 0
+}
+
 impl CodeSlice<'_> {
+    /// Runs the frame (`valid`, these codes) through `driver`, read in place
+    /// ([`ValidTdc`]); a valid code outside 0 ..= `max_code` is refused afterwards, naming
+    /// the pulse (the driver's registers are then not to be read).
+    pub fn run_pixel(
+        &self,
+        valid: &[bool],
+        max_code: u32,
+        driver: &mut FrameDriver<'_>,
+    ) -> Result<(), String> {
+        fn go<T: Code>(
+            valid: &[bool],
+            tdc: &[T],
+            max_code: u32,
+            driver: &mut FrameDriver<'_>,
+        ) -> Result<(), String> {
+            let frame = ValidTdc::new(valid, tdc, max_code);
+            driver.run(&frame, 0).map_err(|e| e.to_string())?;
+            frame.check()
+        }
+        match *self {
+            CodeSlice::U8(s) => go(valid, s, max_code, driver),
+            CodeSlice::U16(s) => go(valid, s, max_code, driver),
+            CodeSlice::U32(s) => go(valid, s, max_code, driver),
+            CodeSlice::U64(s) => go(valid, s, max_code, driver),
+            CodeSlice::I8(s) => go(valid, s, max_code, driver),
+            CodeSlice::I16(s) => go(valid, s, max_code, driver),
+            CodeSlice::I32(s) => go(valid, s, max_code, driver),
+            CodeSlice::I64(s) => go(valid, s, max_code, driver),
+        }
+    }
+
     /// Writes pulses `first .. first + valid.len()` of the frame (`valid`, these codes) into
     /// `out` in the drivers' compact form: the code where valid, `NO_DETECTION` elsewhere
     /// (the code of an invalid pulse is ignored). One branch-free pass the compiler
@@ -219,10 +341,8 @@ impl CodeSlice<'_> {
     }
 }
 
-/// [`CodeSlice::compact_into`] for one integer type: masks instead of selects (a valid
-/// pulse's mask is all ones, an in-range code's too; the code OR the complement of both
-/// masks is the code or all ones, `NO_DETECTION`), so the pass has no branch; only a
-/// failing range check looks for the pulse to name.
+/// [`CodeSlice::compact_into`] for one integer type ([`mask_codes`]); only a failing
+/// range check looks for the pulse to name.
 fn compact_codes<T: Code>(
     valid: &[bool],
     codes: &[T],
@@ -232,15 +352,8 @@ fn compact_codes<T: Code>(
 ) -> Result<(), String> {
     out.clear();
     out.resize(valid.len(), NO_DETECTION);
-    let mut bad = 0u32;
-    for ((o, &v), &c) in out.iter_mut().zip(valid).zip(codes) {
-        let valid_mask = u32::from(v).wrapping_neg();
-        let ok_mask = u32::from(c.within(max_code)).wrapping_neg();
-        bad |= valid_mask & !ok_mask;
-        *o = c.wrapped() | !(valid_mask & ok_mask);
-    }
-    const _: () = assert!(NO_DETECTION == u32::MAX, "the masks make all ones");
-    if bad == 0 {
+    let bad = mask_codes(valid, codes, max_code, out);
+    if !bad {
         return Ok(());
     }
     let (i, c) = valid
@@ -332,7 +445,7 @@ pub trait Code: Copy + Into<i128> + Send + Sync {
 }
 
 macro_rules! code {
-    ($($t:ty),*) => {$(
+    ($wide:ty: $($t:ty),*) => {$(
         impl Code for $t {
             #[inline]
             fn wrapped(self) -> u32 {
@@ -340,13 +453,16 @@ macro_rules! code {
             }
             #[inline]
             fn within(self, max: u32) -> bool {
-                // One unsigned compare: a negative code sign-extends to above any max.
-                (self as i64 as u64) <= u64::from(max)
+                // One unsigned compare in the type's own width (or 32 bits): a negative
+                // code sign-extends to above any max, so the pass vectorises in narrow
+                // lanes.
+                (self as $wide) <= <$wide>::from(max)
             }
         }
     )*};
 }
-code!(u8, u16, u32, u64, i8, i16, i32, i64);
+code!(u32: u8, u16, u32, i8, i16, i32);
+code!(u64: u64, i64);
 
 /// A dict shaped like the configuration document as TOML text (through `json.dumps`: a
 /// value JSON cannot hold is a `TypeError` naming `d`; a `None` a `ValueError`).

@@ -36,10 +36,6 @@ type PyRect = ((usize, usize), (usize, usize));
 /// Origin of a design given as a dict.
 const DICT_ORIGIN: &str = "<dict>";
 
-/// Pulses converted and run per step of `run_pixel` (64 k: 256 kB of compact codes per
-/// buffer, in cache; 153 steps for 10^7 pulses).
-const CHUNK: usize = 1 << 16;
-
 /// A tofprobe design resolved once (``tofprobe config``'s resolution): sensor, scene,
 /// acquisition, the pixel's parameters and widths, the Fourier bins and the ΣΔ probe.
 ///
@@ -220,8 +216,10 @@ impl Design {
         Ok(out)
     }
 
-    /// One frame's photons: ``(valid, tdc)``, numpy ``bool`` and ``int32`` arrays of N =
-    /// ``frame_pulses`` pulses (``tdc`` is 0 where ``valid`` is False). The same photons as
+    /// One frame's photons: ``(valid, tdc)``, numpy ``bool`` and ``uint16`` arrays of N =
+    /// ``frame_pulses`` pulses (``tdc`` is 0 where ``valid`` is False; TDC codes have at most
+    /// 16 bits, and the narrowest dtype is the cheapest for ``run_pixel`` to read: any
+    /// integer dtype is accepted there). The same photons as
     /// ``tofprobe simulate``'s bit-true frame; ``seed`` replaces ``[acquisition] seed``.
     /// For an ``[array]`` design, ``pixel=(row, col)`` gives that pixel's own stream (its
     /// rates, the scene at its centre, its own seed), the one ``simulate_array`` runs.
@@ -245,7 +243,8 @@ impl Design {
         let (valid, tdc) = py.detach(|| {
             let record = source.record(n);
             let valid: Vec<bool> = record.iter().map(Option::is_some).collect();
-            let tdc: Vec<i32> = record.iter().map(|d| d.map_or(0, |c| c as i32)).collect();
+            // Codes have at most MAX_TDC_BITS = 16 bits: u16 holds every one.
+            let tdc: Vec<u16> = record.iter().map(|d| d.map_or(0, |c| c as u16)).collect();
             (valid, tdc)
         });
         PyTuple::new(
@@ -276,34 +275,13 @@ impl Design {
         let rom = self.rom(py)?.map(|r| &r.image);
         let params = &self.inner.pixel;
         let max_code = self.max_code();
-        // The frame goes to the driver in its compact form (4 bytes a pulse, what the Monte
-        // Carlo hands the array), a chunk at a time: the conversion of chunk k + 1 (one
-        // branch-free pass, with the range check) overlaps the pixel's run of chunk k on
-        // a second thread of rayon's pool (scripts/python-bench.py, docs/performance.md).
+        // The driver reads (valid, tdc) in place (convert::ValidTdc: a block of 256 pulses
+        // decoded at a time into the compact codes it steps, the range check riding
+        // along): no conversion pass, no second thread (scripts/python-bench.py,
+        // docs/performance.md).
         let words = py.detach(|| -> Result<Vec<i64>, String> {
             let mut driver = FrameDriver::new(params, rom).map_err(|e| e.to_string())?;
-            let (mut cur, mut next) = (Vec::with_capacity(CHUNK), Vec::with_capacity(CHUNK));
-            let chunks: Vec<&[bool]> = valid_s.chunks(CHUNK).collect();
-            if let Some(v) = chunks.first() {
-                tdc_s.compact_into(v, 0, max_code, &mut cur)?;
-            }
-            for k in 0..chunks.len() {
-                let first = k * CHUNK;
-                let (ran, converted) = rayon::join(
-                    || {
-                        driver
-                            .run(&cur[..], first as u64)
-                            .map_err(|e| e.to_string())
-                    },
-                    || match chunks.get(k + 1) {
-                        Some(v) => tdc_s.compact_into(v, first + CHUNK, max_code, &mut next),
-                        None => Ok(()),
-                    },
-                );
-                ran?;
-                converted?;
-                std::mem::swap(&mut cur, &mut next);
-            }
+            tdc_s.run_pixel(valid_s, max_code, &mut driver)?;
             Ok(driver.readout().words)
         });
         Ok(words.map_err(PyValueError::new_err)?.into_pyarray(py))

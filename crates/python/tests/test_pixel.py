@@ -44,7 +44,7 @@ def test_registers_give_the_cli_spectrum_bit_for_bit(cli, tmp_path, seed):
 def test_scene_photons(small):
     valid, tdc = small.simulate_scene()
     n = small.summary()["frame_pulses"]
-    assert valid.dtype == np.bool_ and tdc.dtype == np.int32
+    assert valid.dtype == np.bool_ and tdc.dtype == np.uint16
     assert valid.shape == tdc.shape == (n,)
     # ρ_s = 1, ρ_b = 0: nearly every pulse detects (the window clips the jitter's far
     # tails: ±30 mm = ±4σ, p ≈ 6·10^−5 → ~13 misses of 2·10^5).
@@ -136,7 +136,7 @@ def test_bad_input_names_the_argument(small):
         small.run_pixel(valid.reshape(2, -1), tdc.reshape(2, -1))
     i = int(np.argmax(valid))
     for code in [-1, 128]:  # T = 7 bits: codes 0 ..= 127
-        bad = tdc.copy()
+        bad = tdc.astype(np.int32)  # a signed dtype, to hold −1 (simulate_scene's is uint16)
         bad[i] = code
         with pytest.raises(ValueError, match=rf"`tdc\[{i}\]` = {code} .* 0 ..= 127"):
             small.run_pixel(valid, bad)
@@ -144,7 +144,12 @@ def test_bad_input_names_the_argument(small):
         small.run_pixel(np.ones(n + 1, bool), np.zeros(n + 1, np.int32))
     # Lists, other integer dtypes, strided and misaligned arrays read the same codes.
     want = small.run_pixel(valid, tdc)
-    for codes in [tdc.astype(np.uint8), tdc.astype(np.int64), tdc.astype(np.uint64)]:
+    for codes in [
+        tdc.astype(np.uint8),
+        tdc.astype(np.int32),
+        tdc.astype(np.int64),
+        tdc.astype(np.uint64),
+    ]:
         np.testing.assert_array_equal(small.run_pixel(valid, codes), want)
     raw = np.zeros(2 * n + 1, np.uint8)[1:].view(np.int16)  # an odd address
     raw[:] = tdc
