@@ -15,6 +15,9 @@ use tofprobe_design::{ArrayConfig, Document, ResolvedDesign, resolve};
 use crate::BenchError;
 use crate::cpu::{process_cpu_seconds, thread_cpu_ns};
 
+/// Fewest pulses the Monte Carlo alone is timed over (≈ 0.1 CPU-s).
+const MC_MIN_PULSES: u64 = 1 << 25;
+
 /// The target: a 64 × 64 array, N = 10^7, on 2 cores in ≤ 60 s.
 pub const TARGET_SECONDS: f64 = 60.0;
 
@@ -107,15 +110,18 @@ pub fn measure(
         let cpu = cpu0.zip(process_cpu_seconds()).map(|(a, b)| b - a);
         std::hint::black_box(&frame);
         drop(frame);
-        // The Monte Carlo alone: pixel (0, 0)'s source over the same N on this thread.
+        // The Monte Carlo alone: pixel (0, 0)'s source on this thread, over N pulses or
+        // MC_MIN_PULSES if more (the thread's CPU clock may advance by scheduler ticks of
+        // milliseconds: 10^6 pulses are a few of them).
         let src = d.pixel_source(0, 0)?;
+        let mc_pulses = n.max(MC_MIN_PULSES);
         // The compact codes, the form the array streams (`PhotonSource::fill_codes`).
         let mut buf = vec![0u32; 1 << 16];
         let c0 = thread_cpu_ns();
         let t1 = Instant::now();
         let mut first = 0u64;
-        while first < n {
-            let k = (n - first).min(buf.len() as u64) as usize;
+        while first < mc_pulses {
+            let k = (mc_pulses - first).min(buf.len() as u64) as usize;
             src.fill_codes(first, &mut buf[..k]);
             first += k as u64;
         }
@@ -123,7 +129,7 @@ pub fn measure(
         let mc_cpu = c0
             .zip(thread_cpu_ns())
             .map(|(a, b)| (b.saturating_sub(a)) as f64 * 1e-9);
-        let mc_rate = n as f64 / mc_cpu.unwrap_or(mc_wall).max(1e-9);
+        let mc_rate = mc_pulses as f64 / mc_cpu.unwrap_or(mc_wall).max(1e-9);
         let pixel_pulses = f64::from(rows) * f64::from(cols) * n as f64;
         let per_cpu = cpu.map(|c| pixel_pulses / c.max(1e-9));
         let array_rate = per_cpu.unwrap_or(pixel_pulses / seconds.max(1e-9) / threads as f64);
