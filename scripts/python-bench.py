@@ -3,10 +3,10 @@
 frame of the default design (docs/performance.md records the figures).
 
 Both sides run the same frame through the same pixel (`FrameDriver`): `run_pixel(valid,
-tdc)` is the whole Python call (argument checks, numpy borrowing, the conversion of
-(valid, tdc) into the library's detections, the run, the readout, the int64 array back);
-`time_library_run_pixel` times, inside Rust, only what a Rust caller holding the
-detections pays (FrameDriver::new, run, readout). Best of --repeat for each, interleaved,
+tdc)` is the whole Python call (argument checks, numpy borrowing, the driver reading
+(valid, tdc) in place, the run, the readout, the int64 array back);
+`time_library_run_pixel` times, inside Rust, only what a Rust caller holding the frame in
+the drivers' compact codes pays (FrameDriver::new, run, readout). Best of --repeat for each, interleaved,
 so a busy machine affects both alike. Prints both, the overhead in % and whether it is
 within the issue's 5 %. Usage: python scripts/python-bench.py [--repeat 7] [--pulses N]
 """
