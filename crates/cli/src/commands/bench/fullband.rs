@@ -147,7 +147,7 @@ fn print_text(r: &FullBandReport) {
         None => println!(),
     }
     println!(
-        "  target <= {:.0} s, judged on CPU time over {} threads ({:.1} s; wall {:.1} s): {}",
+        "  target: the full band <= {:.0} s, judged on CPU time over {} threads ({:.1} s; this run's wall {:.1} s): {}",
         r.target_seconds,
         r.threads,
         r.judged_seconds,
