@@ -3,8 +3,9 @@
 //! the binary runs on any x86-64; where the CPU has AVX2 the same kernel is compiled a
 //! second time with `#[target_feature(enable = "avx2")]` and twice the lanes (sixteen
 //! 256-bit registers hold what sixteen 128-bit ones held at half the width), and where it
-//! has AVX-512 (F and VL) and FMA a third time with four times the lanes (thirty-two
-//! 512-bit registers: nothing spills).
+//! has AVX-512 (F and VL) and FMA a third time with four times the f64 lanes (thirty-two
+//! 512-bit registers: nothing spills; f32 lanes on that path run the AVX2 copy, faster
+//! for them).
 //!
 //! Determinism: every copy is the same Rust source with the same operations in the same
 //! order per lane; rustc never contracts a·b + c on its own, the AVX2 copy cannot (no

@@ -1,6 +1,7 @@
 //! The inner loop of the full-band probe kernel ([`super::pairs`]): one anchor span of a
 //! group of `L` lanes, in three copies of one body chosen at run time ([`super::isa`]):
-//! the x86-64 baseline (SSE2), AVX2, and AVX-512 (with FMA).
+//! the x86-64 baseline (SSE2), AVX2, and AVX-512 (with FMA; f64 lanes only: f32 lanes on
+//! the AVX-512 path run the AVX2 copy, faster for them, see `LANES_F32_AVX512`).
 //!
 //! Lane layout: lanes 0 .. L/2 are the I streams of the group's bins, lanes L/2 .. L their
 //! Q streams, so the rotation's partner of lane l is lane l ^ L/2: at every width that is
@@ -64,12 +65,13 @@ pub(crate) fn step_on<
 ) {
     #[cfg(target_arch = "x86_64")]
     {
-        if path == KernelPath::Avx512 && KernelPath::Avx512.available() {
+        if path == KernelPath::Avx512 && T::AVX512 && KernelPath::Avx512.available() {
             // SAFETY: the CPU has AVX-512 F and VL, AVX2 and FMA, checked on the line above.
             unsafe { step_span_avx512::<T, L, N, RES, TRACE>(span, k, aw, x, trace) };
             return;
         }
-        if path == KernelPath::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
+        let wide = path == KernelPath::Avx2 || path == KernelPath::Avx512;
+        if wide && std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2, checked on the line above.
             unsafe { step_span_avx2::<T, L, N, RES, TRACE>(span, k, aw, x, trace) };
             return;
