@@ -3,8 +3,9 @@
 //! of the same prefiltered record, timed, with the instruction path that ran and the rate
 //! against the scalar reference loop measured in the same run; optionally also every
 //! in-band bin of the chip's periodic ROM. Target: 0–20 kHz at 1 Hz (20,001 bins,
-//! N = 10^7, 4·10^11 modulator steps) in ≤ 300 s; a shorter run reports the time the full
-//! band would take at its rate.
+//! N = 10^7, 4·10^11 modulator steps) in ≤ 90 s on idle cores, judged on the CPU time of
+//! the ΣΔ pass spread over the pool's threads; a shorter run is judged on the time the full
+//! band would take at its rate per CPU-second.
 
 use std::path::Path;
 use std::time::Instant;
@@ -50,7 +51,8 @@ pub struct FullBandReport {
     pub pulses: u64,
     pub threads: usize,
     pub precision: String,
-    /// Instruction path the lanes ran on ("avx2" or "baseline") and their group width.
+    /// Instruction path the lanes ran on ("avx512", "avx2" or "baseline") and their group
+    /// width.
     pub path: String,
     pub lanes_per_group: usize,
     pub record_seconds: f64,
@@ -69,15 +71,17 @@ pub struct FullBandReport {
     pub full_band_seconds_at_this_rate: f64,
     pub full_band_seconds_idle: Option<f64>,
     pub target_seconds: f64,
-    /// The ΣΔ pass's time on idle cores (its CPU time ÷ threads; wall time where CPU time
-    /// is not measured), s: what `pass` compares with the target.
+    /// The full band's ΣΔ pass on idle cores: `full_band_seconds_idle` (this run's CPU
+    /// time ÷ threads, scaled to the full band's steps; the full band's own run is judged on
+    /// its own CPU time), or the wall-time figure where CPU time is not measured, s: what
+    /// `pass` compares with the target.
     pub judged_seconds: f64,
     pub periodic: Option<BandOut>,
     pub svg: Option<String>,
     pub pass: bool,
 }
 
-pub const TARGET_S: f64 = 300.0;
+pub const TARGET_S: f64 = 90.0;
 /// Modulator steps of the full band: 2 streams × 20,001 bins × 10^7 pulses.
 pub const FULL_BAND_STEPS: f64 = 2.0 * 20_001.0 * 1e7;
 /// Samples of the scalar reference's speed run.
@@ -167,7 +171,9 @@ pub fn measure(
     let scalar = scalar_reference_rate(&design, &speed_record(N_SCALAR))?;
     let steps_per_cpu_second = cpu.map(|c| spec.steps as f64 / c);
     let per_core = windowed.steps_per_s / threads as f64;
-    let judged = cpu.map_or(windowed.sd_seconds, |c| c / threads as f64);
+    let full_band_at_this_rate = FULL_BAND_STEPS / windowed.steps_per_s;
+    let full_band_idle = steps_per_cpu_second.map(|r| FULL_BAND_STEPS / (r * threads as f64));
+    let judged = full_band_idle.unwrap_or(full_band_at_this_rate);
     Ok(FullBandReport {
         configuration: loaded.origin.clone(),
         pulses,
@@ -181,13 +187,14 @@ pub fn measure(
         steps_per_s_per_core: per_core,
         scalar_reference_steps_per_s_per_core: scalar,
         speedup_vs_scalar: per_core / scalar,
-        full_band_seconds_at_this_rate: FULL_BAND_STEPS / windowed.steps_per_s,
-        full_band_seconds_idle: steps_per_cpu_second
-            .map(|r| FULL_BAND_STEPS / (r * threads as f64)),
+        full_band_seconds_at_this_rate: full_band_at_this_rate,
+        full_band_seconds_idle: full_band_idle,
         target_seconds: TARGET_S,
         judged_seconds: judged,
         // Judged on CPU time spread over the threads (the run on idle cores): wall time on a
-        // shared machine also counts the waits for a core.
+        // shared machine also counts the waits for a core. A shorter run is scaled to the
+        // full band by its steps; with fewer bins a step costs a little more (the window
+        // and block overheads are shared by fewer lanes), so that estimate errs high.
         pass: judged <= TARGET_S,
         windowed,
         periodic,

@@ -87,8 +87,8 @@ pub struct SdReport {
     /// Full-band prober (`FullBandProber`, probe generated and accumulated in one pass)
     /// against the scalar reference (`Modulator::run` + direct accumulation), both on one
     /// thread in this run: modulator steps per second per core. `fullband_path` is the
-    /// instruction path `FullBandProber::new` runs on this CPU ("avx2" or "baseline"); the
-    /// `_baseline_` figures are the x86-64 baseline path in the same run.
+    /// instruction path `FullBandProber::new` runs on this CPU ("avx512", "avx2" or
+    /// "baseline"); the `_baseline_` figures are the x86-64 baseline path in the same run.
     pub scalar_reference_steps_per_s_per_core: f64,
     pub fullband_path: String,
     pub fullband_f64_steps_per_s_per_core: f64,

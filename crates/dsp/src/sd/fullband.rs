@@ -13,7 +13,8 @@
 use super::config::ProbeConvention;
 use super::isa::KernelPath;
 use super::pairs::{
-    Coeffs, LANES_F32, LANES_F32_AVX2, LANES_F64, LANES_F64_AVX2, Lane, LanePrecision, PairGroup,
+    Coeffs, LANES_F32, LANES_F32_AVX2, LANES_F32_AVX512, LANES_F64, LANES_F64_AVX2,
+    LANES_F64_AVX512, Lane, LanePrecision, PairGroup,
 };
 use super::probe::ProbeDesign;
 use super::probing::prefilter_response;
@@ -33,6 +34,8 @@ enum Groups {
     F32(Vec<PairGroup<f32, LANES_F32>>),
     F64Avx2(Vec<PairGroup<f64, LANES_F64_AVX2>>),
     F32Avx2(Vec<PairGroup<f32, LANES_F32_AVX2>>),
+    F64Avx512(Vec<PairGroup<f64, LANES_F64_AVX512>>),
+    F32Avx512(Vec<PairGroup<f32, LANES_F32_AVX512>>),
 }
 
 /// Groups of `L` lanes (L/2 bins each) for `bins`.
@@ -119,6 +122,12 @@ impl FullBandProber {
             (LanePrecision::F32, KernelPath::Avx2) => {
                 Groups::F32Avx2(groups(bins, frame, order, path))
             }
+            (LanePrecision::F64, KernelPath::Avx512) => {
+                Groups::F64Avx512(groups(bins, frame, order, path))
+            }
+            (LanePrecision::F32, KernelPath::Avx512) => {
+                Groups::F32Avx512(groups(bins, frame, order, path))
+            }
         };
         Ok(FullBandProber {
             coeffs,
@@ -160,6 +169,8 @@ impl FullBandProber {
                 Groups::F64Avx2(g) => run_all(g, k, n0, &self.aw, block)?,
                 Groups::F32(g) => run_all(g, k, n0, &narrow(&self.aw), &narrow(block))?,
                 Groups::F32Avx2(g) => run_all(g, k, n0, &narrow(&self.aw), &narrow(block))?,
+                Groups::F64Avx512(g) => run_all(g, k, n0, &self.aw, block)?,
+                Groups::F32Avx512(g) => run_all(g, k, n0, &narrow(&self.aw), &narrow(block))?,
             }
             self.n += block.len() as u64;
         }
@@ -193,6 +204,8 @@ impl FullBandProber {
             Groups::F32(g) => g.iter().flat_map(PairGroup::sums).collect(),
             Groups::F64Avx2(g) => g.iter().flat_map(PairGroup::sums).collect(),
             Groups::F32Avx2(g) => g.iter().flat_map(PairGroup::sums).collect(),
+            Groups::F64Avx512(g) => g.iter().flat_map(PairGroup::sums).collect(),
+            Groups::F32Avx512(g) => g.iter().flat_map(PairGroup::sums).collect(),
         }
     }
 

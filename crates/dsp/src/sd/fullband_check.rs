@@ -15,7 +15,8 @@ use super::fullband::FullBandProber;
 use super::isa::KernelPath;
 use super::modulator::Modulator;
 use super::pairs::{
-    Coeffs, LANES_F32, LANES_F32_AVX2, LANES_F64, LANES_F64_AVX2, Lane, LanePrecision, PairGroup,
+    Coeffs, LANES_F32, LANES_F32_AVX2, LANES_F32_AVX512, LANES_F64, LANES_F64_AVX2,
+    LANES_F64_AVX512, Lane, LanePrecision, PairGroup,
 };
 use super::probe::ProbeDesign;
 use crate::error::DspError;
@@ -90,7 +91,8 @@ pub fn naive_sums(
             let mut sums = [0.0; 2];
             let mut bits = [Vec::new(), Vec::new()];
             for (q, (sum, b)) in sums.iter_mut().zip(bits.iter_mut()).enumerate() {
-                let u: Vec<f64> = inputs.iter().map(|r| r[q]).collect();
+                let lane = PairGroup::<f64, LANES_F64>::lane(0, q == 1);
+                let u: Vec<f64> = inputs.iter().map(|r| r[lane]).collect();
                 let mut v = vec![0.0; x.len()];
                 m.run(&u, &mut m.zero_state(), &mut v, amp, 0)?;
                 for (xn, vn) in x.iter().zip(&v) {
@@ -133,6 +135,12 @@ pub fn fast_bits(
         (LanePrecision::F32, KernelPath::Avx2) => {
             traced::<f32, LANES_F32_AVX2>(&k, frame, bins, &narrow(&aw), &narrow(x), path)
         }
+        (LanePrecision::F64, KernelPath::Avx512) => {
+            traced::<f64, LANES_F64_AVX512>(&k, frame, bins, &aw, x, path)
+        }
+        (LanePrecision::F32, KernelPath::Avx512) => {
+            traced::<f32, LANES_F32_AVX512>(&k, frame, bins, &narrow(&aw), &narrow(x), path)
+        }
     }
 }
 
@@ -150,7 +158,11 @@ fn traced<T: Lane, const L: usize>(
         let mut trace = vec![0u32; x.len()];
         g.run(k, 0, aw, x, &mut trace)?;
         for p in 0..chunk.len() {
-            out.push([2 * p, 2 * p + 1].map(|l| trace.iter().map(|w| (w >> l) & 1 == 1).collect()));
+            out.push(
+                [false, true]
+                    .map(|q| PairGroup::<T, L>::lane(p, q))
+                    .map(|l| trace.iter().map(|w| (w >> l) & 1 == 1).collect()),
+            );
         }
     }
     Ok(out)
@@ -245,7 +257,7 @@ mod tests {
         let d = design();
         let x = depths(N as usize, 100, 3.0, 0x9e37_79b9_7f4a_7c15);
         // Chunks of 1000 cross the anchor (1024) and block boundaries off-grid.
-        for path in [KernelPath::Baseline, KernelPath::Avx2] {
+        for path in KernelPath::ALL {
             if !path.available() {
                 eprintln!("skipped: this CPU cannot run the {} path", path.name());
                 continue;

@@ -9,6 +9,7 @@ pub mod lanes;
 pub mod modulator;
 pub mod ntf;
 pub mod pairs;
+mod pairs_kernel;
 pub mod probe;
 pub mod probing;
 pub mod quality;

@@ -1,14 +1,15 @@
 //! The full-band probe kernel: many I/Q modulator pairs stepped together in a
-//! structure-of-arrays loop the compiler vectorises (SSE2 on the x86-64 baseline; a second
-//! copy for AVX2 with twice the lanes, chosen at run time, [`super::isa`]), each lane's ±1
-//! output accumulated against the shared depth record x[n] in the same pass, so no
-//! bitstream is ever stored. The lane count only groups independent lanes: a lane's
-//! arithmetic, hence its bits and sums, is the same at every width.
+//! structure-of-arrays loop the compiler vectorises (SSE2 on the x86-64 baseline; copies for
+//! AVX2 with twice the lanes and for AVX-512 with four times, chosen at run time,
+//! [`super::isa`]; the loop itself is [`super::pairs_kernel`]), each lane's ±1 output
+//! accumulated against the shared depth record x[n] in the same pass, so no bitstream is
+//! ever stored. The lane count only groups independent lanes: a lane's arithmetic, hence
+//! its bits and sums, is the same at every width.
 //!
-//! Lane 2p is the I stream of a bin, lane 2p + 1 its Q stream: their inputs are
-//! A·w[n]·cos θ and A·w[n]·sin θ with θ = 2πkn/N, so one complex rotation per pair and step
-//! ((c, s) ← (c·cos d − s·sin d, s·cos d + c·sin d), a swap and two vector products) feeds
-//! both lanes. The rotators are re-anchored from the exact integer phase (k·n mod N) at every
+//! Of a group's L lanes, lane p < L/2 is the I stream of its bin p and lane p + L/2 the Q
+//! stream: their inputs are A·w[n]·cos θ and A·w[n]·sin θ with θ = 2πkn/N, so one complex
+//! rotation per pair and step ((c, s) ← (c·cos d − s·sin d, s·cos d + c·sin d), two vector
+//! products of one half of the lanes by the other) feeds both lanes. The rotators are re-anchored from the exact integer phase (k·n mod N) at every
 //! multiple of [`ANCHOR`] samples, so rounding never accumulates beyond one anchor span and
 //! the input at sample n depends on n alone, whatever the chunking.
 //!
@@ -27,12 +28,13 @@
 //!   one anchor span (≤ 1024 terms) and f64 across spans. Its effect on the readout is
 //!   measured against the f64 path by the tests and by `tofprobe bench fullband`.
 
-// The lane loops index several same-length arrays in lockstep (`x[l]`, `x[l ^ 1]`): the
+// The lane loops index several same-length arrays in lockstep (`x[l]`, `x[l ^ h]`): the
 // plain index form is what the vectoriser and the reader both follow best.
 #![allow(clippy::needless_range_loop)]
 
 use super::isa::KernelPath;
 use super::modulator::STATE_BOUND;
+use super::pairs_kernel::{Consts, Span, step_on};
 use super::realize::StateSpace;
 use crate::error::DspError;
 use std::f64::consts::PI;
@@ -54,6 +56,14 @@ pub const LANES_F64_AVX2: usize = 8;
 /// Lanes per f32 group on the AVX2 path: four 256-bit registers (same run: 32 lanes
 /// 2.2–2.4·10⁹, 16 lanes 0.94–1.0·10⁹, the baseline's 16 lanes 0.73–0.77·10⁹).
 pub const LANES_F32_AVX2: usize = 32;
+/// Lanes per f64 group on the AVX-512 path ([`KernelPath::Avx512`]): two 512-bit
+/// registers, the I and the Q halves (measured in one session, 801 bins of N = 2·10⁶,
+/// steps per CPU-second: 16 lanes 2.5–2.8·10⁹, 8 lanes 1.2–2.1·10⁹, 32 lanes 1.1–1.4·10⁹).
+pub const LANES_F64_AVX512: usize = 16;
+/// Lanes per f32 group on the AVX-512 path: f32 lanes run the AVX2 copy there (its 32
+/// lanes measured 2.4–3.7·10⁹ steps per CPU-second against the AVX-512 copy's 1.6·10⁹ at
+/// 32 lanes and 2.0·10⁹ at 64, 4000 bins, one thread, same session).
+pub const LANES_F32_AVX512: usize = LANES_F32_AVX2;
 
 /// Arithmetic of the modulator lanes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -92,16 +102,22 @@ pub(crate) trait Lane:
     /// Whether the accumulator is flushed into an f64 total at every anchor (f32), or is
     /// itself the f64 sequential sum (f64: bit-exact with sample-by-sample accumulation).
     const FLUSH: bool;
+    /// Whether the AVX-512 copy of the kernel runs these lanes (f64); f32 lanes on the
+    /// AVX-512 path run the AVX2 copy, faster for them ([`LANES_F32_AVX512`]).
+    const AVX512: bool;
     fn bits(self) -> Self::Bits;
     fn from_bits(b: Self::Bits) -> Self;
     fn of(v: f64) -> Self;
     fn wide(self) -> f64;
+    /// self·a + b rounded once (used only with self = ±1, where it equals ±a + b).
+    fn mul_add(self, a: Self, b: Self) -> Self;
 }
 
 impl Lane for f64 {
     type Bits = u64;
     const SIGN: u64 = 1 << 63;
     const FLUSH: bool = false;
+    const AVX512: bool = true;
     #[inline(always)]
     fn bits(self) -> u64 {
         self.to_bits()
@@ -118,12 +134,17 @@ impl Lane for f64 {
     fn wide(self) -> f64 {
         self
     }
+    #[inline(always)]
+    fn mul_add(self, a: f64, b: f64) -> f64 {
+        f64::mul_add(self, a, b)
+    }
 }
 
 impl Lane for f32 {
     type Bits = u32;
     const SIGN: u32 = 1 << 31;
     const FLUSH: bool = true;
+    const AVX512: bool = false;
     #[inline(always)]
     fn bits(self) -> u32 {
         self.to_bits()
@@ -139,6 +160,10 @@ impl Lane for f32 {
     #[inline(always)]
     fn wide(self) -> f64 {
         f64::from(self)
+    }
+    #[inline(always)]
+    fn mul_add(self, a: f32, b: f32) -> f32 {
+        f32::mul_add(self, a, b)
     }
 }
 
@@ -202,9 +227,9 @@ impl Coeffs {
 /// One group of `L` lanes (L/2 bins): states, rotators and accumulators.
 #[derive(Debug, Clone)]
 pub(crate) struct PairGroup<T: Lane, const L: usize> {
-    /// Bin index of each lane (lanes 2p and 2p + 1 share a bin).
+    /// Bin index of each lane (lanes p and p + L/2 share a bin).
     bins: [u64; L],
-    /// Live lanes (the last group may be partly idle: amplitude 0, never read).
+    /// Live bins (the last group may be partly idle: bin 0 lanes, never read).
     pub live: usize,
     period: u64,
     states: Vec<[T; L]>,
@@ -224,20 +249,21 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
     /// A group at rest for `bins` (at most L/2), frame length `period` (the window's and
     /// the bins' N), stepping on `path` (the baseline where the CPU lacks it).
     pub fn new(bins: &[u64], period: u64, order: usize, path: KernelPath) -> Self {
+        let h = L / 2;
         let mut lane_bins = [0u64; L];
         for (l, b) in lane_bins.iter_mut().enumerate() {
-            *b = bins.get(l / 2).copied().unwrap_or(0) % period;
+            *b = bins.get(l % h).copied().unwrap_or(0) % period;
         }
         let mut cd = [T::default(); L];
         let mut sdm = [T::default(); L];
         for l in 0..L {
             let d = lane_bins[l] as f64 * (2.0 * PI / period as f64);
             cd[l] = T::of(d.cos());
-            sdm[l] = T::of(if l % 2 == 0 { -d.sin() } else { d.sin() });
+            sdm[l] = T::of(if l < h { -d.sin() } else { d.sin() });
         }
         PairGroup {
             bins: lane_bins,
-            live: (2 * bins.len()).min(L),
+            live: bins.len().min(h),
             period,
             states: vec![[T::default(); L]; order],
             rot: [T::default(); L],
@@ -252,12 +278,22 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
     /// Sets the rotators to the exact phase of sample `n`.
     fn anchor(&mut self, n: u64) {
         let l = self.period;
-        for p in (0..L).step_by(2) {
-            let k = self.bins[p];
-            let ph = ((k as u128 * (n % l) as u128) % l as u128) as f64 * (2.0 * PI / l as f64);
+        for p in 0..L / 2 {
+            let (k, m) = (self.bins[p], n % l);
+            // k·m mod l, in u64 where the product fits (always, below 2^32 pulses).
+            let km = match k.checked_mul(m) {
+                Some(v) => v % l,
+                None => ((k as u128 * m as u128) % l as u128) as u64,
+            };
+            let ph = km as f64 * (2.0 * PI / l as f64);
             self.rot[p] = T::of(ph.cos());
-            self.rot[p + 1] = T::of(ph.sin());
+            self.rot[p + L / 2] = T::of(ph.sin());
         }
+    }
+
+    /// The lane of live bin `p`'s I (`quadrature` false) or Q stream.
+    pub fn lane(p: usize, quadrature: bool) -> usize {
+        p + if quadrature { L / 2 } else { 0 }
     }
 
     /// The inputs u[t][lane] the kernel computes for samples n0 .. n0 + aw.len() of a run
@@ -274,7 +310,7 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
             out.push(g.rot.map(|r| a * r));
             let mut nr = [T::default(); L];
             for l in 0..L {
-                nr[l] = g.rot[l] * g.cd[l] + g.rot[l ^ 1] * g.sdm[l];
+                nr[l] = g.rot[l] * g.cd[l] + g.rot[l ^ (L / 2)] * g.sdm[l];
             }
             g.rot = nr;
         }
@@ -290,8 +326,8 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
                 self.acc[l].wide()
             }
         };
-        (0..self.live / 2)
-            .map(|p| (lane(2 * p), lane(2 * p + 1)))
+        (0..self.live)
+            .map(|p| (lane(Self::lane(p, false)), lane(Self::lane(p, true))))
             .collect()
     }
 
@@ -356,11 +392,18 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
             };
             step(
                 self.path,
-                &mut s,
-                &mut self.rot,
-                &mut self.acc,
-                (&self.cd, &self.sdm),
-                (&sup, &b1, &b2),
+                Span {
+                    s: &mut s,
+                    rot: &mut self.rot,
+                    acc: &mut self.acc,
+                },
+                Consts {
+                    cd: &self.cd,
+                    sdm: &self.sdm,
+                    sup: &sup,
+                    b1: &b1,
+                    b2: &b2,
+                },
                 &aw[done..done + span],
                 &x[done..done + span],
                 tr,
@@ -385,7 +428,8 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
 
     /// Every state of every live lane within [`STATE_BOUND`] (NaN caught explicitly).
     fn check<const N: usize>(&self, s: &[[T; L]; N], sample: u64) -> Result<(), DspError> {
-        for l in 0..self.live {
+        let lanes = (0..self.live).flat_map(|p| [Self::lane(p, false), Self::lane(p, true)]);
+        for l in lanes {
             let peak = s.iter().map(|r| r[l].wide().abs()).fold(0.0, f64::max);
             if peak > STATE_BOUND || s.iter().any(|r| r[l].wide().is_nan()) {
                 return Err(DspError::Unstable {
@@ -396,7 +440,7 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
                     hint: format!(
                         "; full-band probe of bin {} ({}) of a frame of {} pulses",
                         self.bins[l],
-                        if l % 2 == 0 { "I" } else { "Q" },
+                        if l < L / 2 { "I" } else { "Q" },
                         self.period
                     ),
                 });
@@ -404,119 +448,6 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
         }
         Ok(())
     }
-}
-
-/// [`step_span`] on `path`: the AVX2 copy where asked for and the CPU has it (checked here,
-/// so no caller can run it on a CPU without), else the baseline's. The workspace's only
-/// unsafe code (see the root Cargo.toml): entering a `#[target_feature]` function.
-#[allow(clippy::too_many_arguments, unsafe_code)]
-#[inline(always)]
-fn step_on<T: Lane, const L: usize, const N: usize, const RES: bool, const TRACE: bool>(
-    path: KernelPath,
-    s: &mut [[T; L]; N],
-    rot: &mut [T; L],
-    acc: &mut [T; L],
-    rotation: (&[T; L], &[T; L]),
-    coeffs: (&[T; N], &[T; N], &[T; N]),
-    aw: &[T],
-    x: &[T],
-    trace: &mut [u32],
-) {
-    #[cfg(target_arch = "x86_64")]
-    if path == KernelPath::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2, checked on the line above.
-        unsafe {
-            step_span_avx2::<T, L, N, RES, TRACE>(s, rot, acc, rotation, coeffs, aw, x, trace)
-        };
-        return;
-    }
-    let _ = path;
-    step_span::<T, L, N, RES, TRACE>(s, rot, acc, rotation, coeffs, aw, x, trace)
-}
-
-/// [`step_span`] compiled for AVX2 (not FMA: products and sums round as on the baseline).
-#[cfg(target_arch = "x86_64")]
-#[allow(clippy::too_many_arguments)]
-#[target_feature(enable = "avx2")]
-fn step_span_avx2<T: Lane, const L: usize, const N: usize, const RES: bool, const TRACE: bool>(
-    s: &mut [[T; L]; N],
-    rot: &mut [T; L],
-    acc: &mut [T; L],
-    rotation: (&[T; L], &[T; L]),
-    coeffs: (&[T; N], &[T; N], &[T; N]),
-    aw: &[T],
-    x: &[T],
-    trace: &mut [u32],
-) {
-    step_span::<T, L, N, RES, TRACE>(s, rot, acc, rotation, coeffs, aw, x, trace)
-}
-
-/// One anchor span of the interleaved loop (see the module docs for why each rewrite of
-/// the reference's arithmetic is exact). Conditions are compile-time, so each lane loop is
-/// straight-line SIMD.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn step_span<T: Lane, const L: usize, const N: usize, const RES: bool, const TRACE: bool>(
-    s: &mut [[T; L]; N],
-    rot: &mut [T; L],
-    acc: &mut [T; L],
-    (cd, sdm): (&[T; L], &[T; L]),
-    (sup, b1, b2): (&[T; N], &[T; N], &[T; N]),
-    aw: &[T],
-    x: &[T],
-    trace: &mut [u32],
-) {
-    let mut st = *s;
-    let mut r = *rot;
-    let mut ac = *acc;
-    let b2b = b2.map(T::bits);
-    for (t, (&a, &xv)) in aw.iter().zip(x).enumerate() {
-        let mut u = [T::default(); L];
-        for l in 0..L {
-            u[l] = a * r[l];
-        }
-        let mut nr = [T::default(); L];
-        for l in 0..L {
-            nr[l] = r[l] * cd[l] + r[l ^ 1] * sdm[l];
-        }
-        r = nr;
-        // Sign of y = u + x[N−1]: set ⇔ the quantiser outputs −1.
-        let mut sm = [T::Bits::default(); L];
-        for l in 0..L {
-            sm[l] = (u[l] + st[N - 1][l]).bits() & T::SIGN;
-        }
-        if TRACE {
-            let mut w = 0u32;
-            for (l, m) in sm.iter().enumerate() {
-                w |= u32::from(*m == T::Bits::default()) << l;
-            }
-            trace[t] = w;
-        }
-        let mut ns = [[T::default(); L]; N];
-        for row in 0..N {
-            for l in 0..L {
-                let mut v = if row > 0 {
-                    st[row - 1][l] + st[row][l]
-                } else {
-                    st[row][l]
-                };
-                if RES && row + 1 < N {
-                    // Adding 0·x where a row has no resonator is exact (states are never −0).
-                    v = v + sup[row] * st[row + 1][l];
-                }
-                v = v + b1[row] * u[l];
-                ns[row][l] = v + T::from_bits(b2b[row] ^ sm[l]);
-            }
-        }
-        let xb = xv.bits();
-        for l in 0..L {
-            ac[l] = ac[l] + T::from_bits(xb ^ sm[l]);
-        }
-        st = ns;
-    }
-    *s = st;
-    *rot = r;
-    *acc = ac;
 }
 
 #[cfg(test)]
@@ -551,9 +482,11 @@ mod tests {
         for chunk in bins.chunks(L / 2) {
             let g = PairGroup::<T, L>::new(chunk, n, 3, KernelPath::Baseline);
             for (t, u) in g.inputs(0, &aw).iter().enumerate() {
-                for (l, ul) in u.iter().enumerate().take(2 * chunk.len()) {
+                for (p, q) in (0..chunk.len()).flat_map(|p| [(p, false), (p, true)]) {
+                    let l = PairGroup::<T, L>::lane(p, q);
+                    let ul = u[l];
                     let th = 2.0 * PI * ((g.bins[l] * t as u64) % n) as f64 / n as f64;
-                    let c = if l % 2 == 0 { th.cos() } else { th.sin() };
+                    let c = if q { th.sin() } else { th.cos() };
                     worst = worst.max((ul.wide() - 0.5 * w.value(t, n as usize) * c).abs());
                 }
             }

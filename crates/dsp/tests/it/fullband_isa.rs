@@ -1,7 +1,8 @@
-//! The full-band kernel's two instruction paths (x86-64 baseline and AVX2, chosen at run
-//! time) must give the same bitstreams and the same sums, bit for bit, in both precisions
-//! and for CIFB loops with and without resonators; the AVX2 path must equal the naive
-//! scalar reference too. On a CPU without AVX2 the AVX2 half is skipped with a message.
+//! The full-band kernel's instruction paths (x86-64 baseline, AVX2 and AVX-512 with its
+//! σ-FMA, chosen at run time) must give the same bitstreams and the same sums, bit for
+//! bit, in both precisions and for CIFB loops with and without resonators; each wider path
+//! must equal the naive scalar reference too. Every path this CPU runs is checked by name;
+//! one it lacks is skipped with a message (and refused, not run).
 
 use tofprobe_dsp::sd::fullband_check::{compare, fast_bits};
 use tofprobe_dsp::sd::{FullBandProber, KernelPath, LanePrecision, ProbeConfig, ProbeDesign};
@@ -72,11 +73,13 @@ fn sums(d: &ProbeDesign, p: LanePrecision, path: KernelPath, x: &[f64], chunk: u
         .collect()
 }
 
-#[test]
-fn avx2_and_baseline_give_the_same_bits_and_sums() {
-    if !KernelPath::Avx2.available() {
+/// `path`'s bits and sums equal the baseline's, in both precisions, for every design.
+fn same_as_baseline(path: KernelPath) {
+    if !path.available() {
         eprintln!(
-            "skipped the AVX2 half: this CPU lacks AVX2 (the baseline path is checked by fullband_check)"
+            "skipped the {} check: this CPU lacks {} (the baseline path is checked by fullband_check)",
+            path.name(),
+            path.features()
         );
         return;
     }
@@ -84,43 +87,84 @@ fn avx2_and_baseline_give_the_same_bits_and_sums() {
     for (di, d) in designs().iter().enumerate() {
         for p in [LanePrecision::F64, LanePrecision::F32] {
             let bits = |path| fast_bits(d, N, &BINS, &x, p, path).expect("stable");
-            let (base, avx) = (bits(KernelPath::Baseline), bits(KernelPath::Avx2));
+            let (base, wide) = (bits(KernelPath::Baseline), bits(path));
             assert_eq!(
-                first_difference(&base, &avx),
+                first_difference(&base, &wide),
                 None,
-                "design {di} {}: (bin index, stream, sample) where the paths part",
+                "{} design {di} {}: (bin index, stream, sample) where the paths part",
+                path.name(),
                 p.name()
             );
             // Off-grid chunks on one path, whole record on the other: anchors and blocks
             // fall differently, the sums must not move.
-            let (sb, sa) = (
+            let (sb, sw) = (
                 sums(d, p, KernelPath::Baseline, &x, 777),
-                sums(d, p, KernelPath::Avx2, &x, x.len()),
+                sums(d, p, path, &x, x.len()),
             );
-            let first = sb.iter().zip(&sa).position(|(a, b)| a != b);
-            assert_eq!(first, None, "design {di} {}: sum index", p.name());
+            let first = sb.iter().zip(&sw).position(|(a, b)| a != b);
+            assert_eq!(
+                first,
+                None,
+                "{} design {di} {}: sum index",
+                path.name(),
+                p.name()
+            );
             // The streams are real ΣΔ streams, not all one sign.
             assert!(base[3][0].iter().any(|&b| b) && base[3][0].iter().any(|&b| !b));
         }
     }
 }
 
-#[test]
-fn avx2_path_equals_the_naive_scalar_reference() {
-    if !KernelPath::Avx2.available() {
-        eprintln!("skipped: this CPU lacks AVX2");
+/// `path`'s f64 sums equal the naive scalar reference's (`Modulator::run` per stream).
+fn equals_the_naive_reference(path: KernelPath) {
+    if !path.available() {
+        eprintln!("skipped: this CPU lacks {}", path.features());
         return;
     }
     let x = record(N as usize);
     for (di, d) in designs().iter().enumerate() {
-        let m = compare(d, N, &BINS, &BINS, &x, 1000, KernelPath::Avx2).expect("stable");
+        let m = compare(d, N, &BINS, &BINS, &x, 1000, path).expect("stable");
         assert_eq!(
             m,
             None,
-            "design {di}: {}",
+            "{} design {di}: {}",
+            path.name(),
             m.as_ref().map(|m| m.to_string()).unwrap_or_default()
         );
     }
+}
+
+#[test]
+fn avx2_and_baseline_give_the_same_bits_and_sums() {
+    same_as_baseline(KernelPath::Avx2);
+}
+
+#[test]
+fn avx512_and_baseline_give_the_same_bits_and_sums() {
+    same_as_baseline(KernelPath::Avx512);
+}
+
+#[test]
+fn avx2_path_equals_the_naive_scalar_reference() {
+    equals_the_naive_reference(KernelPath::Avx2);
+}
+
+#[test]
+fn avx512_path_equals_the_naive_scalar_reference() {
+    equals_the_naive_reference(KernelPath::Avx512);
+}
+
+/// The paths group 4, 8 and 16 f64 lanes (16, 32, 32 f32): the widths the two tests above
+/// rely on exercising, and `auto` picks the widest this CPU runs.
+#[test]
+fn each_path_has_its_width_and_auto_is_the_widest() {
+    let f64_lanes = KernelPath::ALL.map(|p| p.lanes(LanePrecision::F64));
+    let f32_lanes = KernelPath::ALL.map(|p| p.lanes(LanePrecision::F32));
+    assert_eq!((f64_lanes, f32_lanes), ([4, 8, 16], [16, 32, 32]));
+    assert_eq!(
+        KernelPath::detect(),
+        *KernelPath::supported().last().unwrap()
+    );
 }
 
 /// The check can fail: probing bin 100 where the other side probes 101 parts the streams
@@ -138,8 +182,8 @@ fn a_wrong_bin_fails_the_path_check() {
     assert_eq!(i, 10);
     assert!(n < 1000, "{n}");
     // A path this CPU lacks is refused, not run.
-    if !KernelPath::Avx2.available() {
-        let e = fast_bits(d, N, &BINS, &x, LanePrecision::F64, KernelPath::Avx2).unwrap_err();
-        assert!(e.to_string().contains("avx2"), "{e}");
+    for p in KernelPath::ALL.into_iter().filter(|p| !p.available()) {
+        let e = fast_bits(d, N, &BINS, &x, LanePrecision::F64, p).unwrap_err();
+        assert!(e.to_string().contains(p.name()), "{e}");
     }
 }

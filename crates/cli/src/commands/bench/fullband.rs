@@ -1,5 +1,5 @@
 //! `tofprobe bench fullband [CONFIG] [--json] [--svg FILE] [--max-hz 20000] [--step-hz 1]
-//! [--precision f64|f32] [--path auto|baseline|avx2] [--periodic] [--pulses N]`: the
+//! [--precision f64|f32] [--path auto|baseline|avx2|avx512] [--periodic] [--pulses N]`: the
 //! Fig. 8 scene's full-band spectrum (`tofprobe_bench::fullband` measures; this shows the
 //! progress bar and prints).
 
@@ -34,8 +34,8 @@ pub struct FullBandArgs {
     #[arg(long, default_value = "f64", value_parser = ["f64", "f32"])]
     precision: String,
     /// Instruction path of the lanes: auto (the fastest this CPU runs), baseline (x86-64,
-    /// SSE2) or avx2. Every path gives the same sums, bit for bit.
-    #[arg(long, default_value = "auto", value_parser = ["auto", "baseline", "avx2"])]
+    /// SSE2), avx2 or avx512. Every path gives the same sums, bit for bit.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "baseline", "avx2", "avx512"])]
     path: String,
     /// Also read every in-band bin of the periodic ROM (L from [probe]).
     #[arg(long)]
@@ -54,7 +54,12 @@ pub fn run(args: &FullBandArgs) -> Result<(), CliError> {
         _ => LanePrecision::F64,
     };
     let path = KernelPath::parse(&args.path).map_err(|_| {
-        CliError::option("path", &args.path, "auto or baseline: this CPU lacks AVX2")
+        let runs: Vec<&str> = KernelPath::supported().iter().map(|p| p.name()).collect();
+        CliError::option(
+            "path",
+            &args.path,
+            format!("auto or {}: this CPU lacks the others", runs.join(", ")),
+        )
     })?;
     let pulses = args.pulses.unwrap_or_else(|| loaded.document.pulses());
     let bar = ProgressBar::with_draw_target(Some(pulses), ProgressDrawTarget::hidden());
@@ -142,7 +147,7 @@ fn print_text(r: &FullBandReport) {
         None => println!(),
     }
     println!(
-        "  target <= {:.0} s, judged on CPU time over {} threads ({:.1} s; wall {:.1} s): {}",
+        "  target: the full band <= {:.0} s, judged on CPU time over {} threads ({:.1} s; this run's wall {:.1} s): {}",
         r.target_seconds,
         r.threads,
         r.judged_seconds,
