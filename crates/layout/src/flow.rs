@@ -47,16 +47,23 @@ pub struct LayoutRun {
     pub project: PathBuf,
 }
 
-fn check_density(d: f64) -> Result<()> {
-    if d.is_finite() && (MIN_DENSITY..=0.95).contains(&d) {
-        Ok(())
-    } else {
-        Err(LayoutError::Option {
+/// Checks the request's numbers before anything runs.
+pub fn check_options(density: f64, node_nm: f64) -> Result<()> {
+    if !(density.is_finite() && (MIN_DENSITY..=0.95).contains(&density)) {
+        return Err(LayoutError::Option {
             option: "density",
-            value: d.to_string(),
+            value: density.to_string(),
             allowed: format!("{MIN_DENSITY} ..= 0.95 (0.6 routes the default pixel on osu018)"),
-        })
+        });
     }
+    if !(node_nm.is_finite() && node_nm > 0.0 && node_nm <= 1000.0) {
+        return Err(LayoutError::Option {
+            option: "node-nm",
+            value: node_nm.to_string(),
+            allowed: "0 < node ≤ 1000 (nm), e.g. 40".into(),
+        });
+    }
+    Ok(())
 }
 
 /// The densities tried for a request of `d`.
@@ -73,14 +80,7 @@ pub fn run(
     req: &LayoutRequest,
     progress: &mut dyn FnMut(&str),
 ) -> Result<LayoutRun> {
-    check_density(req.density)?;
-    if !(req.node_nm.is_finite() && req.node_nm > 0.0 && req.node_nm <= 1000.0) {
-        return Err(LayoutError::Option {
-            option: "node-nm",
-            value: req.node_nm.to_string(),
-            allowed: "0 < node ≤ 1000 (nm), e.g. 40".into(),
-        });
-    }
+    check_options(req.density, req.node_nm)?;
     crate::tools::require_all()?;
     let mut steps = Vec::new();
     let timed = |steps: &mut Vec<Step>, name: &str, t: Instant| {
@@ -231,11 +231,14 @@ pub fn run(
     let t = Instant::now();
     let rc_path = project.layout_file("rc");
     let rc = std::fs::read_to_string(&rc_path).map_err(|e| LayoutError::io("reading", &rc_path, e))?;
-    let nets = crate::spef::parse_rc(&rc, &rc_path)?;
+    let mut nets = crate::spef::parse_rc(&rc, &rc_path)?;
+    let netlist = project.synthesis_file("rtlnopwr.v");
+    let verilog =
+        std::fs::read_to_string(&netlist).map_err(|e| LayoutError::io("reading", &netlist, e))?;
+    crate::spef::rename_to_netlist(&mut nets, &verilog);
     let spef_path = project.layout_file("spef");
     std::fs::write(&spef_path, crate::spef::write_spef(&top, &nets))
         .map_err(|e| LayoutError::io("writing", &spef_path, e))?;
-    let netlist = project.synthesis_file("rtlnopwr.v");
     let post_route = crate::sta::run(
         &tech.liberty,
         &netlist,

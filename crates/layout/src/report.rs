@@ -101,7 +101,7 @@ impl LayoutReport {
     /// One line for the terminal.
     pub fn summary(&self) -> String {
         format!(
-            "layout {}: {:.1} × {:.1} µm die ({:.0} µm²), utilisation {:.1} %, wirelength {:.0} µm, DRC {}, LVS {}, post-route f_max {:.1} MHz (setup slack {:.3} ns, hold {:.3} ns at {:.3} ns)",
+            "layout {}: {:.1} × {:.1} µm die ({:.0} µm²), utilisation {:.1} %, wirelength {:.0} µm, DRC {}, LVS {}, post-route f_max {:.1} MHz (setup slack {:.3} ns, hold {:.3} ns, register to register {:.3} ns at {:.3} ns)",
             self.tech,
             self.def.die_width_um,
             self.def.die_height_um,
@@ -113,6 +113,7 @@ impl LayoutReport {
             self.post_route.f_max_mhz,
             self.post_route.setup_slack_ns,
             self.post_route.hold_slack_ns,
+            self.post_route.hold_slack_registers_ns,
             self.post_route.period_ns,
         )
     }
@@ -172,7 +173,7 @@ impl LayoutReport {
             s,
             "## Timing at the configuration's clock ({:.3} ns, {:.1} MHz)\n\n\
              | | synthesis (ideal clock, no wires) | post-route (SPEF, propagated clock) |\n|---|---:|---:|\n\
-             | f_max (MHz) | {} | {:.1} |\n| setup slack (ns) | {} | {:.3} |\n| hold slack (ns) | — | {:.3} |\n\n\
+             | f_max (MHz) | {} | {:.1} |\n| setup slack (ns) | {} | {:.3} |\n| hold slack (ns), all paths | — | {:.3} |\n| hold slack (ns), register to register | — | {:.3} |\n\n\
              Worst setup path: `{}` → `{}`; worst hold path: `{}` → `{}`; {} nets annotated from the SPEF.\n\n",
             p.period_ns,
             1e3 / p.period_ns,
@@ -181,6 +182,7 @@ impl LayoutReport {
             opt(self.synthesis.slack_ns, 3),
             p.setup_slack_ns,
             p.hold_slack_ns,
+            p.hold_slack_registers_ns,
             p.setup_path.0,
             p.setup_path.1,
             p.hold_path.0,

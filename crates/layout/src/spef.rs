@@ -125,12 +125,74 @@ fn parse_point(toks: &[&str], pos: &mut usize, points: &mut Vec<Point>) -> Optio
     }
 }
 
+/// A name as SPEF writes it: every character other than a letter, a digit, `_` and the
+/// bus delimiters `[` `]` escaped with a backslash (qflow's clock buffers drive `clk_hier0_bF$buf6`).
+pub fn escape(name: &str) -> String {
+    let mut s = String::with_capacity(name.len());
+    for c in name.chars() {
+        if !(c.is_ascii_alphanumeric() || matches!(c, '_' | '[' | ']')) {
+            s.push('\\');
+        }
+        s.push(c);
+    }
+    s
+}
+
 /// A pin of the RC file as SPEF names it: `PIN/PORT` → `PORT`, `INST/PIN` → `INST:PIN`.
 fn spef_pin(pin: &str) -> (bool, String) {
     match pin.split_once('/') {
-        Some(("PIN", port)) => (true, port.to_string()),
-        Some((inst, p)) => (false, format!("{inst}:{p}")),
-        None => (true, pin.to_string()),
+        Some(("PIN", port)) => (true, escape(port)),
+        Some((inst, p)) => (false, format!("{}:{}", escape(inst), escape(p))),
+        None => (true, escape(pin)),
+    }
+}
+
+/// The vector ports of a netlist written by qflow's blif2Verilog (`input [6:0] tdc;`).
+/// blif2Verilog keeps a routed net's name `base[i]` only when `base` is such a port;
+/// every other name has its brackets turned into `_` (`y[3]_D` is `y_3__D` in the
+/// netlist), and [`netlist_name`] does the same so that the SPEF's nets are found.
+pub fn vector_ports(verilog: &str) -> std::collections::BTreeSet<String> {
+    verilog
+        .lines()
+        .filter_map(|l| {
+            let t: Vec<&str> = l.split_whitespace().collect();
+            match t.as_slice() {
+                ["input" | "output" | "inout", range, name, ..] if range.starts_with('[') => {
+                    Some(name.trim_end_matches(';').to_string())
+                }
+                _ => None,
+            }
+        })
+        .collect()
+}
+
+/// A routed net's (or port's) name as blif2Verilog wrote it in the netlist.
+pub fn netlist_name(name: &str, vectors: &std::collections::BTreeSet<String>) -> String {
+    if let Some((base, rest)) = name.split_once('[')
+        && vectors.contains(base)
+        && rest.ends_with(']')
+        && !rest[..rest.len() - 1].contains(['[', ']'])
+    {
+        return name.to_string();
+    }
+    name.replace(['[', ']'], "_")
+}
+
+/// Renames every net and port pin of `nets` as the netlist names them ([`netlist_name`]).
+pub fn rename_to_netlist(nets: &mut [Net], verilog: &str) {
+    let v = vector_ports(verilog);
+    let pin = |p: &str| match p.split_once('/') {
+        Some(("PIN", port)) => format!("PIN/{}", netlist_name(port, &v)),
+        _ => p.to_string(),
+    };
+    for n in nets {
+        n.name = netlist_name(&n.name, &v);
+        n.driver = pin(&n.driver);
+        for point in &mut n.points {
+            for s in &mut point.sinks {
+                *s = pin(s);
+            }
+        }
     }
 }
 
@@ -144,7 +206,8 @@ pub fn write_spef(design: &str, nets: &[Net]) -> String {
         env!("CARGO_PKG_VERSION")
     );
     for net in nets.iter().filter(|n| !n.points.is_empty()) {
-        let _ = writeln!(s, "*D_NET {} {:.6e}", net.name, net.total_cap_pf());
+        let name = escape(&net.name);
+        let _ = writeln!(s, "*D_NET {name} {:.6e}", net.total_cap_pf());
         s += "*CONN\n";
         let (drv_port, drv) = spef_pin(&net.driver);
         // A port driving the net is an input of the design; an instance pin an output.
@@ -172,7 +235,7 @@ pub fn write_spef(design: &str, nets: &[Net]) -> String {
             .enumerate()
             .map(|(k, p)| match p.sinks.as_slice() {
                 [one] => spef_pin(one).1,
-                _ => format!("{}:{}", net.name, k + 1),
+                _ => format!("{name}:{}", k + 1),
             })
             .collect();
         s += "*CAP\n";
@@ -244,6 +307,29 @@ mod tests {
         assert!(s.contains("1 clk A:CLK 4.000000e0\n2 A:CLK clk:2 2.000000e0\n"), "{s}");
         // Two sinks at one point: each joined by 1 mΩ.
         assert!(s.contains("3 clk:2 B:CLK 1.000000e-3\n4 clk:2 q 1.000000e-3\n"), "{s}");
+    }
+
+    #[test]
+    fn names_follow_blif2verilog() {
+        let v = vector_ports("module m (a, b);\ninput [6:0] tdc;\noutput [38:0] rd_data;\noutput ready;\n");
+        assert_eq!(v.len(), 2);
+        assert_eq!(netlist_name("tdc[2]", &v), "tdc[2]");
+        assert_eq!(netlist_name("y[3]_DFFPOSX1_Q_9_D", &v), "y_3__DFFPOSX1_Q_9_D");
+        assert_eq!(netlist_name("y[3][29]", &v), "y_3__29_");
+        assert_eq!(netlist_name("rd_ptr[2]", &v), "rd_ptr_2_");
+        assert_eq!(netlist_name("ready", &v), "ready");
+        let mut nets = parse_rc("y[1] 1 PIN/tdc[2] 1 ( 1 0.5 A/B )\n", Path::new("x")).unwrap();
+        rename_to_netlist(&mut nets, "input [6:0] tdc;\n");
+        assert_eq!((nets[0].name.as_str(), nets[0].driver.as_str()), ("y_1_", "PIN/tdc[2]"));
+    }
+
+    #[test]
+    fn special_characters_are_escaped() {
+        assert_eq!(escape("clk_hier0_bF$buf6"), "clk_hier0_bF\\$buf6");
+        assert_eq!(escape("rd_ptr[2]"), "rd_ptr[2]");
+        let nets = parse_rc("a$b 1 X$1/Y 1 ( 1 0.5 Z/A )\n", Path::new("x.rc")).unwrap();
+        let s = write_spef("top", &nets);
+        assert!(s.contains("*D_NET a\\$b 5.000000e-1\n*CONN\n*I X\\$1:Y O\n"), "{s}");
     }
 
     #[test]

@@ -45,6 +45,7 @@ pub struct LayoutArgs {
 /// Runs `tofprobe layout`; the verdict is FAIL when DRC or LVS is not clean.
 pub fn run(a: &LayoutArgs) -> Result<crate::commands::Verdict, CliError> {
     let tech = Tech::parse(&a.tech)?;
+    tofprobe_layout::flow::check_options(a.density, a.node_nm)?;
     let design = crate::commands::load_for_hardware(a.config.as_deref())?;
     design.single_pixel("layout")?;
     let req = LayoutRequest {
