@@ -149,8 +149,9 @@ fn spef_pin(pin: &str) -> (bool, String) {
 
 /// The vector ports of a netlist written by qflow's blif2Verilog (`input [6:0] tdc;`).
 /// blif2Verilog keeps a routed net's name `base[i]` only when `base` is such a port;
-/// every other name has its brackets turned into `_` (`y[3]_D` is `y_3__D` in the
-/// netlist), and [`netlist_name`] does the same so that the SPEF's nets are found.
+/// every other name has its brackets and other specials turned into `_` (`y[3]_D` is
+/// `y_3__D`, the clock buffers' `clk_bF$buf2` is `clk_bF_buf2` in the netlist), and
+/// [`netlist_name`] does the same so that the SPEF's nets are found.
 pub fn vector_ports(verilog: &str) -> std::collections::BTreeSet<String> {
     verilog
         .lines()
@@ -175,7 +176,9 @@ pub fn netlist_name(name: &str, vectors: &std::collections::BTreeSet<String>) ->
     {
         return name.to_string();
     }
-    name.replace(['[', ']'], "_")
+    name.chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' })
+        .collect()
 }
 
 /// Renames every net and port pin of `nets` as the netlist names them ([`netlist_name`]).
@@ -318,6 +321,7 @@ mod tests {
         assert_eq!(netlist_name("y[3][29]", &v), "y_3__29_");
         assert_eq!(netlist_name("rd_ptr[2]", &v), "rd_ptr_2_");
         assert_eq!(netlist_name("ready", &v), "ready");
+        assert_eq!(netlist_name("clk_bF$buf2", &v), "clk_bF_buf2");
         let mut nets = parse_rc("y[1] 1 PIN/tdc[2] 1 ( 1 0.5 A/B )\n", Path::new("x")).unwrap();
         rename_to_netlist(&mut nets, "input [6:0] tdc;\n");
         assert_eq!((nets[0].name.as_str(), nets[0].driver.as_str()), ("y_1_", "PIN/tdc[2]"));
