@@ -16,7 +16,9 @@ pub fn lef_sizes(text: &str) -> BTreeMap<String, (f64, f64)> {
         match t.as_slice() {
             ["MACRO", name, ..] => current = Some((*name).to_string()),
             ["SIZE", w, "BY", h, ..] => {
-                if let (Some(name), Ok(w), Ok(h)) = (&current, w.parse(), h.trim_end_matches(';').parse()) {
+                if let (Some(name), Ok(w), Ok(h)) =
+                    (&current, w.parse(), h.trim_end_matches(';').parse())
+                {
                     sizes.insert(name.clone(), (w, h));
                 }
             }
@@ -113,7 +115,11 @@ pub fn parse_def(
                 .get(*cell)
                 .ok_or_else(|| bad(&format!("a LEF outline for cell `{cell}`")))?;
             let orient = t.get(i + 4).copied().unwrap_or("N");
-            let (w, h) = if orient.contains('E') || orient.contains('W') { (h, w) } else { (w, h) };
+            let (w, h) = if orient.contains('E') || orient.contains('W') {
+                (h, w)
+            } else {
+                (w, h)
+            };
             let u = units.ok_or_else(|| bad("`UNITS DISTANCE MICRONS` before COMPONENTS"))?;
             let (x, y) = (x / u, y / u);
             x0 = x0.min(x);
@@ -156,7 +162,11 @@ fn segment_length(t: &[&str]) -> f64 {
     while i < t.len() {
         if t[i] == "(" && i + 3 < t.len() && t[i + 3] == ")" {
             let coord = |s: &str, prev: Option<f64>| {
-                if s == "*" { prev } else { s.parse::<f64>().ok() }
+                if s == "*" {
+                    prev
+                } else {
+                    s.parse::<f64>().ok()
+                }
             };
             let x = coord(t[i + 1], last.map(|p| p.0));
             let y = coord(t[i + 2], last.map(|p| p.1));
@@ -197,7 +207,11 @@ mod tests {
         assert!((f.cell_area_um2 - 48.0).abs() < 1e-12);
         assert!((f.utilisation() - 48.0 / 112.0).abs() < 1e-12);
         // 800 + 1000 DEF units; the power stripe is not a signal wire.
-        assert!((f.wirelength_um - 18.0).abs() < 1e-12, "{}", f.wirelength_um);
+        assert!(
+            (f.wirelength_um - 18.0).abs() < 1e-12,
+            "{}",
+            f.wirelength_um
+        );
     }
 
     #[test]

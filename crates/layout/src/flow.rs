@@ -185,7 +185,11 @@ pub fn run(
                 });
                 if i + 1 == tries.len() {
                     return Err(LayoutError::Unrouted {
-                        tried: tries.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", "),
+                        tried: tries
+                            .iter()
+                            .map(|d| d.to_string())
+                            .collect::<Vec<_>>()
+                            .join(", "),
                         last: d,
                         nets: format!("{count} ({})", nets.join(", ")),
                         suggest: ((d - 0.1).max(MIN_DENSITY) * 100.0).round() / 100.0,
@@ -230,7 +234,8 @@ pub fn run(
     progress("post-route timing");
     let t = Instant::now();
     let rc_path = project.layout_file("rc");
-    let rc = std::fs::read_to_string(&rc_path).map_err(|e| LayoutError::io("reading", &rc_path, e))?;
+    let rc =
+        std::fs::read_to_string(&rc_path).map_err(|e| LayoutError::io("reading", &rc_path, e))?;
     let mut nets = crate::spef::parse_rc(&rc, &rc_path)?;
     let netlist = project.synthesis_file("rtlnopwr.v");
     let verilog =
@@ -335,5 +340,7 @@ fn notes(tech: &TechFiles, other_b: u64) -> Vec<String> {
 
 /// The directory a design's layout project uses (for tests that look at the logs).
 pub fn project_dir(cache: &Path, tech: Tech, synthesis_key: &str) -> PathBuf {
-    cache.join("layout").join(format!("{}-{synthesis_key}", tech.name()))
+    cache
+        .join("layout")
+        .join(format!("{}-{synthesis_key}", tech.name()))
 }

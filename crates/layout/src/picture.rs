@@ -42,7 +42,10 @@ pub fn draw(gds: &Path, png: &Path, size: u32, dir: &Path) -> Result<()> {
         return Err(LayoutError::ToolFailed {
             step: "picture",
             tool: "klayout",
-            status: out.status.code().map_or("killed".into(), |c| format!("exit {c}")),
+            status: out
+                .status
+                .code()
+                .map_or("killed".into(), |c| format!("exit {c}")),
             log: script,
             tail: tail(&String::from_utf8_lossy(&out.stderr), 10),
         });

@@ -38,6 +38,14 @@ impl Project {
         }
         let src = dir.join("source").join(format!("{top}.v"));
         std::fs::copy(netlist, &src).map_err(|e| LayoutError::io("copying", netlist, e))?;
+        // qflow finds a technology outside its own directory as PROJECT/tech/NAME.
+        if !tech.dir.starts_with(crate::tech::QFLOW_TECH) {
+            let link = dir.join("tech");
+            std::fs::create_dir_all(&link).map_err(|e| LayoutError::io("creating", &link, e))?;
+            let link = link.join(&tech.name);
+            std::os::unix::fs::symlink(&tech.dir, &link)
+                .map_err(|e| LayoutError::io("linking", &link, e))?;
+        }
         let qbin = PathBuf::from("/usr/lib/qflow");
         write(
             &dir.join("qflow_vars.sh"),
@@ -99,7 +107,9 @@ impl Project {
 
     /// A file of the synthesis directory: `synthesis/TOP.EXT`.
     pub fn synthesis_file(&self, ext: &str) -> PathBuf {
-        self.dir.join("synthesis").join(format!("{}.{ext}", self.top))
+        self.dir
+            .join("synthesis")
+            .join(format!("{}.{ext}", self.top))
     }
 
     /// Runs qflow's `stage` (its qflow name) and returns its log's text and the seconds
@@ -132,7 +142,10 @@ impl Project {
             return Err(LayoutError::ToolFailed {
                 step,
                 tool: "qflow",
-                status: out.status.code().map_or("killed".into(), |c| format!("exit {c}")),
+                status: out
+                    .status
+                    .code()
+                    .map_or("killed".into(), |c| format!("exit {c}")),
                 log: log_path,
                 tail: tail(both.trim_end(), 15),
             });
@@ -144,13 +157,20 @@ impl Project {
 /// qrouter's verdict in a route log: `Ok(())` when every net routed, else the unrouted
 /// nets' count and the names qrouter reported as failing in its last pass.
 pub fn route_verdict(log: &str) -> std::result::Result<(), (usize, Vec<String>)> {
-    let last = log.lines().rev().find(|l| l.trim_start().starts_with("Final:"));
+    let last = log
+        .lines()
+        .rev()
+        .find(|l| l.trim_start().starts_with("Final:"));
     if last.is_some_and(|l| l.contains("No failed routes")) {
         return Ok(());
     }
     // The nets failing after the last stage marker (earlier passes rip them up again).
     let from = log.rfind("Progress: Stage").map_or(0, |i| i);
-    let window = if log[from..].contains("Failed to route net") { &log[from..] } else { log };
+    let window = if log[from..].contains("Failed to route net") {
+        &log[from..]
+    } else {
+        log
+    };
     let mut nets: Vec<String> = window
         .lines()
         .filter_map(|l| l.trim().strip_prefix("Failed to route net "))

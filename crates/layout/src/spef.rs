@@ -72,7 +72,8 @@ pub fn parse_rc(text: &str, path: &Path) -> Result<Vec<Net>> {
         let mut points = Vec::new();
         let mut pos = 4;
         if pos < toks.len() {
-            parse_point(&toks, &mut pos, &mut points).ok_or_else(|| bad("a well-formed RC tree"))?;
+            parse_point(&toks, &mut pos, &mut points)
+                .ok_or_else(|| bad("a well-formed RC tree"))?;
             if pos != toks.len() {
                 return Err(bad("the end of the RC tree"));
             }
@@ -177,7 +178,13 @@ pub fn netlist_name(name: &str, vectors: &std::collections::BTreeSet<String>) ->
         return name.to_string();
     }
     name.chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect()
 }
 
@@ -279,7 +286,10 @@ mod tests {
         let nets = parse_rc(LINE, Path::new("x.rc")).unwrap();
         assert_eq!(nets.len(), 1);
         let n = &nets[0];
-        assert_eq!((n.name.as_str(), n.driver.as_str()), ("rd_ptr[2]", "DFFPOSX1_74/Q"));
+        assert_eq!(
+            (n.name.as_str(), n.driver.as_str()),
+            ("rd_ptr[2]", "DFFPOSX1_74/Q")
+        );
         assert_eq!(n.sinks, 5);
         assert_eq!(n.tree_sinks(), 5);
         assert_eq!(n.points.len(), 8);
@@ -292,7 +302,11 @@ mod tests {
             + 0.00104694
             + 0.0001314
             + 0.00053604;
-        assert!((n.total_cap_pf() - total).abs() < 1e-15, "{}", n.total_cap_pf());
+        assert!(
+            (n.total_cap_pf() - total).abs() < 1e-15,
+            "{}",
+            n.total_cap_pf()
+        );
         assert_eq!(n.points[0].children.len(), 3);
     }
 
@@ -305,26 +319,46 @@ mod tests {
         .unwrap();
         let s = write_spef("top", &nets);
         assert!(s.contains("*D_NET clk 3.000000e-3"), "{s}");
-        assert!(s.contains("*P clk I\n*I A:CLK I\n*I B:CLK I\n*P q O\n"), "{s}");
-        assert!(s.contains("1 A:CLK 1.000000e-3\n2 clk:2 2.000000e-3\n"), "{s}");
-        assert!(s.contains("1 clk A:CLK 4.000000e0\n2 A:CLK clk:2 2.000000e0\n"), "{s}");
+        assert!(
+            s.contains("*P clk I\n*I A:CLK I\n*I B:CLK I\n*P q O\n"),
+            "{s}"
+        );
+        assert!(
+            s.contains("1 A:CLK 1.000000e-3\n2 clk:2 2.000000e-3\n"),
+            "{s}"
+        );
+        assert!(
+            s.contains("1 clk A:CLK 4.000000e0\n2 A:CLK clk:2 2.000000e0\n"),
+            "{s}"
+        );
         // Two sinks at one point: each joined by 1 mΩ.
-        assert!(s.contains("3 clk:2 B:CLK 1.000000e-3\n4 clk:2 q 1.000000e-3\n"), "{s}");
+        assert!(
+            s.contains("3 clk:2 B:CLK 1.000000e-3\n4 clk:2 q 1.000000e-3\n"),
+            "{s}"
+        );
     }
 
     #[test]
     fn names_follow_blif2verilog() {
-        let v = vector_ports("module m (a, b);\ninput [6:0] tdc;\noutput [38:0] rd_data;\noutput ready;\n");
+        let v = vector_ports(
+            "module m (a, b);\ninput [6:0] tdc;\noutput [38:0] rd_data;\noutput ready;\n",
+        );
         assert_eq!(v.len(), 2);
         assert_eq!(netlist_name("tdc[2]", &v), "tdc[2]");
-        assert_eq!(netlist_name("y[3]_DFFPOSX1_Q_9_D", &v), "y_3__DFFPOSX1_Q_9_D");
+        assert_eq!(
+            netlist_name("y[3]_DFFPOSX1_Q_9_D", &v),
+            "y_3__DFFPOSX1_Q_9_D"
+        );
         assert_eq!(netlist_name("y[3][29]", &v), "y_3__29_");
         assert_eq!(netlist_name("rd_ptr[2]", &v), "rd_ptr_2_");
         assert_eq!(netlist_name("ready", &v), "ready");
         assert_eq!(netlist_name("clk_bF$buf2", &v), "clk_bF_buf2");
         let mut nets = parse_rc("y[1] 1 PIN/tdc[2] 1 ( 1 0.5 A/B )\n", Path::new("x")).unwrap();
         rename_to_netlist(&mut nets, "input [6:0] tdc;\n");
-        assert_eq!((nets[0].name.as_str(), nets[0].driver.as_str()), ("y_1_", "PIN/tdc[2]"));
+        assert_eq!(
+            (nets[0].name.as_str(), nets[0].driver.as_str()),
+            ("y_1_", "PIN/tdc[2]")
+        );
     }
 
     #[test]
@@ -333,7 +367,10 @@ mod tests {
         assert_eq!(escape("rd_ptr[2]"), "rd_ptr[2]");
         let nets = parse_rc("a$b 1 X$1/Y 1 ( 1 0.5 Z/A )\n", Path::new("x.rc")).unwrap();
         let s = write_spef("top", &nets);
-        assert!(s.contains("*D_NET a\\$b 5.000000e-1\n*CONN\n*I X\\$1:Y O\n"), "{s}");
+        assert!(
+            s.contains("*D_NET a\\$b 5.000000e-1\n*CONN\n*I X\\$1:Y O\n"),
+            "{s}"
+        );
     }
 
     #[test]

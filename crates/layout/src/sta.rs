@@ -100,7 +100,9 @@ pub fn parse(text: &str, period_ns: f64, spef_nets: usize, log: &Path) -> Result
         what: what.into(),
         path: log.to_path_buf(),
     };
-    let (_, rest) = text.split_once("== setup").ok_or_else(|| bad("`== setup`"))?;
+    let (_, rest) = text
+        .split_once("== setup")
+        .ok_or_else(|| bad("`== setup`"))?;
     let (setup, rest) = rest.split_once("== hold").ok_or_else(|| bad("`== hold`"))?;
     let (hold, hold_regs) = rest
         .split_once("== hold-registers")

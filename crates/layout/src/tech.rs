@@ -128,9 +128,13 @@ impl TechFiles {
         std::fs::create_dir_all(&dir).map_err(|e| LayoutError::io("creating", &dir, e))?;
         let write = |name: &str, text: String| -> Result<()> {
             let p = dir.join(name);
-            tofprobe_io::write_atomic(&p, text.as_bytes()).map_err(|e| LayoutError::io("writing", &p, e))
+            tofprobe_io::write_atomic(&p, text.as_bytes())
+                .map_err(|e| LayoutError::io("writing", &p, e))
         };
-        write("sky130.sh", sky130_setup(&cell_lef, &tlef, &cdl, &liberty, &gds, &netgen))?;
+        write(
+            "sky130.sh",
+            sky130_setup(&cell_lef, &tlef, &cdl, &liberty, &gds, &netgen),
+        )?;
         write("sky130.par", SKY130_PAR.to_string())?;
         write(
             "sky130.magicrc",
@@ -152,7 +156,14 @@ impl TechFiles {
 }
 
 /// qflow's setup script for sky130_fd_sc_hd (the variables osu018.sh sets).
-fn sky130_setup(lef: &Path, tlef: &Path, cdl: &Path, lib: &Path, gds: &Path, netgen: &Path) -> String {
+fn sky130_setup(
+    lef: &Path,
+    tlef: &Path,
+    cdl: &Path,
+    lib: &Path,
+    gds: &Path,
+    netgen: &Path,
+) -> String {
     format!(
         "#!/usr/bin/tcsh\n# Written by tofprobe layout: qflow setup for sky130_fd_sc_hd.\n\
 set leffile={lef}\nset techleffile={tlef}\nset spicefile={cdl}\nset libertyfile={lib}\n\

@@ -78,9 +78,11 @@ pub fn require_all() -> Result<()> {
 fn search_path(name: &str) -> Option<PathBuf> {
     use std::os::unix::fs::PermissionsExt;
     let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path).map(|d| d.join(name)).find(|p| {
-        std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
-    })
+    std::env::split_paths(&path)
+        .map(|d| d.join(name))
+        .find(|p| {
+            std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+        })
 }
 
 /// The last `n` lines of a text.
@@ -101,7 +103,10 @@ mod tests {
             package: Tool::Netgen.package(),
         }
         .to_string();
-        assert!(e.contains("`netgen-lvs`") && e.contains("Debian's `netgen-lvs`"), "{e}");
+        assert!(
+            e.contains("`netgen-lvs`") && e.contains("Debian's `netgen-lvs`"),
+            "{e}"
+        );
         assert_eq!(Tool::Sta.package(), "opensta");
         assert_eq!(tail("a\nb\nc", 2), "b\nc");
     }

@@ -67,7 +67,8 @@ pub fn run(a: &LayoutArgs) -> Result<crate::commands::Verdict, CliError> {
     let io = |e: std::io::Error| CliError::output(a.out.clone(), e.to_string());
     let mut set = tofprobe_io::OutputSet::begin(&a.out).map_err(io)?;
     for (name, path) in &run.files {
-        let bytes = std::fs::read(path).map_err(|e| CliError::output(path.clone(), e.to_string()))?;
+        let bytes =
+            std::fs::read(path).map_err(|e| CliError::output(path.clone(), e.to_string()))?;
         set.add(name, &bytes).map_err(io)?;
     }
     set.add("layout-report.md", report.markdown().as_bytes())
@@ -85,7 +86,10 @@ pub fn run(a: &LayoutArgs) -> Result<crate::commands::Verdict, CliError> {
         println!("{}", serde_json::to_string(report)?);
     } else {
         println!("{}", report.summary());
-        println!("qflow project (every tool's log): {}", run.project.display());
+        println!(
+            "qflow project (every tool's log): {}",
+            run.project.display()
+        );
     }
     Ok(crate::commands::Verdict::of(report.clean()))
 }

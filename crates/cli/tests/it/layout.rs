@@ -48,7 +48,10 @@ fn a_two_bin_pixel_routes_drc_and_lvs_clean_on_osu018() {
     assert_eq!(r["schema"], "tofprobe-layout-1");
     assert_eq!(r["drc_errors"], 0, "{r}");
     assert_eq!(r["lvs_match"], true, "{r}");
-    assert!(r["lvs_result"].as_str().unwrap().contains("match uniquely"), "{r}");
+    assert!(
+        r["lvs_result"].as_str().unwrap().contains("match uniquely"),
+        "{r}"
+    );
     let def = &r["def"];
     // The logic cells fill the core to about the density asked for (0.6), never beyond 1.
     let util = def["cell_area_um2"].as_f64().unwrap()
@@ -66,18 +69,33 @@ fn a_two_bin_pixel_routes_drc_and_lvs_clean_on_osu018() {
         p["f_max_mhz"].as_f64().unwrap(),
         r["synthesis"]["f_max_mhz"].as_f64().unwrap(),
     );
-    assert!(post > 50.0 && post < pre, "post-route {post} MHz, synthesis {pre} MHz");
+    assert!(
+        post > 50.0 && post < pre,
+        "post-route {post} MHz, synthesis {pre} MHz"
+    );
     assert!(p["spef_nets"].as_u64().unwrap() * 10 > synth * 9, "{p}");
     // The set is whole, with the macro's views and the picture.
     let check = tofprobe(&["check-set", out.to_str().unwrap()]);
-    assert!(check.status.success(), "{}", String::from_utf8_lossy(&check.stderr));
-    for f in ["tofprobe_pixel.def", "tofprobe_pixel.gds", "tofprobe_pixel.lef", "tofprobe_pixel.spef"] {
+    assert!(
+        check.status.success(),
+        "{}",
+        String::from_utf8_lossy(&check.stderr)
+    );
+    for f in [
+        "tofprobe_pixel.def",
+        "tofprobe_pixel.gds",
+        "tofprobe_pixel.lef",
+        "tofprobe_pixel.spef",
+    ] {
         assert!(std::fs::metadata(out.join(f)).unwrap().len() > 1000, "{f}");
     }
     let png = std::fs::read(out.join("layout.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 10_000);
     let lef = std::fs::read_to_string(out.join("tofprobe_pixel.lef")).unwrap();
-    assert!(lef.contains("MACRO tofprobe_pixel") && lef.contains("PIN clk"), "LEF");
+    assert!(
+        lef.contains("MACRO tofprobe_pixel") && lef.contains("PIN clk"),
+        "LEF"
+    );
     let md = std::fs::read_to_string(out.join("layout-report.md")).unwrap();
     assert!(md.contains("| DRC errors (magic) | 0 |"), "{md}");
 }
