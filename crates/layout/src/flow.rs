@@ -89,8 +89,8 @@ pub fn run(
             seconds: t.elapsed().as_secs_f64(),
         })
     };
-    let tech = match req.tech {
-        Tech::Osu018 => TechFiles::osu018()?,
+    let (tech, sky130_pdk) = match req.tech {
+        Tech::Osu018 => (TechFiles::osu018()?, None),
         Tech::Sky130 => {
             let pdk = tofprobe_eda::pdk::Sky130Pdk::discover(req.sky130_pdk.as_deref())?
                 .ok_or_else(|| LayoutError::TechFile {
@@ -99,7 +99,7 @@ pub fn run(
                     path: tofprobe_eda::pdk::search_path()[0].clone(),
                     hint: "--sky130-pdk DIR or $TOFPROBE_SKY130_PDK",
                 })?;
-            TechFiles::sky130(&pdk.dir, &req.cache)?
+            (TechFiles::sky130(&pdk.dir, &req.cache)?, Some(pdk))
         }
     };
 
@@ -244,15 +244,52 @@ pub fn run(
     let spef_path = project.layout_file("spef");
     std::fs::write(&spef_path, crate::spef::write_spef(&top, &nets))
         .map_err(|e| LayoutError::io("writing", &spef_path, e))?;
-    let post_route = crate::sta::run(
-        &tech.liberty,
-        &netlist,
-        &spef_path,
-        &top,
-        period_ns,
-        nets.iter().filter(|n| !n.points.is_empty()).count(),
-        &dir.join("layout"),
-    )?;
+    let spef_nets = nets.iter().filter(|n| !n.points.is_empty()).count();
+    let post = |lib: &Path, corner: &str| {
+        crate::sta::run(
+            lib,
+            &netlist,
+            &spef_path,
+            &top,
+            period_ns,
+            spef_nets,
+            &dir.join("layout"),
+            corner,
+        )
+    };
+    let post_route = post(&tech.liberty, "typical")?;
+    // Every corner: the synthesis netlist timed on each liberty (the size report's
+    // figures, cached), the routed one with the same wires.
+    let mut corners = Vec::new();
+    let corner_libs: Vec<(String, String, PathBuf)> = match &sky130_pdk {
+        Some(pdk) => pdk
+            .corners
+            .iter()
+            .map(|c| {
+                Ok((
+                    format!("sky130_fd_sc_hd__{}", c.name),
+                    c.name.clone(),
+                    tofprobe_eda::pdk::plain_copy(&c.source, &req.cache)?,
+                ))
+            })
+            .collect::<Result<_>>()?,
+        None => vec![(lib.name.clone(), "typical".into(), tech.liberty.clone())],
+    };
+    for (library, corner, path) in corner_libs {
+        let synth_t = tofprobe_eda::corners::time_cached(syn, &path, &corner, "clk")?;
+        let post_route = if path == tech.liberty {
+            post_route.clone()
+        } else {
+            post(&path, &corner)?
+        };
+        corners.push(crate::report::CornerRow {
+            library,
+            corner,
+            synthesis_f_max_mhz: synth_t.f_max_mhz,
+            synthesis_slack_ns: period_ns - synth_t.critical_path_ns,
+            post_route,
+        });
+    }
     timed(&mut steps, "post-route timing (OpenSTA + SPEF)", t);
 
     // 5. Picture, figures, bins per pitch.
@@ -307,6 +344,7 @@ pub fn run(
         bins_per_pitch,
         steps,
         clock_buffers,
+        corners,
         notes: notes(&tech, other),
     };
     let ext = |e: &str| project.layout_file(e);

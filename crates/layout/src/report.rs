@@ -39,6 +39,21 @@ pub struct SynthFigures {
     pub key: String,
 }
 
+/// Timing at one library corner: synthesis (ideal clock) beside post-route.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct CornerRow {
+    /// The liberty's library name.
+    pub library: String,
+    /// The corner (`typical` for osu018, `tt_025C_1v80`, `ss_n40C_1v40`, `ff_100C_1v95`).
+    pub corner: String,
+    /// Synthesis f_max (MHz), ideal clock, no wires.
+    pub synthesis_f_max_mhz: f64,
+    /// Synthesis setup slack at the configuration's clock (ns).
+    pub synthesis_slack_ns: f64,
+    /// Post-route timing at this corner (the same routed wires).
+    pub post_route: PostRoute,
+}
+
 /// A step and its wall time.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Step {
@@ -83,6 +98,8 @@ pub struct LayoutReport {
     pub steps: Vec<Step>,
     /// Buffers blifFanout added (the clock tree).
     pub clock_buffers: u64,
+    /// Every corner of the technology's liberties (osu018: one; sky130: tt, ss, ff).
+    pub corners: Vec<CornerRow>,
     /// What the figures assume.
     pub notes: Vec<String>,
 }
@@ -189,6 +206,28 @@ impl LayoutReport {
             p.hold_path.1,
             p.spef_nets,
         );
+        s += "## Corners\n\n| library | corner | synthesis f_max (MHz) | synthesis slack (ns) | post-route f_max (MHz) | post-route setup slack (ns) | hold slack (ns), all / register to register | meets the clock |\n|---|---|---:|---:|---:|---:|---:|---|\n";
+        for c in &self.corners {
+            let p = &c.post_route;
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.1} | {:.3} | {:.1} | {:.3} | {:.3} / {:.3} | {} |",
+                c.library,
+                c.corner,
+                c.synthesis_f_max_mhz,
+                c.synthesis_slack_ns,
+                p.f_max_mhz,
+                p.setup_slack_ns,
+                p.hold_slack_ns,
+                p.hold_slack_registers_ns,
+                if p.setup_slack_ns >= 0.0 && p.hold_slack_registers_ns >= 0.0 {
+                    "yes"
+                } else {
+                    "**no**"
+                }
+            );
+        }
+        s += "\n";
         if let Some(b) = &self.bins_per_pitch {
             let _ = write!(
                 s,

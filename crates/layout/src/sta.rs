@@ -50,7 +50,8 @@ pub fn script(liberty: &Path, netlist: &Path, spef: &Path, top: &str, period_ns:
     )
 }
 
-/// Runs OpenSTA in `dir` (script and log kept there).
+/// Runs OpenSTA in `dir` (script and log kept there, named after `corner`).
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     liberty: &Path,
     netlist: &Path,
@@ -59,9 +60,10 @@ pub fn run(
     period_ns: f64,
     spef_nets: usize,
     dir: &Path,
+    corner: &str,
 ) -> Result<PostRoute> {
     let sta = Tool::Sta.locate()?;
-    let path = dir.join("post_route_sta.tcl");
+    let path = dir.join(format!("post_route_sta-{corner}.tcl"));
     std::fs::write(&path, script(liberty, netlist, spef, top, period_ns))
         .map_err(|e| LayoutError::io("writing", &path, e))?;
     let out = Command::new(&sta)
@@ -75,7 +77,7 @@ pub fn run(
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    let log = dir.join("post_route_sta.log");
+    let log = dir.join(format!("post_route_sta-{corner}.log"));
     std::fs::write(&log, &text).map_err(|e| LayoutError::io("writing", &log, e))?;
     // A SPEF the reader stumbles on would leave wires unannotated: an error, not a warning.
     let spef_trouble = text
