@@ -34,6 +34,7 @@ fn timed(
         5.0,
         nets.len(),
         dir,
+        "typical",
     )
 }
 
