@@ -41,12 +41,17 @@ pub struct BinsPerPitch {
     pub routed_factor: f64,
     /// Per pitch.
     pub pitches: Vec<PitchBins>,
+    /// The side of a square pitch the routed macro itself needs at the target node (µm):
+    /// √(die area · area factor).
+    pub routed_side_um: f64,
 }
 
-/// Bins per pitch for `model` (synthesis, at `tech_node_nm`) inflated by `routed_factor`.
+/// Bins per pitch for `model` (synthesis, at `tech_node_nm`) inflated by `routed_factor`;
+/// `die_area_um2` is the routed macro's.
 pub fn bins_per_pitch(
     model: AreaModel,
     routed_factor: f64,
+    die_area_um2: f64,
     tech_node_nm: f64,
     target_node_nm: f64,
     pitches: &[(f64, Option<u64>)],
@@ -71,6 +76,7 @@ pub fn bins_per_pitch(
         tech_node_nm,
         target_node_nm,
         area_factor: (target_node_nm / tech_node_nm).powi(2),
+        routed_side_um: (die_area_um2 * (target_node_nm / tech_node_nm).powi(2)).sqrt(),
         synthesis_model: model,
         routed_factor,
         pitches: out,
@@ -88,12 +94,14 @@ mod tests {
             fixed_um2: 100.0,
             per_bin_um2: 50.0,
         };
-        let r = bins_per_pitch(m, 2.0, 180.0, 180.0, &[(40.0, Some(13))]).unwrap();
+        let r = bins_per_pitch(m, 2.0, 900.0, 180.0, 180.0, &[(40.0, Some(13))]).unwrap();
+        assert!((r.routed_side_um - 30.0).abs() < 1e-12);
         // 1600/2 = 800 → (800 − 100)/50 = 14; without k: (1600 − 100)/50 = 30.
         assert_eq!(r.pitches[0].layout_bins, 14);
         assert_eq!(r.pitches[0].synthesis_bins, 30);
         // At 90 nm from 180 nm the area is a quarter: 6400/2 = 3200 → 62.
-        let r = bins_per_pitch(m, 2.0, 180.0, 90.0, &[(40.0, None)]).unwrap();
+        let r = bins_per_pitch(m, 2.0, 900.0, 180.0, 90.0, &[(40.0, None)]).unwrap();
+        assert!((r.routed_side_um - 15.0).abs() < 1e-12);
         assert_eq!(r.pitches[0].layout_bins, 62);
         assert!((r.area_factor - 0.25).abs() < 1e-15);
         // A model that does not grow with B is refused.
@@ -101,6 +109,6 @@ mod tests {
             fixed_um2: 1.0,
             per_bin_um2: 0.0,
         };
-        assert!(bins_per_pitch(flat, 2.0, 180.0, 90.0, &[(40.0, None)]).is_err());
+        assert!(bins_per_pitch(flat, 2.0, 900.0, 180.0, 90.0, &[(40.0, None)]).is_err());
     }
 }

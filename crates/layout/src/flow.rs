@@ -314,6 +314,7 @@ pub fn run(
         Some(m) => Some(crate::bins::bins_per_pitch(
             m,
             routed_factor,
+            def.die_area_um2(),
             tech.tech.node_nm(),
             req.node_nm,
             &req.pitches,

@@ -232,6 +232,7 @@ impl LayoutReport {
             let _ = write!(
                 s,
                 "## Bins per pitch at {} nm\n\nSynthesis model A(B) = {:.0} + {:.0}·B µm² ({} nm), routed factor k = die / cell area = {:.3}, scaled by ({}/{})² = {:.4}.\n\n\
+                 The routed macro of this pixel (B = {}) needs a {:.1} × {:.1} µm pitch at {} nm.\n\n\
                  | pitch | from layout | from synthesis | paper |\n|---|---:|---:|---:|\n",
                 b.target_node_nm,
                 b.synthesis_model.fixed_um2,
@@ -241,6 +242,10 @@ impl LayoutReport {
                 b.target_node_nm,
                 b.tech_node_nm,
                 b.area_factor,
+                self.bins,
+                b.routed_side_um,
+                b.routed_side_um,
+                b.target_node_nm,
             );
             for p in &b.pitches {
                 let _ = writeln!(
