@@ -28,6 +28,10 @@ pub enum CliError {
     /// changed since (the message names the missing marker or the file that fails).
     #[error("{0}")]
     IncompleteSet(std::io::Error),
+    /// `layout` failed (a tool missing names its Debian package; routing failure names
+    /// the unrouted nets and the densities tried).
+    #[error("layout: {0}")]
+    Layout(#[from] tofprobe_layout::LayoutError),
     /// JSON serialisation failed (should not happen for plain numbers).
     #[error("cannot serialise JSON output: {0}")]
     Json(#[from] serde_json::Error),

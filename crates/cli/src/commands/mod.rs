@@ -6,6 +6,7 @@ pub mod check_set;
 pub mod config;
 pub mod cosim;
 pub mod flow;
+pub mod layout;
 pub mod merge;
 pub mod replay;
 pub mod reproduce;
@@ -46,6 +47,9 @@ pub enum Command {
     Cosim(cosim::CosimArgs),
     /// The main flow: scene -> model -> RTL -> vectors -> co-simulation -> report.
     Flow(flow::FlowArgs),
+    /// Place and route the pixel (qflow, magic, netgen, OpenSTA, klayout): DRC, LVS,
+    /// post-route timing, a picture and bins per pitch from layout; exits 1 unless clean.
+    Layout(layout::LayoutArgs),
     /// The speed/accuracy trade: every fidelity level timed and scored per scene.
     Tradeoff(tradeoff::TradeoffArgs),
     /// Check that a directory holds a whole output set (rtl, vectors, reproduce, flow).
@@ -128,6 +132,7 @@ pub fn run(command: Command) -> Result<Verdict, CliError> {
         Command::Vectors(a) => done(vectors::run(&a)),
         Command::Cosim(a) => cosim::run(&a),
         Command::Flow(a) => flow::run(&a),
+        Command::Layout(a) => layout::run(&a),
         Command::Tradeoff(a) => done(tradeoff::run(&a)),
         Command::CheckSet(a) => done(check_set::run(&a)),
     }

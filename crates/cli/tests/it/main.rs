@@ -24,6 +24,7 @@ mod fuzz_binary;
 mod fuzz_records;
 mod haar;
 mod junit;
+mod layout;
 mod one_resolution;
 mod options;
 mod output_sets;

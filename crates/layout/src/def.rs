@@ -1,0 +1,224 @@
+//! What the routed DEF and the cell LEF say about the macro: die and core area, cell area
+//! and utilisation, routed wirelength, and the cell sizes of the LEF (also the check that
+//! every cell the netlist uses has a layout view).
+
+use crate::error::{LayoutError, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Cell outlines of a LEF: `MACRO name … SIZE w BY h` (µm).
+pub fn lef_sizes(text: &str) -> BTreeMap<String, (f64, f64)> {
+    let mut sizes = BTreeMap::new();
+    let mut current: Option<String> = None;
+    for line in text.lines() {
+        let t: Vec<&str> = line.split_whitespace().collect();
+        match t.as_slice() {
+            ["MACRO", name, ..] => current = Some((*name).to_string()),
+            ["SIZE", w, "BY", h, ..] => {
+                if let (Some(name), Ok(w), Ok(h)) =
+                    (&current, w.parse(), h.trim_end_matches(';').parse())
+                {
+                    sizes.insert(name.clone(), (w, h));
+                }
+            }
+            ["END", name] if current.as_deref() == Some(*name) => current = None,
+            _ => {}
+        }
+    }
+    sizes
+}
+
+/// The figures of a routed DEF.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq)]
+pub struct DefFigures {
+    /// Die width (µm).
+    pub die_width_um: f64,
+    /// Die height (µm).
+    pub die_height_um: f64,
+    /// Core: the bounding box of the placed cells (µm × µm).
+    pub core_width_um: f64,
+    /// Core height (µm).
+    pub core_height_um: f64,
+    /// Area of the logic cells (fill cells excluded), from the LEF outlines (µm²).
+    pub cell_area_um2: f64,
+    /// Logic cells placed.
+    pub cells: u64,
+    /// Fill cells placed.
+    pub fill_cells: u64,
+    /// Routed signal wirelength (µm): the Manhattan length of every ROUTED/NEW segment of
+    /// the NETS section (power stripes are SPECIALNETS, not counted).
+    pub wirelength_um: f64,
+}
+
+impl DefFigures {
+    /// Die area (µm²).
+    pub fn die_area_um2(&self) -> f64 {
+        self.die_width_um * self.die_height_um
+    }
+    /// Core area (µm²).
+    pub fn core_area_um2(&self) -> f64 {
+        self.core_width_um * self.core_height_um
+    }
+    /// Cell area / core area.
+    pub fn utilisation(&self) -> f64 {
+        self.cell_area_um2 / self.core_area_um2()
+    }
+}
+
+/// Parses a routed DEF against the cell outlines `sizes`; `fill` is the fill cell's name.
+pub fn parse_def(
+    text: &str,
+    sizes: &BTreeMap<String, (f64, f64)>,
+    fill: &str,
+    path: &Path,
+) -> Result<DefFigures> {
+    let bad = |what: &str| LayoutError::Parse {
+        tool: "qflow (DEF)",
+        what: what.to_string(),
+        path: path.to_path_buf(),
+    };
+    let mut units = None;
+    let mut die = None;
+    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+    let (mut cell_area, mut cells, mut fills) = (0.0, 0u64, 0u64);
+    let mut wire = 0.0;
+    let mut section = "";
+    for line in text.lines() {
+        let t: Vec<&str> = line.split_whitespace().collect();
+        match t.as_slice() {
+            ["UNITS", "DISTANCE", "MICRONS", u, ..] => units = u.parse::<f64>().ok(),
+            ["DIEAREA", "(", a, b, ")", "(", c, d, ..] => {
+                let v: Vec<f64> = [a, b, c, d].iter().filter_map(|s| s.parse().ok()).collect();
+                if v.len() == 4 {
+                    die = Some((v[2] - v[0], v[3] - v[1]));
+                }
+            }
+            ["COMPONENTS", ..] => section = "components",
+            ["NETS", ..] => section = "nets",
+            ["SPECIALNETS", ..] | ["PINS", ..] => section = "",
+            ["END", "COMPONENTS" | "NETS"] => section = "",
+            _ => {}
+        }
+        if section == "components" && t.first() == Some(&"-") {
+            // - NAME CELL + PLACED ( x y ) ORIENT ;
+            let (Some(cell), Some(i)) = (t.get(2), t.iter().position(|s| *s == "(")) else {
+                continue;
+            };
+            let (Some(x), Some(y)) = (
+                t.get(i + 1).and_then(|v| v.parse::<f64>().ok()),
+                t.get(i + 2).and_then(|v| v.parse::<f64>().ok()),
+            ) else {
+                continue;
+            };
+            let &(w, h) = sizes
+                .get(*cell)
+                .ok_or_else(|| bad(&format!("a LEF outline for cell `{cell}`")))?;
+            let orient = t.get(i + 4).copied().unwrap_or("N");
+            let (w, h) = if orient.contains('E') || orient.contains('W') {
+                (h, w)
+            } else {
+                (w, h)
+            };
+            let u = units.ok_or_else(|| bad("`UNITS DISTANCE MICRONS` before COMPONENTS"))?;
+            let (x, y) = (x / u, y / u);
+            x0 = x0.min(x);
+            y0 = y0.min(y);
+            x1 = x1.max(x + w);
+            y1 = y1.max(y + h);
+            if *cell == fill {
+                fills += 1;
+            } else {
+                cells += 1;
+                cell_area += w * h;
+            }
+        }
+        if section == "nets" && (t.contains(&"ROUTED") || t.contains(&"NEW")) {
+            wire += segment_length(&t);
+        }
+    }
+    let u = units.ok_or_else(|| bad("`UNITS DISTANCE MICRONS`"))?;
+    let (dw, dh) = die.ok_or_else(|| bad("`DIEAREA ( x y ) ( x y )`"))?;
+    if cells == 0 {
+        return Err(bad("placed cells in COMPONENTS"));
+    }
+    Ok(DefFigures {
+        die_width_um: dw / u,
+        die_height_um: dh / u,
+        core_width_um: x1 - x0,
+        core_height_um: y1 - y0,
+        cell_area_um2: cell_area,
+        cells,
+        fill_cells: fills,
+        wirelength_um: wire / u,
+    })
+}
+
+/// The Manhattan length (DEF units) of one routed segment's points `( x y ) ( x * ) …`.
+fn segment_length(t: &[&str]) -> f64 {
+    let mut last: Option<(f64, f64)> = None;
+    let mut len = 0.0;
+    let mut i = 0;
+    while i < t.len() {
+        if t[i] == "(" && i + 3 < t.len() && t[i + 3] == ")" {
+            let coord = |s: &str, prev: Option<f64>| {
+                if s == "*" {
+                    prev
+                } else {
+                    s.parse::<f64>().ok()
+                }
+            };
+            let x = coord(t[i + 1], last.map(|p| p.0));
+            let y = coord(t[i + 2], last.map(|p| p.1));
+            if let (Some(x), Some(y)) = (x, y) {
+                if let Some((px, py)) = last {
+                    len += (x - px).abs() + (y - py).abs();
+                }
+                last = Some((x, y));
+            }
+            i += 4;
+        } else {
+            i += 1;
+        }
+    }
+    len
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LEF: &str = "MACRO INVX1\n  SIZE 2.4 BY 10.0 ;\nEND INVX1\nMACRO FILL\n  SIZE 0.8 BY 10.000 ;\nEND FILL\n";
+
+    #[test]
+    fn figures_of_a_small_def() {
+        let sizes = lef_sizes(LEF);
+        assert_eq!(sizes["INVX1"], (2.4, 10.0));
+        let def = "UNITS DISTANCE MICRONS 100 ;\nDIEAREA ( -320 -300 ) ( 1680 2300 ) ;\n\
+                   COMPONENTS 3 ;\n- a INVX1 + PLACED ( 0 0 ) N ;\n- b INVX1 + PLACED ( 240 1000 ) FS ;\n\
+                   - f FILL + PLACED ( 480 1000 ) N ;\nEND COMPONENTS\nNETS 1 ;\n- n ( a Y ) ( b A )\n\
+                   + ROUTED metal1 ( 100 500 ) ( 900 * ) M2_M1\n  NEW metal2 ( 900 500 ) ( * 1500 ) ;\nEND NETS\n\
+                   SPECIALNETS 1 ;\n- vdd + ROUTED metal4 120 ( 0 0 ) ( 0 9000 ) ;\nEND SPECIALNETS\n";
+        let f = parse_def(def, &sizes, "FILL", Path::new("x.def")).unwrap();
+        assert_eq!((f.die_width_um, f.die_height_um), (20.0, 26.0));
+        // Cells span x 0 … 4.8 + 0.8 = 5.6, y 0 … 20.
+        assert!((f.core_width_um - 5.6).abs() < 1e-12 && (f.core_height_um - 20.0).abs() < 1e-12);
+        assert_eq!((f.cells, f.fill_cells), (2, 1));
+        assert!((f.cell_area_um2 - 48.0).abs() < 1e-12);
+        assert!((f.utilisation() - 48.0 / 112.0).abs() < 1e-12);
+        // 800 + 1000 DEF units; the power stripe is not a signal wire.
+        assert!(
+            (f.wirelength_um - 18.0).abs() < 1e-12,
+            "{}",
+            f.wirelength_um
+        );
+    }
+
+    #[test]
+    fn a_cell_without_a_lef_outline_is_named() {
+        let def = "UNITS DISTANCE MICRONS 100 ;\nDIEAREA ( 0 0 ) ( 10 10 ) ;\nCOMPONENTS 1 ;\n\
+                   - a NAND9 + PLACED ( 0 0 ) N ;\nEND COMPONENTS\n";
+        let e = parse_def(def, &lef_sizes(LEF), "FILL", Path::new("x.def")).unwrap_err();
+        assert!(e.to_string().contains("`NAND9`"), "{e}");
+    }
+}

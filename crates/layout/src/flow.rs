@@ -1,0 +1,385 @@
+//! The layout flow of one resolved design, step by step (see the crate's header).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use tofprobe_design::ResolvedDesign;
+use tofprobe_eda::analysis::analyse_points;
+use tofprobe_eda::generated::GeneratedPixel;
+use tofprobe_eda::liberty::Liberty;
+use tofprobe_eda::scaling::AreaModel;
+
+use crate::error::{LayoutError, Result};
+use crate::qflow::{Project, route_verdict};
+use crate::report::{Attempt, LayoutReport, SCHEMA, Step, SynthFigures};
+use crate::tech::{Tech, TechFiles};
+
+/// Densities below this are not tried (the macro would be mostly fill).
+pub const MIN_DENSITY: f64 = 0.2;
+/// Placement attempts at most (the asked density, then 0.1 lower each time).
+pub const MAX_ATTEMPTS: usize = 3;
+
+/// What to lay out and how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayoutRequest {
+    /// The technology.
+    pub tech: Tech,
+    /// Target placement density (cells / core), 0.2 ..= 0.95.
+    pub density: f64,
+    /// The synthesis cache (`tofprobe_eda::fsutil::synth_cache_dir`), shared with `size`.
+    pub cache: PathBuf,
+    /// The sky130 PDK directory (default: `tofprobe_eda::pdk` discovery).
+    pub sky130_pdk: Option<PathBuf>,
+    /// Node (nm) the bins-per-pitch answer is scaled to.
+    pub node_nm: f64,
+    /// Pixel pitches and the paper's bins for them.
+    pub pitches: Vec<(f64, Option<u64>)>,
+}
+
+/// A finished layout: the report and the files of its output set.
+#[derive(Debug, Clone)]
+pub struct LayoutRun {
+    /// The report.
+    pub report: LayoutReport,
+    /// (name in the output set, file) pairs: DEF, GDS, LEF, SPEF, placed netlist, PNG.
+    pub files: Vec<(String, PathBuf)>,
+    /// The qflow project directory (logs of every tool).
+    pub project: PathBuf,
+}
+
+/// Checks the request's numbers before anything runs.
+pub fn check_options(density: f64, node_nm: f64) -> Result<()> {
+    if !(density.is_finite() && (MIN_DENSITY..=0.95).contains(&density)) {
+        return Err(LayoutError::Option {
+            option: "density",
+            value: density.to_string(),
+            allowed: format!("{MIN_DENSITY} ..= 0.95 (0.6 routes the default pixel on osu018)"),
+        });
+    }
+    if !(node_nm.is_finite() && node_nm > 0.0 && node_nm <= 1000.0) {
+        return Err(LayoutError::Option {
+            option: "node-nm",
+            value: node_nm.to_string(),
+            allowed: "0 < node ≤ 1000 (nm), e.g. 40".into(),
+        });
+    }
+    Ok(())
+}
+
+/// The densities tried for a request of `d`.
+pub fn densities(d: f64) -> Vec<f64> {
+    (0..MAX_ATTEMPTS)
+        .map(|i| ((d - 0.1 * i as f64) * 100.0).round() / 100.0)
+        .filter(|&x| x >= MIN_DENSITY - 1e-9)
+        .collect()
+}
+
+/// Lays out `design`; `progress` hears each step's name as it starts.
+pub fn run(
+    design: &ResolvedDesign,
+    req: &LayoutRequest,
+    progress: &mut dyn FnMut(&str),
+) -> Result<LayoutRun> {
+    check_options(req.density, req.node_nm)?;
+    crate::tools::require_all()?;
+    let mut steps = Vec::new();
+    let timed = |steps: &mut Vec<Step>, name: &str, t: Instant| {
+        steps.push(Step {
+            step: name.into(),
+            seconds: t.elapsed().as_secs_f64(),
+        })
+    };
+    let (tech, sky130_pdk) = match req.tech {
+        Tech::Osu018 => (TechFiles::osu018()?, None),
+        Tech::Sky130 => {
+            let pdk = tofprobe_eda::pdk::Sky130Pdk::discover(req.sky130_pdk.as_deref())?
+                .ok_or_else(|| LayoutError::TechFile {
+                    tech: "sky130",
+                    what: "the PDK directory",
+                    path: tofprobe_eda::pdk::search_path()[0].clone(),
+                    hint: "--sky130-pdk DIR or $TOFPROBE_SKY130_PDK",
+                })?;
+            (TechFiles::sky130(&pdk.dir, &req.cache)?, Some(pdk))
+        }
+    };
+
+    // 1. Synthesis: the configured pixel and a smaller B for the area model.
+    progress("synthesis");
+    let t = Instant::now();
+    let pixel = &design.pixel;
+    let provider = GeneratedPixel {
+        base: pixel.clone(),
+    };
+    let period_ns = 1e9 / (pixel.cycles_per_pulse as f64 * design.sensor().laser_rate_hz);
+    let lib = Liberty::load(&tech.liberty)?;
+    let (b, w) = (pixel.bins as u64, pixel.width);
+    let other = if b > 1 { b / 2 } else { 2 };
+    let points = analyse_points(
+        &provider,
+        &[(b, w), (other, w)],
+        &lib,
+        true,
+        "clk",
+        &req.cache,
+        Some(period_ns * 1e3),
+    )?;
+    let main = &points[0];
+    let syn = &main.synthesis;
+    timed(&mut steps, "synthesis (yosys, cached with `size`)", t);
+
+    // The netlist's cells must all have a layout view.
+    let lef_text = std::fs::read_to_string(&tech.cell_lef)
+        .map_err(|e| LayoutError::io("reading", &tech.cell_lef, e))?;
+    let sizes = crate::def::lef_sizes(&lef_text);
+    if let Some(cell) = syn.cells_by_type.keys().find(|c| !sizes.contains_key(*c)) {
+        return Err(LayoutError::CellMismatch {
+            cell: cell.clone(),
+            liberty: tech.liberty.clone(),
+            lef: tech.cell_lef.clone(),
+        });
+    }
+
+    // 2. The qflow project: convert, then place and route, lower densities on failure.
+    let dir = req
+        .cache
+        .join("layout")
+        .join(format!("{}-{}", tech.tech.name(), syn.key));
+    let top = provider.top();
+    let project = Project::create(&dir, &top, &tech, &syn.netlist_verilog)?;
+    progress("netlist to qflow");
+    let t = Instant::now();
+    let (synth_log, _) = project.stage("netlist conversion", "synthesize", "synth.log")?;
+    let clock_buffers: u64 = synth_log
+        .lines()
+        .filter_map(|l| l.trim().strip_suffix(" buffers were added."))
+        .filter_map(|n| n.trim().parse::<u64>().ok())
+        .sum();
+    timed(&mut steps, "netlist to qflow (BLIF, SPICE)", t);
+    let mut attempts = Vec::new();
+    let tries = densities(req.density);
+    for (i, &d) in tries.iter().enumerate() {
+        project.set_density(d)?;
+        progress(&format!("placement at density {d}"));
+        let t = Instant::now();
+        project.stage("placement", "place", "place.log")?;
+        timed(&mut steps, &format!("placement (graywolf, density {d})"), t);
+        progress("routing");
+        let t = Instant::now();
+        let (log, _) = project.stage("routing", "route", "route.log")?;
+        timed(&mut steps, &format!("routing (qrouter, density {d})"), t);
+        match route_verdict(&log) {
+            Ok(()) => {
+                attempts.push(Attempt {
+                    density: d,
+                    unrouted: 0,
+                    unrouted_nets: vec![],
+                });
+                break;
+            }
+            Err((count, mut nets)) => {
+                nets.truncate(20);
+                attempts.push(Attempt {
+                    density: d,
+                    unrouted: count,
+                    unrouted_nets: nets.clone(),
+                });
+                if i + 1 == tries.len() {
+                    return Err(LayoutError::Unrouted {
+                        tried: tries
+                            .iter()
+                            .map(|d| d.to_string())
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                        last: d,
+                        nets: format!("{count} ({})", nets.join(", ")),
+                        suggest: ((d - 0.1).max(MIN_DENSITY) * 100.0).round() / 100.0,
+                    });
+                }
+            }
+        }
+    }
+
+    // 3. Checks and views.
+    progress("DRC, extraction, LEF");
+    let t = Instant::now();
+    project.stage("layout database", "migrate", "migrate.log")?;
+    let (drc_log, _) = project.stage("DRC", "drc", "drc.log")?;
+    timed(&mut steps, "DRC and extraction (magic)", t);
+    let drc_errors = drc_log
+        .lines()
+        .rev()
+        .find_map(|l| l.trim().strip_prefix("drc = "))
+        .and_then(|v| v.trim().parse::<u64>().ok())
+        .ok_or_else(|| LayoutError::Parse {
+            tool: "magic",
+            what: "`drc = N`".into(),
+            path: dir.join("log/drc.log"),
+        })?;
+    progress("LVS");
+    let t = Instant::now();
+    let (lvs_log, _) = project.stage("LVS", "lvs", "lvs.log")?;
+    timed(&mut steps, "LVS (netgen)", t);
+    let lvs_result = lvs_log
+        .lines()
+        .find(|l| l.starts_with("Result:"))
+        .map(|l| l.trim_start_matches("Result:").trim().to_string())
+        .unwrap_or_else(|| "no result line".into());
+    let lvs_match = lvs_log.contains("Total errors = 0") && lvs_result.contains("match uniquely");
+    progress("GDS");
+    let t = Instant::now();
+    project.stage("GDS", "gdsii", "gdsii.log")?;
+    timed(&mut steps, "GDS (magic)", t);
+
+    // 4. Post-route timing.
+    progress("post-route timing");
+    let t = Instant::now();
+    let rc_path = project.layout_file("rc");
+    let rc =
+        std::fs::read_to_string(&rc_path).map_err(|e| LayoutError::io("reading", &rc_path, e))?;
+    let mut nets = crate::spef::parse_rc(&rc, &rc_path)?;
+    let netlist = project.synthesis_file("rtlnopwr.v");
+    let verilog =
+        std::fs::read_to_string(&netlist).map_err(|e| LayoutError::io("reading", &netlist, e))?;
+    crate::spef::rename_to_netlist(&mut nets, &verilog);
+    let spef_path = project.layout_file("spef");
+    std::fs::write(&spef_path, crate::spef::write_spef(&top, &nets))
+        .map_err(|e| LayoutError::io("writing", &spef_path, e))?;
+    let spef_nets = nets.iter().filter(|n| !n.points.is_empty()).count();
+    let post = |lib: &Path, corner: &str| {
+        crate::sta::run(
+            lib,
+            &netlist,
+            &spef_path,
+            &top,
+            period_ns,
+            spef_nets,
+            &dir.join("layout"),
+            corner,
+        )
+    };
+    let post_route = post(&tech.liberty, "typical")?;
+    // Every corner: the synthesis netlist timed on each liberty (the size report's
+    // figures, cached), the routed one with the same wires.
+    let mut corners = Vec::new();
+    let corner_libs: Vec<(String, String, PathBuf)> = match &sky130_pdk {
+        Some(pdk) => pdk
+            .corners
+            .iter()
+            .map(|c| {
+                Ok((
+                    format!("sky130_fd_sc_hd__{}", c.name),
+                    c.name.clone(),
+                    tofprobe_eda::pdk::plain_copy(&c.source, &req.cache)?,
+                ))
+            })
+            .collect::<Result<_>>()?,
+        None => vec![(lib.name.clone(), "typical".into(), tech.liberty.clone())],
+    };
+    for (library, corner, path) in corner_libs {
+        let synth_t = tofprobe_eda::corners::time_cached(syn, &path, &corner, "clk")?;
+        let post_route = if path == tech.liberty {
+            post_route.clone()
+        } else {
+            post(&path, &corner)?
+        };
+        corners.push(crate::report::CornerRow {
+            library,
+            corner,
+            synthesis_f_max_mhz: synth_t.f_max_mhz,
+            synthesis_slack_ns: period_ns - synth_t.critical_path_ns,
+            post_route,
+        });
+    }
+    timed(&mut steps, "post-route timing (OpenSTA + SPEF)", t);
+
+    // 5. Picture, figures, bins per pitch.
+    progress("picture");
+    let t = Instant::now();
+    let png = project.layout_file("png");
+    crate::picture::draw(&project.layout_file("gds"), &png, 1600, &dir.join("layout"))?;
+    timed(&mut steps, "picture (klayout)", t);
+    let def_path = project.layout_file("def");
+    let def_text =
+        std::fs::read_to_string(&def_path).map_err(|e| LayoutError::io("reading", &def_path, e))?;
+    let def = crate::def::parse_def(&def_text, &sizes, &tech.fill, &def_path)?;
+    let model = AreaModel::fit(
+        &points
+            .iter()
+            .map(|p| (p.bins as f64, p.synthesis.total_area_um2))
+            .collect::<Vec<_>>(),
+    )
+    .ok();
+    let routed_factor = def.die_area_um2() / syn.total_area_um2;
+    let bins_per_pitch = match model {
+        Some(m) => Some(crate::bins::bins_per_pitch(
+            m,
+            routed_factor,
+            def.die_area_um2(),
+            tech.tech.node_nm(),
+            req.node_nm,
+            &req.pitches,
+        )?),
+        None => None,
+    };
+    let synthesis = SynthFigures {
+        area_um2: syn.total_area_um2,
+        cells: syn.cell_count,
+        f_max_mhz: main.timing.as_ref().map(|t| t.f_max_mhz),
+        slack_ns: main.timing.as_ref().map(|t| period_ns - t.critical_path_ns),
+        key: syn.key.clone(),
+    };
+    let report = LayoutReport {
+        schema: SCHEMA.into(),
+        tech: tech.tech.name().into(),
+        config: design.origin.clone(),
+        top: top.clone(),
+        bins: b,
+        width: w,
+        attempts,
+        def,
+        synthesis,
+        drc_errors,
+        lvs_match,
+        lvs_result,
+        post_route,
+        bins_per_pitch,
+        steps,
+        clock_buffers,
+        corners,
+        notes: notes(&tech, other),
+    };
+    let ext = |e: &str| project.layout_file(e);
+    let files = vec![
+        (format!("{top}.def"), ext("def")),
+        (format!("{top}.gds"), ext("gds")),
+        (format!("{top}.lef"), ext("lef")),
+        (format!("{top}.spef"), ext("spef")),
+        (format!("{top}.v"), netlist),
+        ("layout.png".to_string(), png),
+    ];
+    Ok(LayoutRun {
+        report,
+        files,
+        project: dir,
+    })
+}
+
+fn notes(tech: &TechFiles, other_b: u64) -> Vec<String> {
+    let mut n = vec![
+        "Synthesis: the project's delay-driven yosys script (tofprobe_eda::synth), mapped for the configuration's clock; qflow only converts that netlist (BLIF, SPICE); its blifFanout buffers nets of fanout > 16 and resizes nothing (`-f -F 16`): the synthesised nets have fanout ≤ 8, so that is the clock's buffer tree. LVS compares the layout with this netlist: the synthesised one plus the clock buffers.".to_string(),
+        "Placement: graywolf at the stated target density (qflow's initial_density: fill cells are added until the logic covers that fraction); a routing failure retries 0.1 lower, at most 3 attempts. Power: qflow's addspacers stripes (2 µm every 50 µm on osu018).".into(),
+        "Post-route timing: OpenSTA on the placed netlist with qrouter's RC trees written as SPEF (lumped at each route point), the clock propagated through its buffer tree and routed wires (their delays are the skew the hold check sees), inputs at the clock edge, outputs due at the next.".into(),
+        format!("Bins per pitch: the synthesis model A(B) fitted to B and {other_b} on this technology's liberty, times the routed factor die / cell area of the configured pixel (assumed to hold for other B), scaled by (target node / technology node)²."),
+    ];
+    if tech.tech == Tech::Osu018 {
+        n.push("osu018: Debian's qflow-tech-osu018 has no cell GDS, so the GDS and the picture hold the cells' LEF abstracts (pins and obstructions) with the routing, and magic's DRC checks the routing and the abstracts, not the cells' transistors.".into());
+    }
+    n
+}
+
+/// The directory a design's layout project uses (for tests that look at the logs).
+pub fn project_dir(cache: &Path, tech: Tech, synthesis_key: &str) -> PathBuf {
+    cache
+        .join("layout")
+        .join(format!("{}-{synthesis_key}", tech.name()))
+}

@@ -1,0 +1,204 @@
+//! One qflow project: the synthesised netlist converted to qflow's BLIF (no re-synthesis:
+//! a yosys script that only reads the project's netlist and writes it out; qflow's
+//! blifFanout then only buffers nets of fanout > 16, i.e. builds the clock's buffer tree,
+//! and resizes nothing), then qflow's stages (`place`, `route`,
+//! `migrate`, `drc`, `lvs`, `gdsii`), each timed, its log checked for qflow's error
+//! condition.
+
+use crate::error::{LayoutError, Result};
+use crate::tech::TechFiles;
+use crate::tools::{Tool, tail};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// A qflow project directory.
+#[derive(Debug, Clone)]
+pub struct Project {
+    /// The directory (`source/`, `synthesis/`, `layout/`, `log/`).
+    pub dir: PathBuf,
+    /// The top module.
+    pub top: String,
+    /// The technology.
+    pub tech: TechFiles,
+}
+
+fn write(path: &Path, text: &str) -> Result<()> {
+    std::fs::write(path, text).map_err(|e| LayoutError::io("writing", path, e))
+}
+
+impl Project {
+    /// A fresh project in `dir` (removed first if present) holding `netlist`.
+    pub fn create(dir: &Path, top: &str, tech: &TechFiles, netlist: &Path) -> Result<Project> {
+        if dir.exists() {
+            std::fs::remove_dir_all(dir).map_err(|e| LayoutError::io("removing", dir, e))?;
+        }
+        for sub in ["source", "synthesis", "layout", "log"] {
+            let d = dir.join(sub);
+            std::fs::create_dir_all(&d).map_err(|e| LayoutError::io("creating", &d, e))?;
+        }
+        let src = dir.join("source").join(format!("{top}.v"));
+        std::fs::copy(netlist, &src).map_err(|e| LayoutError::io("copying", netlist, e))?;
+        // qflow finds a technology outside its own directory as PROJECT/tech/NAME.
+        if !tech.dir.starts_with(crate::tech::QFLOW_TECH) {
+            let link = dir.join("tech");
+            std::fs::create_dir_all(&link).map_err(|e| LayoutError::io("creating", &link, e))?;
+            let link = link.join(&tech.name);
+            std::os::unix::fs::symlink(&tech.dir, &link)
+                .map_err(|e| LayoutError::io("linking", &link, e))?;
+        }
+        let qbin = PathBuf::from("/usr/lib/qflow");
+        write(
+            &dir.join("qflow_vars.sh"),
+            &format!(
+                "#!/usr/bin/tcsh -f\nset projectpath={p}\nset techdir={t}\nset sourcedir={p}/source\n\
+                 set synthdir={p}/synthesis\nset layoutdir={p}/layout\nset techname={n}\n\
+                 set scriptdir={q}/scripts\nset bindir={q}/bin\nset logdir={p}/log\n",
+                p = dir.display(),
+                t = tech.dir.display(),
+                n = tech.name,
+                q = qbin.display()
+            ),
+        )?;
+        let (buf, a, y) = tech.buffer;
+        let ties = match tech.tech {
+            crate::tech::Tech::Sky130 => {
+                "hilomap -singleton -hicell sky130_fd_sc_hd__conb_1 HI -locell sky130_fd_sc_hd__conb_1 LO\n"
+            }
+            crate::tech::Tech::Osu018 => "",
+        };
+        write(
+            &dir.join("source/convert.ys"),
+            &format!(
+                "# The project's synthesised netlist as qflow's BLIF: no synthesis here.\n\
+                 read_liberty -lib {lib}\nread_verilog {src}\nhierarchy -top {top}\n{ties}opt_clean -purge\n\
+                 write_blif -buf {buf} {a} {y} {top}_mapped.blif\n",
+                lib = tech.liberty.display(),
+                src = src.display(),
+            ),
+        )?;
+        let p = Project {
+            dir: dir.to_path_buf(),
+            top: top.to_string(),
+            tech: tech.clone(),
+        };
+        p.set_density(0.6)?;
+        Ok(p)
+    }
+
+    /// Sets the placement's target density (qflow's `initial_density`: fill cells are
+    /// added until the cells cover that fraction of the core). blifFanout runs as
+    /// buffering only (`-f`, no gate resizing) with fanout ≤ 16: the synthesised nets have
+    /// fanout ≤ 8 already (ABC's buffering), so what it buffers is the clock, whose tree of
+    /// buffers this is.
+    pub fn set_density(&self, density: f64) -> Result<()> {
+        write(
+            &self.dir.join("project_vars.sh"),
+            &format!(
+                "#!/usr/bin/tcsh -f\nset yosys_options = \"-s {}\"\nset fanout_options = \"-f -F 16\"\nset initial_density = {density}\n",
+                self.dir.join("source/convert.ys").display()
+            ),
+        )
+    }
+
+    /// A file of the layout directory: `layout/TOP.EXT`.
+    pub fn layout_file(&self, ext: &str) -> PathBuf {
+        self.dir.join("layout").join(format!("{}.{ext}", self.top))
+    }
+
+    /// A file of the synthesis directory: `synthesis/TOP.EXT`.
+    pub fn synthesis_file(&self, ext: &str) -> PathBuf {
+        self.dir
+            .join("synthesis")
+            .join(format!("{}.{ext}", self.top))
+    }
+
+    /// Runs qflow's `stage` (its qflow name) and returns its log's text and the seconds
+    /// it took; an error names the stage and the log's tail.
+    pub fn stage(&self, step: &'static str, stage: &str, log: &str) -> Result<(String, f64)> {
+        let qflow = Tool::Qflow.locate()?;
+        let start = std::time::Instant::now();
+        let out = Command::new(&qflow)
+            .arg(stage)
+            .arg(&self.top)
+            .current_dir(&self.dir)
+            .output()
+            .map_err(|e| LayoutError::io("running", &qflow, e))?;
+        let seconds = start.elapsed().as_secs_f64();
+        let console = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let console_path = self.dir.join("log").join(format!("qflow-{stage}.txt"));
+        write(&console_path, &console)?;
+        let log_path = self.dir.join("log").join(log);
+        let text = std::fs::read_to_string(&log_path).unwrap_or_default();
+        let failed = !out.status.success()
+            || text.contains("error condition")
+            || text.contains("Premature exit")
+            || text.is_empty();
+        if failed && stage != "route" {
+            let both = format!("{text}\n{console}");
+            return Err(LayoutError::ToolFailed {
+                step,
+                tool: "qflow",
+                status: out
+                    .status
+                    .code()
+                    .map_or("killed".into(), |c| format!("exit {c}")),
+                log: log_path,
+                tail: tail(both.trim_end(), 15),
+            });
+        }
+        Ok((text, seconds))
+    }
+}
+
+/// qrouter's verdict in a route log: `Ok(())` when every net routed, else the unrouted
+/// nets' count and the names qrouter reported as failing in its last pass.
+pub fn route_verdict(log: &str) -> std::result::Result<(), (usize, Vec<String>)> {
+    let last = log
+        .lines()
+        .rev()
+        .find(|l| l.trim_start().starts_with("Final:"));
+    if last.is_some_and(|l| l.contains("No failed routes")) {
+        return Ok(());
+    }
+    // The nets failing after the last stage marker (earlier passes rip them up again).
+    let from = log.rfind("Progress: Stage").map_or(0, |i| i);
+    let window = if log[from..].contains("Failed to route net") {
+        &log[from..]
+    } else {
+        log
+    };
+    let mut nets: Vec<String> = window
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("Failed to route net "))
+        .map(|n| n.trim().to_string())
+        .collect();
+    nets.sort();
+    nets.dedup();
+    let count = last
+        .and_then(|l| l.split_whitespace().find_map(|w| w.parse::<usize>().ok()))
+        .unwrap_or(nets.len().max(1));
+    Err((count, nets))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_route_verdict_reads_the_final_line() {
+        assert_eq!(
+            route_verdict("Failed to route net a\nProgress: Stage 3\nFinal: No failed routes!\n"),
+            Ok(())
+        );
+        let v = route_verdict(
+            "Failed to route net a\nProgress: Stage 3 total routes\nFailed to route net b\nFailed to route net c\nFailed to route net b\nFinal: 2 unrouted nets\n",
+        );
+        assert_eq!(v, Err((2, vec!["b".into(), "c".into()])));
+        // No verdict at all (the router died): a failure.
+        assert!(route_verdict("").is_err());
+    }
+}

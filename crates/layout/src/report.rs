@@ -1,0 +1,273 @@
+//! The layout report: what was routed where, the macro's figures, the checks' verdicts,
+//! timing before and after routing, bins per pitch, and the time of each step; as JSON
+//! and Markdown.
+
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+
+use crate::bins::BinsPerPitch;
+use crate::def::DefFigures;
+use crate::sta::PostRoute;
+
+/// JSON schema name of [`LayoutReport`].
+pub const SCHEMA: &str = "tofprobe-layout-1";
+
+/// One placement-and-routing attempt.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Attempt {
+    /// Target density of the placement.
+    pub density: f64,
+    /// Nets qrouter left unrouted (0: routed).
+    pub unrouted: usize,
+    /// Their names (as qrouter reported them; at most 20).
+    pub unrouted_nets: Vec<String>,
+}
+
+/// Synthesis figures of the routed netlist (the project's delay-driven yosys script,
+/// ideal-clock OpenSTA).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct SynthFigures {
+    /// Cell area (µm²).
+    pub area_um2: f64,
+    /// Cells.
+    pub cells: u64,
+    /// f_max with an ideal clock and no wires (MHz).
+    pub f_max_mhz: Option<f64>,
+    /// Setup slack at the configuration's clock (ns).
+    pub slack_ns: Option<f64>,
+    /// The synthesis cache key.
+    pub key: String,
+}
+
+/// Timing at one library corner: synthesis (ideal clock) beside post-route.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct CornerRow {
+    /// The liberty's library name.
+    pub library: String,
+    /// The corner (`typical` for osu018, `tt_025C_1v80`, `ss_n40C_1v40`, `ff_100C_1v95`).
+    pub corner: String,
+    /// Synthesis f_max (MHz), ideal clock, no wires.
+    pub synthesis_f_max_mhz: f64,
+    /// Synthesis setup slack at the configuration's clock (ns).
+    pub synthesis_slack_ns: f64,
+    /// Post-route timing at this corner (the same routed wires).
+    pub post_route: PostRoute,
+}
+
+/// A step and its wall time.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Step {
+    /// The step.
+    pub step: String,
+    /// Wall time (s).
+    pub seconds: f64,
+}
+
+/// The report of `tofprobe layout`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct LayoutReport {
+    /// [`SCHEMA`].
+    pub schema: String,
+    /// osu018 or sky130.
+    pub tech: String,
+    /// The configuration it came from.
+    pub config: String,
+    /// The module laid out.
+    pub top: String,
+    /// Bins B.
+    pub bins: u64,
+    /// Register width W.
+    pub width: u32,
+    /// Placement attempts, the routed one last.
+    pub attempts: Vec<Attempt>,
+    /// The routed macro.
+    pub def: DefFigures,
+    /// Synthesis.
+    pub synthesis: SynthFigures,
+    /// magic's DRC error count.
+    pub drc_errors: u64,
+    /// netgen's verdict: whether layout and synthesised netlist match.
+    pub lvs_match: bool,
+    /// netgen's result line.
+    pub lvs_result: String,
+    /// Post-route timing.
+    pub post_route: PostRoute,
+    /// Bins per pitch (None when the B sweep's model could not be fitted).
+    pub bins_per_pitch: Option<BinsPerPitch>,
+    /// Steps and their wall times.
+    pub steps: Vec<Step>,
+    /// Buffers blifFanout added (the clock tree).
+    pub clock_buffers: u64,
+    /// Every corner of the technology's liberties (osu018: one; sky130: tt, ss, ff).
+    pub corners: Vec<CornerRow>,
+    /// What the figures assume.
+    pub notes: Vec<String>,
+}
+
+impl LayoutReport {
+    /// Whether the macro is clean: DRC 0 and LVS match.
+    pub fn clean(&self) -> bool {
+        self.drc_errors == 0 && self.lvs_match
+    }
+
+    /// The density that routed.
+    pub fn density(&self) -> f64 {
+        self.attempts.last().map_or(0.0, |a| a.density)
+    }
+
+    /// One line for the terminal.
+    pub fn summary(&self) -> String {
+        format!(
+            "layout {}: {:.1} × {:.1} µm die ({:.0} µm²), utilisation {:.1} %, wirelength {:.0} µm, DRC {}, LVS {}, post-route f_max {:.1} MHz (setup slack {:.3} ns, hold {:.3} ns, register to register {:.3} ns at {:.3} ns)",
+            self.tech,
+            self.def.die_width_um,
+            self.def.die_height_um,
+            self.def.die_area_um2(),
+            100.0 * self.def.utilisation(),
+            self.def.wirelength_um,
+            self.drc_errors,
+            if self.lvs_match { "match" } else { "MISMATCH" },
+            self.post_route.f_max_mhz,
+            self.post_route.setup_slack_ns,
+            self.post_route.hold_slack_ns,
+            self.post_route.hold_slack_registers_ns,
+            self.post_route.period_ns,
+        )
+    }
+
+    /// The Markdown report.
+    pub fn markdown(&self) -> String {
+        let d = &self.def;
+        let mut s = format!(
+            "# Layout of `{}` on {}\n\nConfiguration: `{}`; B = {}, W = {}.\n\n## Macro\n\n\
+             | figure | value |\n|---|---:|\n\
+             | die | {:.2} × {:.2} µm = {:.0} µm² |\n| core (placed cells' extent) | {:.2} × {:.2} µm = {:.0} µm² |\n\
+             | logic cells | {} ({:.0} µm², {} of them clock buffers; {} fill cells) |\n| utilisation (cells / core) | {:.1} % |\n\
+             | target density routed | {} |\n| routed wirelength | {:.0} µm |\n| DRC errors (magic) | {} |\n\
+             | LVS (netgen, layout vs synthesised netlist) | {} — {} |\n\n",
+            self.top,
+            self.tech,
+            self.config,
+            self.bins,
+            self.width,
+            d.die_width_um,
+            d.die_height_um,
+            d.die_area_um2(),
+            d.core_width_um,
+            d.core_height_um,
+            d.core_area_um2(),
+            d.cells,
+            d.cell_area_um2,
+            self.clock_buffers,
+            d.fill_cells,
+            100.0 * d.utilisation(),
+            self.density(),
+            d.wirelength_um,
+            self.drc_errors,
+            if self.lvs_match { "match" } else { "MISMATCH" },
+            self.lvs_result,
+        );
+        if self.attempts.len() > 1 {
+            s += "Placement attempts:\n\n| density | unrouted nets |\n|---:|---|\n";
+            for a in &self.attempts {
+                let _ = writeln!(
+                    s,
+                    "| {} | {}{} |",
+                    a.density,
+                    a.unrouted,
+                    if a.unrouted_nets.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" ({})", a.unrouted_nets.join(", "))
+                    }
+                );
+            }
+            s += "\n";
+        }
+        let p = &self.post_route;
+        let opt = |v: Option<f64>, d: usize| v.map_or("—".into(), |v| format!("{v:.d$}"));
+        let _ = write!(
+            s,
+            "## Timing at the configuration's clock ({:.3} ns, {:.1} MHz)\n\n\
+             | | synthesis (ideal clock, no wires) | post-route (SPEF, propagated clock) |\n|---|---:|---:|\n\
+             | f_max (MHz) | {} | {:.1} |\n| setup slack (ns) | {} | {:.3} |\n| hold slack (ns), all paths | — | {:.3} |\n| hold slack (ns), register to register | — | {:.3} |\n\n\
+             Worst setup path: `{}` → `{}`; worst hold path: `{}` → `{}`; {} nets annotated from the SPEF.\n\n",
+            p.period_ns,
+            1e3 / p.period_ns,
+            opt(self.synthesis.f_max_mhz, 1),
+            p.f_max_mhz,
+            opt(self.synthesis.slack_ns, 3),
+            p.setup_slack_ns,
+            p.hold_slack_ns,
+            p.hold_slack_registers_ns,
+            p.setup_path.0,
+            p.setup_path.1,
+            p.hold_path.0,
+            p.hold_path.1,
+            p.spef_nets,
+        );
+        s += "## Corners\n\n| library | corner | synthesis f_max (MHz) | synthesis slack (ns) | post-route f_max (MHz) | post-route setup slack (ns) | hold slack (ns), all / register to register | meets the clock |\n|---|---|---:|---:|---:|---:|---:|---|\n";
+        for c in &self.corners {
+            let p = &c.post_route;
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.1} | {:.3} | {:.1} | {:.3} | {:.3} / {:.3} | {} |",
+                c.library,
+                c.corner,
+                c.synthesis_f_max_mhz,
+                c.synthesis_slack_ns,
+                p.f_max_mhz,
+                p.setup_slack_ns,
+                p.hold_slack_ns,
+                p.hold_slack_registers_ns,
+                if p.setup_slack_ns >= 0.0 && p.hold_slack_registers_ns >= 0.0 {
+                    "yes"
+                } else {
+                    "**no**"
+                }
+            );
+        }
+        s += "\n";
+        if let Some(b) = &self.bins_per_pitch {
+            let _ = write!(
+                s,
+                "## Bins per pitch at {} nm\n\nSynthesis model A(B) = {:.0} + {:.0}·B µm² ({} nm), routed factor k = die / cell area = {:.3}, scaled by ({}/{})² = {:.4}.\n\n\
+                 The routed macro of this pixel (B = {}) needs a {:.1} × {:.1} µm pitch at {} nm.\n\n\
+                 | pitch | from layout | from synthesis | paper |\n|---|---:|---:|---:|\n",
+                b.target_node_nm,
+                b.synthesis_model.fixed_um2,
+                b.synthesis_model.per_bin_um2,
+                b.tech_node_nm,
+                b.routed_factor,
+                b.target_node_nm,
+                b.tech_node_nm,
+                b.area_factor,
+                self.bins,
+                b.routed_side_um,
+                b.routed_side_um,
+                b.target_node_nm,
+            );
+            for p in &b.pitches {
+                let _ = writeln!(
+                    s,
+                    "| {0} × {0} µm | {1} | {2} | {3} |",
+                    p.side_um,
+                    p.layout_bins,
+                    p.synthesis_bins,
+                    p.paper_bins.map_or("—".into(), |n| n.to_string())
+                );
+            }
+            s += "\n";
+        }
+        s += "## Steps\n\n| step | seconds |\n|---|---:|\n";
+        for st in &self.steps {
+            let _ = writeln!(s, "| {} | {:.1} |", st.step, st.seconds);
+        }
+        let total: f64 = self.steps.iter().map(|s| s.seconds).sum();
+        let _ = writeln!(s, "| total | {total:.1} |\n\n## Notes\n");
+        for n in &self.notes {
+            let _ = writeln!(s, "- {n}");
+        }
+        s
+    }
+}
