@@ -271,7 +271,9 @@ module {{ name }} (
     end
 
     // ---- the readout buffer and the port ----
-    reg [{{ w - 1 }}:0] rbuf [0:{{ r }}];
+{%- for j in words %}
+    reg [{{ w - 1 }}:0] rbuf_{{ j }};
+{%- endfor %}
     reg dr_act;
     reg [{{ ib - 1 }}:0] dj;
 {%- if k > 1 %}
@@ -290,7 +292,15 @@ module {{ name }} (
 {%- else %}
     wire last = (dj == {{ ib }}'d{{ r }});
 {%- endif %}
-    wire [{{ w - 1 }}:0] dw = rbuf[dj];
+    reg [{{ w - 1 }}:0] dw;
+    always @* begin
+        case (dj)
+{%- for j in words %}
+            {{ ib }}'d{{ j }}: dw = rbuf_{{ j }};
+{%- endfor %}
+            default: dw = {{ w }}'d0;
+        endcase
+    end
 {%- if kb > w %}
     // Registers sign-extended, the status word (index {{ r }}) zero-extended, to {{ kb }} bits.
     wire dsx = dw[{{ w - 1 }}] && (dj != {{ ib }}'d{{ r }});
@@ -299,9 +309,11 @@ module {{ name }} (
     wire [{{ kb - 1 }}:0] dx = dw;
 {%- endif %}
     always @(posedge clk) begin
-        if (m_valid) begin
-            rbuf[m_index] <= m_data;
+{%- for j in words %}
+        if (m_valid && (m_index == {{ ib }}'d{{ j }})) begin
+            rbuf_{{ j }} <= m_data;
         end
+{%- endfor %}
     end
     always @(posedge clk) begin
         if (rst) begin

@@ -221,10 +221,11 @@ impl ArrayModel {
         };
         for (i, px) in self.pixels.iter_mut().enumerate() {
             let (r, c) = (i / cols, i % cols);
-            let src = if neighbour == Some(i) {
-                (i + 1) % np
-            } else {
-                i
+            // Two TDCs crossed: the faulty pixel reads the next one's, that one its.
+            let src = match neighbour {
+                Some(n) if n == i => (i + 1) % np,
+                Some(n) if (n + 1) % np == i => n,
+                _ => i,
             };
             px.step(&PinsIn {
                 rst,

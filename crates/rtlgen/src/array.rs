@@ -19,7 +19,8 @@ pub enum ArrayFault {
         /// The late row.
         row: usize,
     },
-    /// The pixel's `tdc` input is wired to the next pixel's (row-major, wrapping).
+    /// The pixel's `tdc` input is wired to the next pixel's (row-major, wrapping) and that
+    /// one's to this one's: two TDCs crossed.
     NeighbourTdc {
         /// The pixel's row.
         row: usize,
@@ -126,6 +127,7 @@ struct ArrayT<'a> {
     kb: usize,
     dx_ext: String,
     parts: Vec<usize>,
+    words: Vec<usize>,
     swap_r0: usize,
     swap_c0: usize,
     swap_r1: usize,
@@ -242,10 +244,10 @@ pub fn render_array(
             i,
             row: i / a.cols,
             col: i % a.cols,
-            tdc: if neighbour == Some(i) {
-                (i + 1) % np
-            } else {
-                i
+            tdc: match neighbour {
+                Some(n) if n == i => (i + 1) % np,
+                Some(n) if (n + 1) % np == i => n,
+                _ => i,
             },
         })
         .collect();
@@ -330,6 +332,7 @@ pub fn render_array(
             "dw".into()
         },
         parts: (0..k).collect(),
+        words: (0..=r).collect(),
         swap_r0: s0.0,
         swap_c0: s0.1,
         swap_r1: s1.0,
