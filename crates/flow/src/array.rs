@@ -76,6 +76,8 @@ pub struct ArrayCosimReport {
     /// The first mismatch: signal, expected, actual and what the array was doing then
     /// (pixel (r, c), register, cycle, pulse), from the model.
     pub first: Option<String>,
+    /// The first mismatch's cycle.
+    pub first_cycle: Option<u64>,
     /// The model's run (its stream and per-pixel words).
     pub run: ArrayRun,
     /// Harness build seconds (0 for Icarus) and whether the cached build was reused.
@@ -219,6 +221,7 @@ pub fn cosim_array(
         cycles: outcome.cycles,
         mismatches: outcome.mismatches,
         first,
+        first_cycle: outcome.first.as_ref().map(|m| m.cycle),
         run: r,
         build_seconds,
         reused,
@@ -240,7 +243,7 @@ pub fn readout_section(design: &ResolvedDesign, md: &mut String) -> Result<(), F
     let _ = writeln!(md, "## Readout (docs/pixel-contract.md \"Array\")\n");
     let _ = writeln!(
         md,
-        "At the configured frame (N = {} pulses): {} × {} pixels × {} words × {} beat(s) of {} bits = {} bits per frame ({} payload), read in {} cycles = {:.6} s at f_clk = {:.3e} Hz (one beat every {} cycle(s), {:.3e} bit/s while streaming); a frame every {} cycles: {:.6} Hz, the pixels see {:.4} % of the laser's pulses{}.\n",
+        "At the configured frame (N = {} pulses): {} × {} pixels × {} words × {} beat(s) of {} bits = {} bits per frame ({} payload), read in {} cycles = {:.3e} s at f_clk = {:.3e} Hz (one beat every {} cycle(s), {:.3e} bit/s while streaming); a frame every {} cycles: {:.6} Hz, the pixels see {:.4} % of the laser's pulses{}.\n",
         ro.frame_pulses,
         ro.rows,
         ro.cols,
