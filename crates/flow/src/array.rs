@@ -138,34 +138,42 @@ pub fn render_array_design(
     Ok((chip, files))
 }
 
-/// Renders the array of `design`, runs the array model on its scene (or the given
-/// detections), writes the golden vectors and replays them under the simulator.
-pub fn cosim_array(
+/// The array's golden vectors written (`tofprobe vectors` on an array design): the chip
+/// for the overrides (the simulating commands' ROM), the array model run on `detections`
+/// (`None`: the array scene's), the files of `tofprobe_array::rtl_vectors` in `vec_dir`.
+#[derive(Debug)]
+pub struct ArrayVectors {
+    pub chip: Chip,
+    pub readout: Readout,
+    pub run: ArrayRun,
+    pub detections: Vec<Vec<Option<u32>>>,
+    pub model_seconds: f64,
+}
+
+/// Runs the array model of `design` and writes its vectors into `vec_dir`.
+pub fn write_array_vectors(
     design: &ResolvedDesign,
-    a: &ArrayCosimOptions,
-) -> Result<ArrayCosimReport, FlowError> {
-    if a.frames == 0 || a.frames > 100 {
-        return Err(FlowError::option("frames", a.frames, "1..=100"));
+    o: &RtlOverrides,
+    frames: u64,
+    detections: Option<Vec<Vec<Option<u32>>>>,
+    vec_dir: &Path,
+    command: &str,
+) -> Result<ArrayVectors, FlowError> {
+    if frames == 0 || frames > 100 {
+        return Err(FlowError::option("frames", frames, "1..=100"));
     }
-    let o = RtlOverrides {
-        frame_pulses: a.frame_pulses,
-        rom_depth: a.rom_depth,
-    };
-    let chip = chip(design, &o, RomPurpose::Replayed)?;
+    let chip = chip(design, o, RomPurpose::Replayed)?;
     let ro = chip
         .readout
         .ok_or_else(|| FlowError::option("array", "none", "an [array] design"))?;
     let p = &chip.pixel;
-    let rtl_dir = a.out.join("rtl");
-    let vec_dir = a.out.join("vectors");
-    render_array_to(&chip, &rtl_dir, a.command.clone(), a.fault)?;
-    let detections = match &a.detections {
-        Some(d) => d.clone(),
-        None => scene_detections(design, p.frame_pulses, a.frames)?,
+    let detections = match detections {
+        Some(d) => d,
+        None => scene_detections(design, p.frame_pulses, frames)?,
     };
     let t0 = std::time::Instant::now();
     let mut model = ArrayModel::new(&ro, p, &chip.rom.words, None)?;
-    let r = run(&mut model, &detections, a.frames)?;
+    let r = run(&mut model, &detections, frames)?;
     let model_seconds = t0.elapsed().as_secs_f64();
     let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
     let header = format!(
@@ -175,10 +183,43 @@ pub fn cosim_array(
         ro.cols,
         p.mode,
         p.frame_pulses,
-        a.frames,
-        tofprobe_io::text::sanitize(&a.command)
+        frames,
+        tofprobe_io::text::sanitize(command)
     );
-    write_generated(&vec_dir, &vector_files(&r, &detections, p, &top, &header))?;
+    write_generated(vec_dir, &vector_files(&r, &detections, p, &top, &header))?;
+    Ok(ArrayVectors {
+        chip,
+        readout: ro,
+        run: r,
+        detections,
+        model_seconds,
+    })
+}
+
+/// Renders the array of `design`, runs the array model on its scene (or the given
+/// detections), writes the golden vectors and replays them under the simulator.
+pub fn cosim_array(
+    design: &ResolvedDesign,
+    a: &ArrayCosimOptions,
+) -> Result<ArrayCosimReport, FlowError> {
+    let o = RtlOverrides {
+        frame_pulses: a.frame_pulses,
+        rom_depth: a.rom_depth,
+    };
+    let rtl_dir = a.out.join("rtl");
+    let vec_dir = a.out.join("vectors");
+    let v = write_array_vectors(
+        design,
+        &o,
+        a.frames,
+        a.detections.clone(),
+        &vec_dir,
+        &a.command,
+    )?;
+    render_array_to(&v.chip, &rtl_dir, a.command.clone(), a.fault)?;
+    let (ro, r, detections, model_seconds) = (v.readout, v.run, v.detections, v.model_seconds);
+    let p = &v.chip.pixel;
+    let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
     let rtl_abs = std::fs::canonicalize(&rtl_dir)
         .map_err(|e| FlowError::output(rtl_dir.clone(), e.to_string()))?;
     let (outcome, build_seconds, reused) = match a.simulator {
