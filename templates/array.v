@@ -9,12 +9,14 @@
 // the buffer drains onto the {{ b }}-bit port, {{ k }} beat(s) per word (least significant
 // first; registers sign-extended, the status word zero-extended), one beat every {{ g }}
 // cycle(s). `pulse_o` tells the TDCs (and a testbench) that the pixels sample `valid` and
-// `tdc` this cycle; pixel (r, c) is bit r*{{ cols }}+c of `valid` and field r*{{ cols }}+c of `tdc`.
+// `tdc` this cycle; {% if let Some(t) = tile %}this is the TILE of rows {{ t.0 }}..{{ t.0 + trows - 1 }}, columns {{ t.1 }}..{{ t.1 + tcols - 1 }}
+// only (the sequencer, broadcast and readout of the whole array, the other pixels absent:
+// their slots carry no beat); its pixel (r, c) is bit (r-{{ t.0 }})*{{ tcols }}+(c-{{ t.1 }}) of `valid` and that field of `tdc`.{% else %}pixel (r, c) is bit r*{{ cols }}+c of `valid` and field r*{{ cols }}+c of `tdc`.{% endif %}
 module {{ name }} (
     input  wire clk,
     input  wire rst,
-    input  wire [{{ np - 1 }}:0] valid,
-    input  wire [{{ np * t - 1 }}:0] tdc,
+    input  wire [{{ npt - 1 }}:0] valid,
+    input  wire [{{ npt * t - 1 }}:0] tdc,
     output wire pulse_o,
     output wire ready,
     output reg  ro_valid,
@@ -125,11 +127,11 @@ module {{ name }} (
     // ---- broadcast stage 2: one register per row (and the TDCs' strobe) ----
     reg o_pulse;
     assign pulse_o = o_pulse;
-    reg [{{ rows - 1 }}:0] r_pulse;
-    reg [{{ rows - 1 }}:0] r_ro;
-    reg [{{ rows * cw - 1 }}:0] r_col;
+    reg [{{ trows - 1 }}:0] r_pulse;
+    reg [{{ trows - 1 }}:0] r_ro;
+    reg [{{ trows * cw - 1 }}:0] r_col;
 {%- if fourier %}
-    reg [{{ rows * r - 1 }}:0] r_word;
+    reg [{{ trows * r - 1 }}:0] r_word;
 {%- endif %}
 {%- if mutation == "row_late" %}
     // DELIBERATELY BROKEN: one row's broadcast passes one extra register.
@@ -141,11 +143,11 @@ module {{ name }} (
     always @(posedge clk) begin
         if (rst) begin
             o_pulse <= 1'b0;
-            r_pulse <= {{ rows }}'d0;
-            r_ro <= {{ rows }}'d0;
-            r_col <= {{ rows * cw }}'d0;
+            r_pulse <= {{ trows }}'d0;
+            r_ro <= {{ trows }}'d0;
+            r_col <= {{ trows * cw }}'d0;
 {%- if fourier %}
-            r_word <= {{ rows * r }}'d0;
+            r_word <= {{ trows * r }}'d0;
 {%- endif %}
 {%- if mutation == "row_late" %}
             late_pulse <= 1'b0;
@@ -158,18 +160,18 @@ module {{ name }} (
 {%- for row in rows_t %}
 {%- if row.late %}
             late_pulse <= b_pulse;
-            r_pulse[{{ row.row }}] <= late_pulse;
+            r_pulse[{{ row.lr }}] <= late_pulse;
 {%- else %}
-            r_pulse[{{ row.row }}] <= b_pulse;
+            r_pulse[{{ row.lr }}] <= b_pulse;
 {%- endif %}
-            r_ro[{{ row.row }}] <= b_ro && (b_row == {{ rw }}'d{{ row.row }});
-            r_col[{{ row.row * cw }} +: {{ cw }}] <= b_col;
+            r_ro[{{ row.lr }}] <= b_ro && (b_row == {{ rw }}'d{{ row.row }});
+            r_col[{{ row.lr * cw }} +: {{ cw }}] <= b_col;
 {%- if fourier %}
 {%- if row.late %}
             late_word <= b_word;
-            r_word[{{ row.row * r }} +: {{ r }}] <= late_word;
+            r_word[{{ row.lr * r }} +: {{ r }}] <= late_word;
 {%- else %}
-            r_word[{{ row.row * r }} +: {{ r }}] <= b_word;
+            r_word[{{ row.lr * r }} +: {{ r }}] <= b_word;
 {%- endif %}
 {%- endif %}
 {%- endfor %}
@@ -177,22 +179,22 @@ module {{ name }} (
     end
 
     // ---- the pixels ----
-    wire [{{ np - 1 }}:0] p_ready;
-    wire [{{ np - 1 }}:0] p_valid;
-    wire [{{ np * ib - 1 }}:0] p_index;
-    wire [{{ np * w - 1 }}:0] p_data;
+    wire [{{ npt - 1 }}:0] p_ready;
+    wire [{{ npt - 1 }}:0] p_valid;
+    wire [{{ npt * ib - 1 }}:0] p_index;
+    wire [{{ npt * w - 1 }}:0] p_data;
     assign ready = &p_ready;
 {%- for px in pixels %}
     {{ pixel_name }} u_pixel_{{ px.row }}_{{ px.col }} (
         .clk(clk),
         .rst(rst),
-        .pulse(r_pulse[{{ px.row }}]),
+        .pulse(r_pulse[{{ px.lr }}]),
         .valid(valid[{{ px.i }}]),
         .tdc(tdc[{{ px.tdc * t }} +: {{ t }}]),
 {%- if fourier %}
-        .rom_word(r_word[{{ px.row * r }} +: {{ r }}]),
+        .rom_word(r_word[{{ px.lr * r }} +: {{ r }}]),
 {%- endif %}
-        .readout(r_ro[{{ px.row }}] && (r_col[{{ px.row * cw }} +: {{ cw }}] == {{ cw }}'d{{ px.col }})),
+        .readout(r_ro[{{ px.lr }}] && (r_col[{{ px.lr * cw }} +: {{ cw }}] == {{ cw }}'d{{ px.col }})),
         .ready(p_ready[{{ px.i }}]),
         .rd_valid(p_valid[{{ px.i }}]),
         .rd_index(p_index[{{ px.i * ib }} +: {{ ib }}]),
@@ -209,7 +211,7 @@ module {{ name }} (
     reg e_ro;
     reg [{{ rw - 1 }}:0] e_row;
     reg [{{ cw - 1 }}:0] e_col;
-    reg [{{ rows - 1 }}:0] m_row;
+    reg [{{ trows - 1 }}:0] m_row;
     reg [{{ cw - 1 }}:0] m_col;
     always @(posedge clk) begin
         if (rst) begin
@@ -219,7 +221,7 @@ module {{ name }} (
             e_ro <= 1'b0;
             e_row <= {{ rw }}'d0;
             e_col <= {{ cw }}'d0;
-            m_row <= {{ rows }}'d0;
+            m_row <= {{ trows }}'d0;
             m_col <= {{ cw }}'d0;
         end else begin
             d_ro <= b_ro;
@@ -233,22 +235,22 @@ module {{ name }} (
 {%- for row in rows_t %}
 {%- if row.stuck %}
                 // DELIBERATELY BROKEN: row {{ row.row }} never leaves readout once selected.
-                m_row[{{ row.row }}] <= m_row[{{ row.row }}] || (e_row == {{ rw }}'d{{ row.row }});
+                m_row[{{ row.lr }}] <= m_row[{{ row.lr }}] || (e_row == {{ rw }}'d{{ row.row }});
 {%- else %}
-                m_row[{{ row.row }}] <= (e_row == {{ rw }}'d{{ row.row }});
+                m_row[{{ row.lr }}] <= (e_row == {{ rw }}'d{{ row.row }});
 {%- endif %}
 {%- endfor %}
             end
         end
     end
     // Column buses: the OR of the selected row's pixels.
-    wire [{{ cols - 1 }}:0] bus_valid;
-    wire [{{ cols * ib - 1 }}:0] bus_index;
-    wire [{{ cols * w - 1 }}:0] bus_data;
+    wire [{{ tcols - 1 }}:0] bus_valid;
+    wire [{{ tcols * ib - 1 }}:0] bus_index;
+    wire [{{ tcols * w - 1 }}:0] bus_data;
 {%- for col in columns %}
-    assign bus_valid[{{ col.col }}] = {{ col.valid }};
-    assign bus_index[{{ col.col * ib }} +: {{ ib }}] = {{ col.index }};
-    assign bus_data[{{ col.col * w }} +: {{ w }}] = {{ col.data }};
+    assign bus_valid[{{ col.lc }}] = {{ col.valid }};
+    assign bus_index[{{ col.lc * ib }} +: {{ ib }}] = {{ col.index }};
+    assign bus_data[{{ col.lc * w }} +: {{ w }}] = {{ col.data }};
 {%- endfor %}
     reg m_valid;
     reg [{{ ib - 1 }}:0] m_index;
@@ -257,9 +259,9 @@ module {{ name }} (
         case (m_col)
 {%- for col in columns %}
             {{ cw }}'d{{ col.col }}: begin
-                m_valid = bus_valid[{{ col.col }}];
-                m_index = bus_index[{{ col.col * ib }} +: {{ ib }}];
-                m_data = bus_data[{{ col.col * w }} +: {{ w }}];
+                m_valid = bus_valid[{{ col.lc }}];
+                m_index = bus_index[{{ col.lc * ib }} +: {{ ib }}];
+                m_data = bus_data[{{ col.lc * w }} +: {{ w }}];
             end
 {%- endfor %}
             default: begin

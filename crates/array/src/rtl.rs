@@ -7,6 +7,7 @@
 //! array). The array's faults ([`ArrayFault`]) are carried exactly, so the cycle where a
 //! broken RTL first differs is predicted by the model.
 
+use tofprobe_design::readout::ArrayTile;
 use tofprobe_design::readout::{ArrayFault, Readout};
 use tofprobe_pixel::sequencer::RESET_CYCLES;
 use tofprobe_pixel::{CycleModel, Mode, PinsIn, PixelParams};
@@ -39,6 +40,8 @@ pub struct ArrayModel {
     rom: Vec<u64>,
     rom_depth: usize,
     fault: Option<ArrayFault>,
+    /// The pixels that exist (the whole array unless a tile of it is co-simulated).
+    tile: ArrayTile,
     // Root sequencer.
     ro_phase: bool,
     ph: u64,
@@ -91,6 +94,28 @@ impl ArrayModel {
         rom: &[u64],
         fault: Option<ArrayFault>,
     ) -> Result<ArrayModel, ArrayError> {
+        Self::tile(readout, p, rom, fault, None)
+    }
+
+    /// [`Self::new`] with only `tile`'s pixels present (`None`: all): the sequencer and the
+    /// readout walk the whole array, the absent pixels' slots carry no beat.
+    pub fn tile(
+        readout: &Readout,
+        p: &PixelParams,
+        rom: &[u64],
+        fault: Option<ArrayFault>,
+        tile: Option<ArrayTile>,
+    ) -> Result<ArrayModel, ArrayError> {
+        let tile = tile.unwrap_or(ArrayTile::whole(readout.rows, readout.cols));
+        if tile.pixels() == 0
+            || tile.row0 + tile.rows > readout.rows
+            || tile.col0 + tile.cols > readout.cols
+        {
+            return Err(ArrayError::Shape(format!(
+                "tile rows {}+{}, cols {}+{} is not inside the {} × {} array",
+                tile.row0, tile.rows, tile.col0, tile.cols, readout.rows, readout.cols
+            )));
+        }
         let fourier = p.mode == Mode::Fourier;
         let words = if fourier {
             p.registers().div_ceil(64)
@@ -111,7 +136,7 @@ impl ArrayModel {
             source,
         };
         let pixel = CycleModel::new(p).map_err(err)?;
-        let rows = readout.rows;
+        let rows = tile.rows;
         Ok(ArrayModel {
             ro: *readout,
             fourier,
@@ -119,6 +144,7 @@ impl ArrayModel {
             rom: rom.to_vec(),
             rom_depth: p.rom_depth.max(1),
             fault,
+            tile,
             ro_phase: false,
             ph: 0,
             pidx: 0,
@@ -139,7 +165,7 @@ impl ArrayModel {
             r_word: vec![vec![0; words]; rows],
             late_pulse: false,
             late_word: vec![0; words],
-            pixels: vec![pixel; readout.pixels()],
+            pixels: vec![pixel; tile.pixels()],
             d_ro: false,
             d_row: 0,
             d_col: 0,
@@ -173,32 +199,40 @@ impl ArrayModel {
         }
     }
 
-    /// Pixel (r, c)'s cycle model.
-    pub fn pixel(&self, r: usize, c: usize) -> &CycleModel {
-        &self.pixels[r * self.ro.cols + c]
+    /// The pixels present.
+    pub fn present(&self) -> ArrayTile {
+        self.tile
+    }
+
+    /// Pixel (r, c)'s cycle model (`None` outside the tile).
+    pub fn pixel(&self, r: usize, c: usize) -> Option<&CycleModel> {
+        self.tile.local(r, c).map(|i| &self.pixels[i])
     }
 
     /// The column buses and the column select: the selected pixel's (rd_valid, rd_index,
     /// rd_data), OR-ed over the selected rows.
     fn mux(&self) -> (bool, usize, u64) {
-        let cols = self.ro.cols;
-        if self.m_col >= cols {
+        let t = self.tile;
+        if !(t.col0..t.col0 + t.cols).contains(&self.m_col) {
             return (false, 0, 0);
         }
+        let lc = self.m_col - t.col0;
         let mut m = (false, 0usize, 0u64);
-        for (r, _) in self.m_row.iter().enumerate().filter(|(_, s)| **s) {
-            let o = self.pixels[r * cols + self.m_col].outputs();
+        for (lr, _) in self.m_row.iter().enumerate().filter(|(_, s)| **s) {
+            let o = self.pixels[lr * t.cols + lc].outputs();
             m = (m.0 | o.rd_valid, m.1 | o.rd_index as usize, m.2 | o.rd_data);
         }
         m
     }
 
     /// One clock cycle: returns the outputs seen during it, then applies the rising edge
-    /// with `rst` and the per-pixel `valid` and `tdc` (row-major).
+    /// with `rst` and the per-pixel `valid` and `tdc` (row-major over the pixels present).
     pub fn step(&mut self, rst: bool, valid: &[bool], tdc: &[u32]) -> ArrayPins {
         let out = self.outputs();
         let ro = self.ro;
-        let (rows, cols, np) = (ro.rows, ro.cols, ro.pixels());
+        let t = self.tile;
+        let np = ro.pixels();
+        let npt = t.pixels();
         let (reg, k, g) = (ro.registers, ro.beats_per_word, ro.beat_cycles);
         // Root, combinational.
         let s_pulse = !rst && !self.ro_phase && self.ph == 0;
@@ -216,15 +250,15 @@ impl ArrayModel {
         let (mv, mi, md) = self.mux();
         // The pixels' edges.
         let neighbour = match self.fault {
-            Some(ArrayFault::NeighbourTdc { row, col }) => Some(row * cols + col),
+            Some(ArrayFault::NeighbourTdc { row, col }) => t.local(row, col),
             _ => None,
         };
         for (i, px) in self.pixels.iter_mut().enumerate() {
-            let (r, c) = (i / cols, i % cols);
+            let (r, c) = (i / t.cols, t.col0 + i % t.cols);
             // Two TDCs crossed: the faulty pixel reads the next one's, that one its.
             let src = match neighbour {
-                Some(n) if n == i => (i + 1) % np,
-                Some(n) if (n + 1) % np == i => n,
+                Some(n) if n == i => (i + 1) % npt,
+                Some(n) if (n + 1) % npt == i => n,
                 _ => i,
             };
             px.step(&PinsIn {
@@ -274,7 +308,8 @@ impl ArrayModel {
         // Read select (from the old stage values).
         if self.e_ro {
             self.m_col = self.e_col;
-            for (r, m) in self.m_row.iter_mut().enumerate() {
+            for (lr, m) in self.m_row.iter_mut().enumerate() {
+                let r = t.row0 + lr;
                 let stuck = self.fault == Some(ArrayFault::RowStuck { row: r });
                 *m = (stuck && *m) || self.e_row == r;
             }
@@ -287,16 +322,16 @@ impl ArrayModel {
             Some(ArrayFault::RowLate { row }) => Some(row),
             _ => None,
         };
-        for r in 0..rows {
-            if late_row == Some(r) {
-                self.r_pulse[r] = self.late_pulse;
-                self.r_word[r].clone_from(&self.late_word);
+        for lr in 0..t.rows {
+            if late_row == Some(t.row0 + lr) {
+                self.r_pulse[lr] = self.late_pulse;
+                self.r_word[lr].clone_from(&self.late_word);
             } else {
-                self.r_pulse[r] = self.b_pulse;
-                self.r_word[r].clone_from(&self.b_word);
+                self.r_pulse[lr] = self.b_pulse;
+                self.r_word[lr].clone_from(&self.b_word);
             }
-            self.r_ro[r] = self.b_ro && self.b_row == r;
-            self.r_col[r] = self.b_col;
+            self.r_ro[lr] = self.b_ro && self.b_row == t.row0 + lr;
+            self.r_col[lr] = self.b_col;
         }
         self.late_pulse = self.b_pulse;
         self.late_word.clone_from(&self.b_word);
@@ -374,8 +409,10 @@ pub struct ArrayRun {
     pub pins: Vec<ArrayPins>,
     /// Per `pulse_o` cycle (in order): the cycle.
     pub pulse_cycles: Vec<u64>,
-    /// Per frame, per pixel (readout order), the R + 1 words the stream carried (raw W
-    /// bits, reassembled from the beats).
+    /// The readout positions of the pixels present (all of them unless a tile), in order.
+    pub positions: Vec<usize>,
+    /// Per frame, per pixel present (readout order: `positions`), the R + 1 words the
+    /// stream carried (raw W bits, reassembled from the beats).
     pub words: Vec<Vec<Vec<u64>>>,
 }
 
@@ -455,21 +492,22 @@ impl ArrayRun {
 }
 
 /// Runs `frames` frames: reset, then every cycle the detections of the pulse the pixels
-/// sample (`detections[i]` is pixel i's, row-major, one per pulse of the run; pulses
-/// beyond present no detection).
+/// sample (`detections[i]` is pixel i's, row-major over the pixels present, one per pulse
+/// of the run; pulses beyond present no detection).
 pub fn run(
     model: &mut ArrayModel,
     detections: &[Vec<Option<u32>>],
     frames: u64,
 ) -> Result<ArrayRun, ArrayError> {
     let ro = *model.readout();
-    let np = ro.pixels();
+    let tile = model.present();
+    let np = tile.pixels();
     if detections.len() != np {
         return Err(ArrayError::Shape(format!(
-            "{} pixels' detections for a {} × {} array",
+            "{} pixels' detections for the {} × {} pixels present",
             detections.len(),
-            ro.rows,
-            ro.cols
+            tile.rows,
+            tile.cols
         )));
     }
     let total = frame_start(&ro, frames) + TAIL_CYCLES;
@@ -493,17 +531,25 @@ pub fn run(
         }
         pins.push(model.step(rst, &valid, &tdc));
     }
+    let positions: Vec<usize> = (0..ro.pixels())
+        .filter(|&q| {
+            let (r, c) = ro.order(q);
+            tile.contains(r, c)
+        })
+        .collect();
     let mut run = ArrayRun {
         readout: ro,
         frames,
         pins,
         pulse_cycles,
+        positions,
         words: Vec::new(),
     };
     run.words = (0..frames)
         .map(|fr| {
-            (0..np)
-                .map(|q| {
+            run.positions
+                .iter()
+                .map(|&q| {
                     (0..ro.words_per_pixel())
                         .map(|j| {
                             let beats: Vec<u64> = (0..ro.beats_per_word)

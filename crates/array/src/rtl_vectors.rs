@@ -3,7 +3,8 @@
 //! and per-pixel digests, as the files `testbench/array_harness.cpp` (Verilator) and
 //! `testbench/array_tb.v` (Icarus) replay:
 //!
-//! - `array_params.vh`: `AR_TOP`, `AR_NP` (pixels), `AR_T`, `AR_B`, `AR_CYCLES`, `AR_PULSES`;
+//! - `array_params.vh`: `AR_TOP`, `AR_NP` (pixels present: all, or a tile's), `AR_T`,
+//!   `AR_B`, `AR_CYCLES`, `AR_PULSES`;
 //! - `array_stim.hex`: one line per pulse the pixels sample, the P·(T+1)-bit value
 //!   {tdc[P·T−1:0], valid[P−1:0]} (pixel i = r·cols + c);
 //! - `array_expect.hex`: one line per cycle, `pulse_o ready ro_valid ro_data`;
@@ -25,21 +26,24 @@ pub const FILES: [&str; 5] = [
     "digests.txt",
 ];
 
-/// Every pixel's detections for `frames` frames of the design's scene (row-major; pixel
-/// (r, c)'s own stream, `ResolvedDesign::pixel_source`), `frame_pulses` per frame.
+/// Every pixel's detections for `frames` frames of the design's scene (row-major over the
+/// pixels of `tile`, all when `None`; pixel (r, c)'s own stream,
+/// `ResolvedDesign::pixel_source`), `frame_pulses` per frame.
 pub fn scene_detections(
     design: &ResolvedDesign,
     frame_pulses: u64,
     frames: u64,
+    tile: Option<tofprobe_design::readout::ArrayTile>,
 ) -> Result<Vec<Vec<Option<u32>>>, ArrayError> {
     let a = design
         .array
         .as_ref()
         .ok_or_else(|| ArrayError::Shape("the design has no [array]".into()))?;
     let n = (frame_pulses * frames) as usize;
-    let mut out = Vec::with_capacity(a.pixels());
-    for r in 0..a.rows {
-        for c in 0..a.cols {
+    let t = tile.unwrap_or(tofprobe_design::readout::ArrayTile::whole(a.rows, a.cols));
+    let mut out = Vec::with_capacity(t.pixels());
+    for r in t.row0..t.row0 + t.rows {
+        for c in t.col0..t.col0 + t.cols {
             let mut v = vec![None; n];
             design.pixel_source(r, c)?.fill(0, &mut v);
             out.push(v);
@@ -77,7 +81,8 @@ pub fn vector_files(
     header: &str,
 ) -> Vec<(String, String)> {
     let ro = &run.readout;
-    let np = ro.pixels();
+    // The pixels present (a tile of a large array, or all).
+    let np = detections.len();
     let t = p.tdc_bits as usize;
     let mut params = format!("{header}\n");
     for (k, v) in [
@@ -118,7 +123,7 @@ pub fn vector_files(
         format!("{header}\n# frame row col: words 0..R-1 then the status word (hex, W bits)\n");
     let mut digests = format!("{header}\n# frame row col fnv1a64(words)\n");
     for (f, frame) in run.words.iter().enumerate() {
-        for (q, words) in frame.iter().enumerate() {
+        for (&q, words) in run.positions.iter().zip(frame) {
             let (r, c) = ro.order(q);
             let list: Vec<String> = words.iter().map(|w| format!("{w:x}")).collect();
             readout.push_str(&format!("{f} {r} {c}: {}\n", list.join(" ")));

@@ -109,10 +109,11 @@ impl Chip {
     }
 
     /// The array's shape and readout as the generator renders them (`None` for the single
-    /// pixel's top), with an optional deliberate fault.
+    /// pixel's top), with an optional deliberate fault and tile (the part rendered).
     pub fn array_spec(
         &self,
         fault: Option<tofprobe_rtlgen::ArrayFault>,
+        tile: Option<tofprobe_rtlgen::array::ArrayTile>,
     ) -> Option<tofprobe_rtlgen::ArraySpec> {
         self.readout.map(|r| tofprobe_rtlgen::ArraySpec {
             rows: r.rows,
@@ -122,6 +123,7 @@ impl Chip {
             beat_cycles: r.beat_cycles,
             slot_cycles: r.slot_cycles(),
             fault,
+            tile,
         })
     }
 

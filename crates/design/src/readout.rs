@@ -401,3 +401,5 @@ pub fn resolve_readout(
 /// The array's deliberate faults (mutation tests), rendered by tofprobe-rtlgen and carried
 /// by the array model.
 pub use tofprobe_rtlgen::ArrayFault;
+/// A tile of an array (the part of a large array co-simulated).
+pub use tofprobe_rtlgen::array::ArrayTile;

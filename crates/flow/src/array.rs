@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use tofprobe_array::rtl::{ArrayModel, ArrayRun, run};
 use tofprobe_array::rtl_vectors::{scene_detections, vector_files};
-use tofprobe_design::readout::{ArrayFault, Readout};
+use tofprobe_design::readout::{ArrayFault, ArrayTile, Readout};
 use tofprobe_design::rom_policy::RtlOverrides;
 use tofprobe_design::{Chip, ResolvedDesign, RomPurpose};
 use tofprobe_rtlgen::render::{HEADER_MARK, RenderOptions};
@@ -42,8 +42,12 @@ pub struct ArrayCosimOptions {
     pub profile: tofprobe_cosim::BuildProfile,
     /// A deliberate fault of the array RTL (mutation tests); the model runs without it.
     pub fault: Option<ArrayFault>,
-    /// Per-pixel detections (row-major; `None`: the array scene's).
+    /// Per-pixel detections (row-major over the pixels present; `None`: the array
+    /// scene's).
     pub detections: Option<Vec<Vec<Option<u32>>>>,
+    /// Co-simulate only this tile of the array, with the whole array's sequencer, broadcast
+    /// and readout (an array too large to build whole under Verilator).
+    pub tile: Option<ArrayTile>,
     /// The regeneration command recorded in the headers.
     pub command: String,
 }
@@ -60,6 +64,7 @@ impl ArrayCosimOptions {
             profile: tofprobe_cosim::BuildProfile::Check,
             fault: None,
             detections: None,
+            tile: None,
             command: "tofprobe cosim".into(),
         }
     }
@@ -103,9 +108,10 @@ pub fn render_array_to(
     out: &Path,
     command: String,
     fault: Option<ArrayFault>,
+    tile: Option<ArrayTile>,
 ) -> Result<Vec<String>, FlowError> {
     let spec = chip
-        .array_spec(fault)
+        .array_spec(fault, tile)
         .ok_or_else(|| FlowError::option("array", "none", "a chip with an [array] readout"))?;
     let options = RenderOptions {
         command,
@@ -134,7 +140,7 @@ pub fn render_array_design(
     command: String,
 ) -> Result<(Chip, Vec<String>), FlowError> {
     let chip = chip(design, o, RomPurpose::Rendered)?;
-    let files = render_array_to(&chip, out, command, None)?;
+    let files = render_array_to(&chip, out, command, None, None)?;
     Ok((chip, files))
 }
 
@@ -156,6 +162,7 @@ pub fn write_array_vectors(
     o: &RtlOverrides,
     frames: u64,
     detections: Option<Vec<Vec<Option<u32>>>>,
+    tile: Option<ArrayTile>,
     vec_dir: &Path,
     command: &str,
 ) -> Result<ArrayVectors, FlowError> {
@@ -169,10 +176,10 @@ pub fn write_array_vectors(
     let p = &chip.pixel;
     let detections = match detections {
         Some(d) => d,
-        None => scene_detections(design, p.frame_pulses, frames)?,
+        None => scene_detections(design, p.frame_pulses, frames, tile)?,
     };
     let t0 = std::time::Instant::now();
-    let mut model = ArrayModel::new(&ro, p, &chip.rom.words, None)?;
+    let mut model = ArrayModel::tile(&ro, p, &chip.rom.words, None, tile)?;
     let r = run(&mut model, &detections, frames)?;
     let model_seconds = t0.elapsed().as_secs_f64();
     let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
@@ -213,10 +220,11 @@ pub fn cosim_array(
         &o,
         a.frames,
         a.detections.clone(),
+        a.tile,
         &vec_dir,
         &a.command,
     )?;
-    render_array_to(&v.chip, &rtl_dir, a.command.clone(), a.fault)?;
+    render_array_to(&v.chip, &rtl_dir, a.command.clone(), a.fault, a.tile)?;
     let (ro, r, detections, model_seconds) = (v.readout, v.run, v.detections, v.model_seconds);
     let p = &v.chip.pixel;
     let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);

@@ -65,6 +65,52 @@ pub struct ArraySpec {
     pub slot_cycles: u64,
     /// A deliberate fault (mutation tests only).
     pub fault: Option<ArrayFault>,
+    /// Render only this tile's pixels, with the whole array's sequencer, broadcast and
+    /// readout (`None`: every pixel).
+    pub tile: Option<ArrayTile>,
+}
+
+/// A rectangle of an array's pixels: the part of an array too large to co-simulate whole
+/// that is rendered, the sequencer and readout still walking every pixel's slot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ArrayTile {
+    /// First row.
+    pub row0: usize,
+    /// First column.
+    pub col0: usize,
+    /// Rows of the tile.
+    pub rows: usize,
+    /// Columns of the tile.
+    pub cols: usize,
+}
+
+impl ArrayTile {
+    /// The whole `rows` × `cols` array as a tile.
+    pub fn whole(rows: usize, cols: usize) -> ArrayTile {
+        ArrayTile {
+            row0: 0,
+            col0: 0,
+            rows,
+            cols,
+        }
+    }
+
+    /// Whether pixel (r, c) of the array is in the tile.
+    pub fn contains(&self, r: usize, c: usize) -> bool {
+        (self.row0..self.row0 + self.rows).contains(&r)
+            && (self.col0..self.col0 + self.cols).contains(&c)
+    }
+
+    /// Pixels of the tile.
+    pub fn pixels(&self) -> usize {
+        self.rows * self.cols
+    }
+
+    /// The tile's index of pixel (r, c) of the array (row-major over the tile), if inside.
+    pub fn local(&self, r: usize, c: usize) -> Option<usize> {
+        self.contains(r, c)
+            .then(|| (r - self.row0) * self.cols + (c - self.col0))
+    }
 }
 
 /// Largest rows × cols the generator renders (the template writes one instance and one
@@ -73,20 +119,27 @@ pub const MAX_RENDERED_PIXELS: usize = 64 * 64;
 
 struct RowT {
     row: usize,
+    /// Its index in the tile.
+    lr: usize,
     late: bool,
     stuck: bool,
 }
 
 struct PixelT {
+    /// Index in the tile (the ports' and the pixel vectors').
     i: usize,
     row: usize,
     col: usize,
+    /// Row index in the tile.
+    lr: usize,
     /// The pixel whose TDC field this one reads (itself unless NeighbourTdc).
     tdc: usize,
 }
 
 struct ColT {
     col: usize,
+    /// Its index in the tile.
+    lc: usize,
     valid: String,
     index: String,
     data: String,
@@ -114,6 +167,10 @@ struct ArrayT<'a> {
     rows: usize,
     cols: usize,
     np: usize,
+    trows: usize,
+    tcols: usize,
+    npt: usize,
+    tile: Option<(usize, usize)>,
     qw: usize,
     scw: usize,
     rw: usize,
@@ -166,14 +223,11 @@ pub fn render_array(
         ));
     }
     let np = a.rows * a.cols;
-    if a.rows == 0 || a.cols == 0 || np > MAX_RENDERED_PIXELS {
+    if a.rows == 0 || a.cols == 0 || a.rows > 4096 || a.cols > 4096 {
         return Err(bad(
             "array.rows × array.cols",
             format!("{} × {}", a.rows, a.cols),
-            format!(
-                "1..={MAX_RENDERED_PIXELS} pixels rendered whole (64 × 64); a larger array is \
-                 built and timed from a tile or a row slice"
-            ),
+            "1..=4096 rows and columns".into(),
         ));
     }
     let w = p.width;
@@ -196,6 +250,31 @@ pub fn render_array(
         ));
     }
     let order = |q: usize| (q / a.cols, q % a.cols);
+    let tile = a.tile.unwrap_or(ArrayTile::whole(a.rows, a.cols));
+    let npt = tile.pixels();
+    if npt == 0 || tile.row0 + tile.rows > a.rows || tile.col0 + tile.cols > a.cols {
+        return Err(bad(
+            "tile",
+            format!(
+                "rows {}+{}, cols {}+{}",
+                tile.row0, tile.rows, tile.col0, tile.cols
+            ),
+            format!(
+                "a non-empty rectangle inside the {} × {} array",
+                a.rows, a.cols
+            ),
+        ));
+    }
+    if npt > MAX_RENDERED_PIXELS {
+        return Err(bad(
+            "array.rows × array.cols",
+            format!("{} × {}", tile.rows, tile.cols),
+            format!(
+                "1..={MAX_RENDERED_PIXELS} pixels rendered (64 × 64); a larger array is \
+                 co-simulated as a tile of it (`tofprobe cosim --tile ROW,COL,ROWS,COLS`)"
+            ),
+        ));
+    }
     match a.fault {
         Some(ArrayFault::OrderSwap) if np < 2 => {
             return Err(bad(
@@ -204,20 +283,22 @@ pub fn render_array(
                 "an array of 2 pixels or more".into(),
             ));
         }
-        Some(ArrayFault::RowLate { row } | ArrayFault::RowStuck { row }) if row >= a.rows => {
+        Some(ArrayFault::RowLate { row } | ArrayFault::RowStuck { row })
+            if !(tile.row0..tile.row0 + tile.rows).contains(&row) =>
+        {
             return Err(bad(
                 "mutation row",
                 row.to_string(),
-                format!("0..{}", a.rows),
+                format!("{}..{}", tile.row0, tile.row0 + tile.rows),
             ));
         }
-        Some(ArrayFault::NeighbourTdc { row, col }) if row >= a.rows || col >= a.cols || np < 2 => {
+        Some(ArrayFault::NeighbourTdc { row, col }) if !tile.contains(row, col) || npt < 2 => {
             return Err(bad(
                 "mutation pixel",
                 format!("({row}, {col})"),
                 format!(
-                    "inside the {} × {} array (2 pixels or more)",
-                    a.rows, a.cols
+                    "inside the rendered {} × {} pixels (2 pixels or more)",
+                    tile.rows, tile.cols
                 ),
             ));
         }
@@ -236,38 +317,40 @@ pub fn render_array(
     let k = a.beats_per_word;
     let kb = k as u32 * a.bits;
     let neighbour = match a.fault {
-        Some(ArrayFault::NeighbourTdc { row, col }) => Some(row * a.cols + col),
+        Some(ArrayFault::NeighbourTdc { row, col }) => tile.local(row, col),
         _ => None,
     };
-    let pixels: Vec<PixelT> = (0..np)
+    let pixels: Vec<PixelT> = (0..npt)
         .map(|i| PixelT {
             i,
-            row: i / a.cols,
-            col: i % a.cols,
+            row: tile.row0 + i / tile.cols,
+            col: tile.col0 + i % tile.cols,
+            lr: i / tile.cols,
             tdc: match neighbour {
-                Some(n) if n == i => (i + 1) % np,
-                Some(n) if (n + 1) % np == i => n,
+                Some(n) if n == i => (i + 1) % npt,
+                Some(n) if (n + 1) % npt == i => n,
                 _ => i,
             },
         })
         .collect();
-    let columns = (0..a.cols)
-        .map(|c| {
+    let columns = (0..tile.cols)
+        .map(|lc| {
             let terms =
-                |f: &dyn Fn(usize) -> String| (0..a.rows).map(f).collect::<Vec<_>>().join(" | ");
+                |f: &dyn Fn(usize) -> String| (0..tile.rows).map(f).collect::<Vec<_>>().join(" | ");
             ColT {
-                col: c,
-                valid: terms(&|row| format!("(m_row[{row}] & p_valid[{}])", row * a.cols + c)),
-                index: terms(&|row| {
+                col: tile.col0 + lc,
+                lc,
+                valid: terms(&|lr| format!("(m_row[{lr}] & p_valid[{}])", lr * tile.cols + lc)),
+                index: terms(&|lr| {
                     format!(
-                        "({{{ib}{{m_row[{row}]}}}} & p_index[{} +: {ib}])",
-                        (row * a.cols + c) * ib as usize
+                        "({{{ib}{{m_row[{lr}]}}}} & p_index[{} +: {ib}])",
+                        (lr * tile.cols + lc) * ib as usize
                     )
                 }),
-                data: terms(&|row| {
+                data: terms(&|lr| {
                     format!(
-                        "({{{w}{{m_row[{row}]}}}} & p_data[{} +: {w}])",
-                        (row * a.cols + c) * w as usize
+                        "({{{w}{{m_row[{lr}]}}}} & p_data[{} +: {w}])",
+                        (lr * tile.cols + lc) * w as usize
                     )
                 }),
             }
@@ -285,6 +368,15 @@ pub fn render_array(
          cycle(s), slot {} cycles (docs/pixel-contract.md \"Array\").",
         a.rows, a.cols, a.bits, k, a.beat_cycles, a.slot_cycles
     ));
+    if a.tile.is_some() {
+        h.push_str(&format!(
+            "\n// Tile: rows {}..{}, columns {}..{} of it rendered (the others' slots carry no beat).",
+            tile.row0,
+            tile.row0 + tile.rows - 1,
+            tile.col0,
+            tile.col0 + tile.cols - 1
+        ));
+    }
     if let Some(f) = a.fault {
         h.push_str(&format!(
             "\n// DELIBERATELY BROKEN ({}: {f:?}) for the array mutation tests.",
@@ -311,6 +403,10 @@ pub fn render_array(
         rows: a.rows,
         cols: a.cols,
         np,
+        trows: tile.rows,
+        tcols: tile.cols,
+        npt,
+        tile: a.tile.map(|t| (t.row0, t.col0)),
         qw: clog2(np as u64 + 1) as usize,
         scw: clog2(a.slot_cycles) as usize,
         rw: clog2(a.rows as u64) as usize,
@@ -333,11 +429,12 @@ pub fn render_array(
         swap_c0: s0.1,
         swap_r1: s1.0,
         swap_c1: s1.1,
-        rows_t: (0..a.rows)
-            .map(|row| RowT {
-                row,
-                late: late == Some(row),
-                stuck: stuck == Some(row),
+        rows_t: (0..tile.rows)
+            .map(|lr| RowT {
+                row: tile.row0 + lr,
+                lr,
+                late: late == Some(tile.row0 + lr),
+                stuck: stuck == Some(tile.row0 + lr),
             })
             .collect(),
         pixels,

@@ -5,7 +5,7 @@
 //! the stream.
 
 use tofprobe_array::rtl::{ArrayModel, run};
-use tofprobe_design::readout::{ArrayFault, Readout, ReadoutKeys};
+use tofprobe_design::readout::{ArrayFault, ArrayTile, Readout, ReadoutKeys};
 use tofprobe_pixel::{CycleModel, Mode, PinsIn, PixelParams};
 use tofprobe_scene::SplitMix64;
 
@@ -240,4 +240,76 @@ fn each_array_fault_changes_the_stream() {
             assert!(what.contains("frame 0's readout, pixel ("), "{what}");
         }
     }
+}
+
+/// A tile of the array (the part co-simulated when the whole is too large) keeps the whole
+/// array's timing: its pixels' beats are the whole array's, at the same cycles, and the
+/// other pixels' slots are silent.
+#[test]
+fn a_tile_streams_its_pixels_at_the_whole_arrays_cycles() {
+    let p = fourier(8);
+    let ro = readout(&p, 5, 6, Some(10), None);
+    let rom = rom(&p, 21);
+    let d = detections(&p, 30, 16, 22);
+    let whole = run(&mut ArrayModel::new(&ro, &p, &rom, None).unwrap(), &d, 2).unwrap();
+    let t = ArrayTile {
+        row0: 3,
+        col0: 4,
+        rows: 2,
+        cols: 2,
+    };
+    let dt: Vec<_> = (3..5)
+        .flat_map(|r| (4..6).map(move |c| r * 6 + c))
+        .map(|i| d[i].clone())
+        .collect();
+    let tile = run(
+        &mut ArrayModel::tile(&ro, &p, &rom, None, Some(t)).unwrap(),
+        &dt,
+        2,
+    )
+    .unwrap();
+    assert_eq!(tile.positions, vec![22, 23, 28, 29]);
+    for f in 0..2 {
+        for (k, &q) in tile.positions.iter().enumerate() {
+            assert_eq!(
+                tile.words[f][k], whole.words[f][q],
+                "frame {f} position {q}"
+            );
+        }
+    }
+    let beats = |r: &tofprobe_array::rtl::ArrayRun| -> Vec<u64> {
+        (0..r.cycles())
+            .filter(|&c| r.pins[c as usize].ro_valid)
+            .collect()
+    };
+    let want: Vec<u64> = beats(&whole)
+        .into_iter()
+        .filter(|&c| {
+            let e = whole.explain(c);
+            ["(3, 4)", "(3, 5)", "(4, 4)", "(4, 5)"]
+                .iter()
+                .any(|p| e.contains(&format!("pixel {p}")))
+        })
+        .collect();
+    assert_eq!(beats(&tile), want);
+    assert_eq!(
+        want.len(),
+        2 * 4 * 7 * 3,
+        "2 frames × 4 pixels × 7 words × 3 beats"
+    );
+    assert!(
+        ArrayModel::tile(
+            &ro,
+            &p,
+            &rom,
+            None,
+            Some(ArrayTile {
+                row0: 4,
+                col0: 4,
+                rows: 2,
+                cols: 2
+            })
+        )
+        .is_err()
+    );
 }

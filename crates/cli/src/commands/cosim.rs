@@ -81,6 +81,10 @@ pub struct CosimArgs {
     /// tasks of a job array cover exactly the configurations of one run.
     #[arg(long, value_name = "I/N", requires = "random")]
     pub shard: Option<String>,
+    /// An `[array]` configuration too large to build whole: co-simulate the tile of ROWS ×
+    /// COLS pixels from (ROW, COL), with the whole array's sequencer, broadcast and readout.
+    #[arg(long, value_name = "ROW,COL,ROWS,COLS")]
+    pub tile: Option<String>,
     /// Also write a JUnit XML report: one test case per frame and configuration, the first
     /// mismatch as the failure message (written whole; an existing file is replaced only if
     /// tofprobe wrote it).

@@ -75,6 +75,7 @@ pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
             &overrides,
             a.frames,
             None,
+            None,
             &a.out,
             &regen_command(a),
         )?;

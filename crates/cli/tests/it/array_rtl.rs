@@ -166,6 +166,49 @@ fn small_design(rows: u32, cols: u32) -> tofprobe_design::ResolvedDesign {
     resolve(Document::from_toml_str(&text, "a.toml").unwrap(), "a.toml").unwrap()
 }
 
+/// Beyond the whole-array line: a 64 × 64 array (4096 pixels: its whole build would take
+/// Verilator tens of minutes) co-simulated as its far-corner 2 × 2 tile, whose readout
+/// slots are the last four rows' last pixels, with the whole array's sequencer and readout
+/// timing: bit-exact under Verilator, the tile's beats where the whole array's formula puts
+/// them.
+#[test]
+fn a_tile_of_a_64x64_array_is_bit_exact_with_the_whole_readout() {
+    if !have_tools(&["verilator"]) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(dir.path(), "a64.toml", &config(64, 64, false, ""));
+    let out = dir.path().join("t64");
+    let o = tofprobe(&[
+        "cosim",
+        &cfg,
+        "--frame-pulses",
+        "16",
+        "--tile",
+        "62,62,2,2",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    let j = crate::common::last_json(&o);
+    assert_eq!(
+        (j["pass"].as_bool(), j["mismatches"].as_u64()),
+        (Some(true), Some(0)),
+        "{j}"
+    );
+    // 4096 slots of 5 cycles + 1: the whole array's readout.
+    assert_eq!(j["readout_cycles"], 4096 * 5 + 1, "{j}");
+    // 2 + 16·4 + 20,481 cycles + the 6 of the tail.
+    assert_eq!(j["cycles"], 2 + 64 + 20_481 + 6, "{j}");
+    let readout = std::fs::read_to_string(out.join("vectors/readout.txt")).unwrap();
+    let rows: Vec<&str> = readout.lines().filter(|l| l.starts_with("0 ")).collect();
+    assert_eq!(rows.len(), 4, "{readout}");
+    assert!(
+        rows[0].starts_with("0 62 62:") && rows[3].starts_with("0 63 63:"),
+        "{readout}"
+    );
+}
+
 /// A 2 × 2 array under Icarus is bit-exact; each array mutant is caught, at the first
 /// cycle where the array model carrying the same fault differs from the correct one, and
 /// the report names what the array was doing there.
@@ -192,7 +235,7 @@ fn icarus_is_bit_exact_and_every_array_mutant_is_caught_where_predicted() {
     };
     let chip = Chip::array_of(&design, &ov, RomPurpose::Replayed).unwrap();
     let ro = chip.readout.unwrap();
-    let det = scene_detections(&design, 16, 2).unwrap();
+    let det = scene_detections(&design, 16, 2, None).unwrap();
     let model = |f| {
         run(
             &mut ArrayModel::new(&ro, &chip.pixel, &chip.rom.words, f).unwrap(),

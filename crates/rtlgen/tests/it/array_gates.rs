@@ -44,6 +44,7 @@ fn spec(p: &PixelParams, rows: usize, cols: usize, bits: u32, g: u64) -> ArraySp
         beat_cycles: g,
         slot_cycles: (p.registers() as u64 + 1) * k as u64 * g,
         fault: None,
+        tile: None,
     }
 }
 
