@@ -15,6 +15,8 @@ pub mod maps;
 pub mod model;
 pub mod output;
 pub mod plot;
+pub mod rtl;
+pub mod rtl_vectors;
 pub mod shard;
 pub mod uff;
 

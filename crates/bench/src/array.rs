@@ -85,6 +85,10 @@ fn array_design(
         distance_mm: None,
         signal_map: None,
         background_map: None,
+        readout_bits: None,
+        readout_bits_per_s: None,
+        frame_rate_hz: None,
+        double_buffer: false,
     });
     (a.rows, a.cols) = (rows, cols);
     Ok(resolve(doc, &base.origin)?)

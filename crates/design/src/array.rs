@@ -47,6 +47,30 @@ pub struct ArrayConfig {
     /// Per-pixel ρ_b (default: `sensor.background_rate` everywhere).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub background_map: Option<RateMap>,
+    /// b: bits per beat of the readout port (default W); see [`crate::readout`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub readout_bits: Option<u32>,
+    /// The output link's rate in bits/s (default: one beat per pixel-clock cycle).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub readout_bits_per_s: Option<f64>,
+    /// A frame rate the readout must allow (Hz).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame_rate_hz: Option<f64>,
+    /// Double-buffered pixel registers (the next frame accumulates during the readout).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub double_buffer: bool,
+}
+
+impl ArrayConfig {
+    /// The readout keys of the section.
+    pub fn readout_keys(&self) -> crate::readout::ReadoutKeys {
+        crate::readout::ReadoutKeys {
+            readout_bits: self.readout_bits,
+            readout_bits_per_s: self.readout_bits_per_s,
+            frame_rate_hz: self.frame_rate_hz,
+            double_buffer: self.double_buffer,
+        }
+    }
 }
 
 /// Which way a gradient runs.
@@ -98,6 +122,10 @@ pub struct SensorArray {
     pub signal_rate: Vec<f64>,
     /// ρ_b of each pixel, row-major.
     pub background_rate: Vec<f64>,
+    /// The readout keys as written; [`crate::ResolvedDesign::readout`] resolves them for
+    /// the pixel (its W, C and N), checked once by the resolution.
+    #[serde(default)]
+    pub readout: crate::readout::ReadoutKeys,
 }
 
 impl SensorArray {
@@ -129,17 +157,17 @@ pub fn pixel_seed(seed: u64, r: usize, c: usize) -> u64 {
     mix(mix(seed ^ 0xA22A_7E5E_ED00_0000) ^ ((r as u64) << 32 | c as u64))
 }
 
-/// Resolves `[array]`: checks the shape (and the memory it needs for `registers` words and
-/// `bins` bins per pixel), the mapping and the maps, with `sensor`'s rates as defaults.
-/// `origin` is the configuration's path (relative map paths are read beside it).
+/// Resolves `[array]`: checks the shape (and the memory it needs for the pixel's registers
+/// and bins), the mapping, the maps, with `sensor`'s rates as defaults, and the readout
+/// ([`crate::readout`]). `origin` is the configuration's path (relative map paths are read
+/// beside it).
 pub fn resolve_array(
     a: &ArrayConfig,
     sensor: &tofprobe_scene::SensorConfig,
-    registers: usize,
-    bins: usize,
-    frame_pulses: u64,
+    pixel: &tofprobe_pixel::PixelParams,
     origin: &str,
 ) -> Result<SensorArray, DesignError> {
+    let (registers, bins, frame_pulses) = (pixel.registers(), pixel.bins, pixel.frame_pulses);
     let err = |m: String| DesignError::array(origin, m);
     for (name, v) in [("rows", a.rows), ("cols", a.cols)] {
         if !(1..=MAX_SIDE).contains(&v) {
@@ -242,6 +270,8 @@ pub fn resolve_array(
         &base,
     )
     .map_err(err)?;
+    let readout = a.readout_keys();
+    crate::readout::Readout::new(&readout, rows, cols, pixel, sensor.laser_rate_hz).map_err(err)?;
     Ok(SensorArray {
         rows,
         cols,
@@ -249,6 +279,7 @@ pub fn resolve_array(
         mm_per_pixel,
         signal_rate,
         background_rate,
+        readout,
     })
 }
 

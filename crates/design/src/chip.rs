@@ -9,6 +9,7 @@
 use tofprobe_pixel::{DirectedOptions, PixelParams};
 
 use crate::error::DesignError;
+use crate::readout::{Readout, resolve_readout};
 use crate::resolve::ResolvedDesign;
 use crate::rom_policy::{RtlOverrides, RtlRom, chip_rom, rtl_params, rtl_rom, simulation_rom};
 
@@ -50,6 +51,8 @@ pub struct Chip {
     pub rom: RtlRom,
     /// The top's sequencer.
     pub sequencer: SequencerKind,
+    /// The array's readout ([`crate::readout`]); `None` for the single pixel's top.
+    pub readout: Option<Readout>,
 }
 
 impl Chip {
@@ -72,6 +75,55 @@ impl Chip {
             pixel,
             rom,
             sequencer: SequencerKind::Reference,
+            readout: None,
+        })
+    }
+
+    /// The array chip of `design` (its `[array]`'s R × C pixels and readout, resolved for
+    /// the pixel as simulated: N and L after the overrides `o`), the ROM chosen for
+    /// `purpose`. Refused for a design without `[array]`.
+    pub fn array_of(
+        design: &ResolvedDesign,
+        o: &RtlOverrides,
+        purpose: RomPurpose,
+    ) -> Result<Chip, DesignError> {
+        let Some(a) = &design.array else {
+            return Err(DesignError::array(
+                &design.origin,
+                "the array RTL needs an [array] section (array.rows, array.cols, array.pitch_um \
+                 and the mapping); without it the chip is the one pixel's `tofprobe_top`",
+            ));
+        };
+        let mut chip = Chip::of(design, o, purpose)?;
+        chip.rows = a.rows;
+        chip.cols = a.cols;
+        chip.readout = Some(resolve_readout(
+            &a.readout,
+            a.rows,
+            a.cols,
+            &chip.pixel,
+            design.sensor().laser_rate_hz,
+            &design.origin,
+        )?);
+        Ok(chip)
+    }
+
+    /// The array's shape and readout as the generator renders them (`None` for the single
+    /// pixel's top), with an optional deliberate fault and tile (the part rendered).
+    pub fn array_spec(
+        &self,
+        fault: Option<tofprobe_rtlgen::ArrayFault>,
+        tile: Option<tofprobe_rtlgen::array::ArrayTile>,
+    ) -> Option<tofprobe_rtlgen::ArraySpec> {
+        self.readout.map(|r| tofprobe_rtlgen::ArraySpec {
+            rows: r.rows,
+            cols: r.cols,
+            bits: r.bits,
+            beats_per_word: r.beats_per_word,
+            beat_cycles: r.beat_cycles,
+            slot_cycles: r.slot_cycles(),
+            fault,
+            tile,
         })
     }
 

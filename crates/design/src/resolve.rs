@@ -248,14 +248,7 @@ pub fn resolve_timed(
         (Vec::new(), None)
     };
     let array = match &d.array {
-        Some(a) => Some(crate::array::resolve_array(
-            a,
-            &d.sensor,
-            pixel.registers(),
-            pixel.bins,
-            pixel.frame_pulses,
-            origin,
-        )?),
+        Some(a) => Some(crate::array::resolve_array(a, &d.sensor, &pixel, origin)?),
         None => None,
     };
     Ok(ResolvedDesign {
@@ -406,6 +399,23 @@ impl ResolvedDesign {
                 ),
             )),
         }
+    }
+
+    /// The readout of the array for the design's pixel (`None` for a single pixel); see
+    /// [`crate::readout`]. [`crate::Chip`] resolves it again for the pixel it renders.
+    pub fn readout(&self) -> Result<Option<crate::readout::Readout>, DesignError> {
+        let Some(a) = &self.array else {
+            return Ok(None);
+        };
+        crate::readout::resolve_readout(
+            &a.readout,
+            a.rows,
+            a.cols,
+            &self.pixel,
+            self.sensor().laser_rate_hz,
+            &self.origin,
+        )
+        .map(Some)
     }
 
     /// The photon source of the design (validated by the resolution).

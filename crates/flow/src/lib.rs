@@ -6,6 +6,7 @@
 //! `tofprobe-experiments`; the EDA tools are driven by `tofprobe-eda` and `tofprobe-cosim`.
 
 pub mod adders;
+pub mod array;
 pub mod error;
 pub mod flow;
 pub mod flowset;

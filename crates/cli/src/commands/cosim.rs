@@ -81,6 +81,10 @@ pub struct CosimArgs {
     /// tasks of a job array cover exactly the configurations of one run.
     #[arg(long, value_name = "I/N", requires = "random")]
     pub shard: Option<String>,
+    /// An `[array]` configuration too large to build whole: co-simulate the tile of ROWS ×
+    /// COLS pixels from (ROW, COL), with the whole array's sequencer, broadcast and readout.
+    #[arg(long, value_name = "ROW,COL,ROWS,COLS")]
+    pub tile: Option<String>,
     /// Also write a JUnit XML report: one test case per frame and configuration, the first
     /// mismatch as the failure message (written whole; an existing file is replaced only if
     /// tofprobe wrote it).
@@ -230,7 +234,14 @@ pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
         // A set killed mid-commit is refused; edited files are named (and co-simulated).
         super::check_set::check_reader(dir)?;
     }
-    let (design, _) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
+    if a.frames == 0 || a.frames > 1000 {
+        return Err(CliError::option("frames", a.frames, "1..=1000"));
+    }
+    let design = super::load_for_hardware(a.config.as_deref())?;
+    if design.array.is_some() {
+        return super::array_rtl::cosim(a, &design);
+    }
+    let (design, _) = super::simulated_design_of(design, &overrides)?;
     // With --rtl, the chip `tofprobe rtl` renders for this configuration (the image in DIR
     // must be its ROM); else the chip the simulating commands replay.
     let purpose = if a.rtl.is_some() {

@@ -3,5 +3,6 @@
 //! `cargo test --release -p tofprobe-design --test it MODULE::`.
 
 mod mutations;
+mod readout;
 mod resolve;
 mod serde_roundtrip;
