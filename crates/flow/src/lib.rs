@@ -6,6 +6,8 @@
 //! `tofprobe-experiments`; the EDA tools are driven by `tofprobe-eda` and `tofprobe-cosim`.
 
 pub mod adders;
+pub mod array_report;
+pub mod array_size;
 pub mod error;
 pub mod flow;
 pub mod flowset;
