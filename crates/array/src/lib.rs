@@ -15,6 +15,7 @@ pub mod maps;
 pub mod model;
 pub mod output;
 pub mod plot;
+pub mod rtl;
 pub mod shard;
 pub mod uff;
 

@@ -108,6 +108,23 @@ impl Chip {
         Ok(chip)
     }
 
+    /// The array's shape and readout as the generator renders them (`None` for the single
+    /// pixel's top), with an optional deliberate fault.
+    pub fn array_spec(
+        &self,
+        fault: Option<tofprobe_rtlgen::ArrayFault>,
+    ) -> Option<tofprobe_rtlgen::ArraySpec> {
+        self.readout.map(|r| tofprobe_rtlgen::ArraySpec {
+            rows: r.rows,
+            cols: r.cols,
+            bits: r.bits,
+            beats_per_word: r.beats_per_word,
+            beat_cycles: r.beat_cycles,
+            slot_cycles: r.slot_cycles(),
+            fault,
+        })
+    }
+
     /// The same chip with the directed sequencer.
     pub fn directed(mut self, d: DirectedOptions) -> Chip {
         self.sequencer = SequencerKind::Directed(d);

@@ -397,3 +397,7 @@ pub fn resolve_readout(
 ) -> Result<Readout, DesignError> {
     Readout::new(keys, rows, cols, pixel, laser_rate_hz).map_err(|m| DesignError::array(origin, m))
 }
+
+/// The array's deliberate faults (mutation tests), rendered by tofprobe-rtlgen and carried
+/// by the array model.
+pub use tofprobe_rtlgen::ArrayFault;

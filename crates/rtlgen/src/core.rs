@@ -99,15 +99,60 @@ pub fn render_core(
     }
     let prefix = &o.module_prefix;
     let (_, _, top) = crate::naming::module_names(prefix);
+    core_files(
+        p,
+        rtl,
+        o,
+        sim,
+        top,
+        format!("{prefix}_pixel"),
+        String::new(),
+    )
+}
+
+/// The core of an array's rendered files (`crate::render_array`): its toplevel the
+/// `<prefix>_array` module of `rows` × `cols` pixels, targets `lint` and `synth` (the
+/// array is co-simulated by `tofprobe cosim`, not by the core's `sim`).
+pub fn render_array_core(
+    p: &PixelParams,
+    rtl: &[RtlFile],
+    o: &RenderOptions,
+    rows: usize,
+    cols: usize,
+) -> Result<Vec<RtlFile>, RtlError> {
+    crate::naming::validate_identifier("module_prefix", &o.module_prefix)?;
+    let prefix = &o.module_prefix;
+    let top = crate::array::array_module_name(prefix);
+    core_files(
+        p,
+        rtl,
+        o,
+        None,
+        top.clone(),
+        top,
+        format!("{rows} x {cols} array of the "),
+    )
+}
+
+fn core_files(
+    p: &PixelParams,
+    rtl: &[RtlFile],
+    o: &RenderOptions,
+    sim: Option<&CoreSim>,
+    top: String,
+    vlnv: String,
+    what: String,
+) -> Result<Vec<RtlFile>, RtlError> {
+    let prefix = &o.module_prefix;
     let yosys_script = format!("{prefix}_yosys_synth.tcl");
     let defines = format!("{prefix}_tb_defines.vh");
     let mut files = Vec::new();
     let core = CoreT {
         header: hash_header(p, "tofprobe.core", o),
-        vlnv_name: format!("tofprobe:tofprobe:{prefix}_pixel"),
+        vlnv_name: format!("tofprobe:tofprobe:{vlnv}"),
         version: env!("CARGO_PKG_VERSION"),
         description: format!(
-            "tofprobe one-bit frequency-probing dToF pixel ({:?}, B={}, U={}, A={}, C={}, W={}, N={}, L={}, hash {})",
+            "tofprobe {what}one-bit frequency-probing dToF pixel ({:?}, B={}, U={}, A={}, C={}, W={}, N={}, L={}, hash {})",
             p.mode,
             p.bins,
             p.haar_scales,

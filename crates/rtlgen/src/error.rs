@@ -38,6 +38,13 @@ pub enum RtlError {
         value: usize,
         allowed: usize,
     },
+    /// The array's shape or readout cannot be rendered.
+    #[error("{field} = {value} cannot be rendered: allowed {allowed}")]
+    Array {
+        field: &'static str,
+        value: String,
+        allowed: String,
+    },
     /// A vector or RTL file is malformed.
     #[error("{path}: line {line}: {message}")]
     Format {

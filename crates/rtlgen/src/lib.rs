@@ -6,6 +6,7 @@
 //! cycle-accurate model and writes what a simulator must reproduce; `core` renders the
 //! FuseSoC core that packages the RTL for users' tools.
 
+pub mod array;
 pub mod core;
 pub mod error;
 pub mod golden;
@@ -15,6 +16,7 @@ pub mod stimulus;
 pub mod vectors;
 pub mod write;
 
+pub use array::{ArrayFault, ArraySpec, render_array};
 pub use error::RtlError;
 pub use naming::{DEFAULT_MODULE_PREFIX, config_hash, module_names};
 pub use render::{RenderOptions, RtlFile, render};

@@ -3,5 +3,6 @@
 
 mod common;
 mod determinism;
+mod rtl;
 mod shard;
 mod validation;

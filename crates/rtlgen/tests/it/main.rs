@@ -3,5 +3,6 @@
 //! `cargo test --release -p tofprobe-rtlgen --test it MODULE::`.
 
 mod accepted_render;
+mod array_gates;
 mod gates;
 mod render;

@@ -1,0 +1,523 @@
+//! The array at the clock edge: docs/pixel-contract.md "Array" register by register, as
+//! `templates/array.v` builds it — the root sequencer and probe ROM, the two broadcast
+//! stages, R × C of the pixel's one cycle model (`tofprobe_pixel::CycleModel`), the row
+//! select onto the column buses, the readout buffer and the port. [`ArrayModel::step`] is
+//! one rising edge; [`run`] drives frames of per-pixel detections through it and records
+//! what the array's ports show every cycle (the golden vectors of `tofprobe cosim` on an
+//! array). The array's faults ([`ArrayFault`]) are carried exactly, so the cycle where a
+//! broken RTL first differs is predicted by the model.
+
+use tofprobe_design::readout::{ArrayFault, Readout};
+use tofprobe_pixel::sequencer::RESET_CYCLES;
+use tofprobe_pixel::{CycleModel, Mode, PinsIn, PixelParams};
+
+use crate::error::ArrayError;
+
+/// Cycles recorded after the last frame: its last beat is at most 5 cycles after the
+/// frame's end (the slot's last beat is 6 cycles after its strobe, 1 before the next).
+pub const TAIL_CYCLES: u64 = 6;
+
+/// The array's outputs during one cycle (before its edge).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ArrayPins {
+    /// The pixels sample `valid`/`tdc` this cycle.
+    pub pulse_o: bool,
+    /// Every pixel's pipeline is free.
+    pub ready: bool,
+    /// A beat is on `ro_data`.
+    pub ro_valid: bool,
+    /// The beat (b bits).
+    pub ro_data: u64,
+}
+
+/// The array's registers, named as in `templates/array.v`.
+#[derive(Debug, Clone)]
+pub struct ArrayModel {
+    ro: Readout,
+    fourier: bool,
+    words: usize,
+    rom: Vec<u64>,
+    rom_depth: usize,
+    fault: Option<ArrayFault>,
+    // Root sequencer.
+    ro_phase: bool,
+    ph: u64,
+    pidx: u64,
+    q: usize,
+    sc: u64,
+    qr: usize,
+    qc: usize,
+    addr: usize,
+    // Broadcast stage 1.
+    b_pulse: bool,
+    b_ro: bool,
+    b_row: usize,
+    b_col: usize,
+    b_word: Vec<u64>,
+    // Broadcast stage 2.
+    o_pulse: bool,
+    r_pulse: Vec<bool>,
+    r_ro: Vec<bool>,
+    r_col: Vec<usize>,
+    r_word: Vec<Vec<u64>>,
+    late_pulse: bool,
+    late_word: Vec<u64>,
+    pixels: Vec<CycleModel>,
+    // Read select.
+    d_ro: bool,
+    d_row: usize,
+    d_col: usize,
+    e_ro: bool,
+    e_row: usize,
+    e_col: usize,
+    m_row: Vec<bool>,
+    m_col: usize,
+    // Readout buffer and port.
+    rbuf: Vec<u64>,
+    dr_act: bool,
+    dj: usize,
+    dm: usize,
+    dg: u64,
+    ro_valid: bool,
+    ro_data: u64,
+}
+
+impl ArrayModel {
+    /// The array of `readout`'s shape, every pixel `p`, the probe ROM `rom` (L entries of
+    /// ceil(R/64) words; empty in Haar mode), in its reset state.
+    pub fn new(
+        readout: &Readout,
+        p: &PixelParams,
+        rom: &[u64],
+        fault: Option<ArrayFault>,
+    ) -> Result<ArrayModel, ArrayError> {
+        let fourier = p.mode == Mode::Fourier;
+        let words = if fourier {
+            p.registers().div_ceil(64)
+        } else {
+            0
+        };
+        if fourier && rom.len() != p.rom_depth * words {
+            return Err(ArrayError::Shape(format!(
+                "the array's probe ROM has {} words: its L = {} entries need {}",
+                rom.len(),
+                p.rom_depth,
+                p.rom_depth * words
+            )));
+        }
+        let err = |source| ArrayError::Pixel {
+            row: 0,
+            col: 0,
+            source,
+        };
+        let pixel = CycleModel::new(p).map_err(err)?;
+        let rows = readout.rows;
+        Ok(ArrayModel {
+            ro: *readout,
+            fourier,
+            words,
+            rom: rom.to_vec(),
+            rom_depth: p.rom_depth.max(1),
+            fault,
+            ro_phase: false,
+            ph: 0,
+            pidx: 0,
+            q: 0,
+            sc: 0,
+            qr: 0,
+            qc: 0,
+            addr: 0,
+            b_pulse: false,
+            b_ro: false,
+            b_row: 0,
+            b_col: 0,
+            b_word: vec![0; words],
+            o_pulse: false,
+            r_pulse: vec![false; rows],
+            r_ro: vec![false; rows],
+            r_col: vec![0; rows],
+            r_word: vec![vec![0; words]; rows],
+            late_pulse: false,
+            late_word: vec![0; words],
+            pixels: vec![pixel; readout.pixels()],
+            d_ro: false,
+            d_row: 0,
+            d_col: 0,
+            e_ro: false,
+            e_row: 0,
+            e_col: 0,
+            m_row: vec![false; rows],
+            m_col: 0,
+            rbuf: vec![0; readout.registers + 1],
+            dr_act: false,
+            dj: 0,
+            dm: 0,
+            dg: 0,
+            ro_valid: false,
+            ro_data: 0,
+        })
+    }
+
+    /// The readout the array follows.
+    pub fn readout(&self) -> &Readout {
+        &self.ro
+    }
+
+    /// The outputs during the current cycle.
+    pub fn outputs(&self) -> ArrayPins {
+        ArrayPins {
+            pulse_o: self.o_pulse,
+            ready: self.pixels.iter().all(|p| p.outputs().ready),
+            ro_valid: self.ro_valid,
+            ro_data: self.ro_data,
+        }
+    }
+
+    /// Pixel (r, c)'s cycle model.
+    pub fn pixel(&self, r: usize, c: usize) -> &CycleModel {
+        &self.pixels[r * self.ro.cols + c]
+    }
+
+    /// The column buses and the column select: the selected pixel's (rd_valid, rd_index,
+    /// rd_data), OR-ed over the selected rows.
+    fn mux(&self) -> (bool, usize, u64) {
+        let cols = self.ro.cols;
+        if self.m_col >= cols {
+            return (false, 0, 0);
+        }
+        let mut m = (false, 0usize, 0u64);
+        for (r, _) in self.m_row.iter().enumerate().filter(|(_, s)| **s) {
+            let o = self.pixels[r * cols + self.m_col].outputs();
+            m = (m.0 | o.rd_valid, m.1 | o.rd_index as usize, m.2 | o.rd_data);
+        }
+        m
+    }
+
+    /// One clock cycle: returns the outputs seen during it, then applies the rising edge
+    /// with `rst` and the per-pixel `valid` and `tdc` (row-major).
+    pub fn step(&mut self, rst: bool, valid: &[bool], tdc: &[u32]) -> ArrayPins {
+        let out = self.outputs();
+        let ro = self.ro;
+        let (rows, cols, np) = (ro.rows, ro.cols, ro.pixels());
+        let (reg, k, g) = (ro.registers, ro.beats_per_word, ro.beat_cycles);
+        // Root, combinational.
+        let s_pulse = !rst && !self.ro_phase && self.ph == 0;
+        let s_ro = !rst && self.ro_phase && self.sc == 0 && self.q != np;
+        let (s_row, s_col) = match (self.fault, self.q) {
+            (Some(ArrayFault::OrderSwap), 0) => ro.order(1),
+            (Some(ArrayFault::OrderSwap), 1) => ro.order(0),
+            _ => (self.qr, self.qc),
+        };
+        let rom_word: Vec<u64> = if self.fourier {
+            self.rom[self.addr * self.words..(self.addr + 1) * self.words].to_vec()
+        } else {
+            Vec::new()
+        };
+        let (mv, mi, md) = self.mux();
+        // The pixels' edges.
+        let neighbour = match self.fault {
+            Some(ArrayFault::NeighbourTdc { row, col }) => Some(row * cols + col),
+            _ => None,
+        };
+        for (i, px) in self.pixels.iter_mut().enumerate() {
+            let (r, c) = (i / cols, i % cols);
+            // Two TDCs crossed: the faulty pixel reads the next one's, that one its.
+            let src = match neighbour {
+                Some(n) if n == i => (i + 1) % np,
+                Some(n) if (n + 1) % np == i => n,
+                _ => i,
+            };
+            px.step(&PinsIn {
+                rst,
+                pulse: self.r_pulse[r],
+                valid: valid[i],
+                tdc: tdc[src],
+                rom_word: &self.r_word[r],
+                readout: self.r_ro[r] && self.r_col[r] == c,
+            });
+        }
+        // The buffer (no reset) and the port.
+        let beat = self.dr_act && (g == 1 || self.dg == 0);
+        let step = self.dr_act && (g == 1 || self.dg == g - 1);
+        let last = self.dj == reg && (k == 1 || self.dm == k - 1);
+        let word = self.rbuf.get(self.dj).copied().unwrap_or(0);
+        let data = ro.beats_of(self.dj, word)[self.dm.min(k - 1)];
+        if mv && mi <= reg {
+            self.rbuf[mi] = md;
+        }
+        if rst {
+            self.reset_registers();
+            return out;
+        }
+        self.ro_valid = beat;
+        if beat {
+            self.ro_data = data;
+        }
+        if mv && mi == 0 {
+            (self.dr_act, self.dj, self.dm, self.dg) = (true, 0, 0, 0);
+        } else if self.dr_act {
+            if g > 1 {
+                self.dg = if step { 0 } else { self.dg + 1 };
+            }
+            if step {
+                if last {
+                    self.dr_act = false;
+                } else if k > 1 && self.dm == k - 1 {
+                    (self.dm, self.dj) = (0, self.dj + 1);
+                } else if k > 1 {
+                    self.dm += 1;
+                } else {
+                    self.dj += 1;
+                }
+            }
+        }
+        // Read select (from the old stage values).
+        if self.e_ro {
+            self.m_col = self.e_col;
+            for (r, m) in self.m_row.iter_mut().enumerate() {
+                let stuck = self.fault == Some(ArrayFault::RowStuck { row: r });
+                *m = (stuck && *m) || self.e_row == r;
+            }
+        }
+        (self.e_ro, self.e_row, self.e_col) = (self.d_ro, self.d_row, self.d_col);
+        (self.d_ro, self.d_row, self.d_col) = (self.b_ro, self.b_row, self.b_col);
+        // Broadcast stage 2 (from the old stage 1).
+        self.o_pulse = self.b_pulse;
+        let late_row = match self.fault {
+            Some(ArrayFault::RowLate { row }) => Some(row),
+            _ => None,
+        };
+        for r in 0..rows {
+            if late_row == Some(r) {
+                self.r_pulse[r] = self.late_pulse;
+                self.r_word[r].clone_from(&self.late_word);
+            } else {
+                self.r_pulse[r] = self.b_pulse;
+                self.r_word[r].clone_from(&self.b_word);
+            }
+            self.r_ro[r] = self.b_ro && self.b_row == r;
+            self.r_col[r] = self.b_col;
+        }
+        self.late_pulse = self.b_pulse;
+        self.late_word.clone_from(&self.b_word);
+        // Stage 1 (from the root).
+        (self.b_pulse, self.b_ro, self.b_row, self.b_col) = (s_pulse, s_ro, s_row, s_col);
+        self.b_word = rom_word;
+        self.sequencer_edge();
+        out
+    }
+
+    /// The root sequencer's edge (not in reset).
+    fn sequencer_edge(&mut self) {
+        let ro = self.ro;
+        let np = ro.pixels();
+        if !self.ro_phase {
+            if self.ph == ro.cycles_per_pulse - 1 {
+                self.ph = 0;
+                self.addr = (self.addr + 1) % self.rom_depth;
+                if self.pidx == ro.frame_pulses - 1 {
+                    self.pidx = 0;
+                    self.ro_phase = true;
+                    (self.q, self.sc, self.qr, self.qc, self.addr) = (0, 0, 0, 0, 0);
+                } else {
+                    self.pidx += 1;
+                }
+            } else {
+                self.ph += 1;
+            }
+        } else if self.q == np {
+            self.ro_phase = false;
+        } else if self.sc == ro.slot_cycles() - 1 {
+            self.sc = 0;
+            self.q += 1;
+            if self.qc == ro.cols - 1 {
+                (self.qc, self.qr) = (0, self.qr + 1);
+            } else {
+                self.qc += 1;
+            }
+        } else {
+            self.sc += 1;
+        }
+    }
+
+    /// Every register with a reset (all but the readout buffer) to zero.
+    fn reset_registers(&mut self) {
+        let words = self.words;
+        (self.ro_phase, self.ph, self.pidx, self.q, self.sc) = (false, 0, 0, 0, 0);
+        (self.qr, self.qc, self.addr) = (0, 0, 0);
+        (self.b_pulse, self.b_ro, self.b_row, self.b_col) = (false, false, 0, 0);
+        self.b_word = vec![0; words];
+        self.o_pulse = false;
+        self.r_pulse.fill(false);
+        self.r_ro.fill(false);
+        self.r_col.fill(0);
+        self.r_word.iter_mut().for_each(|w| w.fill(0));
+        self.late_pulse = false;
+        self.late_word.fill(0);
+        (self.d_ro, self.d_row, self.d_col) = (false, 0, 0);
+        (self.e_ro, self.e_row, self.e_col) = (false, 0, 0);
+        self.m_row.fill(false);
+        self.m_col = 0;
+        (self.dr_act, self.dj, self.dm, self.dg) = (false, 0, 0, 0);
+        (self.ro_valid, self.ro_data) = (false, 0);
+    }
+}
+
+/// What the array's ports showed over a run, cycle by cycle.
+#[derive(Debug, Clone)]
+pub struct ArrayRun {
+    /// The readout followed.
+    pub readout: Readout,
+    /// Frames run.
+    pub frames: u64,
+    /// The outputs of every cycle.
+    pub pins: Vec<ArrayPins>,
+    /// Per `pulse_o` cycle (in order): the cycle.
+    pub pulse_cycles: Vec<u64>,
+    /// Per frame, per pixel (readout order), the R + 1 words the stream carried (raw W
+    /// bits, reassembled from the beats).
+    pub words: Vec<Vec<Vec<u64>>>,
+}
+
+/// A frame's period in cycles and the cycles before the first frame.
+fn frame_start(ro: &Readout, frame: u64) -> u64 {
+    RESET_CYCLES + frame * ro.frame_cycles()
+}
+
+impl ArrayRun {
+    /// The cycles run.
+    pub fn cycles(&self) -> u64 {
+        self.pins.len() as u64
+    }
+
+    /// The cycle of beat (frame, q, word, part) by the contract's formula.
+    pub fn beat_cycle(&self, frame: u64, q: usize, word: usize, part: usize) -> u64 {
+        let ro = &self.readout;
+        frame_start(ro, frame) + ro.accumulate_cycles() + ro.beat_offset(q, word, part)
+    }
+
+    /// Says what the array was doing at `cycle`, in the contract's terms: the beat on the
+    /// port (pixel (r, c), register or status word, part, frame and its pulses), or the
+    /// pulse being presented, or the phase.
+    pub fn explain(&self, cycle: u64) -> String {
+        let ro = &self.readout;
+        let f = ro.frame_cycles();
+        let n = ro.frame_pulses;
+        let frame_of = |c: u64| c.saturating_sub(RESET_CYCLES) / f;
+        if cycle < RESET_CYCLES {
+            return format!("cycle {cycle}: reset");
+        }
+        // The beat whose slot holds this cycle (the latest beat at or before it).
+        for fr in (0..=frame_of(cycle)).rev().take(2) {
+            let base = frame_start(ro, fr) + ro.accumulate_cycles() + ro.beat_offset(0, 0, 0);
+            if cycle < base {
+                continue;
+            }
+            let idx = (cycle - base) / ro.beat_cycles;
+            if idx < ro.beats_per_frame() && fr < self.frames {
+                let b = ro.beat(idx);
+                let word = if b.word == ro.registers {
+                    "status word (refused pulses)".to_string()
+                } else {
+                    format!("register {}", b.word)
+                };
+                return format!(
+                    "cycle {cycle}: frame {fr}'s readout, pixel ({}, {}) (position {} of the order), \
+                     {word}, beat {} of {}; its frame is pulses {}..{}",
+                    b.row,
+                    b.col,
+                    b.position,
+                    b.part,
+                    ro.beats_per_word,
+                    fr * n,
+                    fr * n + n - 1
+                );
+            }
+        }
+        let fr = frame_of(cycle);
+        let within = cycle - frame_start(ro, fr);
+        let lat = tofprobe_design::readout::BROADCAST_LATENCY;
+        if within >= lat && within < ro.accumulate_cycles() + lat {
+            // The pulse the pixels are working on: presented `lat` cycles after the sequencer's.
+            let k = (within - lat) / ro.cycles_per_pulse;
+            let pulse = fr * n + k;
+            format!(
+                "cycle {cycle}: frame {fr}, pulse {pulse} (presented to the pixels at cycle {}, \
+                 slot {} of its {} cycles)",
+                frame_start(ro, fr) + lat + k * ro.cycles_per_pulse,
+                (within - lat) % ro.cycles_per_pulse,
+                ro.cycles_per_pulse
+            )
+        } else {
+            format!("cycle {cycle}: frame {fr}'s readout phase")
+        }
+    }
+}
+
+/// Runs `frames` frames: reset, then every cycle the detections of the pulse the pixels
+/// sample (`detections[i]` is pixel i's, row-major, one per pulse of the run; pulses
+/// beyond present no detection).
+pub fn run(
+    model: &mut ArrayModel,
+    detections: &[Vec<Option<u32>>],
+    frames: u64,
+) -> Result<ArrayRun, ArrayError> {
+    let ro = *model.readout();
+    let np = ro.pixels();
+    if detections.len() != np {
+        return Err(ArrayError::Shape(format!(
+            "{} pixels' detections for a {} × {} array",
+            detections.len(),
+            ro.rows,
+            ro.cols
+        )));
+    }
+    let total = frame_start(&ro, frames) + TAIL_CYCLES;
+    let mut pins = Vec::with_capacity(total as usize);
+    let mut pulse_cycles = Vec::new();
+    let (mut valid, mut tdc) = (vec![false; np], vec![0u32; np]);
+    for cycle in 0..total {
+        let rst = cycle < RESET_CYCLES;
+        let pulse_o = model.outputs().pulse_o;
+        let n = pulse_cycles.len();
+        for i in 0..np {
+            let d = if pulse_o {
+                detections[i].get(n).copied().flatten()
+            } else {
+                None
+            };
+            (valid[i], tdc[i]) = (d.is_some(), d.unwrap_or(0));
+        }
+        if pulse_o {
+            pulse_cycles.push(cycle);
+        }
+        pins.push(model.step(rst, &valid, &tdc));
+    }
+    let mut run = ArrayRun {
+        readout: ro,
+        frames,
+        pins,
+        pulse_cycles,
+        words: Vec::new(),
+    };
+    run.words = (0..frames)
+        .map(|fr| {
+            (0..np)
+                .map(|q| {
+                    (0..ro.words_per_pixel())
+                        .map(|j| {
+                            let beats: Vec<u64> = (0..ro.beats_per_word)
+                                .map(|m| {
+                                    let c = run.beat_cycle(fr, q, j, m) as usize;
+                                    run.pins.get(c).map(|p| p.ro_data).unwrap_or(0)
+                                })
+                                .collect();
+                            ro.word_of(&beats)
+                        })
+                        .collect()
+                })
+                .collect()
+        })
+        .collect();
+    Ok(run)
+}

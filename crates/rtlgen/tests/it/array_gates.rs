@@ -1,0 +1,234 @@
+//! Quality gates on the array RTL (`templates/array.v`): `verilator --lint-only -Wall` with
+//! zero warnings, `iverilog -g2005 -Wall` compiles, yosys `synth` with no latch and no
+//! warning beyond the pixel's register-file note, for a 2 × 2 Fourier array on a one-word
+//! port, a 3 × 5 Haar array on a 5-bit port (3 beats per word), a 2 × 3 array with beats
+//! 3 cycles apart, and each array mutant; and the renderer's refusals.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use tofprobe_pixel::{Mode, PixelParams};
+use tofprobe_rtlgen::array::{ArrayFault, ArraySpec, array_module_name, render_array};
+use tofprobe_rtlgen::render::RenderOptions;
+use tofprobe_rtlgen::stimulus::sign_probe_rom;
+use tofprobe_rtlgen::write::write_generated;
+use tofprobe_rtlgen::{DEFAULT_MODULE_PREFIX, RtlError};
+
+fn have(tool: &str) -> bool {
+    tofprobe_testkit::tools::have(&[tool], "tofprobe-rtlgen array gates")
+}
+
+fn small(mode: Mode) -> PixelParams {
+    let mut p = PixelParams::fourier_default(24, 8, 8);
+    p.bins = 3;
+    p.cycles_per_pulse = 4;
+    p.tdc_bits = 5;
+    p.frac_bits = 4;
+    p.shift = 2;
+    if mode == Mode::Haar {
+        p.mode = Mode::Haar;
+        p.haar_scales = 2;
+        (p.frac_bits, p.shift, p.adders, p.cycles_per_pulse, p.width) = (0, 0, 1, 3, 13);
+    }
+    p.validate().unwrap();
+    p
+}
+
+fn spec(p: &PixelParams, rows: usize, cols: usize, bits: u32, g: u64) -> ArraySpec {
+    let k = p.width.div_ceil(bits) as usize;
+    ArraySpec {
+        rows,
+        cols,
+        bits,
+        beats_per_word: k,
+        beat_cycles: g,
+        slot_cycles: (p.registers() as u64 + 1) * k as u64 * g,
+        fault: None,
+    }
+}
+
+fn configs() -> Vec<(String, PixelParams, ArraySpec)> {
+    let f = small(Mode::Fourier);
+    let h = small(Mode::Haar);
+    let mut v = vec![
+        ("2x2".to_string(), f.clone(), spec(&f, 2, 2, 24, 1)),
+        ("3x5-haar-k3".to_string(), h.clone(), spec(&h, 3, 5, 5, 1)),
+        ("2x3-g3".to_string(), f.clone(), spec(&f, 2, 3, 10, 3)),
+    ];
+    for fault in [
+        ArrayFault::RowLate { row: 1 },
+        ArrayFault::NeighbourTdc { row: 0, col: 1 },
+        ArrayFault::OrderSwap,
+        ArrayFault::RowStuck { row: 0 },
+    ] {
+        let s = ArraySpec {
+            fault: Some(fault),
+            ..spec(&f, 2, 2, 24, 1)
+        };
+        v.push((format!("2x2-{}", fault.name()), f.clone(), s));
+    }
+    v
+}
+
+fn render_to(name: &str, p: &PixelParams, s: &ArraySpec) -> (PathBuf, Vec<String>) {
+    let dir = std::env::temp_dir().join(format!(
+        "tofprobe-array-gates-{}-{name}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    let files = render_array(p, &sign_probe_rom(p), &RenderOptions::default(), s).unwrap();
+    let pairs: Vec<(String, String)> = files.into_iter().map(|f| (f.name, f.contents)).collect();
+    write_generated(&dir, &pairs).unwrap();
+    let mut v: Vec<String> = pairs
+        .into_iter()
+        .map(|p| p.0)
+        .filter(|n| n.ends_with(".v"))
+        .collect();
+    v.sort();
+    (dir, v)
+}
+
+fn top() -> String {
+    array_module_name(DEFAULT_MODULE_PREFIX)
+}
+
+#[test]
+fn array_lint_iverilog_and_yosys_are_clean() {
+    let (v, i, y) = (have("verilator"), have("iverilog"), have("yosys"));
+    for (name, p, s) in configs() {
+        let (dir, sources) = render_to(&name, &p, &s);
+        if v {
+            let out = Command::new("verilator")
+                .current_dir(&dir)
+                .args(["--lint-only", "-Wall", "--top-module", &top()])
+                .args(&sources)
+                .output()
+                .unwrap();
+            let text = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                out.status.success() && text.trim().is_empty(),
+                "{name}: {text}"
+            );
+        }
+        if i {
+            let out = Command::new("iverilog")
+                .current_dir(&dir)
+                .args(["-g2005", "-Wall", "-o", "/dev/null", "-s", &top()])
+                .args(&sources)
+                .output()
+                .unwrap();
+            let text = String::from_utf8_lossy(&out.stderr);
+            // The pixel's `@*` over its register file is the pixel gates' business (it
+            // warns, as in crates/rtlgen/tests/it/gates.rs); the array file warns nothing.
+            let own: Vec<&str> = text
+                .lines()
+                .filter(|l| !l.starts_with("tofprobe_pixel.v:"))
+                .collect();
+            assert!(out.status.success() && own.is_empty(), "{name}: {text}");
+        }
+        // yosys on the correct arrays only (the mutants differ by a register or a wire).
+        if y && s.fault.is_none() {
+            let script = format!(
+                "read_verilog {}; synth -top {}; select -assert-count 0 t:$dlatch t:$_DLATCH_*; tee -o stat.txt stat",
+                sources.join(" "),
+                top()
+            );
+            let out = Command::new("yosys")
+                .current_dir(&dir)
+                .args(["-q", "-p", &script])
+                .output()
+                .unwrap();
+            let text = format!(
+                "{}{}",
+                String::from_utf8_lossy(&out.stdout),
+                String::from_utf8_lossy(&out.stderr)
+            );
+            assert!(out.status.success(), "{name}: {text}");
+            for line in text.lines().filter(|l| l.contains("Warning")) {
+                assert!(
+                    line.contains("Replacing memory \\y with list of registers"),
+                    "{name}: {line}"
+                );
+            }
+            // Every pixel's register file survives: at least R·C·registers·W flip-flops.
+            let stat = std::fs::read_to_string(dir.join("stat.txt")).unwrap();
+            let dff: u64 = stat
+                .lines()
+                .filter(|l| {
+                    l.trim_start().starts_with("$_SDFF") || l.trim_start().starts_with("$_DFF")
+                })
+                .filter_map(|l| l.split_whitespace().last()?.parse::<u64>().ok())
+                .sum();
+            let need = (s.rows * s.cols * p.registers()) as u64 * u64::from(p.width);
+            assert!(dff >= need, "{name}: {dff} flip-flops < {need}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+/// The array file instantiates the one pixel module R × C times and nothing else of its
+/// own; the set holds no single-pixel top.
+#[test]
+fn the_array_is_instances_of_the_one_pixel() {
+    let p = small(Mode::Fourier);
+    let files = render_array(
+        &p,
+        &sign_probe_rom(&p),
+        &RenderOptions::default(),
+        &spec(&p, 3, 5, 24, 1),
+    )
+    .unwrap();
+    let names: Vec<&str> = files.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "tofprobe_pixel.v",
+            "tofprobe_probe_rom.v",
+            "tofprobe_array.v"
+        ]
+    );
+    let a = &files[2].contents;
+    assert_eq!(a.matches("tofprobe_pixel u_pixel_").count(), 15);
+    assert_eq!(a.matches("tofprobe_probe_rom u_rom").count(), 1);
+    assert_eq!(a.matches("\nmodule ").count(), 1);
+}
+
+/// Refusals name the field: a slot that is not (R+1)·k·g, a width beyond W, a mutant
+/// outside the array, an array too large to render whole.
+#[test]
+fn bad_array_specs_are_refused() {
+    let p = small(Mode::Fourier);
+    let rom = sign_probe_rom(&p);
+    let o = RenderOptions::default();
+    let cases = [
+        (
+            ArraySpec {
+                slot_cycles: 5,
+                ..spec(&p, 2, 2, 24, 1)
+            },
+            "array slot = 5",
+        ),
+        (
+            ArraySpec {
+                bits: 25,
+                ..spec(&p, 2, 2, 24, 1)
+            },
+            "array.readout_bits = 25",
+        ),
+        (
+            ArraySpec {
+                fault: Some(ArrayFault::RowLate { row: 2 }),
+                ..spec(&p, 2, 2, 24, 1)
+            },
+            "mutation row = 2",
+        ),
+        (spec(&p, 65, 64, 24, 1), "array.rows × array.cols = 65 × 64"),
+    ];
+    for (s, want) in cases {
+        let e = render_array(&p, &rom, &o, &s).unwrap_err();
+        assert!(
+            matches!(e, RtlError::Array { .. }) && e.to_string().contains(want),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,376 @@
+{{ header }}
+// The array of docs/pixel-contract.md "Array": {{ rows }} x {{ cols }} instances of the one pixel,
+// one probe ROM{% if !fourier %} (none: Haar){% endif %} and one sequencer at the root. The sequencer's
+// `pulse`{% if fourier %}, `rom_word`{% endif %} and readout strobes reach every pixel through two registered
+// fan-out stages (the root, then one per row). After {{ n }} pulses one every {{ c }} cycles,
+// the readout phase reads the pixels one at a time, row-major, one every {{ s }} cycles
+// ({{ rows * cols }} x {{ s }} + 1 cycles, no pulse presented): a row select puts the pixel on
+// its column bus, the selected column's words are captured into a readout buffer, and
+// the buffer drains onto the {{ b }}-bit port, {{ k }} beat(s) per word (least significant
+// first; registers sign-extended, the status word zero-extended), one beat every {{ g }}
+// cycle(s). `pulse_o` tells the TDCs (and a testbench) that the pixels sample `valid` and
+// `tdc` this cycle; pixel (r, c) is bit r*{{ cols }}+c of `valid` and field r*{{ cols }}+c of `tdc`.
+module {{ name }} (
+    input  wire clk,
+    input  wire rst,
+    input  wire [{{ np - 1 }}:0] valid,
+    input  wire [{{ np * t - 1 }}:0] tdc,
+    output wire pulse_o,
+    output wire ready,
+    output reg  ro_valid,
+    output reg  [{{ b - 1 }}:0] ro_data
+);
+    // ---- the sequencer (root) ----
+    reg ro_phase;
+    reg [{{ pw - 1 }}:0] ph;
+    reg [{{ nw - 1 }}:0] pidx;
+    reg [{{ qw - 1 }}:0] q;
+    reg [{{ scw - 1 }}:0] sc;
+    reg [{{ rw - 1 }}:0] qr;
+    reg [{{ cw - 1 }}:0] qc;
+    wire s_pulse = !rst && !ro_phase && (ph == {{ pw }}'d0);
+    wire s_ro = !rst && ro_phase && (sc == {{ scw }}'d0) && (q != {{ qw }}'d{{ np }});
+{%- if mutation == "order_swap" %}
+    // DELIBERATELY BROKEN: the readout order swaps its first two pixels.
+    wire [{{ rw - 1 }}:0] s_row = (q == {{ qw }}'d0) ? {{ rw }}'d{{ swap_r1 }} : (q == {{ qw }}'d1) ? {{ rw }}'d{{ swap_r0 }} : qr;
+    wire [{{ cw - 1 }}:0] s_col = (q == {{ qw }}'d0) ? {{ cw }}'d{{ swap_c1 }} : (q == {{ qw }}'d1) ? {{ cw }}'d{{ swap_c0 }} : qc;
+{%- else %}
+    wire [{{ rw - 1 }}:0] s_row = qr;
+    wire [{{ cw - 1 }}:0] s_col = qc;
+{%- endif %}
+{%- if fourier %}
+    reg [{{ aw - 1 }}:0] addr;
+    wire [{{ r - 1 }}:0] rom_word;
+    {{ rom_name }} u_rom (.addr(addr), .word(rom_word));
+{%- endif %}
+
+    always @(posedge clk) begin
+        if (rst) begin
+            ro_phase <= 1'b0;
+            ph <= {{ pw }}'d0;
+            pidx <= {{ nw }}'d0;
+            q <= {{ qw }}'d0;
+            sc <= {{ scw }}'d0;
+            qr <= {{ rw }}'d0;
+            qc <= {{ cw }}'d0;
+{%- if fourier %}
+            addr <= {{ aw }}'d0;
+{%- endif %}
+        end else if (!ro_phase) begin
+            if (ph == {{ pw }}'d{{ c - 1 }}) begin
+                ph <= {{ pw }}'d0;
+{%- if fourier %}
+                addr <= (addr == {{ aw }}'d{{ l - 1 }}) ? {{ aw }}'d0 : addr + {{ aw }}'d1;
+{%- endif %}
+                if (pidx == {{ nw }}'d{{ n - 1 }}) begin
+                    pidx <= {{ nw }}'d0;
+                    ro_phase <= 1'b1;
+                    q <= {{ qw }}'d0;
+                    sc <= {{ scw }}'d0;
+                    qr <= {{ rw }}'d0;
+                    qc <= {{ cw }}'d0;
+{%- if fourier %}
+                    addr <= {{ aw }}'d0;
+{%- endif %}
+                end else begin
+                    pidx <= pidx + {{ nw }}'d1;
+                end
+            end else begin
+                ph <= ph + {{ pw }}'d1;
+            end
+        end else if (q == {{ qw }}'d{{ np }}) begin
+            ro_phase <= 1'b0;
+        end else if (sc == {{ scw }}'d{{ s - 1 }}) begin
+            sc <= {{ scw }}'d0;
+            q <= q + {{ qw }}'d1;
+            if (qc == {{ cw }}'d{{ cols - 1 }}) begin
+                qc <= {{ cw }}'d0;
+                qr <= qr + {{ rw }}'d1;
+            end else begin
+                qc <= qc + {{ cw }}'d1;
+            end
+        end else begin
+            sc <= sc + {{ scw }}'d1;
+        end
+    end
+
+    // ---- broadcast stage 1: the root's registers ----
+    reg b_pulse;
+    reg b_ro;
+    reg [{{ rw - 1 }}:0] b_row;
+    reg [{{ cw - 1 }}:0] b_col;
+{%- if fourier %}
+    reg [{{ r - 1 }}:0] b_word;
+{%- endif %}
+    always @(posedge clk) begin
+        if (rst) begin
+            b_pulse <= 1'b0;
+            b_ro <= 1'b0;
+            b_row <= {{ rw }}'d0;
+            b_col <= {{ cw }}'d0;
+{%- if fourier %}
+            b_word <= {{ r }}'d0;
+{%- endif %}
+        end else begin
+            b_pulse <= s_pulse;
+            b_ro <= s_ro;
+            b_row <= s_row;
+            b_col <= s_col;
+{%- if fourier %}
+            b_word <= rom_word;
+{%- endif %}
+        end
+    end
+
+    // ---- broadcast stage 2: one register per row (and the TDCs' strobe) ----
+    reg o_pulse;
+    assign pulse_o = o_pulse;
+    reg [{{ rows - 1 }}:0] r_pulse;
+    reg [{{ rows - 1 }}:0] r_ro;
+    reg [{{ rows * cw - 1 }}:0] r_col;
+{%- if fourier %}
+    reg [{{ rows * r - 1 }}:0] r_word;
+{%- endif %}
+{%- if mutation == "row_late" %}
+    // DELIBERATELY BROKEN: one row's broadcast passes one extra register.
+    reg late_pulse;
+{%- if fourier %}
+    reg [{{ r - 1 }}:0] late_word;
+{%- endif %}
+{%- endif %}
+    always @(posedge clk) begin
+        if (rst) begin
+            o_pulse <= 1'b0;
+            r_pulse <= {{ rows }}'d0;
+            r_ro <= {{ rows }}'d0;
+            r_col <= {{ rows * cw }}'d0;
+{%- if fourier %}
+            r_word <= {{ rows * r }}'d0;
+{%- endif %}
+{%- if mutation == "row_late" %}
+            late_pulse <= 1'b0;
+{%- if fourier %}
+            late_word <= {{ r }}'d0;
+{%- endif %}
+{%- endif %}
+        end else begin
+            o_pulse <= b_pulse;
+{%- for row in rows_t %}
+{%- if row.late %}
+            late_pulse <= b_pulse;
+            r_pulse[{{ row.row }}] <= late_pulse;
+{%- else %}
+            r_pulse[{{ row.row }}] <= b_pulse;
+{%- endif %}
+            r_ro[{{ row.row }}] <= b_ro && (b_row == {{ rw }}'d{{ row.row }});
+            r_col[{{ row.row * cw }} +: {{ cw }}] <= b_col;
+{%- if fourier %}
+{%- if row.late %}
+            late_word <= b_word;
+            r_word[{{ row.row * r }} +: {{ r }}] <= late_word;
+{%- else %}
+            r_word[{{ row.row * r }} +: {{ r }}] <= b_word;
+{%- endif %}
+{%- endif %}
+{%- endfor %}
+        end
+    end
+
+    // ---- the pixels ----
+    wire [{{ np - 1 }}:0] p_ready;
+    wire [{{ np - 1 }}:0] p_valid;
+    wire [{{ np * ib - 1 }}:0] p_index;
+    wire [{{ np * w - 1 }}:0] p_data;
+    assign ready = &p_ready;
+{%- for px in pixels %}
+    {{ pixel_name }} u_pixel_{{ px.row }}_{{ px.col }} (
+        .clk(clk),
+        .rst(rst),
+        .pulse(r_pulse[{{ px.row }}]),
+        .valid(valid[{{ px.i }}]),
+        .tdc(tdc[{{ px.tdc * t }} +: {{ t }}]),
+{%- if fourier %}
+        .rom_word(r_word[{{ px.row * r }} +: {{ r }}]),
+{%- endif %}
+        .readout(r_ro[{{ px.row }}] && (r_col[{{ px.row * cw }} +: {{ cw }}] == {{ cw }}'d{{ px.col }})),
+        .ready(p_ready[{{ px.i }}]),
+        .rd_valid(p_valid[{{ px.i }}]),
+        .rd_index(p_index[{{ px.i * ib }} +: {{ ib }}]),
+        .rd_data(p_data[{{ px.i * w }} +: {{ w }}])
+    );
+{%- endfor %}
+
+    // ---- the read select: a row onto the column buses, a column onto the capture ----
+    // The strobe's root registers, two more stages on: the select changes the cycle after
+    // the pixel takes its strobe, when its first word is still a cycle away.
+    reg d_ro;
+    reg [{{ rw - 1 }}:0] d_row;
+    reg [{{ cw - 1 }}:0] d_col;
+    reg e_ro;
+    reg [{{ rw - 1 }}:0] e_row;
+    reg [{{ cw - 1 }}:0] e_col;
+    reg [{{ rows - 1 }}:0] m_row;
+    reg [{{ cw - 1 }}:0] m_col;
+    always @(posedge clk) begin
+        if (rst) begin
+            d_ro <= 1'b0;
+            d_row <= {{ rw }}'d0;
+            d_col <= {{ cw }}'d0;
+            e_ro <= 1'b0;
+            e_row <= {{ rw }}'d0;
+            e_col <= {{ cw }}'d0;
+            m_row <= {{ rows }}'d0;
+            m_col <= {{ cw }}'d0;
+        end else begin
+            d_ro <= b_ro;
+            d_row <= b_row;
+            d_col <= b_col;
+            e_ro <= d_ro;
+            e_row <= d_row;
+            e_col <= d_col;
+            if (e_ro) begin
+                m_col <= e_col;
+{%- for row in rows_t %}
+{%- if row.stuck %}
+                // DELIBERATELY BROKEN: row {{ row.row }} never leaves readout once selected.
+                m_row[{{ row.row }}] <= m_row[{{ row.row }}] || (e_row == {{ rw }}'d{{ row.row }});
+{%- else %}
+                m_row[{{ row.row }}] <= (e_row == {{ rw }}'d{{ row.row }});
+{%- endif %}
+{%- endfor %}
+            end
+        end
+    end
+    // Column buses: the OR of the selected row's pixels.
+    wire [{{ cols - 1 }}:0] bus_valid;
+    wire [{{ cols * ib - 1 }}:0] bus_index;
+    wire [{{ cols * w - 1 }}:0] bus_data;
+{%- for col in columns %}
+    assign bus_valid[{{ col.col }}] = {{ col.valid }};
+    assign bus_index[{{ col.col * ib }} +: {{ ib }}] = {{ col.index }};
+    assign bus_data[{{ col.col * w }} +: {{ w }}] = {{ col.data }};
+{%- endfor %}
+    reg m_valid;
+    reg [{{ ib - 1 }}:0] m_index;
+    reg [{{ w - 1 }}:0] m_data;
+    always @* begin
+        case (m_col)
+{%- for col in columns %}
+            {{ cw }}'d{{ col.col }}: begin
+                m_valid = bus_valid[{{ col.col }}];
+                m_index = bus_index[{{ col.col * ib }} +: {{ ib }}];
+                m_data = bus_data[{{ col.col * w }} +: {{ w }}];
+            end
+{%- endfor %}
+            default: begin
+                m_valid = 1'b0;
+                m_index = {{ ib }}'d0;
+                m_data = {{ w }}'d0;
+            end
+        endcase
+    end
+
+    // ---- the readout buffer and the port ----
+{%- for j in words %}
+    reg [{{ w - 1 }}:0] rbuf_{{ j }};
+{%- endfor %}
+    reg dr_act;
+    reg [{{ ib - 1 }}:0] dj;
+{%- if k > 1 %}
+    reg [{{ kw - 1 }}:0] dm;
+{%- endif %}
+{%- if g > 1 %}
+    reg [{{ gw - 1 }}:0] dg;
+    wire beat = dr_act && (dg == {{ gw }}'d0);
+    wire step = dr_act && (dg == {{ gw }}'d{{ g - 1 }});
+{%- else %}
+    wire beat = dr_act;
+    wire step = dr_act;
+{%- endif %}
+{%- if k > 1 %}
+    wire last = (dj == {{ ib }}'d{{ r }}) && (dm == {{ kw }}'d{{ k - 1 }});
+{%- else %}
+    wire last = (dj == {{ ib }}'d{{ r }});
+{%- endif %}
+    reg [{{ w - 1 }}:0] dw;
+    always @* begin
+        case (dj)
+{%- for j in words %}
+            {{ ib }}'d{{ j }}: dw = rbuf_{{ j }};
+{%- endfor %}
+            default: dw = {{ w }}'d0;
+        endcase
+    end
+{%- if kb > w %}
+    // Registers sign-extended, the status word (index {{ r }}) zero-extended, to {{ kb }} bits.
+    wire dsx = dw[{{ w - 1 }}] && (dj != {{ ib }}'d{{ r }});
+    wire [{{ kb - 1 }}:0] dx = {{ dx_ext }};
+{%- else %}
+    wire [{{ kb - 1 }}:0] dx = dw;
+{%- endif %}
+    always @(posedge clk) begin
+{%- for j in words %}
+        if (m_valid && (m_index == {{ ib }}'d{{ j }})) begin
+            rbuf_{{ j }} <= m_data;
+        end
+{%- endfor %}
+    end
+    always @(posedge clk) begin
+        if (rst) begin
+            dr_act <= 1'b0;
+            dj <= {{ ib }}'d0;
+{%- if k > 1 %}
+            dm <= {{ kw }}'d0;
+{%- endif %}
+{%- if g > 1 %}
+            dg <= {{ gw }}'d0;
+{%- endif %}
+            ro_valid <= 1'b0;
+            ro_data <= {{ b }}'d0;
+        end else begin
+            ro_valid <= beat;
+            if (beat) begin
+{%- if k > 1 %}
+                case (dm)
+{%- for m in parts %}
+                    {{ kw }}'d{{ m }}: ro_data <= dx[{{ m * b }} +: {{ b }}];
+{%- endfor %}
+                    default: ro_data <= {{ b }}'d0;
+                endcase
+{%- else %}
+                ro_data <= dx;
+{%- endif %}
+            end
+            if (m_valid && (m_index == {{ ib }}'d0)) begin
+                // A pixel's word 0 is in the buffer: its drain starts at the next edge.
+                dr_act <= 1'b1;
+                dj <= {{ ib }}'d0;
+{%- if k > 1 %}
+                dm <= {{ kw }}'d0;
+{%- endif %}
+{%- if g > 1 %}
+                dg <= {{ gw }}'d0;
+{%- endif %}
+            end else if (dr_act) begin
+{%- if g > 1 %}
+                dg <= step ? {{ gw }}'d0 : dg + {{ gw }}'d1;
+{%- endif %}
+                if (step) begin
+                    if (last) begin
+                        dr_act <= 1'b0;
+{%- if k > 1 %}
+                    end else if (dm == {{ kw }}'d{{ k - 1 }}) begin
+                        dm <= {{ kw }}'d0;
+                        dj <= dj + {{ ib }}'d1;
+                    end else begin
+                        dm <= dm + {{ kw }}'d1;
+{%- else %}
+                    end else begin
+                        dj <= dj + {{ ib }}'d1;
+{%- endif %}
+                    end
+                end
+            end
+        end
+    end
+endmodule
