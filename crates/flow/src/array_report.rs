@@ -14,6 +14,7 @@ use crate::array_size::{
     ArrayTotal, DEFAULT_UTILISATION, PixelPitch, ReadoutFigures, RomLogic, RomMacroEstimate,
     TimestampComparison, rom_macro_estimates,
 };
+use crate::array_timing::{ArrayTiming, array_timing};
 use crate::error::FlowError;
 
 /// Entries of the probe ROM synthesised as logic (then scaled to the whole ROM).
@@ -52,8 +53,13 @@ pub struct ArraySizeReport {
     pub pitch_fits: bool,
     /// The probe ROM (Fourier; none in Haar mode).
     pub rom: Option<RomSize>,
-    /// Pixels + ROM macro (+ shared logic) per library.
+    /// Pixels + ROM macro + the array's own logic per library.
     pub totals: Vec<ArrayTotal>,
+    /// The broadcast and readout paths at the pixel clock, per library and corner (the
+    /// whole array up to 8 × 8, a row and a column slice beyond: [`crate::array_timing`]).
+    pub timing: Vec<ArrayTiming>,
+    /// Every broadcast and readout path meets the pixel clock with the 10 % margin.
+    pub timing_meets_margin: bool,
     /// The readout (contract: docs/pixel-contract.md, "Array").
     pub readout: ReadoutFigures,
     /// Reading every timestamp out instead.
@@ -74,6 +80,24 @@ pub fn library_node_nm(library: &str) -> Option<f64> {
     }
 }
 
+/// Checks what `tofprobe size` asks of an array before any synthesis: the utilisation
+/// (0 < u ≤ 1; `None`: [`DEFAULT_UTILISATION`]) and the array's readout (the chip resolves
+/// it: a frame rate the readout cannot reach is refused here, naming the bandwidth).
+pub fn check(design: &ResolvedDesign, utilisation: Option<f64>) -> Result<f64, FlowError> {
+    let u = utilisation.unwrap_or(DEFAULT_UTILISATION);
+    if !(u.is_finite() && u > 0.0 && u <= 1.0) {
+        return Err(FlowError::option(
+            "utilisation",
+            u,
+            "0 < utilisation ≤ 1 (0.7 is the usual placement density)",
+        ));
+    }
+    if design.array.is_some() {
+        Chip::array_of(design, &RtlOverrides::default(), RomPurpose::Rendered)?;
+    }
+    Ok(u)
+}
+
 /// The array section for `design` (None without `[array]`), on the libraries of `size`;
 /// `node_nm` the node the pitch is stated at; `cache` the synthesis cache.
 pub fn array_report(
@@ -86,14 +110,7 @@ pub fn array_report(
     let Some(array) = &design.array else {
         return Ok(None);
     };
-    let utilisation = utilisation.unwrap_or(DEFAULT_UTILISATION);
-    if !(utilisation.is_finite() && utilisation > 0.0 && utilisation <= 1.0) {
-        return Err(FlowError::option(
-            "utilisation",
-            utilisation,
-            "0 < utilisation ≤ 1 (0.7 is the usual placement density)",
-        ));
-    }
+    let utilisation = check(design, utilisation)?;
     let chip = Chip::array_of(design, &RtlOverrides::default(), RomPurpose::Rendered)?;
     let readout = chip
         .readout
@@ -141,6 +158,35 @@ pub fn array_report(
         None
     };
 
+    // The array's paths: the timing liberty, then every sky130 corner (mapped on tt).
+    let mut libs = vec![(size.area.liberty.clone(), None)];
+    if let Some(s) = &size.sky130
+        && s.has_timing
+    {
+        for c in size
+            .timing_corners
+            .iter()
+            .filter(|c| c.library.starts_with("sky130"))
+        {
+            libs.push((s.area.liberty.clone(), Some(c.liberty.clone())));
+        }
+    }
+    let timing = array_timing(design, &libs, cache)?;
+    let timing_meets_margin = timing
+        .iter()
+        .all(|t| t.broadcast.meets_margin && t.readout.meets_margin);
+    // The array's own logic per mapped library: the slices' sum stands for the whole
+    // array only when it was timed whole; else scaled (a row's logic × R, stated).
+    let shared = |lib: &str| -> Option<f64> {
+        let on: Vec<&ArrayTiming> = timing.iter().filter(|t| t.library == lib).collect();
+        match on.as_slice() {
+            [whole] => Some(whole.shared_logic_um2),
+            [row, column] => {
+                Some(row.shared_logic_um2 * chip.rows as f64 + column.shared_logic_um2)
+            }
+            _ => None,
+        }
+    };
     let totals = areas
         .iter()
         .map(|(lib, a)| {
@@ -154,7 +200,7 @@ pub fn array_report(
                         .map(|e| e.area_um2)
                 })
                 .unwrap_or(0.0);
-            ArrayTotal::of(lib, pixels, *a, rom_um2, None)
+            ArrayTotal::of(lib, pixels, *a, rom_um2, shared(lib))
         })
         .collect();
 
@@ -172,6 +218,16 @@ pub fn array_report(
          a mask ROM), scaled by node²; the ROM as logic: a 1024-entry prefix of the real ROM \
          synthesised and scaled by L/1024"
             .into(),
+        format!(
+            "broadcast and readout timing: OpenSTA on the array's top (pixels and ROM as black \
+             boxes, mapped by the delay-driven ABC script) linked with the gate-level pixel, at \
+             the pixel clock, ideal clock, no wire load; arrays above {} pixels are timed as a \
+             row (1 × C: a row stage's fan-out to C pixels, the column select over C) and a \
+             column (R × 1: the root's fan-out to R row stages, a column bus over R rows); the \
+             array's own logic is then the row's × R plus the column's (an upper bound: the \
+             root is counted R times)",
+            crate::array_timing::WHOLE_TIMING_MAX_PIXELS
+        ),
         "timestamps: one T-bit timestamp per laser pulse per pixel (every pulse detected: the \
          paper's 17.5 MB per pixel per second at 10 MHz and 14 bits)"
             .into(),
@@ -185,6 +241,8 @@ pub fn array_report(
         pitch_fits,
         rom,
         totals,
+        timing,
+        timing_meets_margin,
         readout: figures,
         timestamps,
         assumptions,
@@ -229,7 +287,7 @@ pub fn rom_logic(chip: &Chip, liberty: &Path, cache: &Path) -> Result<RomLogic, 
         delay_target_ps: None,
         keep: vec![],
     };
-    let s = synthesise(&spec, cache)?;
+    let s = synthesise(&spec, &cache.join("synth"))?;
     let lib = tofprobe_eda::liberty::Liberty::load(liberty)?;
     Ok(RomLogic {
         library: lib.name,
@@ -309,6 +367,45 @@ pub fn markdown(a: &ArraySizeReport) -> String {
             t.pixel_share * 100.0
         );
     }
+    if !a.timing.is_empty() {
+        m += &format!(
+            "\n### Broadcast and readout timing (pixel clock {:.1} MHz, margin 10 %)\n\n\
+             | netlist | library | array logic (µm²) | broadcast delay (ns) | slack | readout delay (ns) | slack |\n|---|---|---|---|---|---|---|\n",
+            a.timing[0].clock_mhz
+        );
+        for t in &a.timing {
+            m += &format!(
+                "| {} | {} | {:.0} | {:.3} | {:.3} ns ({:.1} %){} | {:.3} | {:.3} ns ({:.1} %){} |\n",
+                t.netlist,
+                t.library,
+                t.shared_logic_um2,
+                t.broadcast.delay_ns,
+                t.broadcast.slack_ns,
+                t.broadcast.slack_percent,
+                if t.broadcast.meets_margin {
+                    ""
+                } else {
+                    " **short**"
+                },
+                t.readout.delay_ns,
+                t.readout.slack_ns,
+                t.readout.slack_percent,
+                if t.readout.meets_margin {
+                    ""
+                } else {
+                    " **short**"
+                },
+            );
+        }
+        m += &format!(
+            "\nBroadcast and readout {} the pixel clock with ≥ 10 % slack on every library and corner timed.\n",
+            if a.timing_meets_margin {
+                "meet"
+            } else {
+                "do NOT all meet"
+            }
+        );
+    }
     let r = &a.readout;
     m += &format!(
         "\n### Readout\n\n\
@@ -348,7 +445,11 @@ pub fn markdown(a: &ArraySizeReport) -> String {
         t.laser_rate_hz / 1e6,
         t.bytes_per_pixel_per_s / 1e6,
         t.array_bits_per_s / 1e9,
-        if t.exceeds_paper_line { "above" } else { "below" },
+        if t.exceeds_paper_line {
+            "above"
+        } else {
+            "below"
+        },
         t.readout_bits_per_s / 1e6,
         t.reduction
     );

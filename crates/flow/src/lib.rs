@@ -8,6 +8,7 @@
 pub mod adders;
 pub mod array_report;
 pub mod array_size;
+pub mod array_timing;
 pub mod error;
 pub mod flow;
 pub mod flowset;

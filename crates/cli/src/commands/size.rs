@@ -94,6 +94,8 @@ pub struct FullReport {
 /// Builds the report for the arguments (no printing).
 pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
     let design = crate::commands::load_for_hardware(a.config.as_deref())?;
+    // Before minutes of synthesis: the array's options and readout.
+    tofprobe_flow::array_report::check(&design, a.utilisation)?;
     let options = size_options(a);
     let req = if a.options {
         let req = options_request(
