@@ -50,10 +50,20 @@ pub struct PathTiming {
     pub startpoint: String,
     /// End of the worst path.
     pub endpoint: String,
+    /// The pixel's own part: its worst path from those inputs (broadcast, the inputs at the
+    /// clock edge) or to those outputs (readout), the pixel timed alone (ns).
+    pub pixel_part_ns: f64,
+    /// The array's part: `delay_ns` − `pixel_part_ns` (the stage's clock-to-output, the
+    /// fan-out and its buffers; or the buses, selects and the capture's setup).
+    pub array_part_ns: f64,
 }
 
 impl PathTiming {
-    fn of(t: &tofprobe_eda::sta::Timing, clock_mhz: f64) -> Self {
+    fn of(
+        t: &tofprobe_eda::sta::Timing,
+        pixel: &tofprobe_eda::sta::Timing,
+        clock_mhz: f64,
+    ) -> Self {
         let period = 1e3 / clock_mhz;
         let slack = period - t.critical_path_ns;
         let pct = (slack / period * 1000.0).round() / 10.0;
@@ -64,8 +74,49 @@ impl PathTiming {
             meets_margin: pct >= MARGIN_PERCENT,
             startpoint: t.startpoint.clone(),
             endpoint: t.endpoint.clone(),
+            pixel_part_ns: pixel.critical_path_ns,
+            array_part_ns: t.critical_path_ns - pixel.critical_path_ns,
         }
     }
+}
+
+/// OpenSTA on `script` (written to `tcl`), its output split at the `== NAME` markers the
+/// script prints, each part parsed as a `report_checks` text.
+fn run_sta(
+    tcl: &Path,
+    script: &str,
+    parts: &[&str],
+) -> Result<Vec<tofprobe_eda::sta::Timing>, FlowError> {
+    tofprobe_io::write_atomic(tcl, script.as_bytes())
+        .map_err(|e| FlowError::output(tcl.to_path_buf(), e.to_string()))?;
+    let sta = tofprobe_eda::tools::Tool::Sta.locate()?;
+    let out = std::process::Command::new(&sta)
+        .arg("-no_init")
+        .arg("-exit")
+        .arg(tcl)
+        .output()
+        .map_err(|e| FlowError::output(sta.clone(), e.to_string()))?;
+    let log = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut found = Vec::new();
+    for (i, name) in parts.iter().enumerate() {
+        let marker = format!("== {name}");
+        let start = log.find(&marker).ok_or_else(|| {
+            FlowError::output(
+                tcl.to_path_buf(),
+                format!("OpenSTA stopped before `{marker}`: {log}"),
+            )
+        })? + marker.len();
+        let end = parts
+            .get(i + 1)
+            .and_then(|n| log[start..].find(&format!("== {n}")))
+            .map_or(log.len(), |e| start + e);
+        found.push(parse_report(&log[start..end])?);
+    }
+    Ok(found)
 }
 
 /// The array's paths timed on one liberty.
@@ -231,35 +282,38 @@ fn time_on(
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let tcl = dir.join(format!("sta-{stem}.tcl"));
-    tofprobe_io::write_atomic(&tcl, script.as_bytes())
-        .map_err(|e| FlowError::output(tcl.clone(), e.to_string()))?;
-    let sta = tofprobe_eda::tools::Tool::Sta.locate()?;
-    let out = std::process::Command::new(&sta)
-        .arg("-no_init")
-        .arg("-exit")
-        .arg(&tcl)
-        .output()
-        .map_err(|e| FlowError::output(sta.clone(), e.to_string()))?;
-    let log = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
+    let linked = run_sta(
+        &dir.join(format!("sta-{stem}.tcl")),
+        &script,
+        &["broadcast", "readout"],
+    )?;
+    // The pixel alone: its worst paths from the broadcast inputs and to the readout outputs.
+    let alone = format!(
+        "read_liberty {lib}\nread_verilog {pixel}\nlink_design {pixel_name}\n\
+         create_clock -name clk -period {PROBE_PERIOD_NS} [get_ports clk]\n\
+         set_input_delay 0 -clock clk [delete_from_list [all_inputs] [get_ports clk]]\n\
+         set_output_delay 0 -clock clk [all_outputs]\n\
+         puts \"== from\"\n\
+         report_checks -path_delay max -digits 4 -from [get_ports {{pulse rom_word* readout}}]\n\
+         puts \"== to\"\n\
+         report_checks -path_delay max -digits 4 -to [get_ports {{rd_valid rd_index* rd_data*}}]\n\
+         exit\n",
+        lib = time_lib.display(),
+        pixel = pixel.synthesis.netlist_verilog.display(),
     );
-    let (b, rd) = log
-        .split_once("== readout")
-        .ok_or_else(|| FlowError::output(tcl.clone(), format!("OpenSTA failed: {log}")))?;
-    let b = b.split_once("== broadcast").map_or(b, |x| x.1);
-    let broadcast = parse_report(b)?;
-    let readout = parse_report(rd)?;
+    let own = run_sta(
+        &dir.join(format!("sta-pixel-{stem}.tcl")),
+        &alone,
+        &["from", "to"],
+    )?;
     let time_name = Liberty::load(time_lib)?.name;
     Ok(ArrayTiming {
         netlist: name.into(),
         library: time_name,
         clock_mhz,
         shared_logic_um2: top_syn.total_area_um2,
-        broadcast: PathTiming::of(&broadcast, clock_mhz),
-        readout: PathTiming::of(&readout, clock_mhz),
+        broadcast: PathTiming::of(&linked[0], &own[0], clock_mhz),
+        readout: PathTiming::of(&linked[1], &own[1], clock_mhz),
     })
 }
 
