@@ -137,9 +137,10 @@ pub struct ArrayTiming {
     pub readout: PathTiming,
 }
 
-/// The netlists to time for a `rows` × `cols` array: the whole, or a row and a column.
-pub fn slices(rows: usize, cols: usize) -> Vec<(String, usize, usize)> {
-    if rows * cols <= WHOLE_TIMING_MAX_PIXELS {
+/// The netlists to time for a `rows` × `cols` array: the whole (up to `whole_max` pixels),
+/// or a row and a column.
+pub fn slices(rows: usize, cols: usize, whole_max: usize) -> Vec<(String, usize, usize)> {
+    if rows * cols <= whole_max {
         vec![(format!("whole {rows} × {cols}"), rows, cols)]
     } else {
         vec![
@@ -157,10 +158,21 @@ pub fn array_timing(
     liberties: &[(PathBuf, Option<PathBuf>)],
     cache: &Path,
 ) -> Result<Vec<ArrayTiming>, FlowError> {
+    array_timing_with(design, liberties, cache, WHOLE_TIMING_MAX_PIXELS)
+}
+
+/// [`array_timing`] timing arrays of up to `whole_max` pixels whole (0: always slices; the
+/// slice model is tested against the whole with it).
+pub fn array_timing_with(
+    design: &ResolvedDesign,
+    liberties: &[(PathBuf, Option<PathBuf>)],
+    cache: &Path,
+    whole_max: usize,
+) -> Result<Vec<ArrayTiming>, FlowError> {
     let chip = Chip::array_of(design, &RtlOverrides::default(), RomPurpose::Rendered)?;
     let mut out = Vec::new();
     for (map_lib, time_lib) in liberties {
-        for (name, rows, cols) in slices(chip.rows, chip.cols) {
+        for (name, rows, cols) in slices(chip.rows, chip.cols, whole_max) {
             out.push(time_on(
                 design,
                 &chip,
@@ -323,8 +335,9 @@ mod tests {
 
     #[test]
     fn small_arrays_are_timed_whole_and_large_ones_by_a_row_and_a_column() {
-        assert_eq!(slices(8, 8).len(), 1);
-        let s = slices(64, 64);
+        assert_eq!(slices(8, 8, WHOLE_TIMING_MAX_PIXELS).len(), 1);
+        assert_eq!(slices(8, 8, 0).len(), 2);
+        let s = slices(64, 64, WHOLE_TIMING_MAX_PIXELS);
         assert_eq!((s[0].1, s[0].2), (1, 64));
         assert_eq!((s[1].1, s[1].2), (64, 1));
     }
