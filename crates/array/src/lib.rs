@@ -16,6 +16,7 @@ pub mod model;
 pub mod output;
 pub mod plot;
 pub mod rtl;
+pub mod rtl_vectors;
 pub mod shard;
 pub mod uff;
 

@@ -2,6 +2,7 @@
 //! driver (cached builds, the C++ harness of `testbench/`), an Icarus driver for the plain
 //! self-checking testbench, the first-mismatch report and its JUnit XML for CI.
 
+pub mod array;
 pub mod check;
 pub mod coverage;
 pub mod driver;

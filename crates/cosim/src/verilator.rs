@@ -69,7 +69,7 @@ fn verilog_sources(rtl_dir: &Path) -> Result<Vec<PathBuf>, CosimError> {
 /// A per-process counter: two threads of one process (parallel tests) building the same
 /// RTL must not share a temporary directory (the first to finish publishes, the other's
 /// copy is dropped).
-fn next_build_id() -> u64 {
+pub(crate) fn next_build_id() -> u64 {
     static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
@@ -236,7 +236,7 @@ pub fn build_with(
 /// whole, else built by `build` into a temporary directory (which must leave the executable
 /// at `harness` in it) and published by renaming that directory into place. The key's lock
 /// is held throughout. Returns the executable and whether it was reused.
-fn cached_entry(
+pub(crate) fn cached_entry(
     root: &Path,
     hash: &str,
     build: impl FnOnce(&Path) -> Result<(), CosimError>,

@@ -29,6 +29,9 @@ pub enum FlowError {
     /// RTL generation or vector writing failed.
     #[error("{0}")]
     Rtl(#[from] tofprobe_rtlgen::RtlError),
+    /// The array model refused (a shape, a pixel's stream).
+    #[error(transparent)]
+    Array(Box<tofprobe_array::ArrayError>),
     /// Co-simulation failed to run (a tool missing: the message names the install script).
     #[error("{0}")]
     Cosim(#[from] tofprobe_cosim::CosimError),
@@ -51,6 +54,12 @@ impl FlowError {
 impl From<tofprobe_design::DesignError> for FlowError {
     fn from(e: tofprobe_design::DesignError) -> Self {
         FlowError::Design(Box::new(e))
+    }
+}
+
+impl From<tofprobe_array::ArrayError> for FlowError {
+    fn from(e: tofprobe_array::ArrayError) -> Self {
+        FlowError::Array(Box::new(e))
     }
 }
 

@@ -339,10 +339,10 @@ fn run_flow_in(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome, 
 
 /// First line of every flow report: a `report.md` that does not start with it was written by
 /// someone else and is never replaced.
-const REPORT_TITLE: &str = "# tofprobe flow report";
+pub(crate) const REPORT_TITLE: &str = "# tofprobe flow report";
 
 /// Refuses to replace a `report.md` that the flow did not write.
-fn refuse_foreign_report(path: &std::path::Path) -> Result<(), FlowError> {
+pub(crate) fn refuse_foreign_report(path: &std::path::Path) -> Result<(), FlowError> {
     match std::fs::read(path) {
         Ok(bytes) if !bytes.starts_with(REPORT_TITLE.as_bytes()) => {
             Err(tofprobe_rtlgen::RtlError::Foreign {

@@ -63,6 +63,13 @@ pub fn seal(out: &Path) -> Result<(), FlowError> {
     }
     for (sub, marker) in [("rtl", SET_MARKER), ("vectors", "manifest.toml")] {
         let dir = out.join(sub);
+        // An array's vectors are a plain set (`tofprobe_array::rtl_vectors`): its marker is
+        // the generic one.
+        let marker = if sub == "vectors" && !dir.join(marker).exists() {
+            SET_MARKER
+        } else {
+            marker
+        };
         let listed = tofprobe_io::check_set(&dir, marker).map_err(|e| out_err(&dir, e))?;
         for name in listed
             .into_iter()

@@ -6,6 +6,7 @@
 //! `tofprobe-experiments`; the EDA tools are driven by `tofprobe-eda` and `tofprobe-cosim`.
 
 pub mod adders;
+pub mod array;
 pub mod array_report;
 pub mod array_size;
 pub mod array_timing;

@@ -253,12 +253,8 @@ pub fn render_array(
         .collect();
     let columns = (0..a.cols)
         .map(|c| {
-            let terms = |f: &dyn Fn(usize) -> String| {
-                (0..a.rows)
-                    .map(|row| f(row))
-                    .collect::<Vec<_>>()
-                    .join(" | ")
-            };
+            let terms =
+                |f: &dyn Fn(usize) -> String| (0..a.rows).map(f).collect::<Vec<_>>().join(" | ");
             ColT {
                 col: c,
                 valid: terms(&|row| format!("(m_row[{row}] & p_valid[{}])", row * a.cols + c)),

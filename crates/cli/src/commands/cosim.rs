@@ -230,7 +230,14 @@ pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
         // A set killed mid-commit is refused; edited files are named (and co-simulated).
         super::check_set::check_reader(dir)?;
     }
-    let (design, _) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
+    if a.frames == 0 || a.frames > 1000 {
+        return Err(CliError::option("frames", a.frames, "1..=1000"));
+    }
+    let design = super::load_for_hardware(a.config.as_deref())?;
+    if design.array.is_some() {
+        return super::array_rtl::cosim(a, &design);
+    }
+    let (design, _) = super::simulated_design_of(design, &overrides)?;
     // With --rtl, the chip `tofprobe rtl` renders for this configuration (the image in DIR
     // must be its ROM); else the chip the simulating commands replay.
     let purpose = if a.rtl.is_some() {

@@ -62,7 +62,13 @@ pub fn run(a: &FlowArgs) -> Result<super::Verdict, CliError> {
         return Err(CliError::option("frames", a.frames.to_string(), "1..=100"));
     }
     let mut design = crate::commands::load_for_hardware(a.config.as_deref())?;
-    design.single_pixel("flow")?;
+    if design.array.is_some() && a.recommended {
+        return Err(CliError::option(
+            "recommended",
+            "given",
+            "a single-pixel configuration",
+        ));
+    }
     let options = if a.recommended {
         let (chosen, report) =
             tofprobe_flow::flow::recommended(&design, a.only.clone(), a.target_error_um)?;
@@ -79,7 +85,12 @@ pub fn run(a: &FlowArgs) -> Result<super::Verdict, CliError> {
     } else {
         None
     };
-    let o = run_flow(
+    let run = if design.array.is_some() {
+        tofprobe_flow::array::run_array_flow
+    } else {
+        run_flow
+    };
+    let o = run(
         &design,
         &FlowOptions {
             out: a.out.clone(),

@@ -1,6 +1,7 @@
 //! The subcommands: one file each. To add one, add a variant to [`Command`] and a line to
 //! [`run`].
 
+pub mod array_rtl;
 pub mod bench;
 pub mod check_set;
 pub mod config;
@@ -90,6 +91,14 @@ pub fn simulated_design(
         return Err(CliError::option("frames", frames, "1..=1000"));
     }
     let design = crate::commands::load_for_hardware(config)?;
+    simulated_design_of(design, overrides)
+}
+
+/// [`simulated_design`] of a design already loaded (refused for an `[array]`).
+pub fn simulated_design_of(
+    design: tofprobe_design::ResolvedDesign,
+    overrides: &tofprobe_design::RtlOverrides,
+) -> Result<(tofprobe_design::ResolvedDesign, tofprobe_pixel::PixelParams), CliError> {
     design.single_pixel("vectors and cosim")?;
     let p = tofprobe_design::rtl_params(&design, overrides)?;
     Ok((design, p))

@@ -71,7 +71,9 @@ pub fn regen_command(a: &RtlArgs) -> String {
 /// Runs `tofprobe rtl`.
 pub fn run(a: &RtlArgs) -> Result<(), CliError> {
     let design = crate::commands::load_for_hardware(a.config.as_deref())?;
-    design.single_pixel("rtl")?;
+    if design.array.is_some() {
+        return super::array_rtl::rtl(a, &design);
+    }
     let overrides = RtlOverrides {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,

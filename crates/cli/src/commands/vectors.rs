@@ -40,12 +40,61 @@ pub struct VectorsArgs {
 }
 
 /// Runs `tofprobe vectors`.
+/// The command line that regenerates an array's vectors (recorded in their headers), paths
+/// as typed from the working directory.
+fn regen_command(a: &VectorsArgs) -> String {
+    use tofprobe_io::text::path_as_typed;
+    let mut s = String::from("tofprobe vectors");
+    if let Some(c) = &a.config {
+        s.push_str(&format!(" {}", path_as_typed(c)));
+    }
+    s.push_str(&format!(
+        " --out {} --frames {}",
+        path_as_typed(&a.out),
+        a.frames
+    ));
+    if let Some(n) = a.frame_pulses {
+        s.push_str(&format!(" --frame-pulses {n}"));
+    }
+    if let Some(l) = a.rom_depth {
+        s.push_str(&format!(" --rom-depth {l}"));
+    }
+    s
+}
+
 pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
     let overrides = RtlOverrides {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
     };
-    let (design, _) = super::simulated_design(a.frames, a.config.as_deref(), &overrides)?;
+    let design = super::load_for_hardware(a.config.as_deref())?;
+    if design.array.is_some() {
+        // An array's vectors: every pixel's own scene stream (not --seed's random one).
+        let v = tofprobe_flow::array::write_array_vectors(
+            &design,
+            &overrides,
+            a.frames,
+            None,
+            &a.out,
+            &regen_command(a),
+        )?;
+        println!(
+            "vectors: {} x {} array, {} frames, N = {}, {} cycles, {} beats per frame -> {}; {}",
+            v.readout.rows,
+            v.readout.cols,
+            a.frames,
+            v.readout.frame_pulses,
+            v.run.cycles(),
+            v.readout.beats_per_frame(),
+            a.out.display(),
+            v.chip.rom.note
+        );
+        return Ok(());
+    }
+    if a.frames == 0 || a.frames > 1000 {
+        return Err(CliError::option("frames", a.frames, "1..=1000"));
+    }
+    let (design, _) = super::simulated_design_of(design, &overrides)?;
     let chip = Chip::of(&design, &overrides, RomPurpose::Replayed)?;
     let (p, rom, note) = (chip.pixel, chip.rom.words, chip.rom.note);
     let stim = random_stimulus(&p, a.frames * p.frame_pulses, a.seed);

@@ -1,0 +1,133 @@
+//! The array's golden vectors (docs/pixel-contract.md "Array"): the per-pixel detections
+//! from the array scene, the ports the array model shows every cycle, the readout stream
+//! and per-pixel digests, as the files `testbench/array_harness.cpp` (Verilator) and
+//! `testbench/array_tb.v` (Icarus) replay:
+//!
+//! - `array_params.vh`: `AR_TOP`, `AR_NP` (pixels), `AR_T`, `AR_B`, `AR_CYCLES`, `AR_PULSES`;
+//! - `array_stim.hex`: one line per pulse the pixels sample, the P·(T+1)-bit value
+//!   {tdc[P·T−1:0], valid[P−1:0]} (pixel i = r·cols + c);
+//! - `array_expect.hex`: one line per cycle, `pulse_o ready ro_valid ro_data`;
+//! - `readout.txt`: per frame and pixel (readout order) its R + 1 words;
+//! - `digests.txt`: per frame and pixel, FNV-1a 64 of its words (little-endian u64s).
+
+use tofprobe_design::ResolvedDesign;
+use tofprobe_pixel::PixelParams;
+
+use crate::error::ArrayError;
+use crate::rtl::ArrayRun;
+
+/// The file names of a vector set, the params include first.
+pub const FILES: [&str; 5] = [
+    "array_params.vh",
+    "array_stim.hex",
+    "array_expect.hex",
+    "readout.txt",
+    "digests.txt",
+];
+
+/// Every pixel's detections for `frames` frames of the design's scene (row-major; pixel
+/// (r, c)'s own stream, `ResolvedDesign::pixel_source`), `frame_pulses` per frame.
+pub fn scene_detections(
+    design: &ResolvedDesign,
+    frame_pulses: u64,
+    frames: u64,
+) -> Result<Vec<Vec<Option<u32>>>, ArrayError> {
+    let a = design
+        .array
+        .as_ref()
+        .ok_or_else(|| ArrayError::Shape("the design has no [array]".into()))?;
+    let n = (frame_pulses * frames) as usize;
+    let mut out = Vec::with_capacity(a.pixels());
+    for r in 0..a.rows {
+        for c in 0..a.cols {
+            let mut v = vec![None; n];
+            design.pixel_source(r, c)?.fill(0, &mut v);
+            out.push(v);
+        }
+    }
+    Ok(out)
+}
+
+fn hex_of_bits(bits: &[bool]) -> String {
+    let digits = bits.len().div_ceil(4).max(1);
+    (0..digits)
+        .rev()
+        .map(|d| {
+            let nib = (0..4).fold(0u32, |a, b| {
+                a | (u32::from(*bits.get(d * 4 + b).unwrap_or(&false)) << b)
+            });
+            char::from_digit(nib, 16).unwrap_or('0')
+        })
+        .collect()
+}
+
+/// FNV-1a 64 of a pixel's words (each as 8 little-endian bytes).
+pub fn digest(words: &[u64]) -> u64 {
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    tofprobe_io::fnv1a64(&bytes)
+}
+
+/// The vector files of `run` (driven by `detections`, pixel `p`), each starting with
+/// `header` (a `//` line naming the generator); `top` is the array module.
+pub fn vector_files(
+    run: &ArrayRun,
+    detections: &[Vec<Option<u32>>],
+    p: &PixelParams,
+    top: &str,
+    header: &str,
+) -> Vec<(String, String)> {
+    let ro = &run.readout;
+    let np = ro.pixels();
+    let t = p.tdc_bits as usize;
+    let mut params = format!("{header}\n");
+    for (k, v) in [
+        ("AR_NP", np.to_string()),
+        ("AR_T", t.to_string()),
+        ("AR_B", ro.bits.to_string()),
+        ("AR_CYCLES", run.cycles().to_string()),
+        ("AR_PULSES", run.pulse_cycles.len().max(1).to_string()),
+        ("AR_TOP", top.to_string()),
+    ] {
+        params.push_str(&format!("`define {k} {v}\n"));
+    }
+    let mut stim = format!("{header}\n");
+    for n in 0..run.pulse_cycles.len().max(1) {
+        let mut bits = vec![false; np * (t + 1)];
+        for (i, d) in detections.iter().enumerate() {
+            if let Some(Some(code)) = d.get(n) {
+                bits[i] = true;
+                for b in 0..t {
+                    bits[np + i * t + b] = (code >> b) & 1 == 1;
+                }
+            }
+        }
+        stim.push_str(&hex_of_bits(&bits));
+        stim.push('\n');
+    }
+    let mut expect = format!("{header}\n");
+    for pin in &run.pins {
+        expect.push_str(&format!(
+            "{} {} {} {:x}\n",
+            u8::from(pin.pulse_o),
+            u8::from(pin.ready),
+            u8::from(pin.ro_valid),
+            pin.ro_data
+        ));
+    }
+    let mut readout =
+        format!("{header}\n# frame row col: words 0..R-1 then the status word (hex, W bits)\n");
+    let mut digests = format!("{header}\n# frame row col fnv1a64(words)\n");
+    for (f, frame) in run.words.iter().enumerate() {
+        for (q, words) in frame.iter().enumerate() {
+            let (r, c) = ro.order(q);
+            let list: Vec<String> = words.iter().map(|w| format!("{w:x}")).collect();
+            readout.push_str(&format!("{f} {r} {c}: {}\n", list.join(" ")));
+            digests.push_str(&format!("{f} {r} {c} {:016x}\n", digest(words)));
+        }
+    }
+    FILES
+        .iter()
+        .map(|s| s.to_string())
+        .zip([params, stim, expect, readout, digests])
+        .collect()
+}

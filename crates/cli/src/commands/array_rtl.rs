@@ -1,0 +1,111 @@
+//! The RTL commands on an `[array]` design (docs/pixel-contract.md "Array"): `tofprobe rtl`
+//! renders the array (`tofprobe_flow::array::render_array_design`), `tofprobe cosim`
+//! co-simulates it at its ports (`tofprobe_flow::array::cosim_array`); `tofprobe flow`
+//! calls `tofprobe_flow::array::run_array_flow` from its own file. Printing only.
+
+use tofprobe_design::{ResolvedDesign, RtlOverrides};
+use tofprobe_flow::array::{ArrayCosimOptions, ArraySimulator, cosim_array, render_array_design};
+
+use crate::commands::cosim::{CosimArgs, SimulatorArg};
+use crate::commands::rtl::{RtlArgs, regen_command};
+use crate::error::CliError;
+
+/// `tofprobe rtl` on an array design.
+pub fn rtl(a: &RtlArgs, design: &ResolvedDesign) -> Result<(), CliError> {
+    if a.core_vectors.is_some() {
+        return Err(CliError::option(
+            "core-vectors",
+            "given",
+            "the pixel's top only (an array is co-simulated by `tofprobe cosim`)",
+        ));
+    }
+    let o = RtlOverrides {
+        frame_pulses: a.frame_pulses,
+        rom_depth: a.rom_depth,
+    };
+    let (chip, files) = render_array_design(design, &o, &a.out, regen_command(a))?;
+    let p = &chip.pixel;
+    let ro = chip.readout.as_ref();
+    println!(
+        "rtl: {} x {} array of {:?} pixels ({} registers x {} bits), N = {}, L = {}; readout {} bits x {} beat(s) per word, slot {} cycles, {} cycles per readout -> {} ({}); {}",
+        chip.rows,
+        chip.cols,
+        p.mode,
+        p.registers(),
+        p.width,
+        p.frame_pulses,
+        p.rom_depth,
+        ro.map(|r| r.bits).unwrap_or(0),
+        ro.map(|r| r.beats_per_word).unwrap_or(0),
+        ro.map(|r| r.slot_cycles()).unwrap_or(0),
+        ro.map(|r| r.readout_cycles()).unwrap_or(0),
+        a.out.display(),
+        files.join(", "),
+        chip.rom.note
+    );
+    Ok(())
+}
+
+/// `tofprobe cosim` on an array design.
+pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<super::Verdict, CliError> {
+    if a.rtl.is_some() || a.directed || a.coverage || a.trace || a.bare {
+        return Err(CliError::option(
+            "rtl/directed/coverage/trace/bare",
+            "given",
+            "the pixel's co-simulation (an array runs its reference sequencer on fresh RTL)",
+        ));
+    }
+    let mut o = ArrayCosimOptions::new(&a.out);
+    o.frame_pulses = a.frame_pulses;
+    o.rom_depth = a.rom_depth;
+    o.frames = a.frames;
+    o.simulator = match a.simulator {
+        SimulatorArg::Verilator => ArraySimulator::Verilator,
+        SimulatorArg::Icarus => ArraySimulator::Icarus,
+    };
+    o.command = "tofprobe cosim".into();
+    let r = cosim_array(design, &o)?;
+    let ro = &r.readout;
+    if a.json {
+        let j = serde_json::json!({
+            "pass": r.pass,
+            "rows": ro.rows,
+            "cols": ro.cols,
+            "frames": a.frames,
+            "frame_pulses": ro.frame_pulses,
+            "cycles": r.cycles,
+            "mismatches": r.mismatches,
+            "first_mismatch": r.first,
+            "readout_cycles": ro.readout_cycles(),
+            "beats_per_frame": ro.beats_per_frame(),
+            "build_seconds": r.build_seconds,
+            "build_reused": r.reused,
+            "simulator_seconds": r.sim_seconds,
+            "model_seconds": r.model_seconds,
+        });
+        println!("{j}");
+    } else {
+        println!(
+            "cosim {}: {} x {} array, N = {}, {} frame(s), {} cycles, {} mismatches; {} beats of {} bits per frame in {} readout cycles; build {:.1} s{}, simulator {:.2} s, model {:.2} s{}",
+            if r.pass { "PASS" } else { "FAIL" },
+            ro.rows,
+            ro.cols,
+            ro.frame_pulses,
+            a.frames,
+            r.cycles,
+            r.mismatches,
+            ro.beats_per_frame(),
+            ro.bits,
+            ro.readout_cycles(),
+            r.build_seconds,
+            if r.reused { " (cached)" } else { "" },
+            r.sim_seconds,
+            r.model_seconds,
+            r.first
+                .as_ref()
+                .map(|f| format!("; first mismatch: {f}"))
+                .unwrap_or_default()
+        );
+    }
+    Ok(super::Verdict::of(r.pass))
+}

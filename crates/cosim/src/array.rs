@@ -1,0 +1,170 @@
+//! Co-simulation of the array RTL (`templates/array.v`) at its ports: the Verilator
+//! harness `testbench/array_harness.cpp` (built once per RTL, cached by content hash like
+//! the pixel's: every run of one design shares the build, whatever vectors it replays) and
+//! the Icarus testbench `testbench/array_tb.v`, both replaying the array's golden vectors
+//! (`tofprobe_array::rtl_vectors`) and reporting mismatches in the harness protocol.
+
+use std::path::Path;
+use std::process::Command;
+use std::time::Instant;
+
+use tofprobe_io::fnv1a64;
+
+use crate::error::CosimError;
+use crate::harness::{RunOutcome, parse_output};
+use crate::tools::require;
+use crate::verilator::{BuildProfile, HarnessBuild, VERILATOR_FLAGS, cache_root, cached_entry};
+
+/// The array harness, embedded so the binary works outside the source tree.
+pub const ARRAY_HARNESS_CPP: &str = include_str!("../../../testbench/array_harness.cpp");
+
+/// The array testbench for Icarus.
+pub const ARRAY_TB_V: &str = include_str!("../../../testbench/array_tb.v");
+
+fn sources(rtl_dir: &Path) -> Result<Vec<std::path::PathBuf>, CosimError> {
+    let mut v: Vec<_> = std::fs::read_dir(rtl_dir)
+        .map_err(|e| CosimError::io(rtl_dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "v"))
+        .collect();
+    v.sort();
+    Ok(v)
+}
+
+/// Builds (or reuses) the Verilator harness of the array RTL in `rtl_dir` (top `top`).
+pub fn build(rtl_dir: &Path, top: &str, profile: BuildProfile) -> Result<HarnessBuild, CosimError> {
+    let verilator = require("verilator")?;
+    let t0 = Instant::now();
+    let srcs = sources(rtl_dir)?;
+    let version = Command::new(&verilator)
+        .arg("--version")
+        .output()
+        .map_err(|e| CosimError::io(&verilator, e))?;
+    let mut key = b"array ".to_vec();
+    key.extend_from_slice(&version.stdout);
+    key.extend_from_slice(ARRAY_HARNESS_CPP.as_bytes());
+    key.extend_from_slice(format!("{top} {profile:?} {VERILATOR_FLAGS:?}").as_bytes());
+    for s in &srcs {
+        key.extend_from_slice(
+            s.file_name()
+                .map(|n| n.as_encoded_bytes())
+                .unwrap_or_default(),
+        );
+        key.extend_from_slice(&std::fs::read(s).map_err(|e| CosimError::io(s, e))?);
+    }
+    let hash = format!("array-{:016x}", fnv1a64(&key));
+    let root = cache_root().join("verilator");
+    let (exe, reused) = cached_entry(&root, &hash, |tmp| {
+        let cpp = tmp.join("array_harness.cpp");
+        std::fs::write(&cpp, ARRAY_HARNESS_CPP).map_err(|e| CosimError::io(&cpp, e))?;
+        let obj = tmp.join("obj");
+        let mut cmd = Command::new(&verilator);
+        cmd.args(["--cc", "--exe", "--build", "-j", "2", "--prefix", "Vtop"])
+            .args(VERILATOR_FLAGS)
+            .args(["--top-module", top, "-Mdir"])
+            .arg(&obj)
+            .args(["-o", "harness", "-CFLAGS"])
+            .arg(format!(
+                "-DTOP_HEADER='\"Vtop.h\"' -DTOP_CLASS=Vtop {}",
+                match profile {
+                    BuildProfile::Check => "-O1",
+                    BuildProfile::Speed => "-O2",
+                }
+            ))
+            .arg("-MAKEFLAGS")
+            .arg(match profile {
+                BuildProfile::Check => "OPT_FAST=-O1 OPT_SLOW=-O0 OPT_GLOBAL=-O1",
+                BuildProfile::Speed => "OPT_FAST=-O2 OPT_SLOW=-O1 OPT_GLOBAL=-O2",
+            })
+            .args(&srcs)
+            .arg(&cpp);
+        let out = cmd.output().map_err(|e| CosimError::io(&verilator, e))?;
+        if !out.status.success() {
+            return Err(CosimError::ToolFailed {
+                tool: "verilator",
+                status: out.status.to_string(),
+                output: format!(
+                    "{}{}",
+                    String::from_utf8_lossy(&out.stdout),
+                    String::from_utf8_lossy(&out.stderr)
+                ),
+            });
+        }
+        let built = obj.join("harness");
+        std::fs::rename(&built, tmp.join("harness")).map_err(|e| CosimError::io(&built, e))?;
+        let _ = std::fs::remove_dir_all(&obj);
+        Ok(())
+    })?;
+    Ok(HarnessBuild {
+        exe,
+        reused,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Runs a built array harness on the vectors in `vec_dir`, from `rtl_dir` (where a deep
+/// probe ROM's hex file is read).
+pub fn run_verilator(exe: &Path, rtl_dir: &Path, vec_dir: &Path) -> Result<RunOutcome, CosimError> {
+    let vec_dir = std::path::absolute(vec_dir).map_err(|e| CosimError::io(vec_dir, e))?;
+    let out = Command::new(exe)
+        .current_dir(rtl_dir)
+        .arg(&vec_dir)
+        // Randomised initial values (recorded seed): a register the reset forgets shows.
+        .args(["+verilator+rand+reset+2", "+verilator+seed+1"])
+        .output()
+        .map_err(|e| CosimError::io(exe, e))?;
+    parse_output(
+        "verilator array harness",
+        &format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        ),
+    )
+}
+
+/// Compiles `testbench/array_tb.v` with the array RTL of `rtl_dir` and the vectors of
+/// `vec_dir` under Icarus (in `work`), runs it from `rtl_dir` and parses its output.
+pub fn run_icarus(rtl_dir: &Path, vec_dir: &Path, work: &Path) -> Result<RunOutcome, CosimError> {
+    let iverilog = require("iverilog")?;
+    let vvp = require("vvp")?;
+    std::fs::create_dir_all(work).map_err(|e| CosimError::io(work, e))?;
+    let vec_dir = std::path::absolute(vec_dir).map_err(|e| CosimError::io(vec_dir, e))?;
+    let tb = work.join("array_tb.v");
+    std::fs::write(&tb, ARRAY_TB_V).map_err(|e| CosimError::io(&tb, e))?;
+    let exe =
+        std::path::absolute(work.join("array_tb.vvp")).map_err(|e| CosimError::io(work, e))?;
+    let t0 = Instant::now();
+    let out = Command::new(&iverilog)
+        .args(["-g2005", "-o"])
+        .arg(&exe)
+        .arg(format!("-I{}", vec_dir.display()))
+        .arg(format!("-DAR_VECTORS=\"{}/\"", vec_dir.display()))
+        .arg(&tb)
+        .args(sources(rtl_dir)?)
+        .output()
+        .map_err(|e| CosimError::io(&iverilog, e))?;
+    if !out.status.success() {
+        return Err(CosimError::ToolFailed {
+            tool: "iverilog",
+            status: out.status.to_string(),
+            output: String::from_utf8_lossy(&out.stderr).into_owned(),
+        });
+    }
+    let run = Command::new(&vvp)
+        .current_dir(rtl_dir)
+        .arg("-n")
+        .arg(&exe)
+        .output()
+        .map_err(|e| CosimError::io(&vvp, e))?;
+    let mut o = parse_output(
+        "icarus array testbench",
+        &format!(
+            "{}{}",
+            String::from_utf8_lossy(&run.stdout),
+            String::from_utf8_lossy(&run.stderr)
+        ),
+    )?;
+    o.seconds = t0.elapsed().as_secs_f64();
+    Ok(o)
+}

@@ -1,0 +1,480 @@
+//! The hardware flow of an `[array]` design: its RTL (`tofprobe_rtlgen::render_array`: R × C
+//! of the one pixel, the broadcast ROM and sequencer, the readout of
+//! `tofprobe_design::readout`) with its FuseSoC core; its co-simulation at the array's
+//! ports (the array model `tofprobe_array::rtl` against Verilator or Icarus, the first
+//! mismatch named by pixel (r, c), register, cycle and pulse); and the flow's report (the
+//! verdict, the per-pixel digests' count, the readout's figures at the configured frame and
+//! the comparison with reading every timestamp out).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use tofprobe_array::rtl::{ArrayModel, ArrayRun, run};
+use tofprobe_array::rtl_vectors::{scene_detections, vector_files};
+use tofprobe_design::readout::{ArrayFault, Readout};
+use tofprobe_design::rom_policy::RtlOverrides;
+use tofprobe_design::{Chip, ResolvedDesign, RomPurpose};
+use tofprobe_rtlgen::render::{HEADER_MARK, RenderOptions};
+use tofprobe_rtlgen::write::write_generated;
+
+use crate::error::FlowError;
+
+/// Which simulator replays the array's vectors.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ArraySimulator {
+    Verilator,
+    Icarus,
+}
+
+/// How to co-simulate an array.
+#[derive(Debug, Clone)]
+pub struct ArrayCosimOptions {
+    /// Output directory: `rtl/` and `vectors/` are written under it.
+    pub out: PathBuf,
+    /// Pulses per frame N (`None`: the design's).
+    pub frame_pulses: Option<u64>,
+    /// ROM depth override (the sign probe, as `tofprobe rtl --rom-depth`).
+    pub rom_depth: Option<usize>,
+    /// Frames.
+    pub frames: u64,
+    pub simulator: ArraySimulator,
+    /// Verilator's build profile.
+    pub profile: tofprobe_cosim::BuildProfile,
+    /// A deliberate fault of the array RTL (mutation tests); the model runs without it.
+    pub fault: Option<ArrayFault>,
+    /// Per-pixel detections (row-major; `None`: the array scene's).
+    pub detections: Option<Vec<Vec<Option<u32>>>>,
+    /// The regeneration command recorded in the headers.
+    pub command: String,
+}
+
+impl ArrayCosimOptions {
+    /// Verilator, one frame of the design's N, the scene's detections, no fault.
+    pub fn new(out: &Path) -> Self {
+        ArrayCosimOptions {
+            out: out.to_path_buf(),
+            frame_pulses: None,
+            rom_depth: None,
+            frames: 1,
+            simulator: ArraySimulator::Verilator,
+            profile: tofprobe_cosim::BuildProfile::Check,
+            fault: None,
+            detections: None,
+            command: "tofprobe cosim".into(),
+        }
+    }
+}
+
+/// What an array co-simulation found.
+#[derive(Debug, Clone)]
+pub struct ArrayCosimReport {
+    pub pass: bool,
+    /// The readout the RTL and the model follow (N as simulated).
+    pub readout: Readout,
+    pub cycles: u64,
+    pub mismatches: u64,
+    /// The first mismatch: signal, expected, actual and what the array was doing then
+    /// (pixel (r, c), register, cycle, pulse), from the model.
+    pub first: Option<String>,
+    /// The first mismatch's cycle.
+    pub first_cycle: Option<u64>,
+    /// The model's run (its stream and per-pixel words).
+    pub run: ArrayRun,
+    /// Harness build seconds (0 for Icarus) and whether the cached build was reused.
+    pub build_seconds: f64,
+    pub reused: bool,
+    /// Simulation and model seconds.
+    pub sim_seconds: f64,
+    pub model_seconds: f64,
+    /// Detections over all pixels and frames.
+    pub detections: u64,
+}
+
+/// The array chip of `design` for the overrides `o` (refused for a design without
+/// `[array]`).
+fn chip(design: &ResolvedDesign, o: &RtlOverrides, purpose: RomPurpose) -> Result<Chip, FlowError> {
+    Ok(Chip::array_of(design, o, purpose)?)
+}
+
+/// Renders the array chip into `out` (the RTL and its FuseSoC core, one set); returns the
+/// chip and the file names.
+pub fn render_array_to(
+    chip: &Chip,
+    out: &Path,
+    command: String,
+    fault: Option<ArrayFault>,
+) -> Result<Vec<String>, FlowError> {
+    let spec = chip
+        .array_spec(fault)
+        .ok_or_else(|| FlowError::option("array", "none", "a chip with an [array] readout"))?;
+    let options = RenderOptions {
+        command,
+        rom_note: chip.rom.note.clone(),
+        ..RenderOptions::default()
+    };
+    let mut files = tofprobe_rtlgen::render_array(&chip.pixel, &chip.rom.words, &options, &spec)?;
+    let core = tofprobe_rtlgen::core::render_array_core(
+        &chip.pixel,
+        &files,
+        &options,
+        chip.rows,
+        chip.cols,
+    )?;
+    files.extend(core);
+    let pairs: Vec<(String, String)> = files.into_iter().map(|f| (f.name, f.contents)).collect();
+    write_generated(out, &pairs)?;
+    Ok(pairs.into_iter().map(|(n, _)| n).collect())
+}
+
+/// `tofprobe rtl` on an array design: the chip ROM policy's ROM, N and L as overridden.
+pub fn render_array_design(
+    design: &ResolvedDesign,
+    o: &RtlOverrides,
+    out: &Path,
+    command: String,
+) -> Result<(Chip, Vec<String>), FlowError> {
+    let chip = chip(design, o, RomPurpose::Rendered)?;
+    let files = render_array_to(&chip, out, command, None)?;
+    Ok((chip, files))
+}
+
+/// The array's golden vectors written (`tofprobe vectors` on an array design): the chip
+/// for the overrides (the simulating commands' ROM), the array model run on `detections`
+/// (`None`: the array scene's), the files of `tofprobe_array::rtl_vectors` in `vec_dir`.
+#[derive(Debug)]
+pub struct ArrayVectors {
+    pub chip: Chip,
+    pub readout: Readout,
+    pub run: ArrayRun,
+    pub detections: Vec<Vec<Option<u32>>>,
+    pub model_seconds: f64,
+}
+
+/// Runs the array model of `design` and writes its vectors into `vec_dir`.
+pub fn write_array_vectors(
+    design: &ResolvedDesign,
+    o: &RtlOverrides,
+    frames: u64,
+    detections: Option<Vec<Vec<Option<u32>>>>,
+    vec_dir: &Path,
+    command: &str,
+) -> Result<ArrayVectors, FlowError> {
+    if frames == 0 || frames > 100 {
+        return Err(FlowError::option("frames", frames, "1..=100"));
+    }
+    let chip = chip(design, o, RomPurpose::Replayed)?;
+    let ro = chip
+        .readout
+        .ok_or_else(|| FlowError::option("array", "none", "an [array] design"))?;
+    let p = &chip.pixel;
+    let detections = match detections {
+        Some(d) => d,
+        None => scene_detections(design, p.frame_pulses, frames)?,
+    };
+    let t0 = std::time::Instant::now();
+    let mut model = ArrayModel::new(&ro, p, &chip.rom.words, None)?;
+    let r = run(&mut model, &detections, frames)?;
+    let model_seconds = t0.elapsed().as_secs_f64();
+    let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
+    let header = format!(
+        "{HEADER_MARK} {} (array vectors): {} x {} {:?} pixels, N = {}, {} frame(s); `{}`. DO NOT EDIT.",
+        env!("CARGO_PKG_VERSION"),
+        ro.rows,
+        ro.cols,
+        p.mode,
+        p.frame_pulses,
+        frames,
+        tofprobe_io::text::sanitize(command)
+    );
+    write_generated(vec_dir, &vector_files(&r, &detections, p, &top, &header))?;
+    Ok(ArrayVectors {
+        chip,
+        readout: ro,
+        run: r,
+        detections,
+        model_seconds,
+    })
+}
+
+/// Renders the array of `design`, runs the array model on its scene (or the given
+/// detections), writes the golden vectors and replays them under the simulator.
+pub fn cosim_array(
+    design: &ResolvedDesign,
+    a: &ArrayCosimOptions,
+) -> Result<ArrayCosimReport, FlowError> {
+    let o = RtlOverrides {
+        frame_pulses: a.frame_pulses,
+        rom_depth: a.rom_depth,
+    };
+    let rtl_dir = a.out.join("rtl");
+    let vec_dir = a.out.join("vectors");
+    let v = write_array_vectors(
+        design,
+        &o,
+        a.frames,
+        a.detections.clone(),
+        &vec_dir,
+        &a.command,
+    )?;
+    render_array_to(&v.chip, &rtl_dir, a.command.clone(), a.fault)?;
+    let (ro, r, detections, model_seconds) = (v.readout, v.run, v.detections, v.model_seconds);
+    let p = &v.chip.pixel;
+    let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
+    let rtl_abs = std::fs::canonicalize(&rtl_dir)
+        .map_err(|e| FlowError::output(rtl_dir.clone(), e.to_string()))?;
+    let (outcome, build_seconds, reused) = match a.simulator {
+        ArraySimulator::Verilator => {
+            let b = tofprobe_cosim::array::build(&rtl_abs, &top, a.profile)?;
+            (
+                tofprobe_cosim::array::run_verilator(&b.exe, &rtl_abs, &vec_dir)?,
+                b.seconds,
+                b.reused,
+            )
+        }
+        ArraySimulator::Icarus => {
+            let work = a.out.join("icarus");
+            let o = tofprobe_cosim::array::run_icarus(&rtl_abs, &vec_dir, &work)?;
+            let _ = std::fs::remove_dir_all(&work);
+            (o, 0.0, false)
+        }
+    };
+    let first = outcome.first.as_ref().map(|m| {
+        format!(
+            "{} expected {} actual {} at {}",
+            m.signal,
+            m.expected,
+            m.actual,
+            r.explain(m.cycle)
+        )
+    });
+    let count: u64 = detections
+        .iter()
+        .map(|d| {
+            d.iter()
+                .take((a.frames * p.frame_pulses) as usize)
+                .filter(|x| x.is_some())
+                .count() as u64
+        })
+        .sum();
+    Ok(ArrayCosimReport {
+        pass: outcome.mismatches == 0 && outcome.cycles == r.cycles(),
+        readout: ro,
+        cycles: outcome.cycles,
+        mismatches: outcome.mismatches,
+        first,
+        first_cycle: outcome.first.as_ref().map(|m| m.cycle),
+        run: r,
+        build_seconds,
+        reused,
+        sim_seconds: outcome.seconds,
+        model_seconds,
+        detections: count,
+    })
+}
+
+/// The report's readout section: the configured frame's figures and the comparison with
+/// reading every timestamp out (T bits per pixel per laser pulse).
+pub fn readout_section(design: &ResolvedDesign, md: &mut String) -> Result<(), FlowError> {
+    let Some(ro) = design.readout()? else {
+        return Ok(());
+    };
+    let f_laser = design.sensor().laser_rate_hz;
+    let stamps = ro.pixels() as f64 * f_laser * f64::from(design.pixel.tdc_bits);
+    let regs = ro.payload_bits_per_frame() as f64 * ro.frame_rate_hz();
+    let _ = writeln!(md, "## Readout (docs/pixel-contract.md \"Array\")\n");
+    let _ = writeln!(
+        md,
+        "At the configured frame (N = {} pulses): {} × {} pixels × {} words × {} beat(s) of {} bits = {} bits per frame ({} payload), read in {} cycles = {:.3e} s at f_clk = {:.3e} Hz (one beat every {} cycle(s), {:.3e} bit/s while streaming); a frame every {} cycles: {:.6} Hz, the pixels see {:.4} % of the laser's pulses{}.\n",
+        ro.frame_pulses,
+        ro.rows,
+        ro.cols,
+        ro.words_per_pixel(),
+        ro.beats_per_word,
+        ro.bits,
+        ro.stream_bits_per_frame(),
+        ro.payload_bits_per_frame(),
+        ro.readout_cycles(),
+        ro.readout_seconds(),
+        ro.clock_hz,
+        ro.beat_cycles,
+        ro.port_bits_per_s(),
+        ro.frame_cycles(),
+        ro.frame_rate_hz(),
+        100.0 * ro.duty(),
+        if ro.double_buffer {
+            ", double-buffered"
+        } else {
+            ""
+        }
+    );
+    let _ = writeln!(
+        md,
+        "Reading every timestamp out instead: {} pixels × {:.3e} pulses/s × T = {} bits = {:.3e} bit/s ({:.3e} B per pixel per second); the registers need {:.3e} bit/s on average, {:.1}x less.\n",
+        ro.pixels(),
+        f_laser,
+        design.pixel.tdc_bits,
+        stamps,
+        f_laser * f64::from(design.pixel.tdc_bits) / 8.0,
+        regs,
+        stamps / regs
+    );
+    Ok(())
+}
+
+/// The array flow's default frame: one period of a periodic ΣΔ ROM (the default's 20,000
+/// pulses), else 4096 pulses (a power of two for Haar), never beyond the design's N.
+pub fn array_short_frame(design: &ResolvedDesign) -> u64 {
+    let probe = &design.document.probe;
+    let n = if design.pixel.mode == tofprobe_pixel::Mode::Fourier
+        && probe.rom_mode == tofprobe_dsp::sd::RomMode::Periodic
+    {
+        probe.rom_depth as u64
+    } else {
+        4096
+    };
+    n.min(design.pixel.frame_pulses)
+}
+
+/// `tofprobe flow` on an `[array]` design: renders the array, co-simulates it under
+/// Verilator at its ports against the array model, and writes `report.md` (verdict, the
+/// first mismatch named by pixel, register, cycle and pulse, per-pixel digests, the
+/// readout at the configured frame and its comparison with reading every timestamp out);
+/// the directory is one output set, as the pixel's flow.
+pub fn run_array_flow(
+    design: &ResolvedDesign,
+    a: &crate::flow::FlowOptions,
+) -> Result<crate::flow::FlowOutcome, FlowError> {
+    if a.signoff {
+        return Err(FlowError::option(
+            "signoff",
+            "true",
+            "the pixel's flow (an array is co-simulated here; its synthesis and timing are `tofprobe size`)",
+        ));
+    }
+    if a.frames == 0 || a.frames > 100 {
+        return Err(FlowError::option("frames", a.frames, "1..=100"));
+    }
+    crate::flow::refuse_foreign_report(&a.out.join("report.md"))?;
+    let created = crate::flowset::open(&a.out)?;
+    let r = array_flow_in(design, a);
+    if r.is_err() {
+        crate::flowset::discard(&a.out, created);
+    }
+    r
+}
+
+fn array_flow_in(
+    design: &ResolvedDesign,
+    a: &crate::flow::FlowOptions,
+) -> Result<crate::flow::FlowOutcome, FlowError> {
+    let t0 = std::time::Instant::now();
+    let n = match (a.full_frame, a.frame_pulses) {
+        (_, Some(n)) => Some(n),
+        (true, None) => None,
+        (false, None) => Some(array_short_frame(design)),
+    };
+    let mut o = ArrayCosimOptions::new(&a.out);
+    o.frame_pulses = n;
+    o.frames = a.frames;
+    o.command = format!(
+        "tofprobe flow {} --out {}",
+        tofprobe_io::text::sanitize(&design.origin),
+        tofprobe_io::text::path_as_typed(&a.out)
+    );
+    let r = cosim_array(design, &o)?;
+    let ro = &r.readout;
+    let mut md = String::new();
+    let _ = writeln!(md, "{}\n", crate::flow::REPORT_TITLE);
+    let _ = writeln!(
+        md,
+        "Configuration: {}, a {} × {} array of {:?} pixels ({} registers × W = {} bits), N = {} pulses/frame (simulated), {} frame(s), probe ROM: {}.\n",
+        tofprobe_io::text::sanitize(&design.origin),
+        ro.rows,
+        ro.cols,
+        design.pixel.mode,
+        ro.registers,
+        ro.width,
+        ro.frame_pulses,
+        a.frames,
+        Chip::array_of(
+            design,
+            &RtlOverrides {
+                frame_pulses: n,
+                rom_depth: None
+            },
+            RomPurpose::Replayed
+        )?
+        .rom
+        .note
+    );
+    let _ = writeln!(md, "## Verdict\n");
+    let _ = writeln!(
+        md,
+        "Co-simulation at the array's ports (Verilator vs the array model `tofprobe_array::rtl`): **{}**, {} cycles, {} mismatches; build {:.1} s{}, Verilator {:.2} s, model {:.2} s; {} detections over the pixels.{}\n",
+        if r.pass { "PASS" } else { "FAIL" },
+        r.cycles,
+        r.mismatches,
+        r.build_seconds,
+        if r.reused { " (cached)" } else { "" },
+        r.sim_seconds,
+        r.model_seconds,
+        r.detections,
+        r.first
+            .as_ref()
+            .map(|f| format!(" First mismatch: {f}."))
+            .unwrap_or_default()
+    );
+    let _ = writeln!(
+        md,
+        "The simulated readout: {} beats of {} bits per frame, {} cycles per frame ({} accumulating, {} reading); per-pixel digests in `vectors/digests.txt`.\n",
+        ro.beats_per_frame(),
+        ro.bits,
+        ro.frame_cycles(),
+        ro.accumulate_cycles(),
+        ro.readout_cycles()
+    );
+    if let Some(words) = r.run.words.first() {
+        let _ = writeln!(
+            md,
+            "| pixel | register 0 | register 1 | status |\n|---|---|---|---|"
+        );
+        for (q, w) in words.iter().enumerate().take(16) {
+            let (row, col) = ro.order(q);
+            let signed = |v: u64| tofprobe_pixel::fixed::sign_extend(v, ro.width);
+            let _ = writeln!(
+                md,
+                "| ({row}, {col}) | {} | {} | {} |",
+                signed(w[0]),
+                w.get(1).map(|&v| signed(v)).unwrap_or(0),
+                w[ro.registers]
+            );
+        }
+        let _ = writeln!(md);
+    }
+    readout_section(design, &mut md)?;
+    let size_line =
+        "size: the array's area, pitch and timing are `tofprobe size CONFIG`".to_string();
+    let seconds = t0.elapsed().as_secs_f64();
+    let _ = writeln!(md, "Flow time: {seconds:.1} s.");
+    let path = a.out.join("report.md");
+    tofprobe_io::write_atomic(&path, md.as_bytes())
+        .map_err(|e| FlowError::output(path.clone(), e.to_string()))?;
+    crate::flowset::seal(&a.out)?;
+    Ok(crate::flow::FlowOutcome {
+        pass: r.pass,
+        frame_pulses: ro.frame_pulses,
+        cycles: r.cycles,
+        mismatches: r.mismatches,
+        seconds,
+        headline: format!(
+            "{} × {} array, {} bits per frame read in {} cycles",
+            ro.rows,
+            ro.cols,
+            ro.stream_bits_per_frame(),
+            ro.readout_cycles()
+        ),
+        size_line,
+        report: path,
+        signoff: Vec::new(),
+    })
+}
