@@ -138,24 +138,29 @@ module {{ name }} (
     reg [{{ r - 1 }}:0] late_word;
 {%- endif %}
 {%- endif %}
-    always @(posedge clk) begin
+    // Each row's stage is its own register (`keep`): the rows' stages take the same value,
+    // and a synthesis tool merges equal registers unless told not to — into one register
+    // driving every pixel, the fan-out the stages are there to split.
+    (* keep *) always @(posedge clk) begin
+        if (rst) o_pulse <= 1'b0;
+        else o_pulse <= b_pulse;
+    end
+{%- for row in rows_t %}
+    (* keep *) always @(posedge clk) begin
         if (rst) begin
-            o_pulse <= 1'b0;
-            r_pulse <= {{ rows }}'d0;
-            r_ro <= {{ rows }}'d0;
-            r_col <= {{ rows * cw }}'d0;
+            r_pulse[{{ row.row }}] <= 1'b0;
+            r_ro[{{ row.row }}] <= 1'b0;
+            r_col[{{ row.row * cw }} +: {{ cw }}] <= {{ cw }}'d0;
 {%- if fourier %}
-            r_word <= {{ rows * r }}'d0;
+            r_word[{{ row.row * r }} +: {{ r }}] <= {{ r }}'d0;
 {%- endif %}
-{%- if mutation == "row_late" %}
+{%- if row.late %}
             late_pulse <= 1'b0;
 {%- if fourier %}
             late_word <= {{ r }}'d0;
 {%- endif %}
 {%- endif %}
         end else begin
-            o_pulse <= b_pulse;
-{%- for row in rows_t %}
 {%- if row.late %}
             late_pulse <= b_pulse;
             r_pulse[{{ row.row }}] <= late_pulse;
@@ -172,9 +177,9 @@ module {{ name }} (
             r_word[{{ row.row * r }} +: {{ r }}] <= b_word;
 {%- endif %}
 {%- endif %}
-{%- endfor %}
         end
     end
+{%- endfor %}
 
     // ---- the pixels ----
     wire [{{ np - 1 }}:0] p_ready;
