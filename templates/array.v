@@ -140,24 +140,29 @@ module {{ name }} (
     reg [{{ r - 1 }}:0] late_word;
 {%- endif %}
 {%- endif %}
-    always @(posedge clk) begin
+    // Each row's stage is its own register (`keep`): the rows' stages take the same value,
+    // and a synthesis tool merges equal registers unless told not to — into one register
+    // driving every pixel, the fan-out the stages are there to split.
+    (* keep *) always @(posedge clk) begin
+        if (rst) o_pulse <= 1'b0;
+        else o_pulse <= b_pulse;
+    end
+{%- for row in rows_t %}
+    (* keep *) always @(posedge clk) begin
         if (rst) begin
-            o_pulse <= 1'b0;
-            r_pulse <= {{ trows }}'d0;
-            r_ro <= {{ trows }}'d0;
-            r_col <= {{ trows * cw }}'d0;
+            r_pulse[{{ row.lr }}] <= 1'b0;
+            r_ro[{{ row.lr }}] <= 1'b0;
+            r_col[{{ row.lr * cw }} +: {{ cw }}] <= {{ cw }}'d0;
 {%- if fourier %}
-            r_word <= {{ trows * r }}'d0;
+            r_word[{{ row.lr * r }} +: {{ r }}] <= {{ r }}'d0;
 {%- endif %}
-{%- if mutation == "row_late" %}
+{%- if row.late %}
             late_pulse <= 1'b0;
 {%- if fourier %}
             late_word <= {{ r }}'d0;
 {%- endif %}
 {%- endif %}
         end else begin
-            o_pulse <= b_pulse;
-{%- for row in rows_t %}
 {%- if row.late %}
             late_pulse <= b_pulse;
             r_pulse[{{ row.lr }}] <= late_pulse;
@@ -174,9 +179,9 @@ module {{ name }} (
             r_word[{{ row.lr * r }} +: {{ r }}] <= b_word;
 {%- endif %}
 {%- endif %}
-{%- endfor %}
         end
     end
+{%- endfor %}
 
     // ---- the pixels ----
     wire [{{ npt - 1 }}:0] p_ready;

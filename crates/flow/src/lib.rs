@@ -7,6 +7,9 @@
 
 pub mod adders;
 pub mod array;
+pub mod array_report;
+pub mod array_size;
+pub mod array_timing;
 pub mod error;
 pub mod flow;
 pub mod flowset;

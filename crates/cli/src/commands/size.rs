@@ -12,6 +12,7 @@ use tofprobe_eda::{markdown, plot};
 use tofprobe_experiments::options::OptionsReport;
 use tofprobe_experiments::options::markdown::render as options_markdown;
 use tofprobe_experiments::options::plot::front_svg;
+use tofprobe_flow::array_report::{ArraySizeReport, array_report, markdown as array_markdown};
 use tofprobe_flow::sizing::{SizeOptions, options_request, size_report};
 
 use crate::error::CliError;
@@ -43,6 +44,10 @@ pub struct SizeArgs {
     /// Node (nm) for the bins-per-pixel answer, scaled from sky130 by (node/130)².
     #[arg(long, default_value_t = 40.0)]
     pub node_nm: f64,
+    /// An [array] configuration: the placement utilisation at which the pixel's cell area
+    /// becomes a pitch (default 0.7).
+    #[arg(long)]
+    pub utilisation: Option<f64>,
     /// Bins of the B sweep (comma-separated; default 4, 8 and the configured B).
     #[arg(long, value_delimiter = ',')]
     pub sweep_bins: Option<Vec<u64>>,
@@ -81,12 +86,16 @@ pub struct FullReport {
     /// The architecture options, with `--options`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub options: Option<OptionsReport>,
+    /// The array (an `[array]` configuration): pitch, shared ROM, area, readout.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub array: Option<ArraySizeReport>,
 }
 
 /// Builds the report for the arguments (no printing).
 pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
     let design = crate::commands::load_for_hardware(a.config.as_deref())?;
-    design.single_pixel("size")?;
+    // Before minutes of synthesis: the array's options and readout.
+    tofprobe_flow::array_report::check(&design, a.utilisation)?;
     let options = size_options(a);
     let req = if a.options {
         let req = options_request(
@@ -107,7 +116,13 @@ pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
         Some(req) => Some(tofprobe_experiments::options::run(&design, req)?),
         None => None,
     };
-    Ok(FullReport { size, options })
+    let cache = tofprobe_eda::fsutil::synth_cache_dir(a.cache.as_deref());
+    let array = array_report(&design, &size, a.node_nm, a.utilisation, &cache)?;
+    Ok(FullReport {
+        size,
+        options,
+        array,
+    })
 }
 
 fn size_options(a: &SizeArgs) -> SizeOptions {
@@ -130,6 +145,9 @@ pub fn run(a: &SizeArgs) -> Result<(), CliError> {
         let mut m = markdown::render(r);
         if let Some(o) = &full.options {
             m += &options_markdown(o);
+        }
+        if let Some(arr) = &full.array {
+            m += &array_markdown(arr);
         }
         m
     };

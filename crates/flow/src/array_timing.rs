@@ -1,0 +1,356 @@
+//! Timing of the array's own paths (issue 27 point 5): the broadcast (the root's and the
+//! rows' registered stages into every pixel's `pulse`, `rom_word` and `readout`) and the
+//! readout (the pixels' `rd_*` through the row select, the column buses and the column
+//! select into the readout buffer), timed by OpenSTA at the pixel clock C·f_laser.
+//!
+//! The pixel is synthesised once (the size report's netlist, cached); the array's top is
+//! synthesised with the pixel and the probe ROM as black boxes, and OpenSTA links the two
+//! netlists, so every pixel instance is the real gate-level pixel and every broadcast net
+//! carries its real loads. An array of at most [`WHOLE_TIMING_MAX_PIXELS`] pixels is timed
+//! whole; a larger one as two slices that keep the whole array's fan-outs and fan-ins:
+//! a **row** (1 × C: a row stage drives C pixels, the column select picks one of C) and a
+//! **column** (R × 1: the root drives R row stages, a column bus gathers R pixels).
+//! The ROM's own read path (address register → ROM → root stage) is timed with the ROM
+//! as a black box, i.e. not at all: the ROM is sized apart ([`crate::array_report`]).
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use tofprobe_design::readout::Readout;
+use tofprobe_design::{Chip, ResolvedDesign, RomPurpose, RtlOverrides};
+use tofprobe_eda::analysis::analyse_point;
+use tofprobe_eda::corners::MARGIN_PERCENT;
+use tofprobe_eda::generated::GeneratedPixel;
+use tofprobe_eda::liberty::Liberty;
+use tofprobe_eda::sta::parse_report;
+use tofprobe_eda::synth::{SynthSpec, synthesise};
+use tofprobe_rtlgen::{ArraySpec, RenderOptions, render_array};
+
+use crate::error::FlowError;
+
+/// Largest array timed whole (8 × 8); beyond it, a row and a column slice.
+pub const WHOLE_TIMING_MAX_PIXELS: usize = 64;
+
+/// OpenSTA's probe period (ns): long enough that every path has positive slack; the
+/// critical delay is period − slack (as `tofprobe_eda::sta`).
+const PROBE_PERIOD_NS: f64 = 1000.0;
+
+/// One kind of path of one timed netlist.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct PathTiming {
+    /// Minimum period for the path: arrival + setup (ns).
+    pub delay_ns: f64,
+    /// Slack at the pixel clock (ns).
+    pub slack_ns: f64,
+    /// Slack as a share of the period (%).
+    pub slack_percent: f64,
+    /// Slack ≥ [`MARGIN_PERCENT`] % of the period.
+    pub meets_margin: bool,
+    /// Start of the worst path.
+    pub startpoint: String,
+    /// End of the worst path.
+    pub endpoint: String,
+    /// The pixel's own part: its worst path from those inputs (broadcast, the inputs at the
+    /// clock edge) or to those outputs (readout), the pixel timed alone (ns).
+    pub pixel_part_ns: f64,
+    /// The array's part: `delay_ns` − `pixel_part_ns` (the stage's clock-to-output, the
+    /// fan-out and its buffers; or the buses, selects and the capture's setup).
+    pub array_part_ns: f64,
+}
+
+impl PathTiming {
+    fn of(
+        t: &tofprobe_eda::sta::Timing,
+        pixel: &tofprobe_eda::sta::Timing,
+        clock_mhz: f64,
+    ) -> Self {
+        let period = 1e3 / clock_mhz;
+        let slack = period - t.critical_path_ns;
+        let pct = (slack / period * 1000.0).round() / 10.0;
+        PathTiming {
+            delay_ns: t.critical_path_ns,
+            slack_ns: slack,
+            slack_percent: pct,
+            meets_margin: pct >= MARGIN_PERCENT,
+            startpoint: t.startpoint.clone(),
+            endpoint: t.endpoint.clone(),
+            pixel_part_ns: pixel.critical_path_ns,
+            array_part_ns: t.critical_path_ns - pixel.critical_path_ns,
+        }
+    }
+}
+
+/// OpenSTA on `script` (written to `tcl`), its output split at the `== NAME` markers the
+/// script prints, each part parsed as a `report_checks` text.
+fn run_sta(
+    tcl: &Path,
+    script: &str,
+    parts: &[&str],
+) -> Result<Vec<tofprobe_eda::sta::Timing>, FlowError> {
+    tofprobe_io::write_atomic(tcl, script.as_bytes())
+        .map_err(|e| FlowError::output(tcl.to_path_buf(), e.to_string()))?;
+    let sta = tofprobe_eda::tools::Tool::Sta.locate()?;
+    let out = std::process::Command::new(&sta)
+        .arg("-no_init")
+        .arg("-exit")
+        .arg(tcl)
+        .output()
+        .map_err(|e| FlowError::output(sta.clone(), e.to_string()))?;
+    let log = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut found = Vec::new();
+    for (i, name) in parts.iter().enumerate() {
+        let marker = format!("== {name}");
+        let start = log.find(&marker).ok_or_else(|| {
+            FlowError::output(
+                tcl.to_path_buf(),
+                format!("OpenSTA stopped before `{marker}`: {log}"),
+            )
+        })? + marker.len();
+        let end = parts
+            .get(i + 1)
+            .and_then(|n| log[start..].find(&format!("== {n}")))
+            .map_or(log.len(), |e| start + e);
+        found.push(parse_report(&log[start..end])?);
+    }
+    Ok(found)
+}
+
+/// The array's paths timed on one liberty.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct ArrayTiming {
+    /// What was timed: `whole R × C`, `row 1 × C` or `column R × 1`.
+    pub netlist: String,
+    /// Library name (`library (NAME)`).
+    pub library: String,
+    /// The pixel clock C·f_laser (MHz).
+    pub clock_mhz: f64,
+    /// Cell area of the array's own logic (sequencer, broadcast, readout; the pixels and
+    /// the ROM excluded), µm².
+    pub shared_logic_um2: f64,
+    /// Broadcast paths: into the pixels' `pulse`, `rom_word`, `readout`.
+    pub broadcast: PathTiming,
+    /// Readout paths: out of the pixels' `rd_valid`, `rd_index`, `rd_data`.
+    pub readout: PathTiming,
+}
+
+/// The netlists to time for a `rows` × `cols` array: the whole (up to `whole_max` pixels),
+/// or a row and a column.
+pub fn slices(rows: usize, cols: usize, whole_max: usize) -> Vec<(String, usize, usize)> {
+    if rows * cols <= whole_max {
+        vec![(format!("whole {rows} × {cols}"), rows, cols)]
+    } else {
+        vec![
+            (format!("row 1 × {cols}"), 1, cols),
+            (format!("column {rows} × 1"), rows, 1),
+        ]
+    }
+}
+
+/// Times the array of `design` (with `[array]`) on each liberty of `liberties` (a timing
+/// liberty, then sky130 corners: the top and the pixel mapped on the first of a `group`,
+/// see [`time_on`]).
+pub fn array_timing(
+    design: &ResolvedDesign,
+    liberties: &[(PathBuf, Option<PathBuf>)],
+    cache: &Path,
+) -> Result<Vec<ArrayTiming>, FlowError> {
+    array_timing_with(design, liberties, cache, WHOLE_TIMING_MAX_PIXELS)
+}
+
+/// [`array_timing`] timing arrays of up to `whole_max` pixels whole (0: always slices; the
+/// slice model is tested against the whole with it).
+pub fn array_timing_with(
+    design: &ResolvedDesign,
+    liberties: &[(PathBuf, Option<PathBuf>)],
+    cache: &Path,
+    whole_max: usize,
+) -> Result<Vec<ArrayTiming>, FlowError> {
+    let chip = Chip::array_of(design, &RtlOverrides::default(), RomPurpose::Rendered)?;
+    let mut out = Vec::new();
+    for (map_lib, time_lib) in liberties {
+        for (name, rows, cols) in slices(chip.rows, chip.cols, whole_max) {
+            out.push(time_on(
+                design,
+                &chip,
+                &name,
+                rows,
+                cols,
+                map_lib,
+                time_lib.as_deref(),
+                cache,
+            )?);
+        }
+    }
+    Ok(out)
+}
+
+/// The ports of a rendered module (its header up to `);`) as a black box.
+fn black_box(text: &str, module: &str) -> Option<String> {
+    let start = text.find(&format!("module {module} ("))?;
+    let end = start + text[start..].find(");")? + 2;
+    Some(format!(
+        "(* blackbox *)\n{}\nendmodule\n",
+        text[start..end].replace("output reg ", "output wire ")
+    ))
+}
+
+/// Times one `rows` × `cols` netlist of the chip's array: mapped on `map_lib`, timed on
+/// `time_lib` (default `map_lib`; another corner of the same cells).
+#[allow(clippy::too_many_arguments)]
+fn time_on(
+    design: &ResolvedDesign,
+    chip: &Chip,
+    name: &str,
+    rows: usize,
+    cols: usize,
+    map_lib: &Path,
+    time_lib: Option<&Path>,
+    cache: &Path,
+) -> Result<ArrayTiming, FlowError> {
+    let p = &chip.pixel;
+    let clock_mhz = p.cycles_per_pulse as f64 * design.sensor().laser_rate_hz / 1e6;
+    let target_ps = 1e6 / clock_mhz;
+    let lib = Liberty::load(map_lib)?;
+    // The pixel: the size report's synthesis (same provider, point and target: cached).
+    let pixel = analyse_point(
+        &GeneratedPixel { base: p.clone() },
+        p.bins as u64,
+        p.width,
+        &lib,
+        false,
+        "clk",
+        cache,
+        Some(target_ps),
+    )?;
+    // The array's top with the pixel and the ROM as black boxes.
+    let a = design.array.as_ref().expect("an [array] design");
+    let r = Readout::new(&a.readout, rows, cols, p, design.sensor().laser_rate_hz)
+        .map_err(|m| FlowError::option("array slice", format!("{rows} × {cols}"), &m))?;
+    let spec = ArraySpec {
+        rows,
+        cols,
+        bits: r.bits,
+        beats_per_word: r.beats_per_word,
+        beat_cycles: r.beat_cycles,
+        slot_cycles: r.slot_cycles(),
+        fault: None,
+    };
+    // The ROM's contents do not reach the top's logic (a black box): render a 1-entry one.
+    let mut p1 = p.clone();
+    p1.rom_depth = p.rom_depth.min(2).max(1);
+    let rom = vec![0u64; p1.rom_depth * p1.registers().div_ceil(64)];
+    let files = render_array(&p1, &rom, &RenderOptions::default(), &spec)?;
+    let (pixel_name, rom_name, _) =
+        tofprobe_rtlgen::module_names(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
+    let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
+    let mut text = String::new();
+    for f in files.iter().filter(|f| f.name.ends_with(".v")) {
+        if f.template == "pixel.v" {
+            text += &black_box(&f.contents, &pixel_name).unwrap_or_default();
+        } else if f.template == "probe_rom.v" {
+            text += &black_box(&f.contents, &rom_name).unwrap_or_default();
+        } else {
+            text += &f.contents;
+        }
+    }
+    let key = format!("{:016x}", tofprobe_io::fnv1a64(text.as_bytes()));
+    let dir = cache.join("array-top").join(&key);
+    std::fs::create_dir_all(&dir).map_err(|e| FlowError::output(dir.clone(), e.to_string()))?;
+    let src = dir.join(format!("{top}.v"));
+    tofprobe_io::write_atomic(&src, text.as_bytes())
+        .map_err(|e| FlowError::output(src.clone(), e.to_string()))?;
+    let top_syn = synthesise(
+        &SynthSpec {
+            sources: vec![src],
+            top: top.clone(),
+            params: vec![],
+            liberty: map_lib.to_path_buf(),
+            delay_target_ps: Some(target_ps),
+            keep: vec![],
+        },
+        &cache.join("synth"),
+    )?;
+    // OpenSTA on the two netlists linked.
+    let time_lib = time_lib.unwrap_or(map_lib);
+    let script = format!(
+        "read_liberty {lib}\nread_verilog {pixel}\nread_verilog {array}\nlink_design {top}\n\
+         create_clock -name clk -period {PROBE_PERIOD_NS} [get_ports clk]\n\
+         set_input_delay 0 -clock clk [delete_from_list [all_inputs] [get_ports clk]]\n\
+         set_output_delay 0 -clock clk [all_outputs]\n\
+         puts \"== broadcast\"\n\
+         report_checks -path_delay max -digits 4 -through [get_pins {{u_pixel_*/pulse u_pixel_*/rom_word* u_pixel_*/readout}}]\n\
+         puts \"== readout\"\n\
+         report_checks -path_delay max -digits 4 -through [get_pins {{u_pixel_*/rd_valid u_pixel_*/rd_index* u_pixel_*/rd_data*}}]\n\
+         exit\n",
+        lib = time_lib.display(),
+        pixel = pixel.synthesis.netlist_verilog.display(),
+        array = top_syn.netlist_verilog.display(),
+    );
+    let stem = time_lib
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let linked = run_sta(
+        &dir.join(format!("sta-{stem}.tcl")),
+        &script,
+        &["broadcast", "readout"],
+    )?;
+    // The pixel alone: its worst paths from the broadcast inputs and to the readout outputs.
+    let alone = format!(
+        "read_liberty {lib}\nread_verilog {pixel}\nlink_design {pixel_name}\n\
+         create_clock -name clk -period {PROBE_PERIOD_NS} [get_ports clk]\n\
+         set_input_delay 0 -clock clk [delete_from_list [all_inputs] [get_ports clk]]\n\
+         set_output_delay 0 -clock clk [all_outputs]\n\
+         puts \"== from\"\n\
+         report_checks -path_delay max -digits 4 -from [get_ports {{pulse rom_word* readout}}]\n\
+         puts \"== to\"\n\
+         report_checks -path_delay max -digits 4 -to [get_ports {{rd_valid rd_index* rd_data*}}]\n\
+         exit\n",
+        lib = time_lib.display(),
+        pixel = pixel.synthesis.netlist_verilog.display(),
+    );
+    let own = run_sta(
+        &dir.join(format!("sta-pixel-{stem}.tcl")),
+        &alone,
+        &["from", "to"],
+    )?;
+    let time_name = Liberty::load(time_lib)?.name;
+    Ok(ArrayTiming {
+        netlist: name.into(),
+        library: time_name,
+        clock_mhz,
+        shared_logic_um2: top_syn.total_area_um2,
+        broadcast: PathTiming::of(&linked[0], &own[0], clock_mhz),
+        readout: PathTiming::of(&linked[1], &own[1], clock_mhz),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn small_arrays_are_timed_whole_and_large_ones_by_a_row_and_a_column() {
+        assert_eq!(slices(8, 8, WHOLE_TIMING_MAX_PIXELS).len(), 1);
+        assert_eq!(slices(8, 8, 0).len(), 2);
+        let s = slices(64, 64, WHOLE_TIMING_MAX_PIXELS);
+        assert_eq!((s[0].1, s[0].2), (1, 64));
+        assert_eq!((s[1].1, s[1].2), (64, 1));
+    }
+
+    #[test]
+    fn a_black_box_keeps_the_ports_only() {
+        let v = "// x\nmodule m (\n    input wire a,\n    output reg [3:0] y\n);\n    reg z;\nendmodule\n";
+        let b = black_box(v, "m").unwrap();
+        assert!(b.starts_with("(* blackbox *)\nmodule m ("), "{b}");
+        assert!(
+            b.contains("output wire [3:0] y") && !b.contains("reg z"),
+            "{b}"
+        );
+        assert!(black_box(v, "n").is_none());
+    }
+}
