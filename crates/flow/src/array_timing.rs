@@ -238,6 +238,7 @@ fn time_on(
         beat_cycles: r.beat_cycles,
         slot_cycles: r.slot_cycles(),
         fault: None,
+        tile: None,
     };
     // The ROM's contents do not reach the top's logic (a black box): render a 1-entry one.
     let mut p1 = p.clone();

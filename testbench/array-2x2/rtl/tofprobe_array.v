@@ -113,19 +113,33 @@ module tofprobe_array (
     reg [1:0] r_ro;
     reg [1:0] r_col;
     reg [7:0] r_word;
-    always @(posedge clk) begin
+    // Each row's stage is its own register (`keep`): the rows' stages take the same value,
+    // and a synthesis tool merges equal registers unless told not to — into one register
+    // driving every pixel, the fan-out the stages are there to split.
+    (* keep *) always @(posedge clk) begin
+        if (rst) o_pulse <= 1'b0;
+        else o_pulse <= b_pulse;
+    end
+    (* keep *) always @(posedge clk) begin
         if (rst) begin
-            o_pulse <= 1'b0;
-            r_pulse <= 2'd0;
-            r_ro <= 2'd0;
-            r_col <= 2'd0;
-            r_word <= 8'd0;
+            r_pulse[0] <= 1'b0;
+            r_ro[0] <= 1'b0;
+            r_col[0 +: 1] <= 1'd0;
+            r_word[0 +: 4] <= 4'd0;
         end else begin
-            o_pulse <= b_pulse;
             r_pulse[0] <= b_pulse;
             r_ro[0] <= b_ro && (b_row == 1'd0);
             r_col[0 +: 1] <= b_col;
             r_word[0 +: 4] <= b_word;
+        end
+    end
+    (* keep *) always @(posedge clk) begin
+        if (rst) begin
+            r_pulse[1] <= 1'b0;
+            r_ro[1] <= 1'b0;
+            r_col[1 +: 1] <= 1'd0;
+            r_word[4 +: 4] <= 4'd0;
+        end else begin
             r_pulse[1] <= b_pulse;
             r_ro[1] <= b_ro && (b_row == 1'd1);
             r_col[1 +: 1] <= b_col;

@@ -43,12 +43,22 @@ fn the_row_and_column_slices_time_the_whole_eight_by_eight_array() {
     let r = worst(|t| t.readout.delay_ns);
     let (wb, wr) = (whole[0].broadcast.delay_ns, whole[0].readout.delay_ns);
     // Within 15 %: the same paths, each top mapped by ABC on its own.
-    assert!((b / wb - 1.0).abs() < 0.15, "broadcast: slices {b} ns, whole {wb} ns");
-    assert!((r / wr - 1.0).abs() < 0.15, "readout: slices {r} ns, whole {wr} ns");
+    assert!(
+        (b / wb - 1.0).abs() < 0.15,
+        "broadcast: slices {b} ns, whole {wb} ns"
+    );
+    assert!(
+        (r / wr - 1.0).abs() < 0.15,
+        "readout: slices {r} ns, whole {wr} ns"
+    );
     // The slices' logic (row × R + column) bounds the whole's from above, and not by
     // more than the root counted R times over.
     let bound = sliced[0].shared_logic_um2 * 8.0 + sliced[1].shared_logic_um2;
-    assert!(bound >= whole[0].shared_logic_um2, "{bound} < {}", whole[0].shared_logic_um2);
+    assert!(
+        bound >= whole[0].shared_logic_um2,
+        "{bound} < {}",
+        whole[0].shared_logic_um2
+    );
     // A broken slice model — the row slice alone, which has no column bus over R rows —
     // misses the readout's fan-in: its readout is shorter than the whole's.
     assert!(sliced[0].readout.delay_ns <= wr * 1.02);
