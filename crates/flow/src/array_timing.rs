@@ -242,7 +242,7 @@ fn time_on(
     };
     // The ROM's contents do not reach the top's logic (a black box): render a 1-entry one.
     let mut p1 = p.clone();
-    p1.rom_depth = p.rom_depth.min(2).max(1);
+    p1.rom_depth = p.rom_depth.clamp(1, 2);
     let rom = vec![0u64; p1.rom_depth * p1.registers().div_ceil(64)];
     let files = render_array(&p1, &rom, &RenderOptions::default(), &spec)?;
     let (pixel_name, rom_name, _) =
