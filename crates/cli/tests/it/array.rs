@@ -243,7 +243,6 @@ fn single_pixel_commands_refuse_an_array_and_spatial_motions_need_one() {
     );
     let c = cfg.to_str().unwrap();
     for args in [
-        vec!["rtl", c, "--out", "never-rtl"],
         vec!["tradeoff", c],
         vec!["bench", "pixel", "--config", c, "--pulses", "4096"],
     ] {
@@ -252,7 +251,11 @@ fn single_pixel_commands_refuse_an_array_and_spatial_motions_need_one() {
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains("simulate CONFIG --out DIR"), "{args:?}: {err}");
     }
-    assert!(!Path::new("never-rtl").exists());
+    // `rtl` renders an array (docs/pixel-contract.md "Array"): the array's module.
+    let out = tmp.path().join("array-rtl");
+    let o = run(&["rtl", c, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("tofprobe_array.v").is_file());
     let text = std::fs::read_to_string(&cfg).unwrap();
     let single = tmp.path().join("single.toml");
     std::fs::write(&single, text.split("[array]").next().unwrap()).unwrap();
