@@ -242,7 +242,6 @@ fn single_pixel_commands_refuse_an_array_and_spatial_motions_need_one() {
         "rows = 2\ncols = 2\npitch_um = 30.0\nmm_per_pixel = 10.0",
     );
     let c = cfg.to_str().unwrap();
-    // (`rtl`, `vectors`, `cosim`, `flow` and `size` take an array: crates/cli/tests/it/array_rtl.rs, array_size.rs.)
     for args in [
         vec!["tradeoff", c],
         vec!["bench", "pixel", "--config", c, "--pulses", "4096"],
@@ -252,6 +251,11 @@ fn single_pixel_commands_refuse_an_array_and_spatial_motions_need_one() {
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains("simulate CONFIG --out DIR"), "{args:?}: {err}");
     }
+    // `rtl` renders an array (docs/pixel-contract.md "Array"): the array's module.
+    let out = tmp.path().join("array-rtl");
+    let o = run(&["rtl", c, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("tofprobe_array.v").is_file());
     let text = std::fs::read_to_string(&cfg).unwrap();
     let single = tmp.path().join("single.toml");
     std::fs::write(&single, text.split("[array]").next().unwrap()).unwrap();
