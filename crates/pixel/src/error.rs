@@ -29,6 +29,21 @@ pub enum PixelError {
         /// What the configuration needs.
         needed: String,
     },
+    /// A valid pulse whose TDC code the pixel's T pins cannot carry.
+    #[error(
+        "`tdc[{pulse}]` = {code} is outside the pixel's TDC codes 0 ..= {max} \
+         (pixel.tdc_bits = {bits}); a code in that range would work, or valid[{pulse}] = False"
+    )]
+    CodeOutOfRange {
+        /// The first such pulse.
+        pulse: usize,
+        /// Its code.
+        code: i128,
+        /// The largest code, 2^T − 1.
+        max: u32,
+        /// T.
+        bits: u32,
+    },
 }
 
 impl PixelError {

@@ -6,7 +6,8 @@
 //! - [`config`]: the `[pixel]` TOML section ([`PixelConfig`]) and its validation;
 //! - [`datapath`]: the one datapath (zoom, hold, prefilter, accumulate) both models drive;
 //! - [`detections`]: the drivers' one input, a pulse stream ([`Detections`]: compact codes
-//!   with [`NO_DETECTION`], `Option`s, or any other shape);
+//!   with [`NO_DETECTION`], `Option`s, or any other shape), and [`valid_codes`]: a frame
+//!   held as (`valid`, `tdc`) arrays read in place ([`ValidCodes`]);
 //! - [`fold`]: the folded driver of a Fourier frame (phase sums of the periodic ROM), and
 //!   [`driver`]: [`FrameDriver`], which runs it when it pays and the transaction driver
 //!   otherwise; [`lanes`]: [`FoldLanes`], up to [`LANES`] folded pixels of an array in
@@ -39,6 +40,7 @@ pub mod sequencer;
 pub mod sizing;
 pub mod spectrum;
 pub mod transaction;
+pub mod valid_codes;
 
 /// The cycle-level contract between the models and the RTL (docs/pixel-contract.md).
 ///
@@ -62,6 +64,7 @@ pub use readout::{Readout, ReadoutCollector};
 pub use schedule::{Operation, Schedule};
 pub use sequencer::Sequencer;
 pub use transaction::TransactionModel;
+pub use valid_codes::{TdcCode, ValidCodes};
 
 /// Default prefilter fraction bits F (see `tests/numerics.rs` for the measurement that
 /// chose it).

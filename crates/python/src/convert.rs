@@ -5,13 +5,11 @@
 //! borrowed). Library errors become `ValueError` with the library's message, which names
 //! the field, the value and the allowed range.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-
 use numpy::{Element, PyReadonlyArray1};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use tofprobe_pixel::{Detections, FrameDriver, NO_DETECTION};
+use tofprobe_pixel::{FrameDriver, PixelError, TdcCode, ValidCodes};
 
 /// A library error as a Python `ValueError` carrying its message.
 pub fn value_error(e: impl std::fmt::Display) -> PyErr {
@@ -194,275 +192,63 @@ impl CodeSlice<'_> {
     }
 }
 
-/// The frame `(valid, tdc)` as the pixel drivers' input, read in place (no conversion
-/// pass of its own): pulse i is a detection of code `tdc[i]` where `valid[i]`, none
-/// elsewhere, decoded a block at a time into the compact form as the driver reads it. A
-/// valid code outside 0 ..= `max_code` reads as no detection and is remembered; the caller
-/// then refuses the frame ([`ValidTdc::check`]), so the range check rides along too.
-#[derive(Debug)]
-pub struct ValidTdc<'a, T> {
-    valid: &'a [bool],
-    tdc: &'a [T],
-    max_code: u32,
-    bad: AtomicBool,
-}
-
-impl<'a, T: Code> ValidTdc<'a, T> {
-    /// The frame; `valid` and `tdc` of the same length (checked by the caller).
-    pub fn new(valid: &'a [bool], tdc: &'a [T], max_code: u32) -> Self {
-        ValidTdc {
-            valid,
-            tdc,
-            max_code,
-            bad: AtomicBool::new(false),
+/// Calls `$f::<T>($slice, args...)` for the integer type the codes arrived in (the one
+/// dtype dispatch; the decoding itself is the library's, `tofprobe_pixel::ValidCodes`).
+macro_rules! with_codes {
+    ($codes:expr, |$s:ident| $body:expr) => {
+        match $codes {
+            CodeSlice::U8($s) => $body,
+            CodeSlice::U16($s) => $body,
+            CodeSlice::U32($s) => $body,
+            CodeSlice::U64($s) => $body,
+            CodeSlice::I8($s) => $body,
+            CodeSlice::I16($s) => $body,
+            CodeSlice::I32($s) => $body,
+            CodeSlice::I64($s) => $body,
         }
-    }
-
-    /// `Ok` unless a valid code read so far was out of range: then the error naming the
-    /// first such pulse, its code and the range.
-    pub fn check(&self) -> Result<(), String> {
-        if !self.bad.load(Ordering::Relaxed) {
-            return Ok(());
-        }
-        let (i, c) = self
-            .valid
-            .iter()
-            .zip(self.tdc)
-            .enumerate()
-            .find(|(_, (v, c))| **v && !c.within(self.max_code))
-            .map(|(i, (_, &c))| (i, c.into()))
-            .unwrap_or((0, -1));
-        Err(range_error(i, c, self.max_code))
-    }
-}
-
-impl<T: Code> Detections for ValidTdc<'_, T> {
-    fn len(&self) -> usize {
-        self.valid.len()
-    }
-
-    fn get(&self, i: usize) -> Option<u32> {
-        let (v, c) = (self.valid[i], self.tdc[i]);
-        let ok = c.within(self.max_code);
-        if v && !ok {
-            self.bad.store(true, Ordering::Relaxed);
-        }
-        (v && ok).then(|| c.wrapped())
-    }
-
-    #[inline]
-    fn codes<'b>(&'b self, start: usize, n: usize, buf: &'b mut [u32]) -> &'b [u32] {
-        let out = &mut buf[..n];
-        let bad = mask_codes(
-            &self.valid[start..start + n],
-            &self.tdc[start..start + n],
-            self.max_code,
-            out,
-        );
-        if bad {
-            self.bad.store(true, Ordering::Relaxed);
-        }
-        out
-    }
-}
-
-/// The compact codes of (`valid`, `codes`) into `out` (same lengths): masks instead of
-/// selects (a valid pulse's mask is all ones, an in-range code's too; the code OR the
-/// complement of both masks is the code or all ones, `NO_DETECTION`), so the pass has no
-/// branch and vectorises. Returns whether a valid code was out of 0 ..= `max_code`.
-#[inline(always)]
-fn mask_codes<T: Code>(valid: &[bool], codes: &[T], max_code: u32, out: &mut [u32]) -> bool {
-    const _: () = assert!(NO_DETECTION == u32::MAX, "the masks make all ones");
-    let mut bad = 0u32;
-    for ((o, &v), &c) in out.iter_mut().zip(valid).zip(codes) {
-        let valid_mask = u32::from(v).wrapping_neg();
-        let ok_mask = u32::from(c.within(max_code)).wrapping_neg();
-        bad |= valid_mask & !ok_mask;
-        *o = c.wrapped() | !(valid_mask & ok_mask);
-    }
-    bad != 0
+    };
 }
 
 impl CodeSlice<'_> {
-    /// Runs the frame (`valid`, these codes) through `driver`, read in place
-    /// ([`ValidTdc`]); a valid code outside 0 ..= `max_code` is refused afterwards, naming
-    /// the pulse (the driver's registers are then not to be read).
+    /// Runs the frame (`valid`, these codes) through `driver`, read in place by the
+    /// library ([`ValidCodes`]: decoded a block at a time, the range check riding along);
+    /// a valid code outside 0 ..= `max_code` is refused afterwards, naming the pulse (the
+    /// driver's registers are then not to be read).
     pub fn run_pixel(
         &self,
         valid: &[bool],
         max_code: u32,
         driver: &mut FrameDriver<'_>,
-    ) -> Result<(), String> {
-        fn go<T: Code>(
+    ) -> Result<(), PixelError> {
+        fn go<T: TdcCode>(
             valid: &[bool],
             tdc: &[T],
             max_code: u32,
             driver: &mut FrameDriver<'_>,
-        ) -> Result<(), String> {
-            let frame = ValidTdc::new(valid, tdc, max_code);
-            driver.run(&frame, 0).map_err(|e| e.to_string())?;
+        ) -> Result<(), PixelError> {
+            let frame = ValidCodes::new(valid, tdc, max_code)?;
+            driver.run(&frame, 0)?;
             frame.check()
         }
-        match *self {
-            CodeSlice::U8(s) => go(valid, s, max_code, driver),
-            CodeSlice::U16(s) => go(valid, s, max_code, driver),
-            CodeSlice::U32(s) => go(valid, s, max_code, driver),
-            CodeSlice::U64(s) => go(valid, s, max_code, driver),
-            CodeSlice::I8(s) => go(valid, s, max_code, driver),
-            CodeSlice::I16(s) => go(valid, s, max_code, driver),
-            CodeSlice::I32(s) => go(valid, s, max_code, driver),
-            CodeSlice::I64(s) => go(valid, s, max_code, driver),
-        }
+        with_codes!(*self, |s| go(valid, s, max_code, driver))
     }
 
-    /// Writes pulses `first .. first + valid.len()` of the frame (`valid`, these codes) into
-    /// `out` in the drivers' compact form: the code where valid, `NO_DETECTION` elsewhere
-    /// (the code of an invalid pulse is ignored). One branch-free pass the compiler
-    /// vectorises ([`compact_codes`]); a valid code outside 0 ..= `max_code` is refused,
-    /// naming the pulse and the range.
-    pub fn compact_into(
+    /// The frame (`valid`, these codes) in the drivers' compact form (the library's
+    /// decode), range-checked.
+    pub fn compact(&self, valid: &[bool], max_code: u32) -> Result<Vec<u32>, PixelError> {
+        with_codes!(*self, |s| ValidCodes::new(valid, s, max_code)?.compact())
+    }
+
+    /// The frame (`valid`, these codes) as `Option`s (the float references' form),
+    /// range-checked.
+    pub fn options(
         &self,
         valid: &[bool],
-        first: usize,
         max_code: u32,
-        out: &mut Vec<u32>,
-    ) -> Result<(), String> {
-        let end = first + valid.len();
-        match *self {
-            CodeSlice::U8(s) => compact_codes(valid, &s[first..end], first, max_code, out),
-            CodeSlice::U16(s) => compact_codes(valid, &s[first..end], first, max_code, out),
-            CodeSlice::U32(s) => compact_codes(valid, &s[first..end], first, max_code, out),
-            CodeSlice::U64(s) => compact_codes(valid, &s[first..end], first, max_code, out),
-            CodeSlice::I8(s) => compact_codes(valid, &s[first..end], first, max_code, out),
-            CodeSlice::I16(s) => compact_codes(valid, &s[first..end], first, max_code, out),
-            CodeSlice::I32(s) => compact_codes(valid, &s[first..end], first, max_code, out),
-            CodeSlice::I64(s) => compact_codes(valid, &s[first..end], first, max_code, out),
-        }
+    ) -> Result<Vec<Option<u32>>, PixelError> {
+        with_codes!(*self, |s| ValidCodes::new(valid, s, max_code)?.options())
     }
 }
-
-/// [`CodeSlice::compact_into`] for one integer type ([`mask_codes`]); only a failing
-/// range check looks for the pulse to name.
-fn compact_codes<T: Code>(
-    valid: &[bool],
-    codes: &[T],
-    first: usize,
-    max_code: u32,
-    out: &mut Vec<u32>,
-) -> Result<(), String> {
-    out.clear();
-    out.resize(valid.len(), NO_DETECTION);
-    let bad = mask_codes(valid, codes, max_code, out);
-    if !bad {
-        return Ok(());
-    }
-    let (i, c) = valid
-        .iter()
-        .zip(codes)
-        .enumerate()
-        .find(|(_, (v, c))| **v && !c.within(max_code))
-        .map(|(i, (_, &c))| (first + i, c.into()))
-        .unwrap_or((first, -1));
-    Err(range_error(i, c, max_code))
-}
-
-/// Fills `out` with the detections of pulses `first .. first + valid.len()` of (`valid`,
-/// `tdc`): `Some(code)` where valid, `None` elsewhere (the code of an invalid pulse is
-/// ignored). A valid code outside 0 ..= `max_code` is refused, naming the pulse and the
-/// range.
-pub fn detections(
-    valid: &[bool],
-    tdc: CodeSlice<'_>,
-    first: usize,
-    max_code: u32,
-    out: &mut Vec<Option<u32>>,
-) -> Result<(), String> {
-    let end = first + valid.len();
-    match tdc {
-        CodeSlice::U8(s) => fill(valid, &s[first..end], first, max_code, out),
-        CodeSlice::U16(s) => fill(valid, &s[first..end], first, max_code, out),
-        CodeSlice::U32(s) => fill(valid, &s[first..end], first, max_code, out),
-        CodeSlice::U64(s) => fill(valid, &s[first..end], first, max_code, out),
-        CodeSlice::I8(s) => fill(valid, &s[first..end], first, max_code, out),
-        CodeSlice::I16(s) => fill(valid, &s[first..end], first, max_code, out),
-        CodeSlice::I32(s) => fill(valid, &s[first..end], first, max_code, out),
-        CodeSlice::I64(s) => fill(valid, &s[first..end], first, max_code, out),
-    }
-}
-
-/// [`detections`] for one integer type, in two branch-free passes the compiler
-/// vectorises (the conversion is most of `run_pixel`'s overhead over the library call:
-/// scripts/python-bench.py): the detections (a code out of range wraps here), then the
-/// range check of the valid codes; only a failing check looks for the pulse to name.
-fn fill<T>(
-    valid: &[bool],
-    codes: &[T],
-    first: usize,
-    max_code: u32,
-    out: &mut Vec<Option<u32>>,
-) -> Result<(), String>
-where
-    T: Copy + Into<i128> + Code,
-{
-    out.clear();
-    out.extend(
-        valid
-            .iter()
-            .zip(codes)
-            .map(|(&v, &c)| if v { Some(c.wrapped()) } else { None }),
-    );
-    let bad = valid
-        .iter()
-        .zip(codes)
-        .fold(false, |bad, (&v, &c)| bad | (v & !c.within(max_code)));
-    if !bad {
-        return Ok(());
-    }
-    let (i, c) = valid
-        .iter()
-        .zip(codes)
-        .enumerate()
-        .find(|(_, (v, c))| **v && !c.within(max_code))
-        .map(|(i, (_, &c))| (first + i, c.into()))
-        .unwrap_or((first, -1));
-    Err(range_error(i, c, max_code))
-}
-
-/// The message of a valid pulse `i` whose code `c` is out of 0 ..= `max_code`.
-fn range_error(i: usize, c: i128, max_code: u32) -> String {
-    format!(
-        "`tdc[{i}]` = {c} is outside the pixel's TDC codes 0 ..= {max_code} \
-         (pixel.tdc_bits); a code in that range would work, or valid[{i}] = False"
-    )
-}
-
-/// An integer dtype of TDC codes.
-pub trait Code: Copy + Into<i128> + Send + Sync {
-    /// The code as u32 (wrapping: only used once [`Code::within`] holds).
-    fn wrapped(self) -> u32;
-    /// 0 ≤ code ≤ `max`.
-    fn within(self, max: u32) -> bool;
-}
-
-macro_rules! code {
-    ($wide:ty: $($t:ty),*) => {$(
-        impl Code for $t {
-            #[inline]
-            fn wrapped(self) -> u32 {
-                self as u32
-            }
-            #[inline]
-            fn within(self, max: u32) -> bool {
-                // One unsigned compare in the type's own width (or 32 bits): a negative
-                // code sign-extends to above any max, so the pass vectorises in narrow
-                // lanes.
-                (self as $wide) <= <$wide>::from(max)
-            }
-        }
-    )*};
-}
-code!(u32: u8, u16, u32, i8, i16, i32);
-code!(u64: u64, i64);
 
 /// A dict shaped like the configuration document as TOML text (through `json.dumps`: a
 /// value JSON cannot hold is a `TypeError` naming `d`; a `None` a `ValueError`).
@@ -528,10 +314,7 @@ impl crate::Design {
         let tdc_a = codes("tdc", tdc)?;
         let (valid_s, tdc_s) = self.checked_frame(&valid_a, &tdc_a)?;
         let max_code = self.max_code();
-        py.detach(|| {
-            let mut out = Vec::with_capacity(valid_s.len());
-            detections(valid_s, tdc_s, 0, max_code, &mut out).map(|()| out)
-        })
-        .map_err(PyValueError::new_err)
+        py.detach(|| tdc_s.options(valid_s, max_code))
+            .map_err(value_error)
     }
 }

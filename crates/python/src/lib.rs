@@ -21,7 +21,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 use tofprobe_design::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, ResolvedDesign};
 use tofprobe_dsp::sd::ProbeRom;
-use tofprobe_pixel::FrameDriver;
+use tofprobe_pixel::{FrameDriver, PixelError};
 
 use convert::value_error;
 
@@ -275,16 +275,15 @@ impl Design {
         let rom = self.rom(py)?.map(|r| &r.image);
         let params = &self.inner.pixel;
         let max_code = self.max_code();
-        // The driver reads (valid, tdc) in place (convert::ValidTdc: a block of 256 pulses
-        // decoded at a time into the compact codes it steps, the range check riding
-        // along): no conversion pass, no second thread (scripts/python-bench.py,
-        // docs/performance.md).
-        let words = py.detach(|| -> Result<Vec<i64>, String> {
-            let mut driver = FrameDriver::new(params, rom).map_err(|e| e.to_string())?;
+        // The library reads (valid, tdc) in place (`tofprobe_pixel::ValidCodes`: a block of
+        // pulses decoded at a time into the compact codes the driver steps, the range check
+        // riding along): no conversion pass here (scripts/python-bench.py).
+        let words = py.detach(|| -> Result<Vec<i64>, PixelError> {
+            let mut driver = FrameDriver::new(params, rom)?;
             tdc_s.run_pixel(valid_s, max_code, &mut driver)?;
             Ok(driver.readout().words)
         });
-        Ok(words.map_err(PyValueError::new_err)?.into_pyarray(py))
+        Ok(words.map_err(value_error)?.into_pyarray(py))
     }
 
     /// The spectrum of a Fourier frame's registers (``tofprobe_pixel::spectrum::phasors``,
@@ -471,43 +470,48 @@ impl Design {
         analysis::size(self, py, liberty, sky130, sweep_bins, sweep_widths, node_nm)
     }
 
-    /// Seconds the library's own pixel call takes on the frame (the frame converted to the
-    /// drivers' compact codes first, untimed — what the Monte Carlo hands the array; then
-    /// ``FrameDriver`` run and read out, best of ``repeat``): the baseline of
-    /// ``run_pixel``'s overhead (scripts/python-bench.py).
-    #[pyo3(signature = (valid, tdc, repeat=1))]
+    /// Seconds the library's own pixel call takes on the frame, best of ``repeat``: the
+    /// baseline of ``run_pixel``'s overhead (scripts/python-bench.py). By default the call
+    /// a Rust program holding the same (``valid``, ``tdc``) arrays makes — ``FrameDriver``
+    /// run on ``tofprobe_pixel::ValidCodes`` (decoded in place), range check, readout —
+    /// the very call ``run_pixel`` wraps. With ``codes=True`` the frame is first converted
+    /// (untimed) to the drivers' compact codes, what the Monte Carlo hands the array: the
+    /// difference is the decoding's cost, which the input's form, not Python, sets.
+    #[pyo3(signature = (valid, tdc, repeat=1, codes=false))]
     fn time_library_run_pixel(
         &self,
         py: Python<'_>,
         valid: &Bound<'_, PyAny>,
         tdc: &Bound<'_, PyAny>,
         repeat: usize,
+        codes: bool,
     ) -> PyResult<f64> {
         let valid_a = convert::bool_array("valid", valid)?;
         let tdc_a = convert::codes("tdc", tdc)?;
         let (valid_s, tdc_s) = self.checked_frame(&valid_a, &tdc_a)?;
         let max_code = self.max_code();
-        let detections = py
-            .detach(|| {
-                let mut out = Vec::new();
-                tdc_s
-                    .compact_into(valid_s, 0, max_code, &mut out)
-                    .map(|()| out)
-            })
-            .map_err(PyValueError::new_err)?;
+        let compact = if codes {
+            Some(py.detach(|| tdc_s.compact(valid_s, max_code)).map_err(value_error)?)
+        } else {
+            None
+        };
         let rom = self.rom(py)?.map(|r| &r.image);
         let params = &self.inner.pixel;
         py.detach(|| {
             let mut best = f64::INFINITY;
             for _ in 0..repeat.max(1) {
                 let t0 = std::time::Instant::now();
-                let mut driver = FrameDriver::new(params, rom).map_err(value_error)?;
-                driver.run(&detections, 0).map_err(value_error)?;
+                let mut driver = FrameDriver::new(params, rom)?;
+                match &compact {
+                    Some(c) => driver.run(c.as_slice(), 0)?,
+                    None => tdc_s.run_pixel(valid_s, max_code, &mut driver)?,
+                }
                 std::hint::black_box(driver.readout());
                 best = best.min(t0.elapsed().as_secs_f64());
             }
-            Ok(best)
+            Ok::<_, PixelError>(best)
         })
+        .map_err(value_error)
     }
 
     /// Pickling: the resolved design travels as its JSON, with its probe ROM once it has

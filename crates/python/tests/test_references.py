@@ -183,8 +183,17 @@ def test_size_with_the_tools_reports_area(small):
 def test_the_library_timing_runs_the_frame(small):
     valid, tdc = small.simulate_scene()
     seconds = small.time_library_run_pixel(valid, tdc, repeat=2)
-    # 2·10^5 pulses at 1 ns – 1 µs each (the folded driver: ≈ 3 ns; a loaded machine).
-    assert 2e-4 < seconds < 0.2
+    in_codes = small.time_library_run_pixel(valid, tdc, repeat=2, codes=True)
+    # 2·10^5 pulses at 1 ns – 1 µs each (the folded driver: ≈ 3 ns; a loaded machine),
+    # read in place or from the compact codes alike.
+    assert 2e-4 < seconds < 0.2 and 2e-4 < in_codes < 0.2
+    # A code out of range is refused by the timed call too, as run_pixel refuses it.
+    bad = tdc.astype(np.int64)
+    bad[np.flatnonzero(valid)[0]] = 1 << 16
+    with pytest.raises(ValueError, match="outside"):
+        small.time_library_run_pixel(valid, bad)
+    with pytest.raises(ValueError, match="outside"):
+        small.time_library_run_pixel(valid, bad, codes=True)
 
 
 @pytest.mark.parametrize("call", ["dft", "float_sd", "time_library_run_pixel"])

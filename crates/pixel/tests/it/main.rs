@@ -14,3 +14,4 @@ mod refusal;
 mod register_frac_bits;
 mod sequencer;
 mod sizing;
+mod valid_codes;

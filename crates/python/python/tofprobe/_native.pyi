@@ -89,7 +89,11 @@ class Design:
         node_nm: float = 40.0,
     ) -> dict[str, Any]: ...
     def time_library_run_pixel(
-        self, valid: npt.ArrayLike, tdc: npt.ArrayLike, repeat: int = 1
+        self,
+        valid: npt.ArrayLike,
+        tdc: npt.ArrayLike,
+        repeat: int = 1,
+        codes: bool = False,
     ) -> float: ...
     def __reduce__(self) -> tuple[Any, tuple[str, str | None]]: ...
     @staticmethod
