@@ -5,9 +5,12 @@ against the DFT of simulated frames, the NTF against its defining properties, th
 against the summary and the readout's arithmetic, and the EDA sizing with and without its
 tools."""
 
+import json
 import math
 import os
 import shutil
+import subprocess
+import sys
 import tomllib
 
 import numpy as np
@@ -233,3 +236,18 @@ def test_an_empty_frame_and_haar_designs_are_refused(small):
     # Haar widths still resolve: 2^(U+1) − 1 registers of W bits.
     w = haar.widths()
     assert w["bits_per_frame"] == w["registers"] * w["width"]
+
+
+def test_the_overhead_benchmark_runs_and_prints_its_keys():
+    """scripts/python-bench.py, as docs/performance.md runs it, on a short frame: its JSON
+    keys and the ordering of its figures (the compact-code call skips the decoding)."""
+    script = ROOT / "scripts" / "python-bench.py"
+    out = subprocess.run([sys.executable, str(script), "--pulses", "200000", "--repeat", "3",
+                          "--json"], capture_output=True, text=True, check=True).stdout
+    r = json.loads(out)
+    assert r["pulses"] == 200_000 and r["repeat"] == 3
+    for key in ["python_seconds", "library_seconds", "library_codes_seconds"]:
+        # 2·10^5 pulses at ≈ 1–3 ns each: milliseconds, far from zero and from a second.
+        assert 1e-5 < r[key] < 0.5, (key, r[key])
+    assert np.isfinite(r["python_overhead_percent"]) and isinstance(r["pass"], bool)
+    assert r["pass"] == (r["python_overhead_percent"] <= 5)
