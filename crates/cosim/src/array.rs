@@ -13,7 +13,9 @@ use tofprobe_io::fnv1a64;
 use crate::error::CosimError;
 use crate::harness::{RunOutcome, parse_output};
 use crate::tools::require;
-use crate::verilator::{BuildProfile, HarnessBuild, VERILATOR_FLAGS, cache_root, cached_entry};
+use crate::verilator::{
+    BuildProfile, HarnessBuild, VERILATOR_FLAGS, build_key, cache_root, cached_entry, verilate,
+};
 
 /// The array harness, embedded so the binary works outside the source tree.
 pub const ARRAY_HARNESS_CPP: &str = include_str!("../../../testbench/array_harness.cpp");
@@ -36,64 +38,20 @@ pub fn build(rtl_dir: &Path, top: &str, profile: BuildProfile) -> Result<Harness
     let verilator = require("verilator")?;
     let t0 = Instant::now();
     let srcs = sources(rtl_dir)?;
-    let version = Command::new(&verilator)
-        .arg("--version")
-        .output()
-        .map_err(|e| CosimError::io(&verilator, e))?;
-    let mut key = b"array ".to_vec();
-    key.extend_from_slice(&version.stdout);
-    key.extend_from_slice(ARRAY_HARNESS_CPP.as_bytes());
-    key.extend_from_slice(format!("{top} {profile:?} {VERILATOR_FLAGS:?}").as_bytes());
-    for s in &srcs {
-        key.extend_from_slice(
-            s.file_name()
-                .map(|n| n.as_encoded_bytes())
-                .unwrap_or_default(),
-        );
-        key.extend_from_slice(&std::fs::read(s).map_err(|e| CosimError::io(s, e))?);
-    }
+    let key = build_key(
+        &verilator,
+        "array ",
+        ARRAY_HARNESS_CPP,
+        &format!("{top} {profile:?} {VERILATOR_FLAGS:?}"),
+        &srcs,
+    )?;
     let hash = format!("array-{:016x}", fnv1a64(&key));
     let root = cache_root().join("verilator");
     let (exe, reused) = cached_entry(&root, &hash, |tmp| {
         let cpp = tmp.join("array_harness.cpp");
         std::fs::write(&cpp, ARRAY_HARNESS_CPP).map_err(|e| CosimError::io(&cpp, e))?;
-        let obj = tmp.join("obj");
-        let mut cmd = Command::new(&verilator);
-        cmd.args(["--cc", "--exe", "--build", "-j", "2", "--prefix", "Vtop"])
-            .args(VERILATOR_FLAGS)
-            .args(["--top-module", top, "-Mdir"])
-            .arg(&obj)
-            .args(["-o", "harness", "-CFLAGS"])
-            .arg(format!(
-                "-DTOP_HEADER='\"Vtop.h\"' -DTOP_CLASS=Vtop {}",
-                match profile {
-                    BuildProfile::Check => "-O1",
-                    BuildProfile::Speed => "-O2",
-                }
-            ))
-            .arg("-MAKEFLAGS")
-            .arg(match profile {
-                BuildProfile::Check => "OPT_FAST=-O1 OPT_SLOW=-O0 OPT_GLOBAL=-O1",
-                BuildProfile::Speed => "OPT_FAST=-O2 OPT_SLOW=-O1 OPT_GLOBAL=-O2",
-            })
-            .args(&srcs)
-            .arg(&cpp);
-        let out = cmd.output().map_err(|e| CosimError::io(&verilator, e))?;
-        if !out.status.success() {
-            return Err(CosimError::ToolFailed {
-                tool: "verilator",
-                status: out.status.to_string(),
-                output: format!(
-                    "{}{}",
-                    String::from_utf8_lossy(&out.stdout),
-                    String::from_utf8_lossy(&out.stderr)
-                ),
-            });
-        }
-        let built = obj.join("harness");
-        std::fs::rename(&built, tmp.join("harness")).map_err(|e| CosimError::io(&built, e))?;
-        let _ = std::fs::remove_dir_all(&obj);
-        Ok(())
+        let cflags = "-DTOP_HEADER='\"Vtop.h\"' -DTOP_CLASS=Vtop";
+        verilate(&verilator, tmp, top, profile, cflags, &[], &srcs, &cpp)
     })?;
     Ok(HarnessBuild {
         exe,

@@ -140,28 +140,16 @@ pub fn build_with(
     let verilator = require("verilator")?;
     let t0 = Instant::now();
     let sources = verilog_sources(rtl_dir)?;
-    let version = Command::new(&verilator)
-        .arg("--version")
-        .output()
-        .map_err(|e| CosimError::io(&verilator, e))?;
-    let mut key = Vec::new();
-    key.extend_from_slice(&version.stdout);
-    key.extend_from_slice(HARNESS_CPP.as_bytes());
-    key.extend_from_slice(
-        format!(
+    let key = build_key(
+        &verilator,
+        "",
+        HARNESS_CPP,
+        &format!(
             "{top} {trace} {} {profile:?} {VERILATOR_FLAGS:?}",
             if coverage { "--coverage-line" } else { "" }
-        )
-        .as_bytes(),
-    );
-    for s in &sources {
-        key.extend_from_slice(
-            s.file_name()
-                .map(|n| n.as_encoded_bytes())
-                .unwrap_or_default(),
-        );
-        key.extend_from_slice(&std::fs::read(s).map_err(|e| CosimError::io(s, e))?);
-    }
+        ),
+        &sources,
+    )?;
     let hash = format!("{:016x}", fnv1a64(&key));
     let root = cache_root().join("verilator");
     let (exe, reused) = cached_entry(&root, &hash, |tmp| {
@@ -181,55 +169,107 @@ pub fn build_with(
         std::fs::write(&cfg_path, config).map_err(|e| CosimError::io(&cfg_path, e))?;
         let cpp = tmp.join("harness.cpp");
         std::fs::write(&cpp, HARNESS_CPP).map_err(|e| CosimError::io(&cpp, e))?;
-        let obj = tmp.join("obj");
-        let mut cmd = Command::new(&verilator);
-        cmd.args(["--cc", "--exe", "--build", "-j", "2", "--prefix", "Vtop"])
-            .args(VERILATOR_FLAGS)
-            .args(["--top-module", top, "-Mdir"])
-            .arg(&obj)
-            .args(["-o", "harness", "-CFLAGS"])
-            .arg(format!(
-                "-I{} {}",
-                tmp.display(),
-                match profile {
-                    BuildProfile::Check => "-O1",
-                    BuildProfile::Speed => "-O2",
-                }
-            ));
-        cmd.arg("-MAKEFLAGS").arg(match profile {
-            // CI: verilator's C++ compile dominates, so compile cheaply.
-            BuildProfile::Check => "OPT_FAST=-O1 OPT_SLOW=-O0 OPT_GLOBAL=-O1",
-            BuildProfile::Speed => "OPT_FAST=-O2 OPT_SLOW=-O1 OPT_GLOBAL=-O2",
-        });
+        let mut extra = Vec::new();
         if trace {
-            cmd.arg("--trace");
+            extra.push("--trace");
         }
         if coverage {
-            cmd.arg("--coverage-line");
+            extra.push("--coverage-line");
         }
-        cmd.args(&sources).arg(&cpp);
-        let out = cmd.output().map_err(|e| CosimError::io(&verilator, e))?;
-        if !out.status.success() {
-            return Err(CosimError::ToolFailed {
-                tool: "verilator",
-                status: out.status.to_string(),
-                output: format!(
-                    "{}{}",
-                    String::from_utf8_lossy(&out.stdout),
-                    String::from_utf8_lossy(&out.stderr)
-                ),
-            });
-        }
-        let built = obj.join("harness");
-        std::fs::rename(&built, tmp.join("harness")).map_err(|e| CosimError::io(&built, e))?;
-        let _ = std::fs::remove_dir_all(&obj);
-        Ok(())
+        let cflags = format!("-I{}", tmp.display());
+        verilate(
+            &verilator, tmp, top, profile, &cflags, &extra, &sources, &cpp,
+        )
     })?;
     Ok(HarnessBuild {
         exe,
         reused,
         seconds: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// The cache key of a harness build: the Verilator version, a `tag`, the harness source,
+/// the build's `options` (top, profile, flags) and every RTL source's name and bytes.
+pub(crate) fn build_key(
+    verilator: &Path,
+    tag: &str,
+    harness: &str,
+    options: &str,
+    sources: &[PathBuf],
+) -> Result<Vec<u8>, CosimError> {
+    let version = Command::new(verilator)
+        .arg("--version")
+        .output()
+        .map_err(|e| CosimError::io(verilator, e))?;
+    let mut key = tag.as_bytes().to_vec();
+    key.extend_from_slice(&version.stdout);
+    key.extend_from_slice(harness.as_bytes());
+    key.extend_from_slice(options.as_bytes());
+    for s in sources {
+        key.extend_from_slice(
+            s.file_name()
+                .map(|n| n.as_encoded_bytes())
+                .unwrap_or_default(),
+        );
+        key.extend_from_slice(&std::fs::read(s).map_err(|e| CosimError::io(s, e))?);
+    }
+    Ok(key)
+}
+
+/// Verilates `sources` with the harness `cpp` (top `top`, the class `Vtop`) into the
+/// executable `tmp/harness`, compiled at `profile`'s optimisation with `cflags` and the
+/// `extra` Verilator options; the object directory is removed afterwards.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn verilate(
+    verilator: &Path,
+    tmp: &Path,
+    top: &str,
+    profile: BuildProfile,
+    cflags: &str,
+    extra: &[&str],
+    sources: &[PathBuf],
+    cpp: &Path,
+) -> Result<(), CosimError> {
+    let obj = tmp.join("obj");
+    let out = Command::new(verilator)
+        .args(["--cc", "--exe", "--build", "-j", "2", "--prefix", "Vtop"])
+        .args(VERILATOR_FLAGS)
+        .args(["--top-module", top, "-Mdir"])
+        .arg(&obj)
+        .args(["-o", "harness", "-CFLAGS"])
+        .arg(format!(
+            "{cflags} {}",
+            match profile {
+                BuildProfile::Check => "-O1",
+                BuildProfile::Speed => "-O2",
+            }
+        ))
+        .arg("-MAKEFLAGS")
+        .arg(match profile {
+            // CI: verilator's C++ compile dominates, so compile cheaply.
+            BuildProfile::Check => "OPT_FAST=-O1 OPT_SLOW=-O0 OPT_GLOBAL=-O1",
+            BuildProfile::Speed => "OPT_FAST=-O2 OPT_SLOW=-O1 OPT_GLOBAL=-O2",
+        })
+        .args(extra)
+        .args(sources)
+        .arg(cpp)
+        .output()
+        .map_err(|e| CosimError::io(verilator, e))?;
+    if !out.status.success() {
+        return Err(CosimError::ToolFailed {
+            tool: "verilator",
+            status: out.status.to_string(),
+            output: format!(
+                "{}{}",
+                String::from_utf8_lossy(&out.stdout),
+                String::from_utf8_lossy(&out.stderr)
+            ),
+        });
+    }
+    let built = obj.join("harness");
+    std::fs::rename(&built, tmp.join("harness")).map_err(|e| CosimError::io(&built, e))?;
+    let _ = std::fs::remove_dir_all(&obj);
+    Ok(())
 }
 
 /// The cache entry `root/<hash>` (an executable `harness` and its checksum): reused when

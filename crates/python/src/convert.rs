@@ -241,11 +241,7 @@ impl CodeSlice<'_> {
 
     /// The frame (`valid`, these codes) as `Option`s (the float references' form),
     /// range-checked.
-    pub fn options(
-        &self,
-        valid: &[bool],
-        max_code: u32,
-    ) -> Result<Vec<Option<u32>>, PixelError> {
+    pub fn options(&self, valid: &[bool], max_code: u32) -> Result<Vec<Option<u32>>, PixelError> {
         with_codes!(*self, |s| ValidCodes::new(valid, s, max_code)?.options())
     }
 }

@@ -491,7 +491,10 @@ impl Design {
         let (valid_s, tdc_s) = self.checked_frame(&valid_a, &tdc_a)?;
         let max_code = self.max_code();
         let compact = if codes {
-            Some(py.detach(|| tdc_s.compact(valid_s, max_code)).map_err(value_error)?)
+            Some(
+                py.detach(|| tdc_s.compact(valid_s, max_code))
+                    .map_err(value_error)?,
+            )
         } else {
             None
         };

@@ -54,10 +54,7 @@ fn agrees<T: TdcCode + TryFrom<i64>>(seed: u64) -> bool {
     let frame = ValidCodes::new(&valid, &tdc, max).expect("same lengths");
     let expected = naive(&valid, &tdc, max);
     assert_eq!(frame.options().unwrap(), expected, "seed {seed}: decode");
-    let compact: Vec<u32> = expected
-        .iter()
-        .map(|d| d.unwrap_or(NO_DETECTION))
-        .collect();
+    let compact: Vec<u32> = expected.iter().map(|d| d.unwrap_or(NO_DETECTION)).collect();
     assert_eq!(frame.compact().unwrap(), compact, "seed {seed}: compact");
     for i in 0..n.min(50) {
         assert_eq!(frame.get(i), expected[i], "seed {seed}: pulse {i}");
@@ -124,7 +121,12 @@ fn a_valid_code_out_of_range_is_refused_naming_the_first_pulse() {
         // Without the bad codes the same frame passes.
         tdc[600] = 5;
         tdc[900] = 5;
-        assert!(ValidCodes::new(&valid, &tdc, max).unwrap().compact().is_ok());
+        assert!(
+            ValidCodes::new(&valid, &tdc, max)
+                .unwrap()
+                .compact()
+                .is_ok()
+        );
     }
     // Lengths that differ are refused before any pulse is read.
     let e = ValidCodes::new(&[true; 3], &[1u16; 2], max).unwrap_err();
