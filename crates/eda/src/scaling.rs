@@ -61,6 +61,31 @@ pub struct BinFit {
     pub flop_only_bins: u64,
 }
 
+/// The routed macro's area over its synthesised cells (k = die / cell area) of one
+/// technology, read from a layout report (`tofprobe layout`): what turns a synthesis area
+/// into a routed one for the bins-per-pitch answer (first order: k is taken to hold for
+/// other B and options on the same technology at the same density).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct RoutedFactor {
+    /// `osu018` or `sky130`: the liberties it applies to.
+    pub technology: String,
+    /// k = die area / synthesis cell area (> 1).
+    pub factor: f64,
+    /// Placement density the macro routed at.
+    pub density: f64,
+    /// The configuration that was laid out (its origin, as the layout report names it).
+    pub config: String,
+}
+
+impl RoutedFactor {
+    /// Whether a liberty (its library name) belongs to this technology.
+    pub fn applies_to(&self, library: &str) -> bool {
+        library
+            .to_ascii_lowercase()
+            .contains(&self.technology.to_ascii_lowercase())
+    }
+}
+
 /// Bins that fit when a bin costs only its 2·W flops of `flop_um2` (sky130 area).
 pub fn flop_only_bins(width: u32, flop_um2: f64, side_um: f64, node_nm: f64) -> u64 {
     let per_bin = 2.0 * f64::from(width) * flop_um2 * node_factor(node_nm);

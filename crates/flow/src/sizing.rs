@@ -177,5 +177,6 @@ pub fn options_request(
         cache,
         node_nm: a.node_nm,
         pixel_sides_um: vec![(30.0, Some(6)), (40.0, Some(13))],
+        routed: None,
     })
 }

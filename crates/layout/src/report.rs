@@ -5,8 +5,11 @@
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
+use tofprobe_eda::scaling::RoutedFactor;
+
 use crate::bins::BinsPerPitch;
 use crate::def::DefFigures;
+use crate::error::{LayoutError, Result};
 use crate::sta::PostRoute;
 
 /// JSON schema name of [`LayoutReport`].
@@ -102,6 +105,74 @@ pub struct LayoutReport {
     pub corners: Vec<CornerRow>,
     /// What the figures assume.
     pub notes: Vec<String>,
+}
+
+/// What the options study reads of a layout report: a partial view, so any report of
+/// [`SCHEMA`] reads (fields it does not need are ignored).
+#[derive(Debug, Deserialize)]
+struct AreaView {
+    schema: String,
+    tech: String,
+    config: String,
+    drc_errors: u64,
+    lvs_match: bool,
+    attempts: Vec<DensityView>,
+    bins_per_pitch: Option<FactorView>,
+}
+
+/// An attempt's density.
+#[derive(Debug, Deserialize)]
+struct DensityView {
+    density: f64,
+}
+
+/// The routed factor of the bins per pitch.
+#[derive(Debug, Deserialize)]
+struct FactorView {
+    routed_factor: f64,
+}
+
+/// The routed factor k of the layout report at `path` (`layout-report.json` of `tofprobe
+/// layout`), refused unless the report is of this schema, its macro is clean (DRC 0, LVS
+/// match: a dirty macro's area is not an answer) and it carries bins per pitch, and k is a
+/// finite number ≥ 1.
+pub fn read_routed_factor(path: &std::path::Path) -> Result<RoutedFactor> {
+    let text = std::fs::read_to_string(path).map_err(|e| LayoutError::io("reading", path, e))?;
+    let refuse = |what: String| LayoutError::Parse {
+        tool: "tofprobe layout",
+        what,
+        path: path.to_path_buf(),
+    };
+    let v: AreaView =
+        serde_json::from_str(&text).map_err(|e| refuse(format!("a layout report ({e})")))?;
+    if v.schema != SCHEMA {
+        return Err(refuse(format!(
+            "a report of schema {SCHEMA} (`schema` is {:?})",
+            v.schema
+        )));
+    }
+    if v.drc_errors != 0 || !v.lvs_match {
+        return Err(refuse(format!(
+            "a clean macro (`drc_errors` = {}, `lvs_match` = {}; DRC 0 and LVS match are needed)",
+            v.drc_errors, v.lvs_match
+        )));
+    }
+    let k = v
+        .bins_per_pitch
+        .as_ref()
+        .map(|b| b.routed_factor)
+        .ok_or_else(|| refuse("`bins_per_pitch` (null: the layout had no area model)".into()))?;
+    if !(k.is_finite() && k >= 1.0) {
+        return Err(refuse(format!(
+            "`bins_per_pitch.routed_factor` ≥ 1 (die area over cell area), got {k}"
+        )));
+    }
+    Ok(RoutedFactor {
+        technology: v.tech,
+        factor: k,
+        density: v.attempts.last().map_or(0.0, |a| a.density),
+        config: v.config,
+    })
 }
 
 impl LayoutReport {

@@ -37,8 +37,8 @@ pub enum PixelError {
     CodeOutOfRange {
         /// The first such pulse.
         pulse: usize,
-        /// Its code.
-        code: i128,
+        /// Its code (as written: any integer type's value).
+        code: String,
         /// The largest code, 2^T − 1.
         max: u32,
         /// T.

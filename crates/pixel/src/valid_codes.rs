@@ -114,7 +114,7 @@ impl<'a, T: TdcCode> ValidCodes<'a, T> {
 fn out_of_range(i: usize, c: i128, max_code: u32) -> PixelError {
     PixelError::CodeOutOfRange {
         pulse: i,
-        code: c,
+        code: c.to_string(),
         max: max_code,
         bits: u32::BITS - max_code.leading_zeros(),
     }

@@ -74,6 +74,11 @@ pub struct SizeArgs {
     /// With --options: seeds of the accuracy measurement (comma-separated).
     #[arg(long, value_delimiter = ',', requires = "options", default_values_t = tofprobe_experiments::options::DEFAULT_SEEDS)]
     pub seeds: Vec<u64>,
+    /// With --options: a `layout-report.json` of `tofprobe layout` (DRC- and LVS-clean):
+    /// every option's bins per pitch also from layout, its area model times the macro's
+    /// routed factor k, on the liberties of that technology (docs/layout.md).
+    #[arg(long, value_name = "FILE", requires = "options")]
+    pub layout_report: Option<PathBuf>,
 }
 
 /// The report with the options study when asked (JSON: the size report's keys, plus
@@ -98,13 +103,17 @@ pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
     tofprobe_flow::array_report::check(&design, a.utilisation)?;
     let options = size_options(a);
     let req = if a.options {
-        let req = options_request(
+        let mut req = options_request(
             &design,
             &options,
             a.only.clone(),
             a.seeds.clone(),
             a.target_error_um,
         )?;
+        req.routed = match &a.layout_report {
+            Some(path) => Some(tofprobe_layout::report::read_routed_factor(path)?),
+            None => None,
+        };
         // Before minutes of synthesis: an unknown option or target fails now.
         tofprobe_experiments::options::check(&design, &req)?;
         Some(req)

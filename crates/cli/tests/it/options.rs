@@ -75,8 +75,9 @@ fn options_study_recommendation_and_flow() {
     // `--cache DIR` is the synthesis cache itself; $TOFPROBE_CACHE (flow has no --cache) is
     // its parent.
     let cache = dir.join("cache").join("synth");
-    refusals(cfg_s, &cache);
+    refusals(cfg_s, &cache, &dir);
     let rec = front_and_recommendation(cfg_s, &cache, &dir.join("set"));
+    bins_from_a_layout_report(cfg_s, &cache, &dir);
     unreachable_target_names_the_closest_option(cfg_s, &cache);
     flow_recommended_builds_and_cosimulates_the_choice(cfg_s, &cache, &dir.join("out"), &rec);
 }
@@ -218,8 +219,134 @@ fn unreachable_target_names_the_closest_option(cfg: &str, cache: &Path) {
     }
 }
 
-/// Refused before any synthesis: an unknown option, a target that is no tone error.
-fn refusals(cfg: &str, cache: &Path) {
+/// A layout report as `tofprobe layout` writes it, with the fields `--layout-report` reads
+/// (the rest of a real report is ignored).
+fn layout_report(dir: &Path, name: &str, tech: &str, k: f64, drc: u64) -> PathBuf {
+    let v = serde_json::json!({
+        "schema": tofprobe_layout::report::SCHEMA,
+        "tech": tech,
+        "config": "small.toml",
+        "drc_errors": drc,
+        "lvs_match": true,
+        "attempts": [{"density": 0.6}],
+        "bins_per_pitch": {"routed_factor": k},
+    });
+    let p = dir.join(name);
+    std::fs::write(&p, v.to_string()).expect("write layout report");
+    p
+}
+
+/// `--layout-report`: every option's bins per pitch from layout on the report's technology
+/// (osu018 here, not sky130), recomputed naively from the row's area model times k; the
+/// recommendation's count in the Markdown. At 7 nm so that the counts are not all zero
+/// (the osu018 model's fixed part fills a 40 µm pitch at 40 nm).
+fn bins_from_a_layout_report(cfg: &str, cache: &Path, dir: &Path) {
+    let k = 2.0;
+    let report = layout_report(dir, "osu018-layout.json", "osu018", k, 0);
+    let out_dir = dir.join("set-layout");
+    let args = options_args(
+        cfg,
+        &[
+            "--target-error-um",
+            "30",
+            "--node-nm",
+            "7",
+            "--layout-report",
+            report.to_str().unwrap(),
+            "--json",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+    );
+    let o = run(&args, cache);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j = common::last_json(&o);
+    let opts = &j["options"];
+    assert_eq!(opts["layout"]["factor"], k);
+    assert_eq!(opts["layout"]["technology"], "osu018");
+    let mut nonzero = 0;
+    for r in opts["rows"].as_array().unwrap() {
+        let (osu, sky) = (&r["libraries"][0], &r["libraries"][1]);
+        assert!(
+            sky.get("layout_fits").is_none(),
+            "sky130 has no osu018 layout"
+        );
+        let model = &osu["model"];
+        let (fixed, per_bin) = (f(&model["fixed_um2"]), f(&model["per_bin_um2"]));
+        let synth = osu["fits"].as_array().unwrap();
+        for (i, lf) in osu["layout_fits"].as_array().unwrap().iter().enumerate() {
+            // side² = k·(F + n·b)·(7/180)²: n = ⌊(side²/(k·s) − F)/b⌋, at least 0.
+            let side = f(&lf["pixel_side_um"]);
+            let s = (7.0f64 / 180.0).powi(2);
+            let naive = ((side * side / (k * s) - fixed) / per_bin).floor().max(0.0) as u64;
+            let got = lf["bins"].as_u64().unwrap();
+            // ±1: the naive line and the library's may round the boundary differently.
+            assert!(
+                got.abs_diff(naive) <= 1,
+                "{}: {got} vs {naive}",
+                r["option"]["name"]
+            );
+            let synth_bins = synth[i]["bins"].as_u64().unwrap();
+            assert!(
+                got < synth_bins,
+                "k = 2 must leave fewer bins: {got} vs {synth_bins}"
+            );
+            nonzero += usize::from(got > 0);
+        }
+    }
+    assert!(
+        nonzero > 0,
+        "every layout count is 0: the check would not see a wrong k"
+    );
+    let md = std::fs::read_to_string(out_dir.join("size-report.md")).expect("report");
+    for part in [
+        "Bins per pixel pitch from layout (k = 2.000, the osu018 macro of small.toml",
+        "**The recommended option from layout** (k = 2.000, osu018 at 7 nm)",
+        "Bins per pitch from layout: each option's area model times the routed factor",
+    ] {
+        assert!(md.contains(part), "`{part}` missing from the report");
+    }
+}
+
+/// Refused before any synthesis: an unknown option, a target that is no tone error, a
+/// layout report of a dirty macro or of a technology none of the liberties is.
+fn refusals(cfg: &str, cache: &Path, dir: &Path) {
+    let dirty = layout_report(dir, "dirty.json", "osu018", 1.9, 4);
+    let o = run(
+        &[
+            "size",
+            cfg,
+            "--no-sky130",
+            "--options",
+            "--layout-report",
+            dirty.to_str().unwrap(),
+        ],
+        cache,
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("`drc_errors` = 4") && err.contains("dirty.json"),
+        "{err}"
+    );
+    let sky = layout_report(dir, "sky.json", "sky130", 1.9, 0);
+    let o = run(
+        &[
+            "size",
+            cfg,
+            "--no-sky130",
+            "--options",
+            "--layout-report",
+            sky.to_str().unwrap(),
+        ],
+        cache,
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("layout-report") && err.contains("sky130"),
+        "{err}"
+    );
     // An unknown option lists the catalogue.
     let o = run(
         &["size", cfg, "--no-sky130", "--options", "--option", "G=3"],

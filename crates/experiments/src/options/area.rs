@@ -10,7 +10,7 @@ use tofprobe_eda::analysis::analyse_points;
 use tofprobe_eda::corners::CornerTiming;
 use tofprobe_eda::generated::GeneratedPixel;
 use tofprobe_eda::liberty::Liberty;
-use tofprobe_eda::scaling::{AreaModel, BinFit, bins_that_fit, flop_only_bins};
+use tofprobe_eda::scaling::{AreaModel, BinFit, RoutedFactor, bins_that_fit, flop_only_bins};
 use tofprobe_pixel::PixelParams;
 
 use crate::error::ExperimentError;
@@ -43,6 +43,10 @@ pub struct LibraryArea {
     pub timing: Option<CornerTiming>,
     /// Bins that fit each pitch at the target node, area scaled by (node / library node)².
     pub fits: Vec<BinFit>,
+    /// The same from layout: the area model times the routed factor k of a layout report
+    /// of this library's technology (`size --options --layout-report`); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub layout_fits: Option<Vec<BinFit>>,
 }
 
 /// What [`measure`] needs besides the pixel.
@@ -60,6 +64,8 @@ pub struct AreaRequest<'a> {
     pub pixel_sides_um: &'a [(f64, Option<u64>)],
     /// The B sweep of the area model (see [`model_bins`]).
     pub sweep_bins: &'a [u64],
+    /// A routed factor k: bins per pitch from layout too, when it applies to the library.
+    pub routed: Option<&'a RoutedFactor>,
 }
 
 /// The B points of the area model: the configured B and the sweep's points up to it; when
@@ -119,16 +125,30 @@ pub fn measure(pixel: &PixelParams, req: &AreaRequest<'_>) -> Result<LibraryArea
         per_bin_um2: model.per_bin_um2 * to130,
     };
     let flop = req.lib.smallest_flop().map_or(0.0, |f| f.1) * to130;
-    let mut fits = Vec::new();
-    for &(side, paper) in req.pixel_sides_um {
-        fits.push(BinFit {
-            pixel_side_um: side,
-            node_nm: req.node_nm,
-            bins: bins_that_fit(&rebased, side, req.node_nm)?,
-            paper_bins: paper,
-            flop_only_bins: flop_only_bins(pixel.width, flop, side, req.node_nm),
-        });
-    }
+    // The routed area is k × the cells (`tofprobe layout`'s bins per pitch, the same
+    // scaling): the flop-only bound stays the synthesis one.
+    let fits_at = |k: f64| -> Result<Vec<BinFit>, ExperimentError> {
+        let model = AreaModel {
+            fixed_um2: rebased.fixed_um2 * k,
+            per_bin_um2: rebased.per_bin_um2 * k,
+        };
+        let mut fits = Vec::new();
+        for &(side, paper) in req.pixel_sides_um {
+            fits.push(BinFit {
+                pixel_side_um: side,
+                node_nm: req.node_nm,
+                bins: bins_that_fit(&model, side, req.node_nm)?,
+                paper_bins: paper,
+                flop_only_bins: flop_only_bins(pixel.width, flop, side, req.node_nm),
+            });
+        }
+        Ok(fits)
+    };
+    let fits = fits_at(1.0)?;
+    let layout_fits = match req.routed {
+        Some(k) if k.applies_to(&req.lib.name) => Some(fits_at(k.factor)?),
+        _ => None,
+    };
     let corner = if req.lib.name.contains("sky130") {
         "tt_025C_1v80"
     } else {
@@ -151,6 +171,7 @@ pub fn measure(pixel: &PixelParams, req: &AreaRequest<'_>) -> Result<LibraryArea
             )
         }),
         fits,
+        layout_fits,
     })
 }
 

@@ -131,6 +131,10 @@ pub fn render(r: &OptionsReport) -> String {
         let _ = writeln!(s, "| {name} | {} |", cells.join(" | "));
     }
 
+    if let Some(k) = &r.layout {
+        layout_table(&mut s, r, k);
+    }
+
     let rec = &r.recommendation;
     let saving = rec
         .baseline_area_um2
@@ -161,8 +165,90 @@ pub fn render(r: &OptionsReport) -> String {
                 .join(", ")
         }
     );
+    if let Some(line) = recommended_from_layout(r) {
+        let _ = writeln!(s, "{line}\n");
+    }
     for a in &r.assumptions {
         let _ = writeln!(s, "- {a}");
     }
     s
+}
+
+/// The bins-per-pitch table from layout: each option's model times the routed factor k,
+/// on the libraries of the layout's technology, beside the synthesis count.
+fn layout_table(s: &mut String, r: &OptionsReport, k: &tofprobe_eda::scaling::RoutedFactor) {
+    let _ = writeln!(
+        s,
+        "\n### Bins per pixel pitch from layout (k = {:.3}, the {} macro of {} at density {:.2})\n",
+        k.factor, k.technology, k.config, k.density
+    );
+    let Some(first) = r.rows.first() else {
+        return;
+    };
+    let mut head = "| option |".to_string();
+    let mut rule = "|---|".to_string();
+    for l in first.libraries.iter().filter(|l| l.layout_fits.is_some()) {
+        for f in &l.fits {
+            let _ = write!(
+                head,
+                " {} {:.0}×{:.0} µm: layout (synthesis) |",
+                lib_short(&l.library),
+                f.pixel_side_um,
+                f.pixel_side_um
+            );
+            rule += "---:|";
+        }
+    }
+    let _ = writeln!(s, "{head}\n{rule}");
+    for row in &r.rows {
+        let mut line = format!("| {} |", row.option.name);
+        for l in &row.libraries {
+            if let Some(lf) = &l.layout_fits {
+                for (a, b) in lf.iter().zip(&l.fits) {
+                    let _ = write!(line, " {} ({}) |", a.bins, b.bins);
+                }
+            }
+        }
+        let _ = writeln!(s, "{line}");
+    }
+}
+
+/// The recommended option's bins per pitch from layout, in words (none without a layout).
+pub fn recommended_from_layout(r: &OptionsReport) -> Option<String> {
+    let k = r.layout.as_ref()?;
+    let row = r
+        .rows
+        .iter()
+        .find(|row| row.option.name == r.recommendation.option)?;
+    let parts: Vec<String> = row
+        .libraries
+        .iter()
+        .filter_map(|l| {
+            let lf = l.layout_fits.as_ref()?;
+            Some(
+                lf.iter()
+                    .map(|f| {
+                        format!(
+                            "{} bins in {:.0} µm on {} (paper {})",
+                            f.bins,
+                            f.pixel_side_um,
+                            lib_short(&l.library),
+                            f.paper_bins.map_or("—".into(), |p| p.to_string())
+                        )
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            )
+        })
+        .collect();
+    Some(format!(
+        "**The recommended option from layout** (k = {:.3}, {} at {:.0} nm): {}.",
+        k.factor,
+        k.technology,
+        row.libraries
+            .first()
+            .and_then(|l| l.fits.first())
+            .map_or(0.0, |f| f.node_nm),
+        parts.join("; ")
+    ))
 }

@@ -18,6 +18,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 use tofprobe_design::ResolvedDesign;
 use tofprobe_eda::liberty::Liberty;
+use tofprobe_eda::scaling::RoutedFactor;
 
 pub use catalogue::ArchOption;
 pub use front::Recommendation;
@@ -52,6 +53,9 @@ pub struct OptionsRequest {
     pub sweep_bins: Vec<u64>,
     /// Pitches (µm) with the paper's estimate.
     pub pixel_sides_um: Vec<(f64, Option<u64>)>,
+    /// A routed macro's factor k (`size --options --layout-report`): each option's bins per
+    /// pitch from layout, on the liberties of its technology, beside the synthesis answer.
+    pub routed: Option<RoutedFactor>,
 }
 
 /// One option's row.
@@ -96,6 +100,9 @@ pub struct OptionsReport {
     pub rows: Vec<OptionRow>,
     /// The recommended option (JSON `null` never: a target no option meets is an error).
     pub recommendation: Recommendation,
+    /// The routed factor the layout answers use (`--layout-report`), or absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub layout: Option<RoutedFactor>,
     /// The assumptions, in words.
     pub assumptions: Vec<String>,
 }
@@ -119,6 +126,25 @@ pub fn check(
             "liberty",
             "none",
             "at least one liberty",
+        ));
+    }
+    if let Some(k) = &req.routed
+        && !req
+            .liberties
+            .iter()
+            .any(|l| k.applies_to(&l.to_string_lossy()))
+    {
+        return Err(ExperimentError::option(
+            "layout-report",
+            format!("a {} layout (k = {:.3})", k.technology, k.factor),
+            &format!(
+                "a layout of a technology among the liberties ({}): osu018 (the default) or sky130 (with the shared PDK)",
+                req.liberties
+                    .iter()
+                    .map(|l| l.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
         ));
     }
     if req.seeds.is_empty() {
@@ -188,6 +214,7 @@ pub fn run(
                     node_nm: req.node_nm,
                     pixel_sides_um: &req.pixel_sides_um,
                     sweep_bins: &req.sweep_bins,
+                    routed: req.routed.as_ref(),
                 },
             )
             .map_err(|e| {
@@ -237,6 +264,13 @@ pub fn run(
         ),
         "The Pareto front: no other option has both less area per bin (front library) and a lower mean tone error.".into(),
     ];
+    let mut assumptions = assumptions;
+    if let Some(k) = &req.routed {
+        assumptions.push(format!(
+            "Bins per pitch from layout: each option's area model times the routed factor k = {:.3} (die area / cell area) of the {} macro of {} routed at density {:.2} (`tofprobe layout`), on the {} liberties only; k is taken to hold for every option and B (first order: it follows the density and the technology more than the logic).",
+            k.factor, k.technology, k.config, k.density, k.technology
+        ));
+    }
     Ok(OptionsReport {
         bins: design.pixel.bins as u64,
         clock_mhz,
@@ -246,6 +280,7 @@ pub fn run(
         target_error_um: req.target_error_um,
         rows,
         recommendation,
+        layout: req.routed.clone(),
         assumptions,
     })
 }
