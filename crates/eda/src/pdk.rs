@@ -110,6 +110,20 @@ impl Sky130Pdk {
     pub fn typical(&self, cache: &Path) -> Result<PathBuf> {
         plain_copy(&self.corners[0].source, cache)
     }
+
+    /// The plain liberty of the corner whose name starts with `prefix` (`tt`, `ss`, `ff`,
+    /// or a whole name such as `ss_n40C_1v40`); `Ok(None)` when this PDK has no such corner.
+    pub fn corner(&self, prefix: &str, cache: &Path) -> Result<Option<PathBuf>> {
+        match self.corners.iter().find(|c| c.name.starts_with(prefix)) {
+            Some(c) if !prefix.is_empty() => plain_copy(&c.source, cache).map(Some),
+            _ => Ok(None),
+        }
+    }
+
+    /// The names of the corners this PDK holds, typical first.
+    pub fn corner_names(&self) -> Vec<&str> {
+        self.corners.iter().map(|c| c.name.as_str()).collect()
+    }
 }
 
 /// `path` itself when it is plain text, else its decompressed copy under

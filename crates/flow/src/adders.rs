@@ -72,8 +72,32 @@ fn key_error(value: &str, reason: impl ToString) -> PixelError {
         "timing_liberty",
         format!("\"{shown}\""),
         tofprobe_io::text::clip(&reason, 4 * tofprobe_io::text::MAX_TEXT),
-        "\"osu018\", \"sky130\" or the path of a liberty with timing",
+        "\"osu018\", \"sky130\" (tt), \"sky130:ss\", \"sky130:ff\" or the path of a liberty with timing",
     )
+}
+
+/// The timed sky130 PDK's liberty at `corner` (`tt`, `ss`, `ff`, or a whole corner name)
+/// for the `timing_liberty` value `name`; errors name the key and the corners there are.
+fn sky130_corner(name: &str, corner: &str, cache: &std::path::Path) -> Result<PathBuf, PixelError> {
+    let pdk = Sky130Pdk::discover(None)
+        .map_err(|e| key_error(name, e))?
+        .ok_or_else(|| {
+            key_error(
+                name,
+                "no timed sky130_fd_sc_hd PDK found ($TOFPROBE_SKY130_PDK, ../shared/pdk/sky130_fd_sc_hd)",
+            )
+        })?;
+    pdk.corner(corner, cache)
+        .map_err(|e| key_error(name, e))?
+        .ok_or_else(|| {
+            key_error(
+                name,
+                format!(
+                    "the sky130 PDK has no corner `{corner}`: \"sky130:tt\", \"sky130:ss\" or \"sky130:ff\" (corners {})",
+                    pdk.corner_names().join(", ")
+                ),
+            )
+        })
 }
 
 /// Synthesis + OpenSTA timing on the liberty `pixel.timing_liberty` names.
@@ -85,23 +109,15 @@ pub struct SynthesisTiming {
 
 impl SynthesisTiming {
     /// The oracle for `timing_liberty` (`"osu018"` when `None`, `"sky130"` = the timed
-    /// PDK's tt corner, or a path); errors name `timing_liberty`.
+    /// PDK's tt corner, `"sky130:ss"` / `"sky130:ff"` / `"sky130:tt"` a corner of it — the
+    /// slowest, `ss`, is where sign-off judges —, or a path); errors name `timing_liberty`.
     pub fn new(timing_liberty: Option<&str>) -> Result<Self, PixelError> {
         let cache = synth_cache_dir(None);
         let name = timing_liberty.unwrap_or("osu018");
         let path = match name {
             "osu018" => PathBuf::from(OSU018_LIBERTY),
-            "sky130" => {
-                let pdk = Sky130Pdk::discover(None)
-                    .map_err(|e| key_error("sky130", e))?
-                    .ok_or_else(|| {
-                        key_error(
-                            "sky130",
-                            "no timed sky130_fd_sc_hd PDK found ($TOFPROBE_SKY130_PDK, ../shared/pdk/sky130_fd_sc_hd)",
-                        )
-                    })?;
-                pdk.typical(&cache).map_err(|e| key_error("sky130", e))?
-            }
+            "sky130" => sky130_corner(name, "tt", &cache)?,
+            _ if name.starts_with("sky130:") => sky130_corner(name, &name[7..], &cache)?,
             path => PathBuf::from(path),
         };
         let lib = Liberty::load(&path).map_err(|e| key_error(name, e))?;

@@ -61,7 +61,8 @@ pub struct PixelConfig {
     pub adders: Choice<usize>,
     /// The liberty `adders = "auto"` times on: `"osu018"` (default, Debian's
     /// qflow-tech-osu018), `"sky130"` (the timed sky130_fd_sc_hd PDK's tt corner, found as
-    /// `tofprobe size` finds it) or a path to a liberty with timing.
+    /// `tofprobe size` finds it), `"sky130:ss"` / `"sky130:ff"` (its other corners; ss is
+    /// the slowest) or a path to a liberty with timing.
     pub timing_liberty: Option<String>,
     /// C: clock cycles per laser pulse (default 16).
     pub cycles_per_pulse: usize,
