@@ -26,6 +26,17 @@ pub struct RtlVariant {
 pub trait RtlProvider: Sync {
     /// The RTL for (B, W); `dir` is a scratch directory the provider may write into.
     fn rtl(&self, bins: u64, width: u32, dir: &Path) -> Result<RtlVariant>;
+
+    /// The same pixel with `adders` adders at `cycles_per_pulse` cycles per pulse, when this
+    /// provider can vary them (`Ok(None)` otherwise, or when the contract refuses that
+    /// schedule): the candidates of a missed corner (`crate::corner_option`).
+    fn with_adders(
+        &self,
+        _adders: u64,
+        _cycles_per_pulse: u64,
+    ) -> Result<Option<Box<dyn RtlProvider>>> {
+        Ok(None)
+    }
 }
 
 /// A parameterised Verilog module: (B, W) are set with yosys `chparam`.

@@ -75,4 +75,21 @@ impl RtlProvider for GeneratedPixel {
             params: vec![],
         })
     }
+
+    fn with_adders(
+        &self,
+        adders: u64,
+        cycles_per_pulse: u64,
+    ) -> Result<Option<Box<dyn RtlProvider>>> {
+        let mut base = self.base.clone();
+        let (Ok(a), Ok(c)) = (usize::try_from(adders), usize::try_from(cycles_per_pulse)) else {
+            return Ok(None);
+        };
+        base.adders = a;
+        base.cycles_per_pulse = c;
+        Ok(base
+            .validate()
+            .ok()
+            .map(|()| Box::new(GeneratedPixel { base }) as Box<dyn RtlProvider>))
+    }
 }

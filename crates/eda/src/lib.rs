@@ -5,6 +5,7 @@
 
 pub mod analysis;
 pub mod clock_gate;
+pub mod corner_option;
 pub mod corners;
 pub mod equiv;
 pub mod error;

@@ -88,6 +88,52 @@ fn corner_table(out: &mut String, r: &SizeReport) {
     }
 }
 
+/// For each corner below the margin: the number of adders that meets it, and the
+/// candidates synthesised on the way.
+fn corner_options(out: &mut String, r: &SizeReport) {
+    if r.corner_options.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "\n### The option that meets each missed corner\n\nMore adders, fewer cycles per pulse, a slower clock: each candidate synthesised and timed at the corner.\n\n| library | corner | configured f_max MHz | candidates (A, C, clock → f_max, slack) | option |\n|---|---|---:|---|---|"
+    );
+    for o in &r.corner_options {
+        let trials = o
+            .trials
+            .iter()
+            .map(|t| {
+                format!(
+                    "A = {}, C = {}, {:.1} MHz → {:.1} MHz, {:+.1} %",
+                    t.adders, t.cycles_per_pulse, t.clock_mhz, t.f_max_mhz, t.slack_percent
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; ");
+        let option = match (o.adders, o.cycles_per_pulse) {
+            (Some(a), Some(c)) => format!("**A = {a}, C = {c}**"),
+            _ => "none found".to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.1} | {} | {} |",
+            o.library,
+            o.corner,
+            o.configured_f_max_mhz,
+            if trials.is_empty() {
+                "—".into()
+            } else {
+                trials
+            },
+            option
+        );
+    }
+    let _ = writeln!(out);
+    for o in &r.corner_options {
+        let _ = writeln!(out, "- {}", o.note);
+    }
+}
+
 /// Renders the report as Markdown.
 pub fn render(r: &SizeReport) -> String {
     let d = &r.design;
@@ -146,6 +192,7 @@ pub fn render(r: &SizeReport) -> String {
         }
     }
     corner_table(&mut out, r);
+    corner_options(&mut out, r);
     if let Some(s) = &r.sky130 {
         let _ = if s.has_timing {
             writeln!(
@@ -251,7 +298,12 @@ pub fn summary(r: &SizeReport) -> String {
                 )
             })
             .collect();
-        let _ = write!(s, "; sky130→{} nm: {}", k.target_node_nm, fits.join(", "));
+        if fits.is_empty() {
+            // One B point gives no per-bin slope, so no bins per pitch (sweep B for them).
+            let _ = write!(s, "; sky130: bins per pitch need a B sweep");
+        } else {
+            let _ = write!(s, "; sky130→{} nm: {}", k.target_node_nm, fits.join(", "));
+        }
     }
     s
 }

@@ -3,6 +3,7 @@
 //! runs synthesis, timing, the sky130 mapping and the sweeps.
 
 use crate::analysis::{PointResult, RtlProvider, analyse_points};
+use crate::corner_option::{CornerLibraries, CornerOption};
 use crate::corners::{CornerTiming, sky130_corners};
 use crate::error::{EdaError, Result};
 use crate::liberty::Liberty;
@@ -63,6 +64,9 @@ pub struct SizeRequest<'a> {
     pub target_node_nm: f64,
     /// Pixel sides (µm) to answer for, with the paper's estimate where it gave one.
     pub pixel_sides_um: Vec<(f64, Option<u64>)>,
+    /// Candidates synthesised at most for each corner the configured pixel misses
+    /// (`crate::corner_option`); 0 reports the misses without looking for an option.
+    pub corner_trials: usize,
 }
 
 impl std::fmt::Debug for SizeRequest<'_> {
@@ -175,6 +179,10 @@ pub struct SizeReport {
     /// timed: the timing liberty first, then sky130 tt/ss/ff when the PDK is installed.
     #[serde(default)]
     pub timing_corners: Vec<CornerTiming>,
+    /// For each corner below the margin, the number of adders that meets it, measured
+    /// (`crate::corner_option`); absent in reports written before it existed.
+    #[serde(default)]
+    pub corner_options: Vec<CornerOption>,
     /// The assumptions behind the figures, in words.
     pub assumptions: Vec<String>,
     /// Wall time of the build (s).
@@ -292,6 +300,7 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
         .collect();
 
     let mut sky_rows: Vec<PointResult> = Vec::new();
+    let mut sky_typical: Option<Liberty> = None;
     let sky130 =
         match sky_source {
             None => None,
@@ -324,6 +333,7 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
                     }
                 })?;
                 if let Some(pdk) = timed {
+                    sky_typical = Some(sky.clone());
                     timing_corners.extend(sky130_corners(
                         pdk,
                         &sky_main.synthesis,
@@ -366,6 +376,33 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
                 })
             }
         };
+
+    let mut corner_options = Vec::new();
+    for row in timing_corners.iter().filter(|c| !c.meets_margin) {
+        if req.corner_trials == 0 {
+            break;
+        }
+        let map_on = if row.library == lib.name {
+            &lib
+        } else if let Some(sky) = &sky_typical {
+            sky
+        } else {
+            continue;
+        };
+        let libs = CornerLibraries {
+            map_on,
+            same_corner: row.library == map_on.name,
+        };
+        corner_options.push(crate::corner_option::find(
+            req.provider,
+            d,
+            row,
+            &libs,
+            &req.clock_port,
+            &req.cache,
+            req.corner_trials,
+        )?);
+    }
 
     let sweep = results
         .iter()
@@ -420,6 +457,7 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
         sky130,
         sweep,
         timing_corners,
+        corner_options,
         assumptions,
         seconds: start.elapsed().as_secs_f64(),
     })

@@ -122,6 +122,9 @@ pub fn recommended(
         sweep_bins: None,
         sweep_widths: None,
         cache: None,
+        // The study compares options at their own clocks; a missed corner's remedy is
+        // `tofprobe size`'s.
+        corner_trials: 0,
     };
     let req = crate::sizing::options_request(
         design,
@@ -277,6 +280,9 @@ fn run_flow_in(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome, 
             sweep_bins: Some(vec![p.bins as u64]),
             sweep_widths: Some(vec![p.width]),
             cache: None,
+            // The flow reports the corners; the search for the adders that meet a missed
+            // one is `tofprobe size`'s (minutes of synthesis).
+            corner_trials: 0,
         };
         match size_report(design, &sa) {
             Ok(s) => tofprobe_eda::markdown::summary(&s),

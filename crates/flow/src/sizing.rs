@@ -34,7 +34,13 @@ pub struct SizeOptions {
     pub sweep_widths: Option<Vec<u32>>,
     /// Synthesis cache (default: $TOFPROBE_CACHE or ~/.cache/tofprobe, then /synth).
     pub cache: Option<PathBuf>,
+    /// Candidates synthesised at most, per corner the pixel misses, to find the number of
+    /// adders that meets it (`tofprobe_eda::corner_option`); 0 skips the search.
+    pub corner_trials: usize,
 }
+
+/// `tofprobe size`'s default [`SizeOptions::corner_trials`].
+pub const DEFAULT_CORNER_TRIALS: usize = 3;
 
 /// The B sweep: `a.sweep_bins`, or 4, 8 and the configured B (those ≤ B).
 fn sweep_bins_of(a: &SizeOptions, bins: u64) -> Vec<u64> {
@@ -144,6 +150,7 @@ pub fn size_report(design: &ResolvedDesign, a: &SizeOptions) -> Result<SizeRepor
         cache: cache_dir(a.cache.as_deref()),
         target_node_nm: a.node_nm,
         pixel_sides_um: vec![(30.0, Some(6)), (40.0, Some(13))],
+        corner_trials: a.corner_trials,
     };
     Ok(build_with(&req, sky130.as_ref())?)
 }

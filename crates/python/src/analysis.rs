@@ -170,6 +170,7 @@ pub fn size<'py>(
         sweep_bins,
         sweep_widths,
         cache: None,
+        corner_trials: tofprobe_flow::sizing::DEFAULT_CORNER_TRIALS,
     };
     let design = &d.inner;
     let report = py

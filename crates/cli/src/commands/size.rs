@@ -57,6 +57,10 @@ pub struct SizeArgs {
     /// Synthesis cache (default: $TOFPROBE_CACHE or ~/.cache/tofprobe, then /synth).
     #[arg(long)]
     pub cache: Option<PathBuf>,
+    /// For each corner the pixel misses (slack below 10 %), synthesise at most N candidates
+    /// with more adders (a slower clock) to find the A that meets it; 0 skips the search.
+    #[arg(long, value_name = "N", default_value_t = tofprobe_flow::sizing::DEFAULT_CORNER_TRIALS as u64, value_parser = clap::value_parser!(u64).range(0..=8))]
+    pub corner_trials: u64,
     /// Also measure the architecture options (docs/architecture-options.md): each
     /// option's tone error against the float DFT on the scene over several seeds, its area,
     /// timing and bins per pitch on osu018 and sky130, the Pareto front and the
@@ -143,6 +147,7 @@ fn size_options(a: &SizeArgs) -> SizeOptions {
         sweep_bins: a.sweep_bins.clone(),
         sweep_widths: a.sweep_widths.clone(),
         cache: a.cache.clone(),
+        corner_trials: a.corner_trials as usize,
     }
 }
 

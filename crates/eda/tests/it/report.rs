@@ -55,6 +55,7 @@ fn fixture_report_end_to_end() {
         cache: Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-cache/full"),
         target_node_nm: 40.0,
         pixel_sides_um: vec![(30.0, Some(6)), (40.0, Some(13))],
+        corner_trials: 0,
     };
     // The area-only fallback, explicitly (build() would take the timed PDK when installed).
     let r = build_with(&req, Some(&Sky130Source::AreaOnly(sky))).unwrap();

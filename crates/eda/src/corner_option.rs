@@ -1,0 +1,214 @@
+//! The option that meets a corner the configured pixel misses: `tofprobe size`'s answer to
+//! "the default meets its clock at every corner, or the report says which option does".
+//!
+//! A pixel with A adders runs K = ⌈P/A⌉ cycles per pulse, so its clock is K·f_laser: more
+//! adders lower the clock the corner has to meet. For each corner whose slack is below the
+//! margin ([`MARGIN_PERCENT`]), the candidates are the A where K drops below the
+//! configured K, starting from the estimate K·f_laser ≤ (1 − margin)·f_max of the
+//! configured netlist at that corner. The estimate is only a start: f_max moves with A
+//! (the operand multiplexers shrink, the write-enable fan-out grows: on sky130 ss the B = 2
+//! pixel measured 56.3, 48.7 and 46.4 MHz for A = 1, 2, 4), so each candidate is
+//! synthesised (mapped on the library's typical corner, as every corner row is) and timed
+//! at the corner; the first that keeps the margin is the answer, and at most
+//! `max_trials` candidates are synthesised. A corner whose f_max is below
+//! f_laser / (1 − margin) cannot be met by any A: the report says the laser rate it allows.
+
+use crate::analysis::{RtlProvider, analyse_point};
+use crate::corners::{CornerTiming, MARGIN_PERCENT, time_cached};
+use crate::error::Result;
+use crate::liberty::Liberty;
+use crate::size_report::Design;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// One synthesised candidate at a missed corner.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct CornerTrial {
+    /// A.
+    pub adders: u64,
+    /// C = K = ⌈P/A⌉.
+    pub cycles_per_pulse: u64,
+    /// K·f_laser (MHz).
+    pub clock_mhz: f64,
+    /// f_max of this candidate's netlist at the corner (MHz).
+    pub f_max_mhz: f64,
+    /// Slack as a percentage of the period.
+    pub slack_percent: f64,
+    /// Slack ≥ the margin.
+    pub meets_margin: bool,
+}
+
+/// The option found for one missed corner (JSON: `corner_options[]`).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct CornerOption {
+    /// The corner's library (as in `timing_corners`).
+    pub library: String,
+    /// The corner's name.
+    pub corner: String,
+    /// The configured pixel's f_max at this corner (MHz).
+    pub configured_f_max_mhz: f64,
+    /// The A that keeps the margin, if a trial found one.
+    pub adders: Option<u64>,
+    /// Its C.
+    pub cycles_per_pulse: Option<u64>,
+    /// The candidates synthesised, in order.
+    pub trials: Vec<CornerTrial>,
+    /// The verdict in words.
+    pub note: String,
+}
+
+/// The candidate (A, K) pairs below `configured_k`, largest K first, starting at the
+/// estimate from `f_max_mhz`: for each K the fewest adders ⌈P/K⌉ (its own K, ⌈P/A⌉, may be
+/// smaller). Empty when even K = 1 misses the margin at `f_max_mhz`.
+pub fn candidates(ops: u64, configured_k: u64, laser_hz: f64, f_max_mhz: f64) -> Vec<(u64, u64)> {
+    let usable_mhz = f_max_mhz * (1.0 - MARGIN_PERCENT / 100.0);
+    let laser_mhz = laser_hz / 1e6;
+    // NaN (no timing) compares false: no candidate.
+    if ops == 0 || usable_mhz.is_nan() || usable_mhz < laser_mhz {
+        return Vec::new();
+    }
+    let estimate = ((usable_mhz / laser_mhz).floor() as u64).max(1);
+    let start = estimate.min(configured_k.saturating_sub(1)).max(1);
+    let mut out: Vec<(u64, u64)> = Vec::new();
+    for k in (1..=start).rev() {
+        let a = ops.div_ceil(k);
+        let own_k = ops.div_ceil(a);
+        if out.last().is_none_or(|&(_, last)| own_k < last) {
+            out.push((a, own_k));
+        }
+    }
+    out
+}
+
+/// Where a missed corner's candidates are synthesised and timed.
+#[derive(Debug)]
+pub struct CornerLibraries<'a> {
+    /// The library every candidate is mapped on (the row's typical corner).
+    pub map_on: &'a Liberty,
+    /// Whether the row is that library's own corner (no second timing run).
+    pub same_corner: bool,
+}
+
+/// Finds the option for `row` (a corner the configured pixel misses), synthesising at
+/// most `max_trials` candidates from `provider`.
+pub fn find(
+    provider: &dyn RtlProvider,
+    d: &Design,
+    row: &CornerTiming,
+    libs: &CornerLibraries<'_>,
+    clock: &str,
+    cache: &Path,
+    max_trials: usize,
+) -> Result<CornerOption> {
+    let mut trials = Vec::new();
+    let mut found = None;
+    let all = candidates(
+        d.ops_per_pulse,
+        d.cycles_per_pulse,
+        d.laser_rate_hz,
+        row.f_max_mhz,
+    );
+    for &(a, k) in all.iter().take(max_trials) {
+        let Some(variant) = provider.with_adders(a, k)? else {
+            break;
+        };
+        let clock_mhz = k as f64 * d.laser_rate_hz / 1e6;
+        let point = analyse_point(
+            variant.as_ref(),
+            d.bins,
+            d.width,
+            libs.map_on,
+            true,
+            clock,
+            cache,
+            Some(1e6 / clock_mhz),
+        )?;
+        let sta = match (&point.timing, libs.same_corner) {
+            (Some(t), true) => t.clone(),
+            _ => time_cached(&point.synthesis, &row.liberty, &row.corner, clock)?,
+        };
+        let t = CornerTiming::new(
+            &row.library,
+            &row.corner,
+            &row.liberty,
+            &sta,
+            clock_mhz,
+            d.laser_rate_hz,
+        );
+        trials.push(CornerTrial {
+            adders: a,
+            cycles_per_pulse: k,
+            clock_mhz,
+            f_max_mhz: t.f_max_mhz,
+            slack_percent: t.slack_percent,
+            meets_margin: t.meets_margin,
+        });
+        if t.meets_margin {
+            found = Some((a, k));
+            break;
+        }
+    }
+    let laser_mhz = d.laser_rate_hz / 1e6;
+    let note = match found {
+        Some((a, k)) => format!(
+            "A = {a} adders (C = {k}, {:.1} MHz) meet {} {} with ≥ {MARGIN_PERCENT:.0} % slack, where the configured A = {} (C = {}, {:.1} MHz) misses it: set `[pixel] adders = {a}`, or `adders = \"auto\"` with `timing_liberty` naming this corner",
+            k as f64 * laser_mhz,
+            row.library,
+            row.corner,
+            d.adders,
+            d.cycles_per_pulse,
+            d.cycles_per_pulse as f64 * laser_mhz
+        ),
+        None if all.is_empty() => format!(
+            "no number of adders meets {} {}: its f_max {:.1} MHz is below f_laser / (1 − {MARGIN_PERCENT:.0} %) = {:.1} MHz even at C = 1; the laser rate it allows is {:.2} MHz",
+            row.library,
+            row.corner,
+            row.f_max_mhz,
+            laser_mhz / (1.0 - MARGIN_PERCENT / 100.0),
+            row.f_max_mhz * (1.0 - MARGIN_PERCENT / 100.0)
+        ),
+        None => format!(
+            "none of the {} candidate(s) synthesised meets {} {} (the search stops after {max_trials}); try more adders than A = {}",
+            trials.len(),
+            row.library,
+            row.corner,
+            trials.last().map_or(d.adders, |t| t.adders)
+        ),
+    };
+    Ok(CornerOption {
+        library: row.library.clone(),
+        corner: row.corner.clone(),
+        configured_f_max_mhz: row.f_max_mhz,
+        adders: found.map(|f| f.0),
+        cycles_per_pulse: found.map(|f| f.1),
+        trials,
+        note,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn candidates_start_at_the_estimate_and_drop_k() {
+        // The default: P = 32 operations, K = 16 at 10 MHz; sky130 ss f_max 46.8 MHz leaves
+        // 42.1 MHz with the margin, so K ≤ 4 (A = 8), then K = 3 (A = 11), 2 (16), 1 (32).
+        assert_eq!(
+            candidates(32, 16, 10e6, 46.8),
+            vec![(8, 4), (11, 3), (16, 2), (32, 1)]
+        );
+        // B = 2 at 25 MHz: P = 4, configured K = 4 (100 MHz); f_max 56.3 → 50.7 MHz usable,
+        // K ≤ 2 (A = 2), then K = 1 (A = 4).
+        assert_eq!(candidates(4, 4, 25e6, 56.3), vec![(2, 2), (4, 1)]);
+        // An estimate above the configured K (the configured pixel missed by the margin
+        // only on a slower netlist): start one below the configured K.
+        assert_eq!(candidates(32, 16, 10e6, 500.0)[0], (3, 11));
+        // K values whose fewest adders give a smaller K are not repeated: P = 5, K = 4 and
+        // K = 3 both take A = 2 (its K is 3).
+        assert_eq!(candidates(5, 5, 1e6, 1000.0), vec![(2, 3), (3, 2), (5, 1)]);
+        // f_max below f_laser / 0.9: nothing meets, at any A.
+        assert!(candidates(32, 16, 10e6, 11.0).is_empty());
+        assert!(candidates(32, 16, 10e6, f64::NAN).is_empty());
+    }
+}
