@@ -151,7 +151,7 @@ pub fn find(
     let laser_mhz = d.laser_rate_hz / 1e6;
     let note = match found {
         Some((a, k)) => format!(
-            "A = {a} adders (C = {k}, {:.1} MHz) meet {} {} with ≥ {MARGIN_PERCENT:.0} % slack, where the configured A = {} (C = {}, {:.1} MHz) misses it: set `[pixel] adders = {a}`, or `adders = \"auto\"` with `timing_liberty` naming this corner",
+            "A = {a} adders (C = {k}, {:.1} MHz) meet {} {} with ≥ {MARGIN_PERCENT:.0} % slack, where the configured A = {} (C = {}, {:.1} MHz) misses it: set `[pixel] adders = {a}`",
             k as f64 * laser_mhz,
             row.library,
             row.corner,
