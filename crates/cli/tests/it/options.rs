@@ -311,70 +311,31 @@ fn bins_from_a_layout_report(cfg: &str, cache: &Path, dir: &Path) {
 /// Refused before any synthesis: an unknown option, a target that is no tone error, a
 /// layout report of a dirty macro or of a technology none of the liberties is.
 fn refusals(cfg: &str, cache: &Path, dir: &Path) {
+    // Each refused with exit code 2 and an error holding every part.
+    let refused = |extra: &[&str], parts: &[&str]| {
+        let mut args = vec!["size", cfg, "--no-sky130", "--options"];
+        args.extend_from_slice(extra);
+        let o = run(&args, cache);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        for p in parts {
+            assert!(err.contains(p), "`{p}` missing: {err}");
+        }
+    };
     let dirty = layout_report(dir, "dirty.json", "osu018", 1.9, 4);
-    let o = run(
-        &[
-            "size",
-            cfg,
-            "--no-sky130",
-            "--options",
-            "--layout-report",
-            dirty.to_str().unwrap(),
-        ],
-        cache,
-    );
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("`drc_errors` = 4") && err.contains("dirty.json"),
-        "{err}"
+    refused(
+        &["--layout-report", dirty.to_str().unwrap()],
+        &["`drc_errors` = 4", "dirty.json"],
     );
     let sky = layout_report(dir, "sky.json", "sky130", 1.9, 0);
-    let o = run(
-        &[
-            "size",
-            cfg,
-            "--no-sky130",
-            "--options",
-            "--layout-report",
-            sky.to_str().unwrap(),
-        ],
-        cache,
-    );
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("layout-report") && err.contains("sky130"),
-        "{err}"
+    refused(
+        &["--layout-report", sky.to_str().unwrap()],
+        &["layout-report", "sky130"],
     );
     // An unknown option lists the catalogue.
-    let o = run(
-        &["size", cfg, "--no-sky130", "--options", "--option", "G=3"],
-        cache,
-    );
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("\"G=3\"") && err.contains("G=2+clock-gated"),
-        "{err}"
-    );
+    refused(&["--option", "G=3"], &["\"G=3\"", "G=2+clock-gated"]);
     // So does a target that is no number of µm.
-    let o = run(
-        &[
-            "size",
-            cfg,
-            "--no-sky130",
-            "--options",
-            "--target-error-um=-1",
-        ],
-        cache,
-    );
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("target-error-um") && err.contains("> 0"),
-        "{err}"
-    );
+    refused(&["--target-error-um=-1"], &["target-error-um", "> 0"]);
 }
 
 fn flow_recommended_builds_and_cosimulates_the_choice(
