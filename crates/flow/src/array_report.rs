@@ -14,7 +14,7 @@ use crate::array_size::{
     ArrayTotal, DEFAULT_UTILISATION, PixelPitch, ReadoutFigures, RomLogic, RomMacroEstimate,
     TimestampComparison, rom_macro_estimates,
 };
-use crate::array_timing::{ArrayTiming, array_timing};
+use crate::array_timing::{ArrayTiming, CornerOptionPaths, array_timing, corner_option_paths};
 use crate::error::FlowError;
 
 /// Entries of the probe ROM synthesised as logic (then scaled to the whole ROM).
@@ -60,6 +60,10 @@ pub struct ArraySizeReport {
     pub timing: Vec<ArrayTiming>,
     /// Every broadcast and readout path meets the pixel clock with the 10 % margin.
     pub timing_meets_margin: bool,
+    /// Where a corner misses the pixel clock and the size report found the adders that meet
+    /// it (`SizeReport::corner_options`): the same paths at that option's slower clock.
+    #[serde(default)]
+    pub at_corner_options: Vec<CornerOptionPaths>,
     /// The readout (contract: docs/pixel-contract.md, "Array").
     pub readout: ReadoutFigures,
     /// Reading every timestamp out instead.
@@ -175,6 +179,7 @@ pub fn array_report(
     let timing_meets_margin = timing
         .iter()
         .all(|t| t.broadcast.meets_margin && t.readout.meets_margin);
+    let at_corner_options = corner_option_paths(&timing, &size.corner_options);
     // The array's own logic per mapped library: the slices' sum stands for the whole
     // array only when it was timed whole; else scaled (a row's logic × R, stated).
     let shared = |lib: &str| -> Option<f64> {
@@ -243,6 +248,7 @@ pub fn array_report(
         totals,
         timing,
         timing_meets_margin,
+        at_corner_options,
         readout: figures,
         timestamps,
         assumptions,
@@ -411,6 +417,22 @@ pub fn markdown(a: &ArraySizeReport) -> String {
                 "do NOT all meet"
             }
         );
+        for o in &a.at_corner_options {
+            m += &format!(
+                "- {} on {}: with the option that meets this corner (A = {}, {:.1} MHz), broadcast slack {:.1} %, readout slack {:.1} %: {}.\n",
+                o.netlist,
+                o.library,
+                o.adders,
+                o.clock_mhz,
+                o.broadcast_slack_percent,
+                o.readout_slack_percent,
+                if o.meets_margin {
+                    "both meet with ≥ 10 %"
+                } else {
+                    "**short** of the 10 % margin"
+                }
+            );
+        }
     }
     let r = &a.readout;
     m += &format!(

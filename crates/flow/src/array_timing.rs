@@ -330,6 +330,58 @@ fn time_on(
     })
 }
 
+/// The broadcast and readout paths of one timed netlist at the clock of the option that
+/// meets a corner the configured pixel misses (more adders, fewer cycles per pulse).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct CornerOptionPaths {
+    /// What was timed (as in `timing`).
+    pub netlist: String,
+    /// The corner's library.
+    pub library: String,
+    /// The option's adders A.
+    pub adders: u64,
+    /// Its clock C·f_laser (MHz).
+    pub clock_mhz: f64,
+    /// Broadcast slack at that clock, as a share of its period (%).
+    pub broadcast_slack_percent: f64,
+    /// Readout slack at that clock (%).
+    pub readout_slack_percent: f64,
+    /// Both keep the 10 % margin.
+    pub meets_margin: bool,
+}
+
+/// The paths' delays do not depend on A (the array's logic and the pixel's port paths are
+/// the same), so their slack at the option's clock follows from the delays measured.
+pub fn corner_option_paths(
+    timing: &[ArrayTiming],
+    options: &[tofprobe_eda::corner_option::CornerOption],
+) -> Vec<CornerOptionPaths> {
+    let pct = |delay_ns: f64, clock_mhz: f64| {
+        let period = 1e3 / clock_mhz;
+        ((period - delay_ns) / period * 1000.0).round() / 10.0
+    };
+    let mut out = Vec::new();
+    for o in options {
+        let (Some(a), Some(t)) = (o.adders, o.trials.last()) else {
+            continue;
+        };
+        for row in timing.iter().filter(|r| r.library == o.library) {
+            let b = pct(row.broadcast.delay_ns, t.clock_mhz);
+            let r = pct(row.readout.delay_ns, t.clock_mhz);
+            out.push(CornerOptionPaths {
+                netlist: row.netlist.clone(),
+                library: row.library.clone(),
+                adders: a,
+                clock_mhz: t.clock_mhz,
+                broadcast_slack_percent: b,
+                readout_slack_percent: r,
+                meets_margin: b >= MARGIN_PERCENT && r >= MARGIN_PERCENT,
+            });
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -341,6 +393,55 @@ mod tests {
         let s = slices(64, 64, WHOLE_TIMING_MAX_PIXELS);
         assert_eq!((s[0].1, s[0].2), (1, 64));
         assert_eq!((s[1].1, s[1].2), (64, 1));
+    }
+
+    #[test]
+    fn paths_are_judged_again_at_a_corner_options_clock() {
+        use tofprobe_eda::corner_option::{CornerOption, CornerTrial};
+        let path = |delay_ns: f64| PathTiming {
+            delay_ns,
+            slack_ns: 6.25 - delay_ns,
+            slack_percent: 0.0,
+            meets_margin: false,
+            startpoint: String::new(),
+            endpoint: String::new(),
+            pixel_part_ns: 0.0,
+            array_part_ns: delay_ns,
+        };
+        let row = |library: &str, b: f64, r: f64| ArrayTiming {
+            netlist: "whole 2 × 2".into(),
+            library: library.into(),
+            clock_mhz: 160.0,
+            shared_logic_um2: 0.0,
+            broadcast: path(b),
+            readout: path(r),
+        };
+        let option = |library: &str, adders: Option<u64>| CornerOption {
+            library: library.into(),
+            corner: "ss".into(),
+            configured_f_max_mhz: 46.8,
+            adders,
+            cycles_per_pulse: adders.map(|_| 3),
+            trials: vec![CornerTrial {
+                adders: 11,
+                cycles_per_pulse: 3,
+                clock_mhz: 30.0,
+                f_max_mhz: 44.9,
+                slack_percent: 33.1,
+                meets_margin: true,
+            }],
+            note: String::new(),
+        };
+        let timing = [row("ss", 10.0, 31.0), row("tt", 3.0, 3.0)];
+        let got = corner_option_paths(&timing, &[option("ss", Some(11))]);
+        // 30 MHz: a 33.33 ns period; 10 ns leaves 70.0 %, 31 ns 7.0 % (short of 10 %).
+        assert_eq!(got.len(), 1, "only the ss row: {got:?}");
+        assert_eq!(got[0].adders, 11);
+        assert_eq!(got[0].broadcast_slack_percent, 70.0);
+        assert_eq!(got[0].readout_slack_percent, 7.0);
+        assert!(!got[0].meets_margin);
+        // An option that found no A judges nothing.
+        assert!(corner_option_paths(&timing, &[option("ss", None)]).is_empty());
     }
 
     #[test]
