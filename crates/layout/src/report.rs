@@ -277,27 +277,8 @@ impl LayoutReport {
             p.hold_path.1,
             p.spef_nets,
         );
-        s += "## Corners\n\n| library | corner | synthesis f_max (MHz) | synthesis slack (ns) | post-route f_max (MHz) | post-route setup slack (ns) | hold slack (ns), all / register to register | meets the clock |\n|---|---|---:|---:|---:|---:|---:|---|\n";
-        for c in &self.corners {
-            let p = &c.post_route;
-            let _ = writeln!(
-                s,
-                "| {} | {} | {:.1} | {:.3} | {:.1} | {:.3} | {:.3} / {:.3} | {} |",
-                c.library,
-                c.corner,
-                c.synthesis_f_max_mhz,
-                c.synthesis_slack_ns,
-                p.f_max_mhz,
-                p.setup_slack_ns,
-                p.hold_slack_ns,
-                p.hold_slack_registers_ns,
-                if p.setup_slack_ns >= 0.0 && p.hold_slack_registers_ns >= 0.0 {
-                    "yes"
-                } else {
-                    "**no**"
-                }
-            );
-        }
+        s += "## Corners\n\n";
+        s += &corners_markdown(&self.corners);
         s += "\n";
         if let Some(b) = &self.bins_per_pitch {
             let _ = write!(
@@ -341,4 +322,105 @@ impl LayoutReport {
         }
         s
     }
+}
+
+/// The corner table: synthesis beside post-route, setup and hold, per library and corner
+/// (the layout report's and `tofprobe size --layout-report`'s).
+pub fn corners_markdown(corners: &[CornerRow]) -> String {
+    let mut s = String::from(
+        "| library | corner | synthesis f_max (MHz) | synthesis slack (ns) | post-route f_max (MHz) | post-route setup slack (ns) | hold slack (ns), all / register to register | meets the clock |\n|---|---|---:|---:|---:|---:|---:|---|\n",
+    );
+    for c in corners {
+        let p = &c.post_route;
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.1} | {:.3} | {:.1} | {:.3} | {:.3} / {:.3} | {} |",
+            c.library,
+            c.corner,
+            c.synthesis_f_max_mhz,
+            c.synthesis_slack_ns,
+            p.f_max_mhz,
+            p.setup_slack_ns,
+            p.hold_slack_ns,
+            p.hold_slack_registers_ns,
+            if p.setup_slack_ns >= 0.0 && p.hold_slack_registers_ns >= 0.0 {
+                "yes"
+            } else {
+                "**no**"
+            }
+        );
+    }
+    s
+}
+
+/// A routed macro's post-route timing, as `tofprobe size --layout-report` shows it beside
+/// its own synthesis corners.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct PostRouteTable {
+    /// The layout report read.
+    pub report: String,
+    /// Its technology.
+    pub tech: String,
+    /// The configuration it was laid out from.
+    pub config: String,
+    /// Its corners (synthesis and post-route, the same routed wires on each).
+    pub corners: Vec<CornerRow>,
+}
+
+/// What the post-route table reads of a layout report.
+#[derive(Debug, Deserialize)]
+struct CornersView {
+    schema: String,
+    tech: String,
+    config: String,
+    drc_errors: u64,
+    lvs_match: bool,
+    #[serde(default)]
+    bins: Option<u64>,
+    #[serde(default)]
+    width: Option<u32>,
+    #[serde(default)]
+    corners: Vec<CornerRow>,
+}
+
+/// The post-route corners of the layout report at `path` when it is of the pixel with
+/// `bins` bins of `width`-bit registers (`Ok(None)` when it is another pixel's: its k may
+/// still serve `size --options`), refused unless the macro is clean (DRC 0, LVS match) and
+/// of this schema.
+pub fn read_post_route(
+    path: &std::path::Path,
+    bins: u64,
+    width: u32,
+) -> Result<Option<PostRouteTable>> {
+    let text = std::fs::read_to_string(path).map_err(|e| LayoutError::io("reading", path, e))?;
+    let refuse = |what: String| LayoutError::Parse {
+        tool: "tofprobe layout",
+        what,
+        path: path.to_path_buf(),
+    };
+    let v: CornersView =
+        serde_json::from_str(&text).map_err(|e| refuse(format!("a layout report ({e})")))?;
+    if v.schema != SCHEMA {
+        return Err(refuse(format!(
+            "a report of schema {SCHEMA} (`schema` is {:?})",
+            v.schema
+        )));
+    }
+    if v.drc_errors != 0 || !v.lvs_match {
+        return Err(refuse(format!(
+            "a clean macro (`drc_errors` = {}, `lvs_match` = {}; DRC 0 and LVS match are needed)",
+            v.drc_errors, v.lvs_match
+        )));
+    }
+    if v.bins != Some(bins) || v.width != Some(width) || v.corners.is_empty() {
+        return Ok(None);
+    }
+    Ok(Some(PostRouteTable {
+        report: path
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+        tech: v.tech,
+        config: v.config,
+        corners: v.corners,
+    }))
 }

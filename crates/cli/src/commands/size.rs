@@ -14,6 +14,7 @@ use tofprobe_experiments::options::markdown::render as options_markdown;
 use tofprobe_experiments::options::plot::front_svg;
 use tofprobe_flow::array_report::{ArraySizeReport, array_report, markdown as array_markdown};
 use tofprobe_flow::sizing::{SizeOptions, options_request, size_report};
+use tofprobe_layout::report::{PostRouteTable, corners_markdown, read_post_route};
 
 use crate::error::CliError;
 
@@ -78,10 +79,11 @@ pub struct SizeArgs {
     /// With --options: seeds of the accuracy measurement (comma-separated).
     #[arg(long, value_delimiter = ',', requires = "options", default_values_t = tofprobe_experiments::options::DEFAULT_SEEDS)]
     pub seeds: Vec<u64>,
-    /// With --options: a `layout-report.json` of `tofprobe layout` (DRC- and LVS-clean):
-    /// every option's bins per pitch also from layout, its area model times the macro's
-    /// routed factor k, on the liberties of that technology (docs/layout.md).
-    #[arg(long, value_name = "FILE", requires = "options")]
+    /// A `layout-report.json` of `tofprobe layout` (DRC- and LVS-clean): when it is of this
+    /// pixel (same B and W), its post-route timing per corner (setup and hold) beside the
+    /// synthesis corners; with --options, every option's bins per pitch also from layout,
+    /// its area model times the macro's routed factor k (docs/layout.md).
+    #[arg(long, value_name = "FILE")]
     pub layout_report: Option<PathBuf>,
 }
 
@@ -98,6 +100,9 @@ pub struct FullReport {
     /// The array (an `[array]` configuration): pitch, shared ROM, area, readout.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub array: Option<ArraySizeReport>,
+    /// With `--layout-report` of this pixel: its post-route corners.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub post_route: Option<PostRouteTable>,
 }
 
 /// Builds the report for the arguments (no printing).
@@ -106,6 +111,25 @@ pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
     // Before minutes of synthesis: the array's options and readout.
     tofprobe_flow::array_report::check(&design, a.utilisation)?;
     let options = size_options(a);
+    // Before minutes of synthesis: the layout report is read (and refused if dirty).
+    let post_route = match &a.layout_report {
+        Some(path) => {
+            let p = &design.pixel;
+            let table = read_post_route(path, p.bins as u64, p.width)?;
+            if table.is_none() && !a.options {
+                return Err(CliError::option(
+                    "layout-report",
+                    path.display(),
+                    format!(
+                        "a layout report of this pixel (B = {}, W = {}; that one is of another, so its post-route timing is not this pixel's): lay this configuration out with `tofprobe layout`, or use that report's routed factor with --options",
+                        p.bins, p.width
+                    ),
+                ));
+            }
+            table
+        }
+        None => None,
+    };
     let req = if a.options {
         let mut req = options_request(
             &design,
@@ -135,6 +159,7 @@ pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
         size,
         options,
         array,
+        post_route,
     })
 }
 
@@ -162,6 +187,15 @@ pub fn run(a: &SizeArgs) -> Result<(), CliError> {
         }
         if let Some(arr) = &full.array {
             m += &array_markdown(arr);
+        }
+        if let Some(t) = &full.post_route {
+            m += &format!(
+                "\n## Post-route, from {} ({}, laid out from {})\n\nThe routed macro timed with its extracted wires and the clock tree the flow built, beside its own synthesis (ideal clock):\n\n{}",
+                t.report,
+                t.tech,
+                t.config,
+                corners_markdown(&t.corners)
+            );
         }
         m
     };

@@ -104,6 +104,53 @@ fn a_two_bin_pixel_routes_drc_and_lvs_clean_on_osu018() {
     );
     let md = std::fs::read_to_string(out.join("layout-report.md")).unwrap();
     assert!(md.contains("| DRC errors (magic) | 0 |"), "{md}");
+
+    // `size --layout-report`: the macro's post-route corners beside the size report's
+    // synthesis corners (the same pixel: one osu018 synthesis, cached by the layout run).
+    let report = out.join("layout-report.json");
+    let size = tofprobe(&[
+        "size",
+        cfg.to_str().unwrap(),
+        "--no-sky130",
+        "--sweep-bins",
+        "2",
+        "--sweep-widths",
+        "39",
+        "--cache",
+        cache.to_str().unwrap(),
+        "--layout-report",
+        report.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(
+        size.status.success(),
+        "{}",
+        String::from_utf8_lossy(&size.stderr)
+    );
+    let s = common::last_json(&size);
+    let row = &s["post_route"]["corners"][0];
+    assert_eq!(row["library"], "osu018_stdcells", "{s}");
+    // The post-route f_max is the layout's own, and below the size report's synthesis
+    // f_max of the same netlist (the wires only slow it).
+    assert_eq!(row["post_route"]["f_max_mhz"], p["f_max_mhz"], "{row}");
+    let synth_fmax = s["timing_corners"][0]["f_max_mhz"].as_f64().unwrap();
+    assert!(
+        post < synth_fmax,
+        "post-route {post}, synthesis {synth_fmax}"
+    );
+    // A report of another pixel (the default, B = 16) is refused naming the option.
+    let other = tofprobe(&[
+        "size",
+        "--no-sky130",
+        "--layout-report",
+        report.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert_eq!(other.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--layout-report") && err.contains("B = 16"),
+        "{err}"
+    );
 }
 
 #[test]
