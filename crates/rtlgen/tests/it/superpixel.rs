@@ -17,9 +17,10 @@ fn have(tools: &[&str]) -> bool {
 }
 
 fn pixel(t: u32) -> PixelParams {
-    let mut p = PixelParams::default();
-    p.tdc_bits = t;
-    p
+    PixelParams {
+        tdc_bits: t,
+        ..PixelParams::default()
+    }
 }
 
 /// Renders the front end of (G, T) into its own directory; `corrupt` alters the text.
