@@ -7,7 +7,9 @@
 //! (`FoldLanes`: each pixel's folded driver, in lockstep; [`run_group`]), with the same
 //! registers as one pixel at a time ([`run_pixel`]). A tile is a rectangle of pixels run
 //! in parallel on the current rayon pool; tiles merge into the array byte for byte
-//! whatever the tiling, the threads or the process.
+//! whatever the tiling, the threads or the process. A superpixel (`[array] superpixel = G`)
+//! reads its G² SPADs' streams and hands the driver their average, one code a pulse
+//! ([`PixelStream`], `pixel::Superpixel`): the datapath is the one pixel's either way.
 
 use std::ops::Range;
 
@@ -15,7 +17,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use tofprobe_design::ResolvedDesign;
 use tofprobe_dsp::rom::RomImage;
-use tofprobe_pixel::{FoldLanes, FrameDriver, LANES, fold_pays};
+use tofprobe_pixel::{FoldLanes, FrameDriver, LANES, Superpixel, fold_pays};
+use tofprobe_scene::PhotonSource;
 
 use crate::error::ArrayError;
 
@@ -60,6 +63,61 @@ impl ArrayFrame {
     }
 }
 
+/// The pulses pixel (r, c) sees: its one SPAD's codes, or (G > 1) its G² SPADs' codes
+/// averaged by the superpixel front end.
+#[derive(Debug)]
+pub struct PixelStream {
+    sources: Vec<PhotonSource>,
+    front: Option<Superpixel>,
+    /// One chunk of each SPAD's codes (G > 1).
+    scratch: Vec<Vec<u32>>,
+}
+
+impl PixelStream {
+    /// The stream of pixel (r, c), in chunks of at most `chunk` pulses.
+    pub fn new(
+        design: &ResolvedDesign,
+        r: usize,
+        c: usize,
+        chunk: usize,
+    ) -> Result<Self, ArrayError> {
+        let sources = design.pixel_sources(r, c)?;
+        let front = match &design.array {
+            Some(a) => a
+                .front_end(design.pixel.tdc_bits)
+                .map_err(|source| ArrayError::Pixel {
+                    row: r,
+                    col: c,
+                    source,
+                })?,
+            None => None,
+        };
+        let scratch = match front {
+            Some(_) => vec![vec![0u32; chunk]; sources.len()],
+            None => Vec::new(),
+        };
+        Ok(PixelStream {
+            sources,
+            front,
+            scratch,
+        })
+    }
+
+    /// The pixel's codes of pulses `first ..` into `out` (at most the chunk); returns its
+    /// pulses with a detection (a superpixel: with at least one valid SPAD).
+    pub fn fill(&mut self, first: u64, out: &mut [u32]) -> u64 {
+        let Some(front) = &self.front else {
+            return self.sources[0].fill_counted_codes(first, out).detections;
+        };
+        let k = out.len();
+        for (src, buf) in self.sources.iter().zip(&mut self.scratch) {
+            src.fill_codes(first, &mut buf[..k]);
+        }
+        let streams: Vec<&[u32]> = self.scratch.iter().map(|b| &b[..k]).collect();
+        front.combine_streams(&streams, out)
+    }
+}
+
 /// One frame of pixel (r, c): its register words and its detections.
 pub fn run_pixel(
     design: &ResolvedDesign,
@@ -67,7 +125,8 @@ pub fn run_pixel(
     r: usize,
     c: usize,
 ) -> Result<(Vec<i64>, u64), ArrayError> {
-    let source = design.pixel_source(r, c)?;
+    let n = design.pixel.frame_pulses;
+    let mut source = PixelStream::new(design, r, c, CHUNK.min(n as usize))?;
     let err = |source| ArrayError::Pixel {
         row: r,
         col: c,
@@ -77,13 +136,12 @@ pub fn run_pixel(
     // otherwise: bit-identical registers either way.
     let mut tm = FrameDriver::new(&design.pixel, rom).map_err(err)?;
     // The source counts the detections as it draws them: no second pass over the pulses.
-    let n = design.pixel.frame_pulses;
     // The compact codes (4 bytes a pulse), read by the driver without conversion.
     let mut buf = vec![0u32; CHUNK.min(n as usize)];
     let (mut first, mut detections) = (0u64, 0u64);
     while first < n {
         let k = (n - first).min(buf.len() as u64) as usize;
-        detections += source.fill_counted_codes(first, &mut buf[..k]).detections;
+        detections += source.fill(first, &mut buf[..k]);
         tm.run(&buf[..k], first).map_err(err)?;
         first += k as u64;
     }
@@ -103,20 +161,20 @@ pub fn run_group(
     let first = *group
         .first()
         .ok_or_else(|| ArrayError::Shape("a lane group of no pixels".into()))?;
-    let sources = group
-        .iter()
-        .map(|&(r, c)| design.pixel_source(r, c))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut lanes = FoldLanes::new(&design.pixel, rom, group.len()).map_err(err(first))?;
     let n = design.pixel.frame_pulses;
     let len = LANE_CHUNK.min(n as usize);
+    let mut sources = group
+        .iter()
+        .map(|&(r, c)| PixelStream::new(design, r, c, len))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut lanes = FoldLanes::new(&design.pixel, rom, group.len()).map_err(err(first))?;
     let mut bufs = vec![vec![0u32; len]; group.len()];
     let mut detections = vec![0u64; group.len()];
     let mut start = 0u64;
     while start < n {
         let k = (n - start).min(len as u64) as usize;
-        for ((src, buf), d) in sources.iter().zip(&mut bufs).zip(&mut detections) {
-            *d += src.fill_counted_codes(start, &mut buf[..k]).detections;
+        for ((src, buf), d) in sources.iter_mut().zip(&mut bufs).zip(&mut detections) {
+            *d += src.fill(start, &mut buf[..k]);
         }
         let chunk: Vec<&[u32]> = bufs.iter().map(|b| &b[..k]).collect();
         lanes.run(&chunk, start).map_err(err(first))?;

@@ -40,6 +40,8 @@ pub struct ArraySummary {
     pub cols: usize,
     pub pitch_um: f64,
     pub mm_per_pixel: f64,
+    /// G: a pixel is G × G SPADs whose detections it averages (1: one SPAD).
+    pub superpixel: usize,
     pub frame_pulses: u64,
     pub registers_per_pixel: usize,
     pub mean_detections_per_pixel: f64,
@@ -129,6 +131,7 @@ pub fn finish(
         cols: a.cols,
         pitch_um: a.pitch_um,
         mm_per_pixel: a.mm_per_pixel,
+        superpixel: a.superpixel,
         frame_pulses: design.pixel.frame_pulses,
         registers_per_pixel: frame.registers_per_pixel,
         mean_detections_per_pixel: frame.detections.iter().sum::<u64>() as f64 / pixels,

@@ -89,6 +89,7 @@ fn array_design(
         readout_bits_per_s: None,
         frame_rate_hz: None,
         double_buffer: false,
+        superpixel: 1,
     });
     (a.rows, a.cols) = (rows, cols);
     Ok(resolve(doc, &base.origin)?)

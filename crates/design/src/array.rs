@@ -6,6 +6,12 @@
 //! file. Pixel (r, c) sits at ((c + ½)·s, (r + ½)·s) mm, s the mm per pixel; its photon
 //! stream depends only on (seed, r, c) ([`pixel_seed`]). A document without `[array]` is
 //! the single pixel, unchanged.
+//!
+//! With `superpixel = G` (docs/pixel-contract.md "Superpixel") the written rows × cols are
+//! SPADs and G × G of them share one pixel: the resolved array is R/G × C/G pixels (its
+//! `rows`, `cols`, `pitch_um` and `mm_per_pixel` are the pixels'), while the rate maps, the
+//! SPAD centres and the streams' seeds stay on the SPAD grid, so SPAD (r, c) draws the same
+//! photons whatever G.
 
 use std::path::{Path, PathBuf};
 
@@ -59,6 +65,21 @@ pub struct ArrayConfig {
     /// Double-buffered pixel registers (the next frame accumulates during the readout).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub double_buffer: bool,
+    /// G: G × G SPADs share one pixel, their detections averaged each pulse (1: none).
+    #[serde(default = "one_u32", skip_serializing_if = "is_one")]
+    pub superpixel: u32,
+}
+
+fn one_u32() -> u32 {
+    1
+}
+
+fn one_usize() -> usize {
+    1
+}
+
+fn is_one(v: &u32) -> bool {
+    *v == 1
 }
 
 impl ArrayConfig {
@@ -113,14 +134,20 @@ fn one() -> f64 {
 /// The resolved array.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SensorArray {
+    /// Rows of pixels (of superpixels when G > 1: the written rows / G).
     pub rows: usize,
+    /// Columns of pixels (the written cols / G).
     pub cols: usize,
+    /// A pixel's pitch on the die (µm): G × the written SPAD pitch.
     pub pitch_um: f64,
-    /// Scene-plane size of one pixel (mm).
+    /// Scene-plane size of one pixel (mm): G × a SPAD's.
     pub mm_per_pixel: f64,
-    /// ρ_s of each pixel, row-major.
+    /// G: SPADs per pixel side (1: a pixel is one SPAD).
+    #[serde(default = "one_usize")]
+    pub superpixel: usize,
+    /// ρ_s of each SPAD, row-major over the (rows·G) × (cols·G) SPADs.
     pub signal_rate: Vec<f64>,
-    /// ρ_b of each pixel, row-major.
+    /// ρ_b of each SPAD, row-major.
     pub background_rate: Vec<f64>,
     /// The readout keys as written; [`crate::ResolvedDesign::readout`] resolves them for
     /// the pixel (its W, C and N), checked once by the resolution.
@@ -140,6 +167,49 @@ impl SensorArray {
             (c as f64 + 0.5) * self.mm_per_pixel,
             (r as f64 + 0.5) * self.mm_per_pixel,
         )
+    }
+
+    /// Rows of SPADs (rows · G).
+    pub fn spad_rows(&self) -> usize {
+        self.rows * self.superpixel
+    }
+
+    /// Columns of SPADs (cols · G).
+    pub fn spad_cols(&self) -> usize {
+        self.cols * self.superpixel
+    }
+
+    /// SPADs per pixel, G².
+    pub fn spads_per_pixel(&self) -> usize {
+        self.superpixel * self.superpixel
+    }
+
+    /// A SPAD's pitch on the die (µm), as written.
+    pub fn spad_pitch_um(&self) -> f64 {
+        self.pitch_um / self.superpixel as f64
+    }
+
+    /// Centre of SPAD (r, c) on the scene plane, (x, y) mm.
+    pub fn spad_centre_mm(&self, r: usize, c: usize) -> (f64, f64) {
+        let s = self.mm_per_pixel / self.superpixel as f64;
+        ((c as f64 + 0.5) * s, (r as f64 + 0.5) * s)
+    }
+
+    /// The SPADs of pixel (r, c), row-major within it: (rows·G + i, cols·G + j).
+    pub fn spads_of(&self, r: usize, c: usize) -> impl Iterator<Item = (usize, usize)> {
+        let g = self.superpixel;
+        (0..g * g).map(move |k| (r * g + k / g, c * g + k % g))
+    }
+
+    /// The superpixel front end of a pixel with `tdc_bits` TDC bits (`None` when G = 1).
+    pub fn front_end(
+        &self,
+        tdc_bits: u32,
+    ) -> Result<Option<tofprobe_pixel::Superpixel>, tofprobe_pixel::PixelError> {
+        if self.superpixel == 1 {
+            return Ok(None);
+        }
+        tofprobe_pixel::Superpixel::new(self.superpixel as u32, tdc_bits).map(Some)
     }
 
     /// The bytes an array of `registers` words and `bins` spectral bins per pixel needs:
@@ -176,16 +246,39 @@ pub fn resolve_array(
             )));
         }
     }
-    let need =
-        SensorArray::bytes_needed(a.rows.into(), a.cols.into(), registers as u64, bins as u64);
+    let g = a.superpixel;
+    let max_g = tofprobe_pixel::superpixel::MAX_SUPERPIXEL;
+    if !(1..=max_g).contains(&g) {
+        return Err(err(format!(
+            "array.superpixel = {g} is out of range: allowed 1..={max_g} (G × G SPADs share one \
+             pixel; 1: no superpixel)"
+        )));
+    }
+    for (name, v) in [("rows", a.rows), ("cols", a.cols)] {
+        if v % g != 0 {
+            let down = v / g * g;
+            let nearest = if down == 0 || v - down > down + g - v {
+                down + g
+            } else {
+                down
+            };
+            return Err(err(format!(
+                "array.{name} = {v} is not a multiple of array.superpixel = {g}: the SPADs form \
+                 {g} × {g} superpixels; array.{name} = {nearest} is the nearest that does"
+            )));
+        }
+    }
+    // The pixels: G × G SPADs each.
+    let (prows, pcols) = (a.rows / g, a.cols / g);
+    let need = SensorArray::bytes_needed(prows.into(), pcols.into(), registers as u64, bins as u64);
     if need > MAX_ARRAY_BYTES {
         let per_pixel = 8 * (registers as u64 + 2 * bins as u64 + 2);
         let side = ((MAX_ARRAY_BYTES / per_pixel) as f64).sqrt().floor() as u64;
         return Err(err(format!(
             "array.rows × array.cols = {} × {} needs {:.1} GiB for its registers ({registers} \
-             per pixel), spectra and maps: allowed at most {} GiB; {side} × {side} fits",
-            a.rows,
-            a.cols,
+             per pixel), spectra and maps: allowed at most {} GiB; {side} × {side} pixels fit",
+            prows,
+            pcols,
             need as f64 / (1u64 << 30) as f64,
             MAX_ARRAY_BYTES >> 30
         )));
@@ -271,12 +364,16 @@ pub fn resolve_array(
     )
     .map_err(err)?;
     let readout = a.readout_keys();
-    crate::readout::Readout::new(&readout, rows, cols, pixel, sensor.laser_rate_hz).map_err(err)?;
+    let (g, prows, pcols) = (g as usize, prows as usize, pcols as usize);
+    crate::readout::Readout::new(&readout, prows, pcols, pixel, sensor.laser_rate_hz)
+        .map_err(err)?;
     Ok(SensorArray {
-        rows,
-        cols,
-        pitch_um: a.pitch_um,
-        mm_per_pixel,
+        rows: prows,
+        cols: pcols,
+        pitch_um: a.pitch_um * g as f64,
+        // The mapping above is per SPAD (cols SPADs across the field of view).
+        mm_per_pixel: mm_per_pixel * g as f64,
+        superpixel: g,
         signal_rate,
         background_rate,
         readout,

@@ -357,14 +357,10 @@ impl ResolvedDesign {
 
     /// The photon source of pixel (r, c) of the array: the sensor with that pixel's ρ_s and
     /// ρ_b, the scene at its centre on the plane, and its own seed
-    /// ([`crate::array::pixel_seed`]). Refused for a single-pixel design or a pixel outside.
+    /// ([`crate::array::pixel_seed`]). Refused for a single-pixel design, a pixel outside,
+    /// or a superpixel (G > 1: [`Self::pixel_sources`]).
     pub fn pixel_source(&self, r: usize, c: usize) -> Result<PhotonSource, DesignError> {
-        let Some(a) = &self.array else {
-            return Err(DesignError::array(
-                &self.origin,
-                "the design has no [array]: its one pixel is `photon_source()`",
-            ));
-        };
+        let a = self.array_or_refuse()?;
         if r >= a.rows || c >= a.cols {
             return Err(DesignError::array(
                 &self.origin,
@@ -374,15 +370,67 @@ impl ResolvedDesign {
                 ),
             ));
         }
+        if a.superpixel > 1 {
+            return Err(DesignError::array(
+                &self.origin,
+                format!(
+                    "pixel ({r}, {c}) is a superpixel of {g} × {g} SPADs (array.superpixel = {g}): \
+                     its streams are `pixel_sources`, averaged by the superpixel front end",
+                    g = a.superpixel
+                ),
+            ));
+        }
+        self.spad_source(r, c)
+    }
+
+    /// The photon sources of pixel (r, c)'s G² SPADs, row-major within the pixel
+    /// ([`crate::SensorArray::spads_of`]); one source when G = 1, `pixel_source(r, c)`.
+    pub fn pixel_sources(&self, r: usize, c: usize) -> Result<Vec<PhotonSource>, DesignError> {
+        let a = self.array_or_refuse()?;
+        if r >= a.rows || c >= a.cols {
+            return Err(DesignError::array(
+                &self.origin,
+                format!(
+                    "pixel ({r}, {c}) is outside the {} × {} array",
+                    a.rows, a.cols
+                ),
+            ));
+        }
+        a.spads_of(r, c)
+            .map(|(sr, sc)| self.spad_source(sr, sc))
+            .collect()
+    }
+
+    /// The photon source of SPAD (r, c) (the SPAD grid: rows·G × cols·G): its rates, the
+    /// scene at its centre, the seed of (seed, r, c).
+    pub fn spad_source(&self, r: usize, c: usize) -> Result<PhotonSource, DesignError> {
+        let a = self.array_or_refuse()?;
+        let (rows, cols) = (a.spad_rows(), a.spad_cols());
+        if r >= rows || c >= cols {
+            return Err(DesignError::array(
+                &self.origin,
+                format!("SPAD ({r}, {c}) is outside the {rows} × {cols} SPADs"),
+            ));
+        }
         let mut sensor = self.document.sensor.clone();
-        sensor.signal_rate = a.signal_rate[r * a.cols + c];
-        sensor.background_rate = a.background_rate[r * a.cols + c];
+        sensor.signal_rate = a.signal_rate[r * cols + c];
+        sensor.background_rate = a.background_rate[r * cols + c];
         let scene =
             Scene::new(&self.document.scene).map_err(|e| DesignError::scene(&self.origin, e))?;
-        let (x, y) = a.centre_mm(r, c);
+        let (x, y) = a.spad_centre_mm(r, c);
         let seed = crate::array::pixel_seed(self.document.acquisition.seed, r, c);
         PhotonSource::new(&sensor, &scene.at_point(x, y), seed)
             .map_err(|e| DesignError::scene(&self.origin, e))
+    }
+
+    /// The array, or the error of a design without one.
+    fn array_or_refuse(&self) -> Result<&crate::SensorArray, DesignError> {
+        self.array.as_ref().ok_or_else(|| {
+            DesignError::array(
+                &self.origin,
+                "the design has no [array]: its one pixel is `photon_source()`",
+            )
+        })
     }
 
     /// Refuses an array design for a command that runs one pixel (`command` names it, and

@@ -13,6 +13,7 @@ pub mod preprocess;
 pub mod rom;
 pub mod sd;
 pub mod stats;
+pub mod superpixel;
 pub mod window;
 
 pub use error::DspError;

@@ -96,8 +96,18 @@ pub struct ArrayCosimReport {
 }
 
 /// The array chip of `design` for the overrides `o` (refused for a design without
-/// `[array]`).
+/// `[array]`, and for a superpixel array: the array RTL renders one SPAD per pixel, the
+/// superpixel's averaging is modelled and sized but not rendered).
 fn chip(design: &ResolvedDesign, o: &RtlOverrides, purpose: RomPurpose) -> Result<Chip, FlowError> {
+    if let Some(a) = design.array.as_ref().filter(|a| a.superpixel > 1) {
+        return Err(FlowError::option(
+            "array.superpixel",
+            a.superpixel,
+            "1 for the array's RTL, vectors, co-simulation and flow (they render one SPAD per \
+             pixel); a superpixel array is modelled by `tofprobe simulate` and sized by \
+             `tofprobe size`",
+        ));
+    }
     Ok(Chip::array_of(design, o, purpose)?)
 }
 

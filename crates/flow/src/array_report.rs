@@ -10,6 +10,7 @@ use tofprobe_eda::size_report::SizeReport;
 use tofprobe_eda::synth::{SynthSpec, synthesise};
 use tofprobe_pixel::Mode;
 
+use crate::array_options::{DoubleBuffer, SuperpixelSize, double_buffer, libraries, superpixel};
 use crate::array_size::{
     ArrayTotal, DEFAULT_UTILISATION, PixelPitch, ReadoutFigures, RomLogic, RomMacroEstimate,
     TimestampComparison, rom_macro_estimates,
@@ -68,6 +69,13 @@ pub struct ArraySizeReport {
     pub readout: ReadoutFigures,
     /// Reading every timestamp out instead.
     pub timestamps: TimestampComparison,
+    /// The double buffer's shadow registers: their bits and area per pixel and in the array
+    /// (an estimate from the register-file split; reported whether or not it is on).
+    pub double_buffer: DoubleBuffer,
+    /// `[array] superpixel = G > 1`: the averaging front end synthesised, memory and area
+    /// per SPAD beside the plain pixel's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub superpixel: Option<SuperpixelSize>,
     /// The assumptions behind the figures.
     pub assumptions: Vec<String>,
 }
@@ -192,7 +200,7 @@ pub fn array_report(
             _ => None,
         }
     };
-    let totals = areas
+    let totals: Vec<ArrayTotal> = areas
         .iter()
         .map(|(lib, a)| {
             let tech = library_node_nm(lib);
@@ -209,6 +217,25 @@ pub fn array_report(
         })
         .collect();
 
+    let libs = libraries(size);
+    let double_buffer = double_buffer(
+        readout.double_buffer,
+        chip.pixel.registers() as u64,
+        chip.pixel.width,
+        pixels,
+        &libs,
+        &totals,
+    );
+    let superpixel = match array.front_end(chip.pixel.tdc_bits)? {
+        Some(sp) => Some(superpixel(
+            &chip.pixel,
+            &sp,
+            array.spad_pitch_um(),
+            &libs,
+            cache,
+        )?),
+        None => None,
+    };
     let figures = ReadoutFigures::of(readout);
     let s = design.sensor();
     let timestamps = TimestampComparison::of(pixels, s.tdc_bits(), s.laser_rate_hz, &figures);
@@ -251,6 +278,8 @@ pub fn array_report(
         at_corner_options,
         readout: figures,
         timestamps,
+        double_buffer,
+        superpixel,
         assumptions,
     }))
 }
@@ -434,6 +463,7 @@ pub fn markdown(a: &ArraySizeReport) -> String {
             );
         }
     }
+    m += &crate::array_options::markdown(&a.double_buffer, a.superpixel.as_ref());
     let r = &a.readout;
     m += &format!(
         "\n### Readout\n\n\

@@ -18,7 +18,8 @@
 //! - [`sequencer`]: the reference pin sequence the testbench and vectors drive;
 //! - [`directed`]: the directed schedule beside it (refusals, saturation, wrap-around);
 //! - [`sizing`]: register widths, readout bytes and compression from a scene;
-//! - [`spectrum`]: the bit-true spectrum of a scene for `tofprobe simulate`.
+//! - [`spectrum`]: the bit-true spectrum of a scene for `tofprobe simulate`;
+//! - [`superpixel`]: the averaging of G × G SPADs in front of the datapath ([`Superpixel`]).
 
 pub mod autobins;
 pub mod bench;
@@ -39,6 +40,7 @@ pub mod schedule;
 pub mod sequencer;
 pub mod sizing;
 pub mod spectrum;
+pub mod superpixel;
 pub mod transaction;
 pub mod valid_codes;
 
@@ -63,6 +65,7 @@ pub use params::{Mode, PixelParams, RegisterFile, Rounding};
 pub use readout::{Readout, ReadoutCollector};
 pub use schedule::{Operation, Schedule};
 pub use sequencer::Sequencer;
+pub use superpixel::Superpixel;
 pub use transaction::TransactionModel;
 pub use valid_codes::{TdcCode, ValidCodes};
 

@@ -13,6 +13,7 @@ pub mod golden;
 pub mod naming;
 pub mod render;
 pub mod stimulus;
+pub mod superpixel;
 pub mod vectors;
 pub mod write;
 

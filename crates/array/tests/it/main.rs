@@ -5,4 +5,5 @@ mod common;
 mod determinism;
 mod rtl;
 mod shard;
+mod superpixel;
 mod validation;

@@ -217,8 +217,15 @@ pub fn print_array(
     }
     println!("configuration      {}", summary.configuration);
     println!(
-        "array              {} × {} pixels, pitch {} um, {:.4} mm per pixel on the scene",
-        summary.rows, summary.cols, summary.pitch_um, summary.mm_per_pixel
+        "array              {} × {} pixels{}, pitch {} um, {:.4} mm per pixel on the scene",
+        summary.rows,
+        summary.cols,
+        match summary.superpixel {
+            1 => String::new(),
+            g => format!(" (superpixels of {g} × {g} SPADs, their detections averaged)"),
+        },
+        summary.pitch_um,
+        summary.mm_per_pixel
     );
     println!(
         "frame              {} pulses per pixel, {} mode, {:.1} detections per pixel",

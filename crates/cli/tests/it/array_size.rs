@@ -132,6 +132,95 @@ fn a_three_by_five_array_is_sized_against_the_readout_contract() {
             .abs()
             < 1e-6
     );
+    double_buffer_is_the_register_file_again(&v, 15.0, false);
+}
+
+/// The double buffer's shadow (reported whether the option is on or off): R·W flops — the synthesised
+/// register file holds exactly that many — at the file's own area per flop, added to every
+/// pixel and to the array's total.
+fn double_buffer_is_the_register_file_again(v: &serde_json::Value, pixels: f64, enabled: bool) {
+    let db = &v["array"]["double_buffer"];
+    assert_eq!(db["enabled"], enabled);
+    let bits = num(v, &["design", "registers"]) * num(v, &["design", "width"]);
+    assert_eq!(num(db, &["shadow_bits_per_pixel"]), bits);
+    let a = &db["areas"][0];
+    let rf = &v["area"]["split"]["register_file"];
+    assert_eq!(
+        num(a, &["register_file_flops"]),
+        bits,
+        "R·W flops in the file"
+    );
+    assert_eq!(num(rf, &["flops"]), bits);
+    let shadow = num(rf, &["area_um2"]);
+    assert!((num(a, &["shadow_um2"]) - shadow).abs() < 1e-6 * shadow);
+    let flop = v["area"]["smallest_flop"][1].as_f64().expect("a flop");
+    assert!((num(a, &["shadow_flops_only_um2"]) - bits * flop).abs() < 1e-6);
+    assert!(num(a, &["shadow_flops_only_um2"]) < num(a, &["shadow_um2"]));
+    let pixel = num(v, &["area", "total_area_um2"]);
+    assert!((num(a, &["pixel_with_um2"]) - (pixel + shadow)).abs() < 1e-6);
+    let total = num(&v["array"]["totals"][0], &["total_um2"]);
+    assert!((num(a, &["array_total_um2"]) - total).abs() < 1e-6);
+    assert!((num(a, &["array_total_with_um2"]) - (total + pixels * shadow)).abs() < 1e-3);
+}
+
+/// 4 × 4 SPADs as 2 × 2 superpixels of G = 2: the front end synthesised, the register bits
+/// per SPAD a quarter of the plain pixel's, the area per SPAD (pixel + front end) / 4.
+#[test]
+fn a_superpixel_array_reports_memory_and_area_per_spad() {
+    if !crate::common::have_tools(&["yosys", "sta"]) {
+        return;
+    }
+    let dir = scratch("superpixel");
+    let cfg = config(&dir, 4, 4, "superpixel = 2\ndouble_buffer = true");
+    let out = size(
+        &[
+            cfg.to_str().unwrap(),
+            "--no-sky130",
+            "--json",
+            "--sweep-bins",
+            "1",
+        ],
+        &dir.join("cache"),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    let a = &v["array"];
+    assert_eq!(a["pixels"], 4, "2 × 2 superpixels");
+    assert_eq!(num(a, &["configured_pitch_um"]), 80.0, "2 × the 40 µm SPAD");
+    let sp = &a["superpixel"];
+    assert_eq!(
+        (sp["side"].as_u64(), sp["spads_per_pixel"].as_u64()),
+        (Some(2), Some(4))
+    );
+    assert_eq!(num(sp, &["spad_pitch_um"]), 40.0);
+    // T = 7: k = 7 + 2·⌈log2 4⌉ = 11, a word of 12 bits.
+    assert_eq!(
+        (num(sp, &["shift"]), num(sp, &["table_bits"])),
+        (11.0, 12.0)
+    );
+    let bits = num(&v, &["design", "registers"]) * num(&v, &["design", "width"]);
+    assert_eq!(num(sp, &["plain_bits_per_spad"]), bits);
+    assert_eq!(num(sp, &["bits_per_spad"]), bits / 4.0);
+    let s = &sp["area"][0];
+    let pixel = num(&v, &["area", "total_area_um2"]);
+    let fe = num(s, &["front_end_um2"]);
+    assert!(fe > 0.0 && num(s, &["front_end_cells"]) > 0.0, "{s}");
+    assert_eq!(num(s, &["plain_per_spad_um2"]), pixel);
+    assert!((num(s, &["per_spad_um2"]) - (pixel + fe) / 4.0).abs() < 1e-9);
+    double_buffer_is_the_register_file_again(&v, 4.0, true);
+    // The array RTL renders one SPAD per pixel: `rtl` refuses the superpixel, naming it.
+    let out = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .args(["rtl", cfg.to_str().unwrap(), "--out"])
+        .arg(dir.join("rtl"))
+        .output()
+        .expect("run tofprobe");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("array.superpixel") && err.contains('2'),
+        "{err}"
+    );
 }
 
 #[test]

@@ -14,4 +14,5 @@ mod refusal;
 mod register_frac_bits;
 mod sequencer;
 mod sizing;
+mod superpixel;
 mod valid_codes;

@@ -6,3 +6,4 @@ mod accepted_render;
 mod array_gates;
 mod gates;
 mod render;
+mod superpixel;
