@@ -34,11 +34,11 @@ pub const LANES: usize = 8;
 const BLOCK: usize = 64;
 
 /// The front-end state (t, x, u) of the lanes ([`crate::datapath::FourierStream`]'s).
-#[derive(Debug, Clone, Copy, Default)]
-struct LaneState {
-    target: [i64; LANES],
-    x: [i64; LANES],
-    u: [i64; LANES],
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct LaneState {
+    pub target: [i64; LANES],
+    pub x: [i64; LANES],
+    pub u: [i64; LANES],
 }
 
 /// Up to [`LANES`] folded pixels of the same parameters and ROM, run in lockstep.
@@ -208,17 +208,18 @@ impl<'rom> FoldLanes<'rom> {
 
 /// The constants of one lockstep run.
 #[derive(Debug, Clone, Copy)]
-struct Lockstep {
-    k: StepConsts,
+pub(crate) struct Lockstep {
+    pub k: StepConsts,
     /// −1 for a live lane, 0 for a masked one (its operands are not added).
-    keep: [i64; LANES],
-    start: usize,
-    addr: usize,
+    pub keep: [i64; LANES],
+    pub start: usize,
+    pub addr: usize,
 }
 
 /// The lockstep loop: the AVX-512 copy where the CPU has it (the same integer operations
-/// on the same arrays: bit-identical), the baseline copy elsewhere.
-fn run_lockstep<D: Detections + ?Sized>(
+/// on the same arrays: bit-identical), the baseline copy elsewhere. Also the segmented
+/// driver's ([`crate::segments`]: the lanes are segments of one pixel's run).
+pub(crate) fn run_lockstep<D: Detections + ?Sized>(
     ctx: &Lockstep,
     streams: &[&D],
     phases: &mut [[i64; LANES]],
@@ -252,7 +253,7 @@ fn lockstep_avx512<D: Detections + ?Sized>(
 }
 
 #[inline(always)]
-fn lockstep_body<D: Detections + ?Sized>(
+pub(crate) fn lockstep_body<D: Detections + ?Sized>(
     ctx: &Lockstep,
     streams: &[&D],
     phases: &mut [[i64; LANES]],
