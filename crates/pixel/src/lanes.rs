@@ -262,22 +262,22 @@ pub(crate) fn lockstep_body<D: Detections + ?Sized>(
     let depth = phases.len();
     let n = streams[0].len();
     let (mut pos, mut addr) = (ctx.start, ctx.addr);
-    // Masked lanes read "no detection" throughout (their columns are never written).
+    // Masked lanes read "no detection" throughout.
+    static DARK: [u32; BLOCK] = [NO_DETECTION; BLOCK];
     let mut rows = [[NO_DETECTION; LANES]; BLOCK];
-    let mut buf = [0u32; BLOCK];
+    let mut bufs = [[0u32; BLOCK]; LANES];
     while pos < n {
         let len = (depth - addr).min(n - pos);
         for (b, cells) in phases[addr..addr + len].chunks_mut(BLOCK).enumerate() {
             let first = pos + b * BLOCK;
             let m = cells.len();
-            for (j, s) in streams.iter().enumerate() {
+            let mut cols: [&[u32]; LANES] = [&DARK[..m]; LANES];
+            for (j, (s, buf)) in streams.iter().zip(bufs.iter_mut()).enumerate() {
                 if ctx.keep[j] != 0 {
-                    let codes = s.codes(first, m, &mut buf);
-                    for (row, &c) in rows.iter_mut().zip(codes) {
-                        row[j] = c;
-                    }
+                    cols[j] = s.codes(first, m, buf);
                 }
             }
+            transpose(&cols, &mut rows[..m]);
             if ctx.k.register_shift == 0 {
                 step::<false>(&rows[..m], cells, &ctx.k, &ctx.keep, st);
             } else {
@@ -289,6 +289,25 @@ pub(crate) fn lockstep_body<D: Detections + ?Sized>(
         if addr == depth {
             addr = 0;
         }
+    }
+}
+
+/// `rows[i][j] = cols[j][i]`: the lanes' codes, one row per pulse. Whole 8 × 8 tiles
+/// (the compiler makes them register shuffles; lane by lane it scatters), the rest singly.
+#[inline(always)]
+fn transpose(cols: &[&[u32]; LANES], rows: &mut [[u32; LANES]]) {
+    let done = rows.len() / 8 * 8;
+    let mut tiles = rows.chunks_exact_mut(8);
+    for (t, tile) in (&mut tiles).enumerate() {
+        let src: [[u32; 8]; LANES] =
+            std::array::from_fn(|j| cols[j][8 * t..8 * t + 8].try_into().expect("8 codes"));
+        for (i, row) in tile.iter_mut().enumerate() {
+            *row = std::array::from_fn(|j| src[j][i]);
+        }
+    }
+    for (i, row) in tiles.into_remainder().iter_mut().enumerate() {
+        let i = done + i;
+        *row = std::array::from_fn(|j| cols[j][i]);
     }
 }
 
