@@ -118,7 +118,8 @@ pub fn measure(
     let pixel_err = |e| BenchError::from(tofprobe_design::DesignError::pixel("bench pixel", e));
     let t = bench_transaction(&params, pulses as usize, &rom, rate).map_err(pixel_err)?;
     let f = bench_fold(&params, pulses as usize, &rom, rate).map_err(pixel_err)?;
-    let (sg, repaired) = bench_segmented(&params, pulses as usize, &rom, rate).map_err(pixel_err)?;
+    let (sg, repaired) =
+        bench_segmented(&params, pulses as usize, &rom, rate).map_err(pixel_err)?;
     let segmented_chosen = tofprobe_pixel::segments_pay(&params);
     let fold_chosen = tofprobe_pixel::fold::fold_pays(&params);
     // The driver the library picks for this frame, on CPU time where measured.

@@ -173,7 +173,13 @@ pub fn bench_fold(
         }
         None => Some(fm.readout()),
     });
-    check_against_transaction(params, &stimuli, rom, &readout, "benchmark readouts of the folded and transaction drivers")?;
+    check_against_transaction(
+        params,
+        &stimuli,
+        rom,
+        &readout,
+        "benchmark readouts of the folded and transaction drivers",
+    )?;
     Ok(bench)
 }
 
@@ -195,7 +201,13 @@ pub fn bench_segmented(
         }
         None => Some(sm.readout()),
     });
-    check_against_transaction(params, &stimuli, rom, &readout, "benchmark readouts of the segmented and transaction drivers")?;
+    check_against_transaction(
+        params,
+        &stimuli,
+        rom,
+        &readout,
+        "benchmark readouts of the segmented and transaction drivers",
+    )?;
     Ok((bench, sm.repaired_pulses()))
 }
 
@@ -241,11 +253,7 @@ fn check_against_transaction(
         tm.run(chunk, Some(rom), (i << 16) as u64)?;
     }
     if tm.readout() != *readout {
-        return Err(PixelError::mismatch(
-            what,
-            "different",
-            "identical",
-        ));
+        return Err(PixelError::mismatch(what, "different", "identical"));
     }
     Ok(())
 }

@@ -556,8 +556,18 @@ mod tests {
                 let a = fast.step(&pins);
                 let b = full.edge::<false>(&pins);
                 assert_eq!(a, b, "outputs at edge {}", full.cycle());
-                assert_eq!(fast.writes(), full.writes(), "writes at edge {}", full.cycle());
-                assert_eq!(format!("{fast:?}"), format!("{full:?}"), "state at edge {}", full.cycle());
+                assert_eq!(
+                    fast.writes(),
+                    full.writes(),
+                    "writes at edge {}",
+                    full.cycle()
+                );
+                assert_eq!(
+                    format!("{fast:?}"),
+                    format!("{full:?}"),
+                    "state at edge {}",
+                    full.cycle()
+                );
             }
         }
         assert!(quiet_edges > 20_000, "{quiet_edges} quiet edges");

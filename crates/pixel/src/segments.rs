@@ -135,7 +135,8 @@ impl<'rom> SegmentedModel<'rom> {
             let upto = (0..total)
                 .find(|&i| detections.get(i).is_some())
                 .map_or(total, |f| f + 1);
-            self.fold.run(&Window::new(detections, 0..upto), addr0 as u64);
+            self.fold
+                .run(&Window::new(detections, 0..upto), addr0 as u64);
             pos = upto;
         }
         if let Some(m) = self.segment_len(total - pos) {
@@ -209,11 +210,11 @@ impl<'rom> SegmentedModel<'rom> {
         run_lockstep(&ctx, &streams, &mut self.rows, &mut st);
         // Lane 0 started true: its end is true. Each next segment starts from it.
         let mut truth = (st.target[0], st.x[0], st.u[0]);
-        for j in 1..LANES {
+        for (j, segment) in windows.iter().enumerate().skip(1) {
             let guessed = (guesses.target[j], guesses.x[j], guesses.u[j]);
             let phase = (addr + j * m) % depth;
             truth = self
-                .repair(&windows[j], phase, truth, guessed, &k)
+                .repair(segment, phase, truth, guessed, &k)
                 .unwrap_or((st.target[j], st.x[j], st.u[j]));
         }
         front.set_state(truth, detections.last_detection(pos, pos + LANES * m));
@@ -270,7 +271,11 @@ impl<'rom> SegmentedModel<'rom> {
 
     /// The register file as it stands (each value sign-extended from W bits).
     pub fn registers(&self) -> Vec<i64> {
-        fold_registers(self.fold.params(), self.fold.rom(), self.merged_phases().into_iter())
+        fold_registers(
+            self.fold.params(),
+            self.fold.rom(),
+            self.merged_phases().into_iter(),
+        )
     }
 
     /// Reads the frame out and clears the registers and the frame counters (the depth
@@ -290,7 +295,11 @@ fn add_columns(phases: &mut [i64], rows: &[[i64; LANES]], stride: usize) {
     for j in 0..LANES {
         let off = j * stride % depth;
         for (r, row) in rows.iter().enumerate() {
-            let p = if r + off >= depth { r + off - depth } else { r + off };
+            let p = if r + off >= depth {
+                r + off - depth
+            } else {
+                r + off
+            };
             phases[p] = phases[p].wrapping_add(row[j]);
         }
     }
@@ -355,7 +364,11 @@ mod tests {
             assert!(sm.repaired_pulses() > 0, "the segments were repaired");
             let got = sm.readout();
             let first = got.words.iter().zip(&want.words).position(|(a, b)| a != b);
-            assert_eq!(first.is_none(), equal, "limit {limit}: first differing register {first:?}");
+            assert_eq!(
+                first.is_none(),
+                equal,
+                "limit {limit}: first differing register {first:?}"
+            );
         }
     }
 

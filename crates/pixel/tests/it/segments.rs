@@ -117,7 +117,11 @@ fn readouts(c: &Case, shift: usize) -> (Vec<Readout>, Vec<Readout>, u64) {
         sm.run(&shifted[at..at + len], addr);
         assert_eq!(sm.pulses_in_frame(), tm.pulses_in_frame());
         if ends {
-            assert_eq!(sm.registers(), tm.registers().to_vec(), "registers before the readout");
+            assert_eq!(
+                sm.registers(),
+                tm.registers().to_vec(),
+                "registers before the readout"
+            );
             want.push(tm.readout());
             got.push(sm.readout());
         }
@@ -174,7 +178,10 @@ fn the_cases_reach_the_repairs() {
             whole += 1;
         }
     }
-    assert!(met >= 50 && whole >= 5, "repaired: {met} fast, {whole} slow");
+    assert!(
+        met >= 50 && whole >= 5,
+        "repaired: {met} fast, {whole} slow"
+    );
 }
 
 /// `FrameDriver` runs the segmented fold for a long frame of a fast prefilter and the
@@ -184,15 +191,22 @@ fn the_cases_reach_the_repairs() {
 fn the_frame_driver_picks_the_segments() {
     assert!(segments_pay(&PixelParams::default()));
     let mut rng = Rng(11);
-    for (n, shift, segmented) in [(100_000u64, 5, true), (100_000, 9, false), (20_000, 5, false)]
-    {
+    for (n, shift, segmented) in [
+        (100_000u64, 5, true),
+        (100_000, 9, false),
+        (20_000, 5, false),
+    ] {
         let params = PixelParams {
             shift,
             ..PixelParams::fourier_default(30, n, 1000)
         };
         let rom = random_rom(&mut rng, &params);
         let mut d = FrameDriver::new(&params, Some(&rom)).unwrap();
-        assert_eq!((d.is_segmented(), d.is_folded()), (segmented, true), "N = {n}, S = {shift}");
+        assert_eq!(
+            (d.is_segmented(), d.is_folded()),
+            (segmented, true),
+            "N = {n}, S = {shift}"
+        );
         let codes: Vec<u32> = (0..n)
             .map(|_| compact(random_detection(&mut rng, &params)))
             .collect();
