@@ -213,9 +213,11 @@ impl<'rom> SegmentedModel<'rom> {
         for (j, segment) in windows.iter().enumerate().skip(1) {
             let guessed = (guesses.target[j], guesses.x[j], guesses.u[j]);
             let phase = (addr + j * m) % depth;
-            truth = self
-                .repair(segment, phase, truth, guessed, &k)
-                .unwrap_or((st.target[j], st.x[j], st.u[j]));
+            truth = self.repair(segment, phase, truth, guessed, &k).unwrap_or((
+                st.target[j],
+                st.x[j],
+                st.u[j],
+            ));
         }
         front.set_state(truth, detections.last_detection(pos, pos + LANES * m));
         self.fold.datapath_mut().end_stream(front);
