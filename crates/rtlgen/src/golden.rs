@@ -174,6 +174,7 @@ pub fn run(p: &PixelParams, seq: &Sequencer<'_>, o: &GoldenOptions) -> Result<Go
     // pair was copied through memory with an 8-byte load over the bytes just stored (a
     // store-forwarding stall, half the golden run's time under perf).
     let mut next_cycle = 0u64;
+    #[allow(clippy::explicit_counter_loop)] // `enumerate` pairs them again: the stall above
     for pins in seq.clone() {
         let c = next_cycle;
         next_cycle += 1;
