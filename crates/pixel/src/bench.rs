@@ -1,7 +1,8 @@
 //! Speed of the two fidelities (issue point 8), measured by `tofprobe bench pixel`: the
 //! transaction model's pulses per second at B = 16 with the ROM read for every pulse, the
 //! folded driver's on the same frame (issue 28; [`bench_fold`], checked bit-identical to
-//! the transaction driver's readout), and the cycle model's clock edges per second under
+//! the transaction driver's readout), the segmented fold's ([`bench_segmented`], checked
+//! the same way), and the cycle model's clock edges per second under
 //! the reference sequencer. Both transaction-level drivers read the compact codes
 //! ([`synthetic_codes`]), the form the Monte Carlo writes.
 
