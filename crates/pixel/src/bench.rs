@@ -1,7 +1,8 @@
 //! Speed of the two fidelities (issue point 8), measured by `tofprobe bench pixel`: the
 //! transaction model's pulses per second at B = 16 with the ROM read for every pulse, the
 //! folded driver's on the same frame (issue 28; [`bench_fold`], checked bit-identical to
-//! the transaction driver's readout), and the cycle model's clock edges per second under
+//! the transaction driver's readout), the segmented fold's ([`bench_segmented`], checked
+//! the same way), and the cycle model's clock edges per second under
 //! the reference sequencer. Both transaction-level drivers read the compact codes
 //! ([`synthetic_codes`]), the form the Monte Carlo writes.
 
@@ -13,6 +14,8 @@ use crate::cycle::CycleModel;
 use crate::error::PixelError;
 use crate::fold::FoldModel;
 use crate::params::PixelParams;
+use crate::readout::Readout;
+use crate::segments::SegmentedModel;
 use crate::sequencer::Sequencer;
 use crate::transaction::TransactionModel;
 
@@ -162,37 +165,98 @@ pub fn bench_fold(
     rom: &RomImage,
     laser_rate_hz: f64,
 ) -> Result<FoldBench, PixelError> {
-    let stimuli = synthetic_codes(pulses, 80);
     let mut fm = FoldModel::new(params, rom)?;
+    let stimuli = synthetic_codes(pulses, 80);
+    let (readout, bench) = timed(&stimuli, laser_rate_hz, |chunk, first| match chunk {
+        Some(chunk) => {
+            fm.run(chunk, first);
+            None
+        }
+        None => Some(fm.readout()),
+    });
+    check_against_transaction(
+        params,
+        &stimuli,
+        rom,
+        &readout,
+        "benchmark readouts of the folded and transaction drivers",
+    )?;
+    Ok(bench)
+}
+
+/// [`bench_fold`] for the segmented fold ([`SegmentedModel`], the frame driver's choice
+/// for a long frame): the same stimuli in the same chunks, readout included, the same
+/// check. Also returns the pulses its repairs stepped again.
+pub fn bench_segmented(
+    params: &PixelParams,
+    pulses: usize,
+    rom: &RomImage,
+    laser_rate_hz: f64,
+) -> Result<(FoldBench, u64), PixelError> {
+    let mut sm = SegmentedModel::new(params, rom)?;
+    let stimuli = synthetic_codes(pulses, 80);
+    let (readout, bench) = timed(&stimuli, laser_rate_hz, |chunk, first| match chunk {
+        Some(chunk) => {
+            sm.run(chunk, first);
+            None
+        }
+        None => Some(sm.readout()),
+    });
+    check_against_transaction(
+        params,
+        &stimuli,
+        rom,
+        &readout,
+        "benchmark readouts of the segmented and transaction drivers",
+    )?;
+    Ok((bench, sm.repaired_pulses()))
+}
+
+/// Times a driver over `stimuli` in chunks of 2^16 pulses (`drive(Some(chunk), its first
+/// pulse's ROM address)`), then its readout (`drive(None, 0)`).
+fn timed(
+    stimuli: &[u32],
+    laser_rate_hz: f64,
+    mut drive: impl FnMut(Option<&[u32]>, u64) -> Option<Readout>,
+) -> (Readout, FoldBench) {
     let c0 = thread_cpu_seconds();
     let t0 = Instant::now();
     for (i, chunk) in stimuli.chunks(1 << 16).enumerate() {
-        fm.run(chunk, (i << 16) as u64);
+        drive(Some(chunk), (i << 16) as u64);
     }
-    let folded = fm.readout();
+    let readout = drive(None, 0).unwrap_or_default();
     let seconds = t0.elapsed().as_secs_f64().max(1e-9);
     let cpu_seconds = c0.zip(thread_cpu_seconds()).map(|(a, b)| b - a);
-
-    let mut tm = TransactionModel::new(params)?;
-    for (i, chunk) in stimuli.chunks(1 << 16).enumerate() {
-        tm.run(chunk, Some(rom), (i << 16) as u64)?;
-    }
-    if tm.readout() != folded {
-        return Err(PixelError::mismatch(
-            "benchmark readouts of the folded and transaction drivers",
-            "different",
-            "identical",
-        ));
-    }
+    let pulses = stimuli.len();
     let simulated = pulses as f64 / laser_rate_hz;
-    Ok(FoldBench {
+    let bench = FoldBench {
         pulses: pulses as u64,
         seconds,
         cpu_seconds,
         pulses_per_s: pulses as f64 / seconds,
         realtime_factor: simulated / seconds,
         cpu_realtime_factor: cpu_seconds.map(|c| simulated / c.max(1e-9)),
-    })
+    };
+    (readout, bench)
+}
+
+/// The transaction driver's readout of `stimuli` (in the benchmark's chunks) must be
+/// `readout`: a mismatch is an error, `what` naming the pair.
+fn check_against_transaction(
+    params: &PixelParams,
+    stimuli: &[u32],
+    rom: &RomImage,
+    readout: &Readout,
+    what: &'static str,
+) -> Result<(), PixelError> {
+    let mut tm = TransactionModel::new(params)?;
+    for (i, chunk) in stimuli.chunks(1 << 16).enumerate() {
+        tm.run(chunk, Some(rom), (i << 16) as u64)?;
+    }
+    if tm.readout() != *readout {
+        return Err(PixelError::mismatch(what, "different", "identical"));
+    }
+    Ok(())
 }
 
 /// Result of the cycle-model benchmark.

@@ -1,8 +1,9 @@
 //! The one entry point for running frames at transaction level: [`FrameDriver`] picks the
-//! folded driver ([`crate::fold`]) when [`fold_pays`] says it does fewer adds, and the
-//! transaction driver ([`TransactionModel::run`], the naive reference) otherwise (Haar,
-//! short frames, very deep ROMs). Both read out bit-identical registers, so a caller never
-//! sees which one ran except in the time it took.
+//! segmented fold ([`crate::segments`]) for long frames of a fast prefilter
+//! ([`segments_pay`]), else the folded driver ([`crate::fold`]) when [`fold_pays`] says it
+//! does fewer adds, and the transaction driver ([`TransactionModel::run`], the naive
+//! reference) otherwise (Haar, short frames, very deep ROMs). All read out bit-identical
+//! registers, so a caller never sees which one ran except in the time it took.
 
 use tofprobe_dsp::RomImage;
 
@@ -11,11 +12,14 @@ use crate::error::PixelError;
 use crate::fold::{FoldModel, fold_pays};
 use crate::params::PixelParams;
 use crate::readout::Readout;
+use crate::segments::{SegmentedModel, segments_pay};
 use crate::transaction::{TransactionModel, frame_len};
 
 /// A transaction-level pixel run by the driver that pays for its parameters.
 #[derive(Debug, Clone)]
 pub enum FrameDriver<'rom> {
+    /// The segmented fold (a long Fourier frame, periodic ROM, S small).
+    Segmented(SegmentedModel<'rom>),
     /// The folded driver (Fourier, periodic ROM).
     Fold(FoldModel<'rom>),
     /// The transaction driver and the ROM it reads (`None` in Haar mode).
@@ -23,11 +27,14 @@ pub enum FrameDriver<'rom> {
 }
 
 impl<'rom> FrameDriver<'rom> {
-    /// A pixel just out of reset, folded when [`fold_pays`] for `params` (N =
-    /// `frame_pulses` pulses per frame). Fails if the parameters do not validate or the
-    /// ROM does not fit them (Fourier).
+    /// A pixel just out of reset: segmented when [`segments_pay`], folded when
+    /// [`fold_pays`] for `params` (N = `frame_pulses` pulses per frame). Fails if the
+    /// parameters do not validate or the ROM does not fit them (Fourier).
     pub fn new(params: &PixelParams, rom: Option<&'rom RomImage>) -> Result<Self, PixelError> {
         match rom {
+            Some(rom) if segments_pay(params) => {
+                Ok(FrameDriver::Segmented(SegmentedModel::new(params, rom)?))
+            }
             Some(rom) if fold_pays(params) => Ok(FrameDriver::Fold(FoldModel::new(params, rom)?)),
             _ => Self::transaction(params, rom),
         }
@@ -46,9 +53,14 @@ impl<'rom> FrameDriver<'rom> {
         Ok(FrameDriver::Transaction(tm, rom))
     }
 
-    /// Whether the folded driver runs.
+    /// Whether a folded driver (the fold or the segmented fold) runs.
     pub fn is_folded(&self) -> bool {
-        matches!(self, FrameDriver::Fold(_))
+        matches!(self, FrameDriver::Fold(_) | FrameDriver::Segmented(_))
+    }
+
+    /// Whether the segmented fold runs.
+    pub fn is_segmented(&self) -> bool {
+        matches!(self, FrameDriver::Segmented(_))
     }
 
     /// Runs many pulses: pulse i reads ROM address (`first_address` + i) mod L (see
@@ -59,6 +71,10 @@ impl<'rom> FrameDriver<'rom> {
         first_address: u64,
     ) -> Result<(), PixelError> {
         match self {
+            FrameDriver::Segmented(s) => {
+                s.run(detections, first_address);
+                Ok(())
+            }
             FrameDriver::Fold(f) => {
                 f.run(detections, first_address);
                 Ok(())
@@ -70,6 +86,7 @@ impl<'rom> FrameDriver<'rom> {
     /// Pulses run since the last readout.
     pub fn pulses_in_frame(&self) -> u64 {
         match self {
+            FrameDriver::Segmented(s) => s.pulses_in_frame(),
             FrameDriver::Fold(f) => f.pulses_in_frame(),
             FrameDriver::Transaction(tm, _) => tm.pulses_in_frame(),
         }
@@ -78,6 +95,7 @@ impl<'rom> FrameDriver<'rom> {
     /// Reads the frame out and clears the registers (the depth tracking continues).
     pub fn readout(&mut self) -> Readout {
         match self {
+            FrameDriver::Segmented(s) => s.readout(),
             FrameDriver::Fold(f) => f.readout(),
             FrameDriver::Transaction(tm, _) => tm.readout(),
         }

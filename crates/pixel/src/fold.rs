@@ -206,6 +206,32 @@ impl<'rom> FoldModel<'rom> {
         self.pcount += total as u64;
     }
 
+    /// The datapath (the segmented driver, [`crate::segments`], steps its primed front end
+    /// itself and hands the state back).
+    pub(crate) fn datapath_mut(&mut self) -> &mut Datapath {
+        &mut self.dp
+    }
+
+    /// The phase sums (L_v of them, phase p reading ROM address p mod L).
+    pub(crate) fn phases(&self) -> &[i64] {
+        &self.phases
+    }
+
+    /// The phase sums, for the segmented driver's repairs and its lanes' sums.
+    pub(crate) fn phases_mut(&mut self) -> &mut [i64] {
+        &mut self.phases
+    }
+
+    /// Counts `n` pulses the segmented driver ran past this driver's own `run`.
+    pub(crate) fn count_pulses(&mut self, n: u64) {
+        self.pcount += n;
+    }
+
+    /// The ROM the readout distributes the phase sums with.
+    pub(crate) fn rom(&self) -> &'rom RomImage {
+        self.rom
+    }
+
     /// The register file as it stands (each value sign-extended from W bits): the phase
     /// sums distributed, without reading out.
     pub fn registers(&self) -> Vec<i64> {

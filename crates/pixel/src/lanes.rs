@@ -34,11 +34,11 @@ pub const LANES: usize = 8;
 const BLOCK: usize = 64;
 
 /// The front-end state (t, x, u) of the lanes ([`crate::datapath::FourierStream`]'s).
-#[derive(Debug, Clone, Copy, Default)]
-struct LaneState {
-    target: [i64; LANES],
-    x: [i64; LANES],
-    u: [i64; LANES],
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct LaneState {
+    pub target: [i64; LANES],
+    pub x: [i64; LANES],
+    pub u: [i64; LANES],
 }
 
 /// Up to [`LANES`] folded pixels of the same parameters and ROM, run in lockstep.
@@ -208,17 +208,18 @@ impl<'rom> FoldLanes<'rom> {
 
 /// The constants of one lockstep run.
 #[derive(Debug, Clone, Copy)]
-struct Lockstep {
-    k: StepConsts,
+pub(crate) struct Lockstep {
+    pub k: StepConsts,
     /// −1 for a live lane, 0 for a masked one (its operands are not added).
-    keep: [i64; LANES],
-    start: usize,
-    addr: usize,
+    pub keep: [i64; LANES],
+    pub start: usize,
+    pub addr: usize,
 }
 
 /// The lockstep loop: the AVX-512 copy where the CPU has it (the same integer operations
-/// on the same arrays: bit-identical), the baseline copy elsewhere.
-fn run_lockstep<D: Detections + ?Sized>(
+/// on the same arrays: bit-identical), the baseline copy elsewhere. Also the segmented
+/// driver's ([`crate::segments`]: the lanes are segments of one pixel's run).
+pub(crate) fn run_lockstep<D: Detections + ?Sized>(
     ctx: &Lockstep,
     streams: &[&D],
     phases: &mut [[i64; LANES]],
@@ -252,7 +253,7 @@ fn lockstep_avx512<D: Detections + ?Sized>(
 }
 
 #[inline(always)]
-fn lockstep_body<D: Detections + ?Sized>(
+pub(crate) fn lockstep_body<D: Detections + ?Sized>(
     ctx: &Lockstep,
     streams: &[&D],
     phases: &mut [[i64; LANES]],
@@ -261,22 +262,22 @@ fn lockstep_body<D: Detections + ?Sized>(
     let depth = phases.len();
     let n = streams[0].len();
     let (mut pos, mut addr) = (ctx.start, ctx.addr);
-    // Masked lanes read "no detection" throughout (their columns are never written).
+    // Masked lanes read "no detection" throughout.
+    static DARK: [u32; BLOCK] = [NO_DETECTION; BLOCK];
     let mut rows = [[NO_DETECTION; LANES]; BLOCK];
-    let mut buf = [0u32; BLOCK];
+    let mut bufs = [[0u32; BLOCK]; LANES];
     while pos < n {
         let len = (depth - addr).min(n - pos);
         for (b, cells) in phases[addr..addr + len].chunks_mut(BLOCK).enumerate() {
             let first = pos + b * BLOCK;
             let m = cells.len();
-            for (j, s) in streams.iter().enumerate() {
+            let mut cols: [&[u32]; LANES] = [&DARK[..m]; LANES];
+            for (j, (s, buf)) in streams.iter().zip(bufs.iter_mut()).enumerate() {
                 if ctx.keep[j] != 0 {
-                    let codes = s.codes(first, m, &mut buf);
-                    for (row, &c) in rows.iter_mut().zip(codes) {
-                        row[j] = c;
-                    }
+                    cols[j] = s.codes(first, m, buf);
                 }
             }
+            transpose(&cols, &mut rows[..m]);
             if ctx.k.register_shift == 0 {
                 step::<false>(&rows[..m], cells, &ctx.k, &ctx.keep, st);
             } else {
@@ -288,6 +289,25 @@ fn lockstep_body<D: Detections + ?Sized>(
         if addr == depth {
             addr = 0;
         }
+    }
+}
+
+/// `rows[i][j] = cols[j][i]`: the lanes' codes, one row per pulse. Whole 8 × 8 tiles
+/// (the compiler makes them register shuffles; lane by lane it scatters), the rest singly.
+#[inline(always)]
+fn transpose(cols: &[&[u32]; LANES], rows: &mut [[u32; LANES]]) {
+    let done = rows.len() / 8 * 8;
+    let mut tiles = rows.chunks_exact_mut(8);
+    for (t, tile) in (&mut tiles).enumerate() {
+        let src: [[u32; 8]; LANES] =
+            std::array::from_fn(|j| cols[j][8 * t..8 * t + 8].try_into().expect("8 codes"));
+        for (i, row) in tile.iter_mut().enumerate() {
+            *row = std::array::from_fn(|j| src[j][i]);
+        }
+    }
+    for (i, row) in tiles.into_remainder().iter_mut().enumerate() {
+        let i = done + i;
+        *row = std::array::from_fn(|j| cols[j][i]);
     }
 }
 

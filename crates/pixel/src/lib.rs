@@ -11,7 +11,9 @@
 //! - [`fold`]: the folded driver of a Fourier frame (phase sums of the periodic ROM), and
 //!   [`driver`]: [`FrameDriver`], which runs it when it pays and the transaction driver
 //!   otherwise; [`lanes`]: [`FoldLanes`], up to [`LANES`] folded pixels of an array in
-//!   lockstep;
+//!   lockstep; [`segments`]: [`SegmentedModel`], one pixel's long run cut into [`LANES`]
+//!   time segments in those lanes and repaired exactly (the frame driver's choice when it
+//!   pays);
 //! - [`schedule`]: the adder schedule, which register each adder touches in which slot;
 //! - [`fault`]: deliberate faults the cycle model carries for the mutation tests;
 //! - [`fixed`]: the fixed-width arithmetic of the datapath;
@@ -37,6 +39,7 @@ pub mod lanes;
 pub mod params;
 pub mod readout;
 pub mod schedule;
+pub mod segments;
 pub mod sequencer;
 pub mod sizing;
 pub mod spectrum;
@@ -64,6 +67,7 @@ pub use lanes::{FoldLanes, LANES};
 pub use params::{Mode, PixelParams, RegisterFile, Rounding};
 pub use readout::{Readout, ReadoutCollector};
 pub use schedule::{Operation, Schedule};
+pub use segments::{SegmentedModel, segments_pay};
 pub use sequencer::Sequencer;
 pub use superpixel::Superpixel;
 pub use transaction::TransactionModel;

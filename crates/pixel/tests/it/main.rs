@@ -12,6 +12,7 @@ mod lanes;
 mod numerics;
 mod refusal;
 mod register_frac_bits;
+mod segments;
 mod sequencer;
 mod sizing;
 mod superpixel;

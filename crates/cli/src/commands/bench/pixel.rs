@@ -175,6 +175,28 @@ fn print_text(r: &PixelReport) {
         }
     );
     println!(
+        "segmented fold     {:.4} s = {:.1} M pulses/s, {:.1}x real time{}; {:.2}x the transaction driver, {:.2}x the fold ({} pulses repaired, {})",
+        r.segmented_fold_seconds,
+        r.segmented_fold_pulses_per_s / 1e6,
+        r.segmented_fold_realtime_factor,
+        r.segmented_fold_cpu_realtime_factor
+            .map(|f| format!(" ({f:.1}x on CPU time)"))
+            .unwrap_or_default(),
+        r.segmented_speedup_vs_transaction,
+        r.segmented_speedup_vs_fold,
+        r.segmented_repaired_pulses,
+        if r.segmented_chosen {
+            "chosen for this frame"
+        } else {
+            "not chosen for this frame"
+        }
+    );
+    println!(
+        "real time          the chosen driver {} the {:.0}x target",
+        if r.realtime_pass { "reaches" } else { "misses" },
+        r.realtime_target
+    );
+    println!(
         "cycle model        {} cycles in {:.4} s = {:.1} M cycles/s ({:.3}x real time at {} cycles/pulse)",
         r.cycle_cycles,
         r.cycle_seconds,
