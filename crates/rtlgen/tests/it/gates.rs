@@ -106,6 +106,27 @@ fn configs() -> Vec<(&'static str, PixelParams)> {
                 ..d.clone()
             },
         ),
+        // Latch registers written in clk's low phase through one clock gate each (both modes).
+        (
+            "latch",
+            PixelParams {
+                register_file: RegisterFile::Latch,
+                ..d.clone()
+            },
+        ),
+        (
+            "haar_latch",
+            PixelParams {
+                mode: Mode::Haar,
+                haar_scales: 2,
+                adders: 2,
+                cycles_per_pulse: 4,
+                frame_pulses: 256,
+                width: 20,
+                register_file: RegisterFile::Latch,
+                ..d.clone()
+            },
+        ),
     ]
 }
 
