@@ -69,7 +69,7 @@ pub struct OptionRow {
     pub register_frac_bits: u32,
     /// `floor` or `nearest`.
     pub prefilter_rounding: String,
-    /// `flops` or `clock_gated`.
+    /// `flops`, `clock_gated` or `latch`.
     pub register_file: String,
     /// Tone error against the float DFT over the seeds (µm).
     pub tone_error_um: Spread,
