@@ -503,5 +503,14 @@ library (tiny) {
         let lib = Liberty::load(p).unwrap();
         assert_eq!(lib.cells["DFFPOSX1"].area, 96.0);
         assert!(lib.has_timing);
+        // Its LATCH has `area : 0`; the LEF beside it draws 5.6 × 10 µm (tolerance: the
+        // product of two decimal sizes in f64), and only that cell is taken from the LEF.
+        assert!((lib.cells["LATCH"].area - 56.0).abs() < 1e-9);
+        assert_eq!(lib.area_from_lef.keys().collect::<Vec<_>>(), ["LATCH"]);
+        // Parsed without its LEF, the liberty's own figure stands.
+        let text = std::fs::read_to_string(p).unwrap();
+        let bare = Liberty::parse(p, &text).unwrap();
+        assert_eq!(bare.cells["LATCH"].area, 0.0);
+        assert!(bare.area_from_lef.is_empty());
     }
 }
