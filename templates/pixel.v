@@ -36,9 +36,9 @@ module {{ name }} (
     reg [{{ ln }}:0] pcount;
 {%- endif %}
     // The register file. Public so the co-simulation harness can observe its writes.
-{%- if clock_gated %}
+{%- if clock_gated || latch %}
     // One clock per register: written from R processes, one element each (mem2reg: yosys
-    // keeps each register as flops on its own gated clock).
+    // keeps each register as {% if latch %}latches{% else %}flops{% endif %} on its own gated clock).
     /* verilator lint_off MULTIDRIVEN */
     (* mem2reg *) reg [{{ w - 1 }}:0] y [0:{{ r - 1 }}] /*verilator public_flat_rd*/;
     /* verilator lint_on MULTIDRIVEN */
@@ -189,7 +189,9 @@ module {{ name }} (
 {%- else %}
     assign we_c[{{ g.r }}] = (active && acc_en && {{ g.sel }}) || (rd_active && rd_ptr == {{ ib }}'d{{ g.r }});
 {%- endif %}
+{%- if !latch || mutation == "schedule_late" %}
     wire [{{ w - 1 }}:0] wval_{{ g.r }} = rd_active ? {{ w }}'d0 : sum_{{ g.adder }};
+{%- endif %}
 {%- endfor %}
 {%- if mutation == "schedule_late" %}
     // FAULT: writes land one edge late.
@@ -228,6 +230,40 @@ module {{ name }} (
         else y[{{ g.r }}] <= wval_{{ g.r }};
 {%- endif %}
     end
+{%- endfor %}
+{%- else if latch %}
+    // Latch register file (pixel.register_file = "latch", docs/pixel-contract.md "Register
+    // file"): register r is W transparent-high latches enabled by clk's low phase gated by
+    // the write enable of the last rising edge. A write decided at rising edge t (we[r] high
+    // before it) is captured at t: its enable in we_q, its value in its adder's word wd_a
+    // (readout clears and reset as 0). The latches pass it while clk is low and close at
+    // edge t+1, so the register holds its new value from the falling edge after t, and at
+    // every rising edge it holds what a flop register file holds. The latch input is a
+    // flop, never the register itself: no loop through the adder while transparent, and
+    // no register is transparent at a rising edge, where it is read.
+    wire clk_n = ~clk;
+    reg [{{ r - 1 }}:0] we_q;
+{%- for ad in adders %}
+    reg [{{ w - 1 }}:0] wd_{{ ad.a }};
+{%- endfor %}
+    always @(posedge clk) begin
+        we_q <= we | { {{- r }}{rst}};
+{%- for ad in adders %}
+        wd_{{ ad.a }} <= (rst || rd_active) ? {{ w }}'d0 : sum_{{ ad.a }};
+{%- endfor %}
+    end
+{%- for g in regs %}
+    wire gclk_{{ g.r }};
+    {{ name }}_clock_gate cg_{{ g.r }} (.clk(clk_n), .en(we_q[{{ g.r }}]), .gclk(gclk_{{ g.r }}));
+    /* verilator lint_off LATCH */
+    always @* begin
+{%- if mutation == "narrow_register" && g.r == 0 %}
+        if (gclk_0) y[0] = {wd_{{ g.adder }}[{{ w - 2 }}], wd_{{ g.adder }}[{{ w - 2 }}:0]};
+{%- else %}
+        if (gclk_{{ g.r }}) y[{{ g.r }}] = wd_{{ g.adder }};
+{%- endif %}
+    end
+    /* verilator lint_on LATCH */
 {%- endfor %}
 {%- else %}
     always @(posedge clk) begin
@@ -362,9 +398,10 @@ module {{ name }} (
         end
     end
 endmodule
-{%- if clock_gated %}
+{%- if clock_gated || latch %}
 
-// The clock gate of one register (pixel.register_file = "clock_gated"): the standard
+// The clock gate of one register (pixel.register_file = "clock_gated", or "latch" on the
+// inverted clock, where it gates the low phase the latches are transparent in): the standard
 // latch-based integrated clock gate. The latch is transparent while clk is low, so the
 // enable settled during a cycle is held through the high phase and gclk carries exactly
 // the rising edges of clk the enable selects, without glitches. This body is for

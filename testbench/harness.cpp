@@ -4,7 +4,8 @@
 // per cycle it sets the inputs, evaluates with clk low, samples the outputs, raises clk and
 // evaluates again (the contract's cycle). It compares, per cycle inside the trace window,
 // the register writes (which registers the pixel's write-enable vector `we` selects at the
-// edge, and their values after it) and the output pins; per digest window, a digest of both
+// edge, and their values at the falling edge after it, where every register file kind holds
+// them) and the output pins; per digest window, a digest of both
 // (everywhere); per frame, the readout. It ends with exactly one line
 //   TOFPROBE-COSIM-DONE cycles=<n> frames=<n> mismatches=<n> seconds=<s> cpu_seconds=<s>
 // (`seconds` wall time, `cpu_seconds` the process's CPU time, of the replay) preceded, on a mismatch, by
@@ -245,6 +246,64 @@ int main(int argc, char** argv) {
         }
     };
 
+    // The register writes of edge `cw` (enables `we`, reset `rst_w`), observed at the
+    // falling edge after it: a latch register file (docs/pixel-contract.md "Register
+    // file") holds a write from that falling edge on, flops and gated flops from the
+    // edge itself, and every kind holds it there. Folded into the digest before the
+    // next cycle's pins, the order the digest has always had.
+    auto observe_writes = [&](uint64_t cw, uint64_t we, bool rst_w, bool full_w) {
+        if (!full_w) {
+            // Hot path of long runs: fold the writes straight into the digest.
+            for (uint64_t m = we; m != 0; m &= m - 1) {
+                const uint32_t r = static_cast<uint32_t>(__builtin_ctzll(m));
+                dh = fold(dh, 1, cw, r, static_cast<uint64_t>(PIX_Y[r]));
+                ++dcount;
+            }
+        } else {
+            act_w.clear();
+            for (uint64_t m = we; m != 0; m &= m - 1) {
+                uint32_t r = static_cast<uint32_t>(__builtin_ctzll(m));
+                uint64_t v = static_cast<uint64_t>(PIX_Y[r]);
+                act_w.push_back({r, v});
+                dh = fold(dh, 1, cw, r, v);
+                ++dcount;
+            }
+            {
+                exp_w.clear();
+                while (tp < trace.size() && trace[tp].cycle == cw) {
+                    exp_w.push_back({trace[tp].reg, trace[tp].value});
+                    ++tp;
+                }
+                size_t n = act_w.size() > exp_w.size() ? act_w.size() : exp_w.size();
+                for (size_t i = 0; i < n; ++i) {
+                    bool ha = i < act_w.size(), he = i < exp_w.size();
+                    if (ha && he && act_w[i] == exp_w[i]) continue;
+                    uint32_t r = ha && he ? (act_w[i].first < exp_w[i].first ? act_w[i].first : exp_w[i].first)
+                                          : (ha ? act_w[i].first : exp_w[i].first);
+                    std::string e = "none", a = "none";
+                    for (auto& x : exp_w) if (x.first == r) e = hexs(x.second);
+                    for (auto& x : act_w) if (x.first == r) a = hexs(x.second);
+                    report(cw, "y[" + std::to_string(r) + "]", e, a);
+                    break;
+                }
+            }
+            // A register whose write enable is low keeps its value: a write `we` does not
+            // show (a clock gate on the wrong enable, a gate that glitches) fails at its edge.
+            if (held_known && !rst_w) {
+                for (uint64_t r = 0; r < R; ++r) {
+                    const uint64_t v = static_cast<uint64_t>(PIX_Y[r]);
+                    if (((we >> r) & 1) == 0 && v != y_held[r]) {
+                        report(cw, "y[" + std::to_string(r) + "]", "none", hexs(v));
+                        break;
+                    }
+                }
+            }
+            for (uint64_t r = 0; r < R; ++r) y_held[r] = static_cast<uint64_t>(PIX_Y[r]);
+            held_known = true;
+        }
+    };
+    uint64_t pend_c = 0, pend_we = 0;
+    bool pend_rst = false, pend_full = false, pending = false;
     for (uint64_t c = 0; c < cycles; ++c) {
         top->rst = c < 2;
         uint32_t s = next_pulse < stim.size() ? stim[next_pulse] : 0;
@@ -255,6 +314,8 @@ int main(int argc, char** argv) {
 #ifdef TOFPROBE_TRACE
         if (vcd && c >= vcd_lo && c < vcd_hi) vcd->dump(static_cast<uint64_t>(2 * c));
 #endif
+        if (pending) observe_writes(pend_c, pend_we, pend_rst, pend_full);
+        pending = false;
         Pins now{c, top->ready != 0, top->rd_valid != 0, static_cast<uint32_t>(top->rd_index),
                  static_cast<uint64_t>(top->rd_data)};
         const bool pulse = top->pulse_o;
@@ -308,56 +369,16 @@ int main(int argc, char** argv) {
                 if (now.rd_index == R) ++frames;
             }
         }
-        // Register writes made at this edge.
-        if (!full) {
-            // Hot path of long runs: fold the writes straight into the digest.
-            for (uint64_t m = we; m != 0; m &= m - 1) {
-                const uint32_t r = static_cast<uint32_t>(__builtin_ctzll(m));
-                dh = fold(dh, 1, c, r, static_cast<uint64_t>(PIX_Y[r]));
-                ++dcount;
-            }
-        } else {
-            act_w.clear();
-            for (uint64_t m = we; m != 0; m &= m - 1) {
-                uint32_t r = static_cast<uint32_t>(__builtin_ctzll(m));
-                uint64_t v = static_cast<uint64_t>(PIX_Y[r]);
-                act_w.push_back({r, v});
-                dh = fold(dh, 1, c, r, v);
-                ++dcount;
-            }
-            {
-                exp_w.clear();
-                while (tp < trace.size() && trace[tp].cycle == c) {
-                    exp_w.push_back({trace[tp].reg, trace[tp].value});
-                    ++tp;
-                }
-                size_t n = act_w.size() > exp_w.size() ? act_w.size() : exp_w.size();
-                for (size_t i = 0; i < n; ++i) {
-                    bool ha = i < act_w.size(), he = i < exp_w.size();
-                    if (ha && he && act_w[i] == exp_w[i]) continue;
-                    uint32_t r = ha && he ? (act_w[i].first < exp_w[i].first ? act_w[i].first : exp_w[i].first)
-                                          : (ha ? act_w[i].first : exp_w[i].first);
-                    std::string e = "none", a = "none";
-                    for (auto& x : exp_w) if (x.first == r) e = hexs(x.second);
-                    for (auto& x : act_w) if (x.first == r) a = hexs(x.second);
-                    report(c, "y[" + std::to_string(r) + "]", e, a);
-                    break;
-                }
-            }
-            // A register whose write enable is low keeps its value: a write `we` does not
-            // show (a clock gate on the wrong enable, a gate that glitches) fails at its edge.
-            if (held_known && !top->rst) {
-                for (uint64_t r = 0; r < R; ++r) {
-                    const uint64_t v = static_cast<uint64_t>(PIX_Y[r]);
-                    if (((we >> r) & 1) == 0 && v != y_held[r]) {
-                        report(c, "y[" + std::to_string(r) + "]", "none", hexs(v));
-                        break;
-                    }
-                }
-            }
-            for (uint64_t r = 0; r < R; ++r) y_held[r] = static_cast<uint64_t>(PIX_Y[r]);
-            held_known = true;
-        }
+        pend_c = c;
+        pend_we = we;
+        pend_rst = top->rst != 0;
+        pend_full = full;
+        pending = true;
+    }
+    if (pending) {
+        top->clk = 0;
+        top->eval();
+        observe_writes(pend_c, pend_we, pend_rst, pend_full);
     }
     close_window(cycles);
     if (window + 1 != digests.size()) {

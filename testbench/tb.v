@@ -2,8 +2,9 @@
 //
 // Replays golden vectors through the generated top: per cycle it sets the inputs with clk
 // low, samples the outputs, raises clk, then compares the register writes of that edge
-// (the pixel's write-enable vector `we` and the register values after the edge) with
-// trace.hex, the output pins with pins.hex (from cycle 1 on) and every readout word with
+// (the pixel's write-enable vector `we` and the register values at the falling edge after
+// it, where every register file kind holds them: a latch register file passes a write
+// while clk is low) with trace.hex, the output pins with pins.hex (from cycle 1 on) and every readout word with
 // readout.hex. It needs a full trace (vectors of short frames). Compile with
 //   iverilog -g2005 -I VECDIR -DTB_TOP=tofprobe_top -DTB_VECTORS=\"VECDIR/\" tb.v RTL/*.v
 // and run vvp from the RTL directory (the probe ROM's $readmemh file is found there). It
@@ -35,6 +36,11 @@ module tb;
     reg [127:0] pins [0:TB_PIN_EVENTS];
 
     integer c, np, tp, pp, ro_i, r, mism, frames, cur;
+    // The cycle a mismatch is reported at, and the edge whose writes are still to be
+    // observed (at the next falling edge) with its enables and reset.
+    integer rep_c, cw;
+    reg [63:0] we_w;
+    reg rst_w, pending;
     reg [19:0] s;
     reg p_s, ready_s, rd_valid_s;
     reg [TB_RD_INDEX_BITS-1:0] rd_index_s;
@@ -58,11 +64,42 @@ module tb;
                 reported = 1;
                 if (reg_index >= 0)
                     $display("TOFPROBE-MISMATCH cycle=%0d pulse=%0d signal=y[%0d] expected=%0h actual=%0h",
-                             c, cur, reg_index, expected, actual);
+                             rep_c, cur, reg_index, expected, actual);
                 else
                     $display("TOFPROBE-MISMATCH cycle=%0d pulse=%0d signal=%0s expected=%0h actual=%0h",
-                             c, cur, signal, expected, actual);
+                             rep_c, cur, signal, expected, actual);
             end
+        end
+    endtask
+
+    // The register writes of edge `cw`, observed at the falling edge after it.
+    task observe_writes;
+        begin
+            rep_c = cw;
+            for (r = 0; r < TB_REGISTERS; r = r + 1) begin
+                if (we_w[r]) begin
+                    v = dut.u_pixel.y[r];
+                    if (tp >= TB_TRACE_EVENTS || trace[tp][127:80] != cw || trace[tp][79:64] != r)
+                        mismatch("write", r, 64'hffffffffffffffff, v);
+                    else if (trace[tp][63:0] !== v)
+                        mismatch("write", r, trace[tp][63:0], v);
+                    if (tp < TB_TRACE_EVENTS && trace[tp][127:80] == cw) tp = tp + 1;
+                end
+            end
+            // An expected write that did not happen at this edge.
+            while (tp < TB_TRACE_EVENTS && trace[tp][127:80] == cw) begin
+                mismatch("write", trace[tp][79:64], trace[tp][63:0], 64'hffffffffffffffff);
+                tp = tp + 1;
+            end
+            // A register whose write enable is low keeps its value: a write `we` does not
+            // show (a clock gate on the wrong enable, a gate that glitches) fails at its edge.
+            for (r = 0; r < TB_REGISTERS; r = r + 1) begin
+                v = dut.u_pixel.y[r];
+                if (held_known && !rst_w && !we_w[r] && v !== y_held[r])
+                    mismatch("write", r, 64'hffffffffffffffff, v);
+                y_held[r] = v;
+            end
+            held_known = 1;
         end
     endtask
 
@@ -78,6 +115,8 @@ module tb;
         clk = 0; rst = 1; valid = 0; tdc = 0;
         np = 0; tp = 0; pp = 0; ro_i = 0; mism = 0; frames = 0; cur = 0; reported = 0;
         held_known = 0;
+        pending = 0;
+        rep_c = 0;
         exp_ready = 0; exp_valid = 0; exp_index = 0; exp_data = 0;
         for (c = 0; c < TB_CYCLES; c = c + 1) begin
             rst = (c < 2);
@@ -85,6 +124,9 @@ module tb;
             valid = s[16];
             tdc = s[TB_TDC_BITS-1:0];
             #1;
+            if (pending) observe_writes;
+            pending = 0;
+            rep_c = c;
             p_s = pulse_o;
             ready_s = ready;
             rd_valid_s = rd_valid;
@@ -118,32 +160,17 @@ module tb;
                     if (rd_index_s == TB_REGISTERS) frames = frames + 1;
                 end
             end
-            for (r = 0; r < TB_REGISTERS; r = r + 1) begin
-                if (we[r]) begin
-                    v = dut.u_pixel.y[r];
-                    if (tp >= TB_TRACE_EVENTS || trace[tp][127:80] != c || trace[tp][79:64] != r)
-                        mismatch("write", r, 64'hffffffffffffffff, v);
-                    else if (trace[tp][63:0] !== v)
-                        mismatch("write", r, trace[tp][63:0], v);
-                    if (tp < TB_TRACE_EVENTS && trace[tp][127:80] == c) tp = tp + 1;
-                end
-            end
-            // An expected write that did not happen at this edge.
-            while (tp < TB_TRACE_EVENTS && trace[tp][127:80] == c) begin
-                mismatch("write", trace[tp][79:64], trace[tp][63:0], 64'hffffffffffffffff);
-                tp = tp + 1;
-            end
-            // A register whose write enable is low keeps its value: a write `we` does not
-            // show (a clock gate on the wrong enable, a gate that glitches) fails at its edge.
-            for (r = 0; r < TB_REGISTERS; r = r + 1) begin
-                v = dut.u_pixel.y[r];
-                if (held_known && !rst && !we[r] && v !== y_held[r])
-                    mismatch("write", r, 64'hffffffffffffffff, v);
-                y_held[r] = v;
-            end
-            held_known = 1;
+            cw = c;
+            we_w = we;
+            rst_w = rst;
+            pending = 1;
             clk = 0;
         end
+        if (pending) begin
+            #1;
+            observe_writes;
+        end
+        rep_c = c;
         if (ro_i != TB_READOUT_WORDS) mismatch("readout_words", -1, TB_READOUT_WORDS, ro_i);
         $display("TOFPROBE-COSIM-DONE cycles=%0d frames=%0d mismatches=%0d seconds=0", TB_CYCLES, frames, mism);
 `ifdef __ICARUS__

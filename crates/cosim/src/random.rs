@@ -93,6 +93,11 @@ pub fn random_case(seed: u64, i: u64) -> RandomCase {
     if rng.next_u64() & 1 == 1 {
         p.register_file = RegisterFile::ClockGated;
     }
+    // Latches, drawn after that (and only over flops), so a case drawn before they existed
+    // keeps every field, its kind included, or turns from flops into latches.
+    if rng.next_u64() & 1 == 1 && p.register_file == RegisterFile::Flops {
+        p.register_file = RegisterFile::Latch;
+    }
     RandomCase {
         params: p,
         seed,

@@ -228,11 +228,11 @@ mod tests {
             ),
             (
                 "[pixel]\nregister_file = 3\n",
-                "`pixel.register_file` = 3 has the wrong type: expected one of `flops` or `clock_gated`",
+                "`pixel.register_file` = 3 has the wrong type: expected one of `flops`, `clock_gated`, `latch`",
             ),
             (
-                "[pixel]\nregister_file = \"latch\"\n",
-                "`pixel.register_file` = \"latch\" is not accepted: unknown variant `latch`, expected `flops` or `clock_gated`",
+                "[pixel]\nregister_file = \"sram\"\n",
+                "`pixel.register_file` = \"sram\" is not accepted: unknown variant `sram`, expected one of `flops`, `clock_gated`, `latch`",
             ),
             (
                 "[pixel]\nprefilter_rounding = 1.5\n",

@@ -122,31 +122,9 @@ impl ClockGateCells {
             path: lib.path.clone(),
             missing: what,
         };
-        // A plain D latch: one data and one enable input, the enable `CLK` (transparent
-        // high) or `!CLK` (transparent low), an output that is the latch's state.
-        let latch = smallest(lib, |n, c| {
-            let (enable, data) = c.latch.as_ref()?;
-            let ins = inputs(c);
-            if ins.len() != 2 || c.clock_gating.is_some() {
-                return None;
-            }
-            let (en, low) = match bare(enable) {
-                e if ins.contains(&e.as_str()) => (e, false),
-                e => {
-                    let pin = e.strip_prefix('!').or_else(|| e.strip_suffix('\''))?;
-                    (pin.to_string(), true)
-                }
-            };
-            let d = bare(data);
-            if !ins.contains(&en.as_str()) || !ins.contains(&d.as_str()) || en == d {
-                return None;
-            }
-            // The output carrying the state (not its complement).
-            let (q, _) = outputs(c).into_iter().map(|(p, f)| (p, bare(&f))).find(|(_, f)| {
-                !f.is_empty() && !f.starts_with('!') && !f.ends_with('\'')
-            })?;
-            Some((n.clone(), en, d, q.to_string(), low))
-        })
+        // A plain D latch, either polarity (crate::latch reads them).
+        let latch = crate::latch::smallest(crate::latch::d_latches(lib))
+            .map(|l| (l.cell, l.enable, l.data, l.q, l.transparent_low))
         .ok_or_else(|| {
             missing(
                 "integrated clock-gating cell (`clock_gating_integrated_cell : \"latch_posedge\"`) nor a D latch (`latch` group)",
@@ -174,18 +152,7 @@ impl ClockGateCells {
         let inverter = if latch.4 {
             None
         } else {
-            let inv = smallest(lib, |n, c| {
-                let ins = inputs(c);
-                let outs = outputs(c);
-                if c.sequential || ins.len() != 1 || outs.len() != 1 {
-                    return None;
-                }
-                let a = ins[0];
-                [format!("!{a}"), format!("{a}'")]
-                    .contains(&bare(&outs[0].1))
-                    .then(|| (n.clone(), a.to_string(), outs[0].0.to_string()))
-            })
-            .ok_or_else(|| {
+            let inv = smallest_inverter(lib).ok_or_else(|| {
                 missing("inverter for its transparent-high latch (for a latch-based clock gate)")
             })?;
             Some(inv)
@@ -260,6 +227,21 @@ impl ClockGateCells {
         s += "endmodule\n";
         s
     }
+}
+
+/// The liberty's smallest inverter: (cell, input pin, output pin).
+pub fn smallest_inverter(lib: &Liberty) -> Option<(String, String, String)> {
+    smallest(lib, |n, c| {
+        let ins = inputs(c);
+        let outs = outputs(c);
+        if c.sequential || ins.len() != 1 || outs.len() != 1 {
+            return None;
+        }
+        let a = ins[0];
+        [format!("!{a}"), format!("{a}'")]
+            .contains(&bare(&outs[0].1))
+            .then(|| (n.clone(), a.to_string(), outs[0].0.to_string()))
+    })
 }
 
 /// Behavioural Verilog of the `latch_posedge` integrated clock gates of `lib` that

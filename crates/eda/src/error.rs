@@ -37,6 +37,14 @@ pub enum EdaError {
         path: PathBuf,
         missing: &'static str,
     },
+    /// `register_file = "latch"` on a liberty with no D latch for the registers.
+    #[error(
+        "liberty {path} has no {missing}: `pixel.register_file = \"latch\"` builds each register bit from the liberty's D latch; pass a liberty that has one (sky130_fd_sc_hd has `dlxtp`, osu018 a LATCH) or set `register_file = \"flops\"`"
+    )]
+    LatchCells {
+        path: PathBuf,
+        missing: &'static str,
+    },
     /// The synthesised netlist still contains generic cells the liberty could not map.
     #[error(
         "liberty {path} cannot implement {cells}: yosys left these generic cells unmapped; pass a liberty with those functions"

@@ -11,6 +11,8 @@ pub mod equiv;
 pub mod error;
 pub mod fsutil;
 pub mod generated;
+pub mod latch;
+pub mod lef;
 pub mod liberty;
 pub mod markdown;
 pub mod memory;

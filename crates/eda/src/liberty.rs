@@ -56,6 +56,9 @@ pub struct Liberty {
     pub cells: BTreeMap<String, LibCell>,
     /// Some pin has a `timing` group: OpenSTA can time a netlist mapped onto it.
     pub has_timing: bool,
+    /// Cells whose liberty area is 0 and whose area (µm²) was taken from the outline in the
+    /// LEF beside the liberty (same stem, `.lef`): osu018's `LATCH`. Their `area` is it.
+    pub area_from_lef: BTreeMap<String, f64>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -113,7 +116,28 @@ impl Liberty {
                 path: path.to_path_buf(),
                 reason: e.to_string(),
             })?;
-        Self::parse(path, &text)
+        let mut lib = Self::parse(path, &text)?;
+        lib.fill_areas_from_lef();
+        Ok(lib)
+    }
+
+    /// A cell the liberty gives no area (`area : 0`, osu018's `LATCH`) takes its outline's
+    /// area from the LEF beside the liberty, when there is one and it draws the cell.
+    fn fill_areas_from_lef(&mut self) {
+        let lef = self.path.with_extension("lef");
+        let Ok(text) = std::fs::read_to_string(&lef) else {
+            return;
+        };
+        let sizes = crate::lef::lef_sizes(&text);
+        for (name, c) in self.cells.iter_mut() {
+            if c.area == 0.0
+                && let Some((w, h)) = sizes.get(name)
+                && w * h > 0.0
+            {
+                c.area = w * h;
+                self.area_from_lef.insert(name.clone(), c.area);
+            }
+        }
     }
 
     /// Parses liberty text (`path` only labels errors).
@@ -124,6 +148,7 @@ impl Liberty {
             name: String::new(),
             cells: BTreeMap::new(),
             has_timing: false,
+            area_from_lef: BTreeMap::new(),
         };
         // Stack of open groups: (group kind, first argument).
         let mut stack: Vec<(String, String)> = Vec::new();
@@ -478,5 +503,14 @@ library (tiny) {
         let lib = Liberty::load(p).unwrap();
         assert_eq!(lib.cells["DFFPOSX1"].area, 96.0);
         assert!(lib.has_timing);
+        // Its LATCH has `area : 0`; the LEF beside it draws 5.6 × 10 µm (tolerance: the
+        // product of two decimal sizes in f64), and only that cell is taken from the LEF.
+        assert!((lib.cells["LATCH"].area - 56.0).abs() < 1e-9);
+        assert_eq!(lib.area_from_lef.keys().collect::<Vec<_>>(), ["LATCH"]);
+        // Parsed without its LEF, the liberty's own figure stands.
+        let text = std::fs::read_to_string(p).unwrap();
+        let bare = Liberty::parse(p, &text).unwrap();
+        assert_eq!(bare.cells["LATCH"].area, 0.0);
+        assert!(bare.area_from_lef.is_empty());
     }
 }

@@ -38,6 +38,13 @@ fn area_block(out: &mut String, a: &AreaSection, bins: u64) {
         a.split.registers_found,
         a.area_per_bin_um2,
     );
+    for (cell, area) in &a.area_from_lef {
+        let _ = writeln!(
+            out,
+            "- `{cell}`: {area:.2} µm² each from LEF (its outline in the LEF beside the liberty; the liberty gives it area 0), {} instance(s)",
+            a.cells_by_type.get(cell).copied().unwrap_or(0)
+        );
+    }
     if let Some(m) = &a.model {
         let _ = writeln!(
             out,

@@ -88,8 +88,13 @@ pub struct AreaSection {
     pub library: String,
     /// Liberty carries timing.
     pub has_timing: bool,
-    /// Total cell area (µm²), from yosys `stat -liberty`.
+    /// Total cell area (µm²), from yosys `stat -liberty`, with `area_from_lef`'s cells at
+    /// their LEF outline.
     pub total_area_um2: f64,
+    /// Cells the liberty gives no area, counted at their LEF outline (µm² each): osu018's
+    /// `LATCH` (a latch register file, or a clock gate's latch). Reported "from LEF".
+    #[serde(default)]
+    pub area_from_lef: std::collections::BTreeMap<String, f64>,
     /// Cell instances.
     pub cell_count: u64,
     /// Instances per cell type.
@@ -195,6 +200,7 @@ fn area_section(lib: &Liberty, p: &PointResult, model: Option<AreaModel>) -> Are
         library: lib.name.clone(),
         has_timing: lib.has_timing,
         total_area_um2: p.synthesis.total_area_um2,
+        area_from_lef: p.synthesis.area_from_lef.clone(),
         cell_count: p.synthesis.cell_count,
         cells_by_type: p.synthesis.cells_by_type.clone(),
         split: p.split,

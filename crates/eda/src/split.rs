@@ -39,6 +39,11 @@ pub struct BlockNames {
     /// Base names of the hold and prefilter state (default `held`, `x`, `primed`, `op` —
     /// the latched prefilter output —, `diff`).
     pub hold_prefilter: Vec<String>,
+    /// Base names of the flops a latch register file captures each write in (`we_q`, the
+    /// enables; `wd_<a>`, adder a's word): charged to the register file but traversed like
+    /// logic, so the adder in front of a word still reaches the several registers it
+    /// writes (and is charged to the adders).
+    pub register_file_stage: Vec<String>,
     /// Register width W: register-file bits of one net are grouped W at a time.
     pub width: u32,
 }
@@ -51,6 +56,7 @@ impl BlockNames {
             hold_prefilter: ["held", "x", "primed", "op", "x_new", "h_new", "diff"]
                 .map(String::from)
                 .to_vec(),
+            register_file_stage: ["we_q", "wd"].map(String::from).to_vec(),
             width: width.max(1),
         }
     }
@@ -211,6 +217,7 @@ pub fn split_area(
     // Classify flops by the net they drive.
     let mut reg_index: HashMap<(String, usize), usize> = HashMap::new();
     let mut flop_sink: HashMap<usize, Sink> = HashMap::new();
+    let mut stage = Vec::new();
     for (i, c) in cells.iter().enumerate().filter(|(_, c)| c.flop) {
         let names_of: Vec<&(String, usize)> = c
             .outputs
@@ -218,6 +225,13 @@ pub fn split_area(
             .filter_map(|b| bit_names.get(b))
             .flatten()
             .collect();
+        if names_of
+            .iter()
+            .any(|(net, _)| matches(base_name(net), &names.register_file_stage))
+        {
+            stage.push(i);
+            continue;
+        }
         let reg = names_of
             .iter()
             .find(|(net, _)| matches(base_name(net), &names.register_file));
@@ -234,6 +248,10 @@ pub fn split_area(
             Sink::Control
         };
         flop_sink.insert(i, sink);
+    }
+    for i in stage {
+        cells[i].flop = false;
+        cells[i].clock_gate = true;
     }
     // Readers of each bit.
     let mut readers: HashMap<u64, Vec<usize>> = HashMap::new();

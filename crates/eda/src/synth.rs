@@ -73,8 +73,13 @@ pub struct Synthesis {
     pub key: String,
     /// The synthesised module.
     pub top: String,
-    /// Total cell area from `stat -liberty` (liberty area unit, µm²).
+    /// Total cell area from `stat -liberty` (liberty area unit, µm²), plus the cells whose
+    /// area the liberty leaves at 0 counted at their LEF outline (`area_from_lef`).
     pub total_area_um2: f64,
+    /// The cells of the netlist counted at their LEF area (µm² each; osu018's `LATCH`,
+    /// which its liberty gives `area : 0`), reported "from LEF".
+    #[serde(default)]
+    pub area_from_lef: BTreeMap<String, f64>,
     /// Number of cell instances.
     pub cell_count: u64,
     /// Instances per cell type.
@@ -97,12 +102,14 @@ pub(crate) fn yosys_version(yosys: &Path) -> String {
 
 /// The yosys script for `spec`, writing into `dir`; `constrained`: a timed run passes
 /// `dir/abc.constr` ([`abc_constraints`]) to ABC; `clock_gate_map`: the clock-gate module
-/// on the liberty's cells ([`crate::clock_gate`]), read over the behavioural one.
+/// on the liberty's cells ([`crate::clock_gate`]), read over the behavioural one;
+/// `latch_map`: the techmap of a latch register file's latches ([`crate::latch`]).
 pub fn yosys_script(
     spec: &SynthSpec,
     dir: &Path,
     constrained: bool,
     clock_gate_map: Option<&Path>,
+    latch_map: Option<&Path>,
 ) -> String {
     let lib = spec.liberty.display();
     let mut s = format!("read_liberty -lib {lib}\n");
@@ -134,16 +141,18 @@ pub fn yosys_script(
         ),
         None => format!("abc -liberty {lib}"),
     };
+    s += &format!("synth -top {} -flatten\n", spec.top);
+    if let Some(map) = latch_map {
+        s += &format!("techmap -map {}\n", map.display());
+    }
     s += &format!(
-        "synth -top {top} -flatten\n\
-         dfflibmap -liberty {lib}\n\
+        "dfflibmap -liberty {lib}\n\
          {abc}\n\
          opt_clean\n\
          autoname\n\
          stat -liberty {lib}\n\
          write_verilog -noattr {net_v}\n\
          write_json {net_json}\n",
-        top = spec.top,
         net_v = dir.join("netlist.v").display(),
         net_json = dir.join("netlist.json").display(),
     );
@@ -179,6 +188,24 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
     }
     if let Some(m) = &clock_gate_map {
         h.feed(b"clock_gate").feed(m.as_bytes());
+    }
+    // A latch register file's latches become the liberty's D latch (refused, naming the
+    // option, on a liberty without one).
+    let latch_map = if spec
+        .sources
+        .iter()
+        .any(|src| std::fs::read_to_string(src).is_ok_and(|t| crate::latch::in_source(&t)))
+    {
+        let m = crate::latch::LatchCells::from_liberty(&lib)?.techmap_verilog();
+        h.feed(b"latch").feed(m.as_bytes());
+        Some(m)
+    } else {
+        None
+    };
+    for (cell, area) in &lib.area_from_lef {
+        h.feed(b"lef-area")
+            .feed(cell.as_bytes())
+            .feed(&area.to_le_bytes());
     }
     for (k, v) in &spec.params {
         h.feed(k.as_bytes()).feed(&v.to_le_bytes());
@@ -238,6 +265,10 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
             constrained = true;
         }
     }
+    let latch_path = dir.join("latch_map.v");
+    if let Some(m) = &latch_map {
+        write_atomic(&latch_path, m.as_bytes())?;
+    }
     let map_path = dir.join("clock_gate_map.v");
     if let Some(m) = &clock_gate_map {
         write_atomic(&map_path, m.as_bytes())?;
@@ -250,6 +281,7 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
             &dir,
             constrained,
             clock_gate_map.as_ref().map(|_| map_path.as_path()),
+            latch_map.as_ref().map(|_| latch_path.as_path()),
         )
         .as_bytes(),
     )?;
@@ -286,7 +318,15 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
             log_tail: tail(&text, 15),
         });
     }
-    let (cells_by_type, cell_count, total_area_um2) = parse_stat(&log)?;
+    let (cells_by_type, cell_count, mut total_area_um2) = parse_stat(&log)?;
+    // `stat -liberty` counts a cell of liberty area 0 as nothing: count it at its LEF outline.
+    let mut area_from_lef = BTreeMap::new();
+    for (cell, area) in &lib.area_from_lef {
+        if let Some(&n) = cells_by_type.get(cell) {
+            total_area_um2 += n as f64 * area;
+            area_from_lef.insert(cell.clone(), *area);
+        }
+    }
     let unmapped: Vec<&str> = cells_by_type
         .keys()
         .filter(|t| t.starts_with('$'))
@@ -302,6 +342,7 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
         key,
         top: spec.top.clone(),
         total_area_um2,
+        area_from_lef,
         cell_count,
         cells_by_type,
         netlist_verilog: dir.join("netlist.v"),
@@ -385,7 +426,7 @@ mod tests {
             delay_target_ps: None,
             keep: vec![],
         };
-        let s = yosys_script(&spec, Path::new("/d"), false, None);
+        let s = yosys_script(&spec, Path::new("/d"), false, None, None);
         assert!(!s.contains("setattr") && !s.contains("-overwrite"));
         assert!(s.contains("chparam -set B 4 -set W 12 pixel"));
         assert!(s.contains("synth -top pixel -flatten"));
@@ -394,18 +435,38 @@ mod tests {
             delay_target_ps: Some(6250.0),
             ..spec
         };
-        let s = yosys_script(&timed, Path::new("/d"), false, None);
+        let s = yosys_script(&timed, Path::new("/d"), false, None, None);
         assert!(
             s.contains("abc -script /d/abc.script -liberty l.lib"),
             "{s}"
         );
-        let s = yosys_script(&timed, Path::new("/d"), true, Some(Path::new("/d/cg.v")));
+        let s = yosys_script(
+            &timed,
+            Path::new("/d"),
+            true,
+            Some(Path::new("/d/cg.v")),
+            None,
+        );
         // The clock gates' cells are read over the behavioural module, before synthesis.
         let (read, synth) = (
             s.find("-overwrite /d/cg.v").unwrap(),
             s.find("synth -top").unwrap(),
         );
         assert!(read < synth, "{s}");
+        // A latch register file's latches are mapped after synthesis, before the flops.
+        let sl = yosys_script(
+            &timed,
+            Path::new("/d"),
+            false,
+            None,
+            Some(Path::new("/d/l.v")),
+        );
+        let (synth, map, dff) = (
+            sl.find("synth -top").unwrap(),
+            sl.find("techmap -map /d/l.v").unwrap(),
+            sl.find("dfflibmap").unwrap(),
+        );
+        assert!(synth < map && map < dff, "{sl}");
         assert!(
             s.contains("abc -script /d/abc.script -constr /d/abc.constr -liberty l.lib"),
             "{s}"

@@ -7,27 +7,8 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Cell outlines of a LEF: `MACRO name … SIZE w BY h` (µm).
-pub fn lef_sizes(text: &str) -> BTreeMap<String, (f64, f64)> {
-    let mut sizes = BTreeMap::new();
-    let mut current: Option<String> = None;
-    for line in text.lines() {
-        let t: Vec<&str> = line.split_whitespace().collect();
-        match t.as_slice() {
-            ["MACRO", name, ..] => current = Some((*name).to_string()),
-            ["SIZE", w, "BY", h, ..] => {
-                if let (Some(name), Ok(w), Ok(h)) =
-                    (&current, w.parse(), h.trim_end_matches(';').parse())
-                {
-                    sizes.insert(name.clone(), (w, h));
-                }
-            }
-            ["END", name] if current.as_deref() == Some(*name) => current = None,
-            _ => {}
-        }
-    }
-    sizes
-}
+/// Cell outlines of a LEF (read in `tofprobe_eda::lef`, which the liberty's LEF areas use too).
+pub use tofprobe_eda::lef::lef_sizes;
 
 /// The figures of a routed DEF.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq)]

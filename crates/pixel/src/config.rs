@@ -80,7 +80,7 @@ pub struct PixelConfig {
     /// G: fraction bits of x kept in the registers' operand (default: all F); fewer
     /// narrow every register by F − G bits.
     pub register_frac_bits: Option<u32>,
-    /// What the register file is built of: `"flops"` (default) or `"clock_gated"`.
+    /// What the register file is built of: `"flops"` (default), `"clock_gated"` or `"latch"`.
     pub register_file: RegisterFile,
     /// W: register width in bits; default: what the whole timing window needs (safe with
     /// any background); `"auto"`: what the scene's code range needs.

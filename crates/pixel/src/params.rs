@@ -59,8 +59,9 @@ impl Rounding {
 }
 
 /// What the register file is built of (`[pixel] register_file`, docs/pixel-contract.md
-/// "Register file"). Every kind updates a register at the same clock edge, so the models
-/// and the vectors are the same for all of them; only the RTL and its area differ.
+/// "Register file"). Every kind holds the same values at every rising clock edge, so the
+/// models and the vectors are the same for all of them; only the RTL and its area differ
+/// (and, for latches, when between two edges a write becomes visible).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum RegisterFile {
@@ -71,6 +72,11 @@ pub enum RegisterFile {
     /// (one clock-gating cell per register: the liberty's integrated clock gate, or a
     /// latch and an AND gate where it has none).
     ClockGated,
+    /// Transparent latches, each register's latches enabled by the low phase of `clk`
+    /// gated (one clock gate per register) by the write enable of the last edge, their
+    /// input the value captured at that edge (one word per adder): a write shows half a
+    /// cycle after the edge a flop would load at, and every edge sees the same values.
+    Latch,
 }
 
 impl RegisterFile {
@@ -85,6 +91,7 @@ impl std::fmt::Display for RegisterFile {
         f.write_str(match self {
             RegisterFile::Flops => "flops",
             RegisterFile::ClockGated => "clock_gated",
+            RegisterFile::Latch => "latch",
         })
     }
 }

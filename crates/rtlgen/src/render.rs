@@ -194,6 +194,9 @@ struct PixelT<'a> {
     /// `register_file = "clock_gated"`: one clock gate per register (the `_clock_gate`
     /// module rendered after the pixel), no enable multiplexer.
     clock_gated: bool,
+    /// `register_file = "latch"`: latch registers written in clk's low phase through one
+    /// clock gate per register (on the inverted clock) from the words captured at the edge.
+    latch: bool,
     mutation: &'a str,
 }
 
@@ -401,6 +404,7 @@ pub fn render(p: &PixelParams, rom: &[u64], o: &RenderOptions) -> Result<Vec<Rtl
         adders,
         regs,
         clock_gated: p.register_file == RegisterFile::ClockGated,
+        latch: p.register_file == RegisterFile::Latch,
         mutation: o.mutation.map(Fault::name).unwrap_or(""),
     };
     files.push(RtlFile {

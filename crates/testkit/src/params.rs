@@ -89,6 +89,10 @@ pub fn random_params(rng: &mut Rng) -> PixelParams {
     if rng.chance(30) {
         p.register_file = RegisterFile::ClockGated;
     }
+    // Latches after that, only over flops: a case's other fields stay what they were.
+    if rng.chance(30) && p.register_file == RegisterFile::Flops {
+        p.register_file = RegisterFile::Latch;
+    }
     p.validate()
         .expect("random parameters are valid by construction");
     p
@@ -128,6 +132,7 @@ mod tests {
             ps.iter()
                 .any(|p| p.register_file == RegisterFile::ClockGated)
         );
+        assert!(ps.iter().any(|p| p.register_file == RegisterFile::Latch));
         assert!(ps.iter().any(|p| p.register_frac_bits.is_some()));
         assert!(
             ps.iter()

@@ -38,12 +38,12 @@ fn a_wrong_type_is_blamed_on_its_key_with_the_schemas_type() {
         (
             "register-file",
             &[("adders = 2 ", "adders = 2\nregister_file = 3 ")],
-            "`pixel.register_file` = 3 has the wrong type: expected one of `flops` or `clock_gated`",
+            "`pixel.register_file` = 3 has the wrong type: expected one of `flops`, `clock_gated`, `latch`",
         ),
         (
             "register-file-name",
             &[("adders = 2 ", "adders = 2\nregister_file = \"latches\" ")],
-            "`pixel.register_file` = \"latches\" is not accepted: unknown variant `latches`, expected `flops` or `clock_gated`",
+            "`pixel.register_file` = \"latches\" is not accepted: unknown variant `latches`, expected one of `flops`, `clock_gated`, `latch`",
         ),
         (
             "rounding",

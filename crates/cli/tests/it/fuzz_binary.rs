@@ -108,7 +108,7 @@ const TYPED: &[(&str, &str, &[&str])] = &[
     (
         "pixel",
         "register_file",
-        &["\"flops\"", "\"clock_gated\"", "\"latch\"", "1"],
+        &["\"flops\"", "\"clock_gated\"", "\"latch\"", "\"sram\"", "1"],
     ),
     (
         "pixel",

@@ -4,7 +4,10 @@
 //! Verilator and in Icarus; the same RTL with a broken clock gate — the enable not latched
 //! (the gate glitches when the enable rises while clk is high), or a register gated by
 //! another register's enable — fails at the first edge it writes wrongly, which the
-//! harness reports as a register that changed without its write enable.
+//! harness reports as a register that changed without its write enable. The same for
+//! `register_file = "latch"` (issue 30 point 4), Fourier and Haar: the latches are written
+//! in clk's low phase from words captured at the edge, observed at the falling edge after
+//! it; latches opened in the high phase, or gated by the unregistered enable, fail.
 
 use crate::common;
 
@@ -20,14 +23,36 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn clock_gated_config(dir: &Path) -> PathBuf {
+    kind_config(dir, "clock_gated")
+}
+
+/// The default with `register_file = kind`.
+fn kind_config(dir: &Path, kind: &str) -> PathBuf {
     let text = edit(
         default_text(),
         &[(
             "adders = 2 ",
-            "register_file = \"clock_gated\"\nadders = 2 ",
+            &format!("register_file = \"{kind}\"\nadders = 2 "),
         )],
     );
-    let p = dir.join("clock_gated.toml");
+    let p = dir.join(format!("{kind}.toml"));
+    std::fs::write(&p, text).expect("write config");
+    p
+}
+
+/// A Haar pixel (U = 2: 7 registers, A = 2) with latch registers.
+fn haar_latch_config(dir: &Path) -> PathBuf {
+    let text = edit(
+        default_text(),
+        &[
+            ("duration_s = 1.0 ", "pulses = 16384 "),
+            ("mode = \"fourier\"", "mode = \"haar\"\nhaar_scales = 2"),
+            ("shift = 5", ""),
+            ("frac_bits = 8", ""),
+            ("adders = 2 ", "register_file = \"latch\"\nadders = 2 "),
+        ],
+    );
+    let p = dir.join("haar_latch.toml");
     std::fs::write(&p, text).expect("write config");
     p
 }
@@ -146,6 +171,78 @@ fn clock_gated_register_file_passes_in_icarus_and_a_glitching_gate_does_not() {
     let (code, text) = cosim(&cfg, 200, &dir.join("o1"), Some(&unlatched), "icarus");
     assert_eq!(code, 1, "{text}");
     assert_eq!(failure(&text), (18, "y[0]".to_string()), "{text}");
+}
+
+#[test]
+fn latch_register_file_cosimulates_and_latches_open_in_the_wrong_phase_do_not() {
+    if !have_tools(&["verilator"]) {
+        return;
+    }
+    let dir = scratch("latch");
+    let cfg = kind_config(&dir, "latch");
+    let out = dir.join("out");
+    let (code, text) = cosim(&cfg, 1000, &out, None, "verilator");
+    assert!(code == 0 && text.contains("cosim PASS"), "{text}");
+    let pixel = std::fs::read_to_string(out.join("rtl/tofprobe_pixel.v")).expect("pixel");
+    // 32 registers of latches, each behind its own gate on the inverted clock, none a flop.
+    assert_eq!(pixel.matches("tofprobe_pixel_clock_gate cg_").count(), 32);
+    assert_eq!(pixel.matches(".clk(clk_n), .en(we_q[").count(), 32);
+    assert_eq!(pixel.matches("] = wd_").count(), 32);
+    assert!(!pixel.contains("if (we["), "an enable multiplexer is left");
+    assert!(!pixel.contains("y[0] <="), "a register is still a flop");
+    assert!(pixel.contains("// Register file: latch"), "header");
+
+    let rtl = out.join("rtl");
+    // Latches open in the high phase after the edge (the gate on clk, not its inverse):
+    // register 0 is written one edge late, with the word of the edge before. Pulse 1 writes
+    // registers 0 and 1 from cycle 18 on (its first word to register 0 is 0, so the first
+    // wrong value shows at cycle 19; measured, the cycle model puts the writes there).
+    let high = broken_copy(
+        &rtl,
+        &dir.join("high"),
+        "wire clk_n = ~clk;",
+        "wire clk_n = clk;",
+    );
+    let (code, text) = cosim(&cfg, 1000, &dir.join("o1"), Some(&high), "verilator");
+    assert_eq!(code, 1, "{text}");
+    assert_eq!(failure(&text), (19, "y[0]".to_string()), "{text}");
+    // Register 1's gate fed the enable of the coming edge instead of the last one: it opens
+    // a cycle early, at the edge its write is decided, and shows a write `we` does not.
+    let early = broken_copy(&rtl, &dir.join("early"), ".en(we_q[1])", ".en(we[1])");
+    let (code, text) = cosim(&cfg, 1000, &dir.join("o2"), Some(&early), "verilator");
+    assert_eq!(code, 1, "{text}");
+    assert_eq!(failure(&text), (18, "y[1]".to_string()), "{text}");
+
+    // Haar (7 registers, 2 adders) bit-exact too.
+    let (code, text) = cosim(
+        &haar_latch_config(&dir),
+        256,
+        &dir.join("haar"),
+        None,
+        "verilator",
+    );
+    assert!(code == 0 && text.contains("cosim PASS"), "{text}");
+}
+
+#[test]
+fn latch_register_file_passes_in_icarus_and_latches_open_in_the_high_phase_do_not() {
+    if !have_tools(&["verilator", "iverilog", "vvp"]) {
+        return;
+    }
+    let dir = scratch("latch-icarus");
+    let cfg = kind_config(&dir, "latch");
+    let out = dir.join("out");
+    let (code, text) = cosim(&cfg, 200, &out, None, "icarus");
+    assert!(code == 0 && text.contains("cosim PASS"), "{text}");
+    let high = broken_copy(
+        &out.join("rtl"),
+        &dir.join("high"),
+        "wire clk_n = ~clk;",
+        "wire clk_n = clk;",
+    );
+    let (code, text) = cosim(&cfg, 200, &dir.join("o1"), Some(&high), "icarus");
+    assert_eq!(code, 1, "{text}");
+    assert_eq!(failure(&text), (19, "y[0]".to_string()), "{text}");
 }
 
 /// osu018's liberty without its `LATCH` cell (and it has no integrated clock gate): a

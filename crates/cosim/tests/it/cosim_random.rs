@@ -1,6 +1,6 @@
 //! Eight random valid configurations (`tofprobe_cosim::random`, the stream `tofprobe cosim
 //! --random N --seed S` draws from: both modes, B or U, A, C, T, Z, S, F, G, N, L, and the
-//! width drawn, `auto`, or sized for a 16× shorter frame so it wraps, flop or clock-gated
+//! width drawn, `auto`, or sized for a 16× shorter frame so it wraps, flop, clock-gated or latch
 //! register files) pass in Verilator,
 //! bit for bit, over 2 frames, each under its own random-reset seed.
 
@@ -46,11 +46,13 @@ fn eight_random_configurations_pass_in_verilator() {
             .any(|c| c.params.register_frac_bits() < c.params.effective_frac_bits()),
         "no case with G < F drawn"
     );
-    // ... and both register files (a clock gate on the wrong enable, or one that glitches,
-    // fails at its first wrong write: crates/cli/tests/register_file.rs).
+    // ... and every register file (a clock gate on the wrong enable, one that glitches, or
+    // latches open at the wrong phase, fail at the first wrong write:
+    // crates/cli/tests/register_file.rs).
     for k in [
         tofprobe_pixel::RegisterFile::Flops,
         tofprobe_pixel::RegisterFile::ClockGated,
+        tofprobe_pixel::RegisterFile::Latch,
     ] {
         assert!(
             cases.iter().any(|c| c.params.register_file == k),

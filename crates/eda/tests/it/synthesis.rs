@@ -125,3 +125,55 @@ fn missing_rtl_and_liberty_name_the_file() {
         "{msg}"
     );
 }
+
+/// A latch register file (issue 30 point 4) on osu018: each register bit is the liberty's
+/// `LATCH` (plus one per register in its latch-and-AND clock gate), and the area counts
+/// them at their LEF outline, 56 µm², where the liberty's `area : 0` would count nothing.
+#[test]
+fn a_latch_pixel_maps_onto_osu018_latches_counted_at_their_lef_area() {
+    use tofprobe_eda::analysis::RtlProvider;
+    use tofprobe_eda::generated::GeneratedPixel;
+    use tofprobe_pixel::{PixelParams, RegisterFile};
+    let px = GeneratedPixel {
+        base: PixelParams {
+            bins: 2,
+            tdc_bits: 4,
+            frac_bits: 2,
+            width: 10,
+            frame_pulses: 1024,
+            rom_depth: 16,
+            register_file: RegisterFile::Latch,
+            ..PixelParams::default()
+        },
+    };
+    let v = px.rtl(2, 10, &cache("latch").join("rtl")).unwrap();
+    let lib = Liberty::load(Path::new(OSU018)).unwrap();
+    let syn = synthesise(
+        &SynthSpec {
+            sources: v.sources.clone(),
+            top: v.top.clone(),
+            params: v.params.clone(),
+            liberty: PathBuf::from(OSU018),
+            delay_target_ps: None,
+            keep: vec![],
+        },
+        &cache("latch").join("syn"),
+    )
+    .unwrap();
+    // R = 2·B = 4 registers of W = 10 bits, and 4 clock gates' enable latches.
+    assert_eq!(syn.cells_by_type.get("LATCH"), Some(&44));
+    assert_eq!(syn.area_from_lef.get("LATCH"), Some(&56.0));
+    // Independent sum: every cell at its liberty area, LATCH at its LEF area (the liberty
+    // reader's), equals the reported total (tolerance: f64 sums of decimal areas).
+    let sum: f64 = syn
+        .cells_by_type
+        .iter()
+        .map(|(t, n)| *n as f64 * lib.cells[t].area)
+        .sum();
+    assert!(
+        (sum - syn.total_area_um2).abs() < 1e-6,
+        "{sum} vs {}",
+        syn.total_area_um2
+    );
+    assert!(syn.total_area_um2 >= 44.0 * 56.0);
+}

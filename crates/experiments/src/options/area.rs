@@ -35,8 +35,13 @@ pub struct LibraryArea {
     pub library_node_nm: f64,
     /// Area of the configured pixel (µm², at the library's node).
     pub total_area_um2: f64,
-    /// Its register file (µm²): flops, their enables or clock gates.
+    /// Its register file (µm²): flops, their enables or clock gates; or latches, their
+    /// gates and the enable and word flops.
     pub register_file_um2: f64,
+    /// Cells counted at their LEF outline (µm² each) because the liberty gives them area 0
+    /// (osu018's `LATCH`); empty when none is used.
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub area_from_lef: std::collections::BTreeMap<String, f64>,
     /// Fixed area and area per bin (µm², library node) through the configured B and B/4.
     pub model: AreaModel,
     /// The timing verdict at C·f_laser, when the library carries timing.
@@ -159,6 +164,7 @@ pub fn measure(pixel: &PixelParams, req: &AreaRequest<'_>) -> Result<LibraryArea
         library_node_nm: lib_node,
         total_area_um2: main.synthesis.total_area_um2,
         register_file_um2: main.split.register_file.area_um2,
+        area_from_lef: main.synthesis.area_from_lef.clone(),
         model,
         timing: main.timing.as_ref().map(|t| {
             CornerTiming::new(

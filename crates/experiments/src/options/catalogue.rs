@@ -7,7 +7,8 @@ use serde::Serialize;
 /// One architecture option: its name and the TOML keys it sets.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct ArchOption {
-    /// Short name (`baseline`, `nearest`, `G=2`, `clock-gated`, combinations joined by `+`).
+    /// Short name (`baseline`, `nearest`, `G=2`, `clock-gated`, `latch`, combinations joined
+    /// by `+`).
     pub name: String,
     /// `(dotted.key, TOML value)` pairs.
     pub overrides: Vec<(String, String)>,
@@ -36,7 +37,7 @@ pub fn fractions(frac_bits: u32) -> Vec<u32> {
 
 /// The catalogue for a pixel with `frac_bits` = F and P operations per pulse: the
 /// configuration as it is, each option alone (nearest rounding, each G, the clock-gated
-/// register file, one adder shared by I and Q at C = P cycles per pulse), and the
+/// register file, the latch register file, one adder shared by I and Q at C = P cycles per pulse), and the
 /// combinations a recommendation picks from: a clock-gated file with each G. Nearest
 /// rounding is not in the combinations: it removes a DC bias the tone bins do not see
 /// (the tone moves by < 0.001 µm, docs/tradeoff.md) and costs an adder in the prefilter
@@ -54,6 +55,13 @@ pub fn catalogue(frac_bits: u32, ops_per_pulse: usize) -> Vec<ArchOption> {
         v.push(opt(&format!("G={g}"), &[g_key(g)]));
     }
     v.push(opt("clock-gated", std::slice::from_ref(&gated)));
+    // Latch registers (issue 30 point 4): the same values at every edge as flops, so the
+    // same accuracy; measured alone (its gate-level sign-off is not automated yet, so it is
+    // not combined into what `flow --recommended` may build).
+    v.push(opt(
+        "latch",
+        &[("pixel.register_file", "\"latch\"".to_string())],
+    ));
     v.push(opt(
         "one-adder",
         &[
@@ -106,6 +114,7 @@ mod tests {
                 "G=2",
                 "G=0",
                 "clock-gated",
+                "latch",
                 "one-adder",
                 "G=4+clock-gated",
                 "G=2+clock-gated",

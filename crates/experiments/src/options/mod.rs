@@ -69,7 +69,7 @@ pub struct OptionRow {
     pub register_frac_bits: u32,
     /// `floor` or `nearest`.
     pub prefilter_rounding: String,
-    /// `flops` or `clock_gated`.
+    /// `flops`, `clock_gated` or `latch`.
     pub register_file: String,
     /// Tone error against the float DFT over the seeds (µm).
     pub tone_error_um: Spread,
@@ -265,6 +265,17 @@ pub fn run(
         "The Pareto front: no other option has both less area per bin (front library) and a lower mean tone error.".into(),
     ];
     let mut assumptions = assumptions;
+    let mut from_lef = std::collections::BTreeMap::new();
+    for l in rows.iter().flat_map(|r| &r.libraries) {
+        for (cell, a) in &l.area_from_lef {
+            from_lef.insert((l.library.clone(), cell.clone()), *a);
+        }
+    }
+    for ((library, cell), a) in from_lef {
+        assumptions.push(format!(
+            "{library}'s `{cell}` counts {a:.2} µm² from LEF: its liberty gives it area 0, so its outline in the LEF beside the liberty is used (the options that use it: a latch register file, or a clock gate built of a latch)."
+        ));
+    }
     if let Some(k) = &req.routed {
         assumptions.push(format!(
             "Bins per pitch from layout: each option's area model times the routed factor k = {:.3} (die area / cell area) of the {} macro of {} routed at density {:.2} (`tofprobe layout`), on the {} liberties only; k is taken to hold for every option and B (first order: it follows the density and the technology more than the logic).",

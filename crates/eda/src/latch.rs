@@ -1,0 +1,228 @@
+//! Mapping a latch register file (`[pixel] register_file = "latch"`) onto a liberty's own
+//! latch cell: yosys infers the registers' `always @*` latches as `$_DLATCH_P_` (enable
+//! active-high), which neither `dfflibmap` (yosys 0.23 maps flops only) nor ABC maps; a
+//! techmap replaces each with the liberty's smallest transparent-high D latch (osu018
+//! `LATCH`, sky130 `sky130_fd_sc_hd__dlxtp_1`), or a transparent-low one behind an
+//! inverter where it has no transparent-high latch. A liberty without a D latch is refused
+//! naming the option. The LEF area of a latch whose liberty gives none lives in
+//! [`crate::liberty::Liberty::load`] (osu018's `LATCH` has `area : 0`).
+
+use crate::error::{EdaError, Result};
+use crate::liberty::{LibCell, Liberty, NOT_FOR_SYNTHESIS};
+
+/// The marker the pixel template writes in a latch register file's comment (templates/pixel.v).
+pub const MARKER: &str = "pixel.register_file = \"latch\"";
+
+/// A plain D latch of a liberty: one data and one enable input and a state output.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DLatch {
+    /// The cell.
+    pub cell: String,
+    /// Its enable pin.
+    pub enable: String,
+    /// Its data pin.
+    pub data: String,
+    /// Its output pin (the state, not its complement).
+    pub q: String,
+    /// Transparent while the enable is low (`enable : "!G"`).
+    pub transparent_low: bool,
+}
+
+fn usable(name: &str, c: &LibCell) -> bool {
+    !c.dont_use && !NOT_FOR_SYNTHESIS.iter().any(|p| name.contains(p))
+}
+
+/// The function without parentheses and blanks.
+fn bare(function: &str) -> String {
+    function
+        .chars()
+        .filter(|c| !c.is_whitespace() && *c != '(' && *c != ')')
+        .collect()
+}
+
+/// `c` read as a plain D latch, if it is one.
+fn as_d_latch(name: &str, c: &LibCell) -> Option<DLatch> {
+    let (enable, data) = c.latch.as_ref()?;
+    let ins: Vec<&str> = c
+        .pins
+        .iter()
+        .filter(|p| p.direction == "input")
+        .map(|p| p.name.as_str())
+        .collect();
+    if ins.len() != 2 || c.clock_gating.is_some() {
+        return None;
+    }
+    let (en, low) = match bare(enable) {
+        e if ins.contains(&e.as_str()) => (e, false),
+        e => {
+            let pin = e.strip_prefix('!').or_else(|| e.strip_suffix('\''))?;
+            (pin.to_string(), true)
+        }
+    };
+    let d = bare(data);
+    if !ins.contains(&en.as_str()) || !ins.contains(&d.as_str()) || en == d {
+        return None;
+    }
+    let q = c.pins.iter().find(|p| {
+        let f = bare(&p.function);
+        p.direction == "output" && !f.is_empty() && !f.starts_with('!') && !f.ends_with('\'')
+    })?;
+    Some(DLatch {
+        cell: name.to_string(),
+        enable: en,
+        data: d,
+        q: q.name.clone(),
+        transparent_low: low,
+    })
+}
+
+/// The liberty's usable plain D latches with their areas, by name.
+pub fn d_latches(lib: &Liberty) -> Vec<(f64, DLatch)> {
+    lib.cells
+        .iter()
+        .filter(|(n, c)| usable(n, c))
+        .filter_map(|(n, c)| as_d_latch(n, c).map(|l| (c.area, l)))
+        .collect()
+}
+
+/// The smallest of `latches` (the first by name among equals).
+pub fn smallest(latches: impl IntoIterator<Item = (f64, DLatch)>) -> Option<DLatch> {
+    latches
+        .into_iter()
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, l)| l)
+}
+
+/// The cells of one register bit: the latch, and the inverter on its enable when the
+/// latch is transparent-low.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LatchCells {
+    /// The latch.
+    pub latch: DLatch,
+    /// (cell, input pin, output pin) for a transparent-low latch.
+    pub inverter: Option<(String, String, String)>,
+}
+
+impl LatchCells {
+    /// The smallest transparent-high D latch of `lib`, else its smallest transparent-low
+    /// one with its smallest inverter; the error names the option.
+    pub fn from_liberty(lib: &Liberty) -> Result<Self> {
+        let all = d_latches(lib);
+        let high = smallest(all.iter().filter(|(_, l)| !l.transparent_low).cloned());
+        let missing = |what| EdaError::LatchCells {
+            path: lib.path.clone(),
+            missing: what,
+        };
+        if let Some(latch) = high {
+            return Ok(LatchCells {
+                latch,
+                inverter: None,
+            });
+        }
+        let latch = smallest(all).ok_or_else(|| missing("D latch (`latch` group)"))?;
+        let inverter = crate::clock_gate::smallest_inverter(lib)
+            .ok_or_else(|| missing("inverter for its transparent-low latch"))?;
+        Ok(LatchCells {
+            latch,
+            inverter: Some(inverter),
+        })
+    }
+
+    /// The techmap (`techmap -map`) of yosys's positive-enable latch onto these cells.
+    pub fn techmap_verilog(&self) -> String {
+        let l = &self.latch;
+        let mut s = String::from(
+            "// Generated by tofprobe-eda: the latch register file on the liberty's latch.\n\
+             module \\$_DLATCH_P_ (E, D, Q);\n    input E, D;\n    output Q;\n",
+        );
+        let en = match &self.inverter {
+            Some((inv, a, y)) => {
+                s += &format!("    wire en_n;\n    {inv} en_inv (.{a}(E), .{y}(en_n));\n");
+                "en_n"
+            }
+            None => "E",
+        };
+        s += &format!(
+            "    {} _TECHMAP_REPLACE_ (.{}({en}), .{}(D), .{}(Q));\nendmodule\n",
+            l.cell, l.enable, l.data, l.q
+        );
+        s
+    }
+}
+
+/// Whether `verilog` is a pixel rendered with `register_file = "latch"`.
+pub fn in_source(verilog: &str) -> bool {
+    verilog.contains(MARKER)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    const LIB: &str = r#"library (t) {
+  cell (INV) { area : 4 ; pin (A) { direction : input ; }
+    pin (Y) { direction : output ; function : "!A" ; } }
+  cell (LATN) { area : 10 ; latch (IQ, IQN) { enable : "!GN" ; data_in : "D" ; }
+    pin (GN) { direction : input ; } pin (D) { direction : input ; }
+    pin (Q) { direction : output ; function : "IQ" ; } }
+"#;
+    const HIGH: &str = r#"  cell (LATP) { area : 12 ; latch (IQ, IQN) { enable : "G" ; data_in : "D" ; }
+    pin (G) { direction : input ; } pin (D) { direction : input ; }
+    pin (Q) { direction : output ; function : "IQ" ; } }
+"#;
+
+    fn lib(text: &str) -> Liberty {
+        Liberty::parse(Path::new("t.lib"), &format!("{text}}}\n")).unwrap()
+    }
+
+    /// A transparent-high latch is preferred even when a transparent-low one is smaller
+    /// (the inverter per bit would cost more than the difference).
+    #[test]
+    fn prefers_a_transparent_high_latch() {
+        let c = LatchCells::from_liberty(&lib(&format!("{LIB}{HIGH}"))).unwrap();
+        assert_eq!(c.latch.cell, "LATP");
+        assert!(c.inverter.is_none());
+        let v = c.techmap_verilog();
+        assert!(
+            v.contains("LATP _TECHMAP_REPLACE_ (.G(E), .D(D), .Q(Q));"),
+            "{v}"
+        );
+        // Only a transparent-low latch: behind the inverter.
+        let c = LatchCells::from_liberty(&lib(LIB)).unwrap();
+        assert_eq!(c.latch.cell, "LATN");
+        let v = c.techmap_verilog();
+        assert!(v.contains("INV en_inv (.A(E), .Y(en_n));"), "{v}");
+        assert!(
+            v.contains("LATN _TECHMAP_REPLACE_ (.GN(en_n), .D(D), .Q(Q));"),
+            "{v}"
+        );
+    }
+
+    /// No latch at all: refused, naming the option and the file.
+    #[test]
+    fn a_liberty_without_a_latch_is_refused_naming_the_option() {
+        let e = LatchCells::from_liberty(&lib(
+            "library (t) {\n  cell (INV) { area : 4 ; pin (A) { direction : input ; }\n    pin (Y) { direction : output ; function : \"!A\" ; } }\n",
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("t.lib") && e.contains("register_file = \"latch\"") && e.contains("D latch"),
+            "{e}"
+        );
+    }
+
+    /// osu018's `LATCH` (transparent-high) and sky130's `dlxtp_1` are what the pixel gets.
+    #[test]
+    fn the_project_liberties_map_onto_their_latches() {
+        let osu = Path::new("/usr/share/qflow/tech/osu018/osu018_stdcells.lib");
+        if osu.exists() {
+            let c = LatchCells::from_liberty(&Liberty::load(osu).unwrap()).unwrap();
+            assert_eq!(
+                (c.latch.cell.as_str(), c.inverter.is_none()),
+                ("LATCH", true)
+            );
+        }
+    }
+}
