@@ -96,18 +96,9 @@ pub struct ArrayCosimReport {
 }
 
 /// The array chip of `design` for the overrides `o` (refused for a design without
-/// `[array]`, and for a superpixel array: the array RTL renders one SPAD per pixel, the
-/// superpixel's averaging is modelled and sized but not rendered).
+/// `[array]`); a superpixel array (G > 1) renders and co-simulates its SPAD inputs, each
+/// pixel behind one averaging front end.
 fn chip(design: &ResolvedDesign, o: &RtlOverrides, purpose: RomPurpose) -> Result<Chip, FlowError> {
-    if let Some(a) = design.array.as_ref().filter(|a| a.superpixel > 1) {
-        return Err(FlowError::option(
-            "array.superpixel",
-            a.superpixel,
-            "1 for the array's RTL, vectors, co-simulation and flow (they render one SPAD per \
-             pixel); a superpixel array is modelled by `tofprobe simulate` and sized by \
-             `tofprobe size`",
-        ));
-    }
     Ok(Chip::array_of(design, o, purpose)?)
 }
 
@@ -189,7 +180,8 @@ pub fn write_array_vectors(
         None => scene_detections(design, p.frame_pulses, frames, tile)?,
     };
     let t0 = std::time::Instant::now();
-    let mut model = ArrayModel::tile(&ro, p, &chip.rom.words, None, tile)?;
+    let mut model = ArrayModel::tile(&ro, p, &chip.rom.words, None, tile)?
+        .with_superpixel(chip.superpixel, p)?;
     let r = run(&mut model, &detections, frames)?;
     let model_seconds = t0.elapsed().as_secs_f64();
     let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);

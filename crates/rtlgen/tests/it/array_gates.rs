@@ -45,6 +45,7 @@ fn spec(p: &PixelParams, rows: usize, cols: usize, bits: u32, g: u64) -> ArraySp
         slot_cycles: (p.registers() as u64 + 1) * k as u64 * g,
         fault: None,
         tile: None,
+        superpixel: 1,
     }
 }
 
