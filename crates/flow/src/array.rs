@@ -420,7 +420,7 @@ fn array_flow_in(
     let _ = writeln!(md, "## Verdict\n");
     let _ = writeln!(
         md,
-        "Co-simulation at the array's ports (Verilator vs the array model `tofprobe_array::rtl`): **{}**, {} cycles, {} mismatches; build {:.1} s{}, Verilator {:.2} s, model {:.2} s; {} detections over the pixels.{}\n",
+        "Co-simulation at the array's ports (Verilator vs the array model `tofprobe_array::rtl`): **{}**, {} cycles, {} mismatches; build {:.1} s{}, Verilator {:.2} s, model {:.2} s; {} detections over the {}.{}\n",
         if r.pass { "PASS" } else { "FAIL" },
         r.cycles,
         r.mismatches,
@@ -429,6 +429,10 @@ fn array_flow_in(
         r.sim_seconds,
         r.model_seconds,
         r.detections,
+        match design.array.as_ref().map_or(1, |a| a.superpixel) {
+            1 => "pixels".to_string(),
+            g => format!("SPADs (superpixels of {g} × {g}, each pixel's averaged)"),
+        },
         r.first
             .as_ref()
             .map(|f| format!(" First mismatch: {f}."))
