@@ -9,14 +9,19 @@
 // the buffer drains onto the {{ b }}-bit port, {{ k }} beat(s) per word (least significant
 // first; registers sign-extended, the status word zero-extended), one beat every {{ g }}
 // cycle(s). `pulse_o` tells the TDCs (and a testbench) that the pixels sample `valid` and
-// `tdc` this cycle; {% if let Some(t) = tile %}this is the TILE of rows {{ t.0 }}..{{ t.0 + trows - 1 }}, columns {{ t.1 }}..{{ t.1 + tcols - 1 }}
+// `tdc` this cycle; {% if sp > 1 %}each pixel is a superpixel of
+// {{ sp }} x {{ sp }} SPADs: `valid` and `tdc` are per SPAD, SPAD (sr, sc) of the {{ trows * sp }} x {{ scols }} SPAD grid{% if let Some(t) = tile %}
+// of the TILE of rows {{ t.0 }}..{{ t.0 + trows - 1 }}, columns {{ t.1 }}..{{ t.1 + tcols - 1 }} (the sequencer, broadcast and readout of the whole array,
+// the other pixels absent: their slots carry no beat){% endif %} is bit sr*{{ scols }}+sc of `valid` and that field of
+// `tdc`, and pixel (r, c) averages SPADs (r*{{ sp }}+i, c*{{ sp }}+j) through one `{{ sp_name }}` (combinational: it
+// samples the average as it would one SPAD's).{% else %}{% if let Some(t) = tile %}this is the TILE of rows {{ t.0 }}..{{ t.0 + trows - 1 }}, columns {{ t.1 }}..{{ t.1 + tcols - 1 }}
 // only (the sequencer, broadcast and readout of the whole array, the other pixels absent:
-// their slots carry no beat); its pixel (r, c) is bit (r-{{ t.0 }})*{{ tcols }}+(c-{{ t.1 }}) of `valid` and that field of `tdc`.{% else %}pixel (r, c) is bit r*{{ cols }}+c of `valid` and field r*{{ cols }}+c of `tdc`.{% endif %}
+// their slots carry no beat); its pixel (r, c) is bit (r-{{ t.0 }})*{{ tcols }}+(c-{{ t.1 }}) of `valid` and that field of `tdc`.{% else %}pixel (r, c) is bit r*{{ cols }}+c of `valid` and field r*{{ cols }}+c of `tdc`.{% endif %}{% endif %}
 module {{ name }} (
     input  wire clk,
     input  wire rst,
-    input  wire [{{ npt - 1 }}:0] valid,
-    input  wire [{{ npt * t - 1 }}:0] tdc,
+    input  wire [{{ nin - 1 }}:0] valid,
+    input  wire [{{ nin * t - 1 }}:0] tdc,
     output wire pulse_o,
     output wire ready,
     output reg  ro_valid,
@@ -189,13 +194,26 @@ module {{ name }} (
     wire [{{ npt * ib - 1 }}:0] p_index;
     wire [{{ npt * w - 1 }}:0] p_data;
     assign ready = &p_ready;
+{%- if sp > 1 %}
+    // Each pixel's {{ sp }} x {{ sp }} SPADs averaged into its (valid, tdc).
+    wire [{{ npt - 1 }}:0] s_valid;
+    wire [{{ npt * t - 1 }}:0] s_tdc;
+{%- for px in pixels %}
+    {{ sp_name }} u_superpixel_{{ px.row }}_{{ px.col }} (
+        .spad_valid({ {% for s in px.spads.iter().rev() %}valid[{{ s }}]{% if !loop.last %}, {% endif %}{% endfor %} }),
+        .spad_tdc({ {% for s in px.spads.iter().rev() %}tdc[{{ s * t }} +: {{ t }}]{% if !loop.last %}, {% endif %}{% endfor %} }),
+        .valid(s_valid[{{ px.i }}]),
+        .tdc(s_tdc[{{ px.i * t }} +: {{ t }}])
+    );
+{%- endfor %}
+{%- endif %}
 {%- for px in pixels %}
     {{ pixel_name }} u_pixel_{{ px.row }}_{{ px.col }} (
         .clk(clk),
         .rst(rst),
         .pulse(r_pulse[{{ px.lr }}]),
-        .valid(valid[{{ px.i }}]),
-        .tdc(tdc[{{ px.tdc * t }} +: {{ t }}]),
+        .valid({{ px.valid }}),
+        .tdc({{ px.tdc }}),
 {%- if fourier %}
         .rom_word(r_word[{{ px.lr * r }} +: {{ r }}]),
 {%- endif %}

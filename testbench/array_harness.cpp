@@ -114,7 +114,8 @@ int main(int argc, char** argv) {
     }
     const std::string dir = argv[1];
     auto defs = read_defines(dir + "/array_params.vh");
-    const size_t np = std::stoul(defs["AR_NP"]);
+    // The inputs: the pixels, or with a superpixel (G > 1) their SPADs (AR_NS).
+    const size_t np = std::stoul(defs.count("AR_NS") ? defs["AR_NS"] : defs["AR_NP"]);
     const size_t t = std::stoul(defs["AR_T"]);
     const size_t b = std::stoul(defs["AR_B"]);
     const uint64_t cycles = std::stoull(defs["AR_CYCLES"]);

@@ -10,11 +10,15 @@
 // array_expect.hex are) and run from the RTL directory (a deep probe ROM's $readmemh).
 `timescale 1ns / 1ps
 `include "array_params.vh"
+// The inputs: the pixels, or with a superpixel (G > 1) their SPADs (AR_NS = AR_NP * G * G).
+`ifndef AR_NS
+`define AR_NS `AR_NP
+`endif
 module array_tb;
     reg clk;
     reg rst;
-    reg [`AR_NP - 1:0] valid;
-    reg [`AR_NP * `AR_T - 1:0] tdc;
+    reg [`AR_NS - 1:0] valid;
+    reg [`AR_NS * `AR_T - 1:0] tdc;
     wire pulse_o;
     wire ready;
     wire ro_valid;
@@ -29,7 +33,7 @@ module array_tb;
         .ro_valid(ro_valid),
         .ro_data(ro_data)
     );
-    reg [`AR_NP * (`AR_T + 1) - 1:0] stim [0:`AR_PULSES - 1];
+    reg [`AR_NS * (`AR_T + 1) - 1:0] stim [0:`AR_PULSES - 1];
     reg [63:0] expect_mem [0:4 * `AR_CYCLES - 1];
     integer cycle;
     integer pidx;

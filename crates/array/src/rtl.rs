@@ -10,7 +10,7 @@
 use tofprobe_design::readout::ArrayTile;
 use tofprobe_design::readout::{ArrayFault, Readout};
 use tofprobe_pixel::sequencer::RESET_CYCLES;
-use tofprobe_pixel::{CycleModel, Mode, PinsIn, PixelParams};
+use tofprobe_pixel::{CycleModel, Mode, NO_DETECTION, PinsIn, PixelParams, Superpixel};
 
 use crate::error::ArrayError;
 
@@ -42,6 +42,10 @@ pub struct ArrayModel {
     fault: Option<ArrayFault>,
     /// The pixels that exist (the whole array unless a tile of it is co-simulated).
     tile: ArrayTile,
+    /// G > 1: each pixel's G × G SPADs averaged by `templates/superpixel.v`'s rule.
+    superpixel: Option<Superpixel>,
+    /// Per pixel present, its (valid, tdc) after the superpixel (scratch of `step`).
+    combined: Vec<(bool, u32)>,
     // Root sequencer.
     ro_phase: bool,
     ph: u64,
@@ -145,6 +149,8 @@ impl ArrayModel {
             rom_depth: p.rom_depth.max(1),
             fault,
             tile,
+            superpixel: None,
+            combined: vec![(false, 0); tile.pixels()],
             ro_phase: false,
             ph: 0,
             pidx: 0,
@@ -182,6 +188,30 @@ impl ArrayModel {
             ro_valid: false,
             ro_data: 0,
         })
+    }
+
+    /// The same array with each pixel a superpixel of `g` × `g` SPADs (`[array]
+    /// superpixel`; 1: one SPAD per pixel): [`Self::step`] then takes per-SPAD inputs and
+    /// averages each pixel's with `tofprobe_pixel::Superpixel` before its cycle model, as
+    /// the array RTL's `<prefix>_superpixel` instances do.
+    pub fn with_superpixel(mut self, g: usize, p: &PixelParams) -> Result<Self, ArrayError> {
+        let sp = Superpixel::new(g as u32, p.tdc_bits).map_err(|source| ArrayError::Pixel {
+            row: 0,
+            col: 0,
+            source,
+        })?;
+        self.superpixel = (g > 1).then_some(sp);
+        Ok(self)
+    }
+
+    /// G (1: one SPAD per pixel).
+    pub fn superpixel(&self) -> usize {
+        self.superpixel.as_ref().map_or(1, |s| s.side() as usize)
+    }
+
+    /// The inputs `step` takes: one per pixel present, or one per SPAD (the pixels × G²).
+    pub fn inputs(&self) -> usize {
+        self.tile.pixels() * self.superpixel() * self.superpixel()
     }
 
     /// The readout the array follows.
@@ -225,8 +255,44 @@ impl ArrayModel {
         m
     }
 
+    /// Each pixel's (valid, tdc) from the inputs: its own (G = 1), or its G² SPADs' — the
+    /// SPAD grid of the pixels present, row-major, pixel (lr, lc) owning SPADs
+    /// (lr·G + i, lc·G + j) — combined by the one averaging rule (no detection: tdc 0, as
+    /// the RTL's multiply by the table's default 0 gives).
+    fn combine_inputs(&mut self, valid: &[bool], tdc: &[u32]) {
+        let t = self.tile;
+        let Some(sp) = &self.superpixel else {
+            for (i, c) in self.combined.iter_mut().enumerate() {
+                *c = (valid[i], tdc[i]);
+            }
+            return;
+        };
+        let g = sp.side() as usize;
+        let scols = t.cols * g;
+        let mask = (1u32 << sp.tdc_bits()) - 1;
+        let mut codes = [0u32; 16];
+        for (i, c) in self.combined.iter_mut().enumerate() {
+            let (lr, lc) = (i / t.cols, i % t.cols);
+            for (s, code) in codes.iter_mut().take(g * g).enumerate() {
+                let k = (lr * g + s / g) * scols + lc * g + s % g;
+                *code = if valid[k] {
+                    tdc[k] & mask
+                } else {
+                    NO_DETECTION
+                };
+            }
+            let m = sp.combine(&codes[..g * g]);
+            *c = if m == NO_DETECTION {
+                (false, 0)
+            } else {
+                (true, m)
+            };
+        }
+    }
+
     /// One clock cycle: returns the outputs seen during it, then applies the rising edge
-    /// with `rst` and the per-pixel `valid` and `tdc` (row-major over the pixels present).
+    /// with `rst` and the `valid` and `tdc` inputs ([`Self::inputs`] of them: per pixel
+    /// present, row-major, or per SPAD with G > 1, row-major over the SPAD grid).
     pub fn step(&mut self, rst: bool, valid: &[bool], tdc: &[u32]) -> ArrayPins {
         let out = self.outputs();
         let ro = self.ro;
@@ -249,6 +315,7 @@ impl ArrayModel {
         };
         let (mv, mi, md) = self.mux();
         // The pixels' edges.
+        self.combine_inputs(valid, tdc);
         let neighbour = match self.fault {
             Some(ArrayFault::NeighbourTdc { row, col }) => t.local(row, col),
             _ => None,
@@ -264,8 +331,8 @@ impl ArrayModel {
             px.step(&PinsIn {
                 rst,
                 pulse: self.r_pulse[r],
-                valid: valid[i],
-                tdc: tdc[src],
+                valid: self.combined[i].0,
+                tdc: self.combined[src].1,
                 rom_word: &self.r_word[r],
                 readout: self.r_ro[r] && self.r_col[r] == c,
             });
@@ -403,6 +470,8 @@ impl ArrayModel {
 pub struct ArrayRun {
     /// The readout followed.
     pub readout: Readout,
+    /// G: SPADs per pixel side (the inputs are the pixels' × G²).
+    pub superpixel: usize,
     /// Frames run.
     pub frames: u64,
     /// The outputs of every cycle.
@@ -492,8 +561,9 @@ impl ArrayRun {
 }
 
 /// Runs `frames` frames: reset, then every cycle the detections of the pulse the pixels
-/// sample (`detections[i]` is pixel i's, row-major over the pixels present, one per pulse
-/// of the run; pulses beyond present no detection).
+/// sample (`detections[i]` is input i's — pixel i's, row-major over the pixels present, or
+/// with G > 1 SPAD i's, row-major over their SPAD grid — one per pulse of the run; pulses
+/// beyond present no detection).
 pub fn run(
     model: &mut ArrayModel,
     detections: &[Vec<Option<u32>>],
@@ -501,13 +571,14 @@ pub fn run(
 ) -> Result<ArrayRun, ArrayError> {
     let ro = *model.readout();
     let tile = model.present();
-    let np = tile.pixels();
+    let np = model.inputs();
     if detections.len() != np {
         return Err(ArrayError::Shape(format!(
-            "{} pixels' detections for the {} × {} pixels present",
+            "{} inputs' detections for the {} × {} pixels present of {g} × {g} SPADs ({np})",
             detections.len(),
             tile.rows,
-            tile.cols
+            tile.cols,
+            g = model.superpixel()
         )));
     }
     let total = frame_start(&ro, frames) + TAIL_CYCLES;
@@ -539,6 +610,7 @@ pub fn run(
         .collect();
     let mut run = ArrayRun {
         readout: ro,
+        superpixel: model.superpixel(),
         frames,
         pins,
         pulse_cycles,

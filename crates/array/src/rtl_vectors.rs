@@ -4,9 +4,11 @@
 //! `testbench/array_tb.v` (Icarus) replay:
 //!
 //! - `array_params.vh`: `AR_TOP`, `AR_NP` (pixels present: all, or a tile's), `AR_T`,
-//!   `AR_B`, `AR_CYCLES`, `AR_PULSES`;
+//!   `AR_B`, `AR_CYCLES`, `AR_PULSES`, and with `[array] superpixel = G > 1` `AR_NS` (the
+//!   SPAD inputs, AR_NP·G²);
 //! - `array_stim.hex`: one line per pulse the pixels sample, the P·(T+1)-bit value
-//!   {tdc[P·T−1:0], valid[P−1:0]} (pixel i = r·cols + c);
+//!   {tdc[P·T−1:0], valid[P−1:0]} over the P inputs (pixel i = r·cols + c; with G > 1 the
+//!   SPADs, i = sr·(cols·G) + sc over the SPAD grid);
 //! - `array_expect.hex`: one line per cycle, `pulse_o ready ro_valid ro_data`;
 //! - `readout.txt`: per frame and pixel (readout order) its R + 1 words;
 //! - `digests.txt`: per frame and pixel, FNV-1a 64 of its words (little-endian u64s).
@@ -26,9 +28,10 @@ pub const FILES: [&str; 5] = [
     "digests.txt",
 ];
 
-/// Every pixel's detections for `frames` frames of the design's scene (row-major over the
-/// pixels of `tile`, all when `None`; pixel (r, c)'s own stream,
-/// `ResolvedDesign::pixel_source`), `frame_pulses` per frame.
+/// Every input's detections for `frames` frames of the design's scene, `frame_pulses` per
+/// frame: row-major over the pixels of `tile` (all when `None`), pixel (r, c)'s own stream
+/// (`ResolvedDesign::pixel_source`); with `[array] superpixel = G > 1`, row-major over the
+/// tile's SPAD grid, SPAD (r, c)'s own stream (`ResolvedDesign::spad_source`).
 pub fn scene_detections(
     design: &ResolvedDesign,
     frame_pulses: u64,
@@ -41,11 +44,13 @@ pub fn scene_detections(
         .ok_or_else(|| ArrayError::Shape("the design has no [array]".into()))?;
     let n = (frame_pulses * frames) as usize;
     let t = tile.unwrap_or(tofprobe_design::readout::ArrayTile::whole(a.rows, a.cols));
-    let mut out = Vec::with_capacity(t.pixels());
-    for r in t.row0..t.row0 + t.rows {
-        for c in t.col0..t.col0 + t.cols {
+    // The SPAD grid of the tile (G = 1: its pixels); SPAD (r, c)'s own stream.
+    let g = a.superpixel;
+    let mut out = Vec::with_capacity(t.pixels() * g * g);
+    for r in t.row0 * g..(t.row0 + t.rows) * g {
+        for c in t.col0 * g..(t.col0 + t.cols) * g {
             let mut v = vec![None; n];
-            design.pixel_source(r, c)?.fill(0, &mut v);
+            design.spad_source(r, c)?.fill(0, &mut v);
             out.push(v);
         }
     }
@@ -83,10 +88,16 @@ pub fn vector_files(
     let ro = &run.readout;
     // The pixels present (a tile of a large array, or all).
     let np = detections.len();
+    let g = run.superpixel;
     let t = p.tdc_bits as usize;
     let mut params = format!("{header}\n");
+    if g > 1 {
+        // The SPAD inputs (the harness's and testbench's port widths); absent when G = 1
+        // (the inputs are the pixels).
+        params.push_str(&format!("`define AR_NS {np}\n"));
+    }
     for (k, v) in [
-        ("AR_NP", np.to_string()),
+        ("AR_NP", (np / (g * g)).to_string()),
         ("AR_T", t.to_string()),
         ("AR_B", ro.bits.to_string()),
         ("AR_CYCLES", run.cycles().to_string()),

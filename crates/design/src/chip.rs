@@ -53,6 +53,8 @@ pub struct Chip {
     pub sequencer: SequencerKind,
     /// The array's readout ([`crate::readout`]); `None` for the single pixel's top.
     pub readout: Option<Readout>,
+    /// G: each pixel a superpixel of G × G SPADs (`[array] superpixel`; 1: one SPAD).
+    pub superpixel: usize,
 }
 
 impl Chip {
@@ -76,6 +78,7 @@ impl Chip {
             rom,
             sequencer: SequencerKind::Reference,
             readout: None,
+            superpixel: 1,
         })
     }
 
@@ -97,6 +100,7 @@ impl Chip {
         let mut chip = Chip::of(design, o, purpose)?;
         chip.rows = a.rows;
         chip.cols = a.cols;
+        chip.superpixel = a.superpixel;
         chip.readout = Some(resolve_readout(
             &a.readout,
             a.rows,
@@ -124,6 +128,7 @@ impl Chip {
             slot_cycles: r.slot_cycles(),
             fault,
             tile,
+            superpixel: self.superpixel as u32,
         })
     }
 

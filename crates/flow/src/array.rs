@@ -96,18 +96,9 @@ pub struct ArrayCosimReport {
 }
 
 /// The array chip of `design` for the overrides `o` (refused for a design without
-/// `[array]`, and for a superpixel array: the array RTL renders one SPAD per pixel, the
-/// superpixel's averaging is modelled and sized but not rendered).
+/// `[array]`); a superpixel array (G > 1) renders and co-simulates its SPAD inputs, each
+/// pixel behind one averaging front end.
 fn chip(design: &ResolvedDesign, o: &RtlOverrides, purpose: RomPurpose) -> Result<Chip, FlowError> {
-    if let Some(a) = design.array.as_ref().filter(|a| a.superpixel > 1) {
-        return Err(FlowError::option(
-            "array.superpixel",
-            a.superpixel,
-            "1 for the array's RTL, vectors, co-simulation and flow (they render one SPAD per \
-             pixel); a superpixel array is modelled by `tofprobe simulate` and sized by \
-             `tofprobe size`",
-        ));
-    }
     Ok(Chip::array_of(design, o, purpose)?)
 }
 
@@ -189,7 +180,8 @@ pub fn write_array_vectors(
         None => scene_detections(design, p.frame_pulses, frames, tile)?,
     };
     let t0 = std::time::Instant::now();
-    let mut model = ArrayModel::tile(&ro, p, &chip.rom.words, None, tile)?;
+    let mut model = ArrayModel::tile(&ro, p, &chip.rom.words, None, tile)?
+        .with_superpixel(chip.superpixel, p)?;
     let r = run(&mut model, &detections, frames)?;
     let model_seconds = t0.elapsed().as_secs_f64();
     let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
@@ -428,7 +420,7 @@ fn array_flow_in(
     let _ = writeln!(md, "## Verdict\n");
     let _ = writeln!(
         md,
-        "Co-simulation at the array's ports (Verilator vs the array model `tofprobe_array::rtl`): **{}**, {} cycles, {} mismatches; build {:.1} s{}, Verilator {:.2} s, model {:.2} s; {} detections over the pixels.{}\n",
+        "Co-simulation at the array's ports (Verilator vs the array model `tofprobe_array::rtl`): **{}**, {} cycles, {} mismatches; build {:.1} s{}, Verilator {:.2} s, model {:.2} s; {} detections over the {}.{}\n",
         if r.pass { "PASS" } else { "FAIL" },
         r.cycles,
         r.mismatches,
@@ -437,6 +429,10 @@ fn array_flow_in(
         r.sim_seconds,
         r.model_seconds,
         r.detections,
+        match design.array.as_ref().map_or(1, |a| a.superpixel) {
+            1 => "pixels".to_string(),
+            g => format!("SPADs (superpixels of {g} × {g}, each pixel's averaged)"),
+        },
         r.first
             .as_ref()
             .map(|f| format!(" First mismatch: {f}."))

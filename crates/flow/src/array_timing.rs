@@ -239,6 +239,7 @@ fn time_on(
         slot_cycles: r.slot_cycles(),
         fault: None,
         tile: None,
+        superpixel: 1,
     };
     // The ROM's contents do not reach the top's logic (a black box): render a 1-entry one.
     let mut p1 = p.clone();

@@ -68,6 +68,10 @@ pub struct ArraySpec {
     /// Render only this tile's pixels, with the whole array's sequencer, broadcast and
     /// readout (`None`: every pixel).
     pub tile: Option<ArrayTile>,
+    /// G: each pixel is a superpixel of G × G SPADs (1: one SPAD per pixel). With G > 1
+    /// the array's `valid`/`tdc` are per SPAD (row-major over the SPAD grid of the pixels
+    /// rendered) and each pixel is fed through one `<prefix>_superpixel` averaging module.
+    pub superpixel: u32,
 }
 
 /// A rectangle of an array's pixels: the part of an array too large to co-simulate whole
@@ -132,8 +136,13 @@ struct PixelT {
     col: usize,
     /// Row index in the tile.
     lr: usize,
-    /// The pixel whose TDC field this one reads (itself unless NeighbourTdc).
-    tdc: usize,
+    /// The pixel's `valid` input: its port bit (G = 1) or its superpixel's output.
+    valid: String,
+    /// The pixel's `tdc` input: its port field, or its superpixel's output (the pixel's
+    /// own unless NeighbourTdc crosses it).
+    tdc: String,
+    /// G > 1: the port bits of its G² SPADs, row-major within the superpixel.
+    spads: Vec<usize>,
 }
 
 struct ColT {
@@ -192,6 +201,13 @@ struct ArrayT<'a> {
     rows_t: Vec<RowT>,
     pixels: Vec<PixelT>,
     columns: Vec<ColT>,
+    /// G (1: no superpixel) and its module.
+    sp: usize,
+    sp_name: String,
+    /// Inputs on the ports: the pixels rendered × G².
+    nin: usize,
+    /// SPAD columns of the rendered grid (tcols · G).
+    scols: usize,
 }
 
 /// The array module's name for a module prefix.
@@ -275,6 +291,24 @@ pub fn render_array(
             ),
         ));
     }
+    let g = a.superpixel as usize;
+    let sp = (g > 1)
+        .then(|| tofprobe_pixel::Superpixel::new(a.superpixel, p.tdc_bits))
+        .transpose()
+        .map_err(|e| {
+            bad(
+                "array.superpixel",
+                a.superpixel.to_string(),
+                format!("1..={} ({e})", tofprobe_pixel::superpixel::MAX_SUPERPIXEL),
+            )
+        })?;
+    if g == 0 {
+        return Err(bad(
+            "array.superpixel",
+            "0".into(),
+            format!("1..={}", tofprobe_pixel::superpixel::MAX_SUPERPIXEL),
+        ));
+    }
     match a.fault {
         Some(ArrayFault::OrderSwap) if np < 2 => {
             return Err(bad(
@@ -320,17 +354,36 @@ pub fn render_array(
         Some(ArrayFault::NeighbourTdc { row, col }) => tile.local(row, col),
         _ => None,
     };
+    let tb = p.tdc_bits as usize;
+    let scols = tile.cols * g;
     let pixels: Vec<PixelT> = (0..npt)
-        .map(|i| PixelT {
-            i,
-            row: tile.row0 + i / tile.cols,
-            col: tile.col0 + i % tile.cols,
-            lr: i / tile.cols,
-            tdc: match neighbour {
+        .map(|i| {
+            let src = match neighbour {
                 Some(n) if n == i => (i + 1) % npt,
                 Some(n) if (n + 1) % npt == i => n,
                 _ => i,
-            },
+            };
+            let (lr, lc) = (i / tile.cols, i % tile.cols);
+            PixelT {
+                i,
+                row: tile.row0 + lr,
+                col: tile.col0 + lc,
+                lr,
+                valid: if g > 1 {
+                    format!("s_valid[{i}]")
+                } else {
+                    format!("valid[{i}]")
+                },
+                tdc: if g > 1 {
+                    format!("s_tdc[{} +: {tb}]", src * tb)
+                } else {
+                    format!("tdc[{} +: {tb}]", src * tb)
+                },
+                spads: (0..g * g)
+                    .filter(|_| g > 1)
+                    .map(|s| (lr * g + s / g) * scols + lc * g + s % g)
+                    .collect(),
+            }
         })
         .collect();
     let columns = (0..tile.cols)
@@ -375,6 +428,12 @@ pub fn render_array(
             tile.row0 + tile.rows - 1,
             tile.col0,
             tile.col0 + tile.cols - 1
+        ));
+    }
+    if g > 1 {
+        h.push_str(&format!(
+            "\n// Superpixel: {g} x {g} SPADs per pixel, averaged by `{}` (docs/pixel-contract.md \"Superpixel\").",
+            crate::superpixel::module_name(&o.module_prefix)
         ));
     }
     if let Some(f) = a.fault {
@@ -439,7 +498,14 @@ pub fn render_array(
             .collect(),
         pixels,
         columns,
+        sp: g,
+        sp_name: crate::superpixel::module_name(&o.module_prefix),
+        nin: npt * g * g,
+        scols,
     };
+    if let Some(sp) = &sp {
+        files.push(crate::superpixel::render_superpixel(p, sp, o)?);
+    }
     files.push(RtlFile {
         name: format!("{name}.v"),
         template: "array.v",

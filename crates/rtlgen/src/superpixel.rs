@@ -1,7 +1,8 @@
 //! The superpixel front end rendered (`templates/superpixel.v`): the averaging of
 //! `tofprobe_pixel::Superpixel` — G² (valid, tdc) in, the pixel's (valid, tdc) out, the
 //! reciprocal table as a case ROM and a multiply-shift — as a module of its own. The array
-//! RTL does not instantiate it yet (docs/pixel-contract.md "Superpixel"); it is linted,
+//! RTL (`templates/array.v`, `[array] superpixel = G > 1`) instantiates it once per pixel
+//! over its G × G SPAD inputs (docs/pixel-contract.md "Superpixel"); it is linted,
 //! simulated against the model (crates/rtlgen/tests/it/superpixel.rs) and synthesised for
 //! the size report's area per SPAD (`tofprobe_flow::array_report`).
 

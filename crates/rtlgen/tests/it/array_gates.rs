@@ -2,7 +2,8 @@
 //! zero warnings, `iverilog -g2005 -Wall` compiles, yosys `synth` with no latch and no
 //! warning beyond the pixel's register-file note, for a 2 × 2 Fourier array on a one-word
 //! port, a 3 × 5 Haar array on a 5-bit port (3 beats per word), a 2 × 3 array with beats
-//! 3 cycles apart, and each array mutant; and the renderer's refusals.
+//! 3 cycles apart, superpixel arrays (G = 2, and a tile at G = 3) and each array mutant;
+//! and the renderer's refusals.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -45,6 +46,7 @@ fn spec(p: &PixelParams, rows: usize, cols: usize, bits: u32, g: u64) -> ArraySp
         slot_cycles: (p.registers() as u64 + 1) * k as u64 * g,
         fault: None,
         tile: None,
+        superpixel: 1,
     }
 }
 
@@ -67,6 +69,38 @@ fn configs() -> Vec<(String, PixelParams, ArraySpec)> {
                     cols: 2,
                 }),
                 ..spec(&f, 64, 64, 24, 1)
+            },
+        ),
+        // Superpixels: 2 × 3 pixels of 2 × 2 SPADs, and a 3 × 3 tile of 3 × 3 SPADs each.
+        (
+            "2x3-sp2".to_string(),
+            f.clone(),
+            ArraySpec {
+                superpixel: 2,
+                ..spec(&f, 2, 3, 24, 1)
+            },
+        ),
+        (
+            "4x4-tile-sp3".to_string(),
+            f.clone(),
+            ArraySpec {
+                superpixel: 3,
+                tile: Some(ArrayTile {
+                    row0: 1,
+                    col0: 1,
+                    rows: 3,
+                    cols: 3,
+                }),
+                ..spec(&f, 4, 4, 24, 1)
+            },
+        ),
+        (
+            "2x2-sp2-neighbour_tdc".to_string(),
+            f.clone(),
+            ArraySpec {
+                superpixel: 2,
+                fault: Some(ArrayFault::NeighbourTdc { row: 0, col: 1 }),
+                ..spec(&f, 2, 2, 24, 1)
             },
         ),
     ];
@@ -239,6 +273,13 @@ fn bad_array_specs_are_refused() {
             "mutation row = 2",
         ),
         (spec(&p, 65, 64, 24, 1), "array.rows × array.cols = 65 × 64"),
+        (
+            ArraySpec {
+                superpixel: 5,
+                ..spec(&p, 2, 2, 24, 1)
+            },
+            "array.superpixel = 5",
+        ),
     ];
     for (s, want) in cases {
         let e = render_array(&p, &rom, &o, &s).unwrap_err();
