@@ -111,11 +111,8 @@ pub struct LayoutReport {
 /// [`SCHEMA`] reads (fields it does not need are ignored).
 #[derive(Debug, Deserialize)]
 struct AreaView {
-    schema: String,
     tech: String,
     config: String,
-    drc_errors: u64,
-    lvs_match: bool,
     attempts: Vec<DensityView>,
     bins_per_pitch: Option<FactorView>,
 }
@@ -137,26 +134,8 @@ struct FactorView {
 /// match: a dirty macro's area is not an answer) and it carries bins per pitch, and k is a
 /// finite number ≥ 1.
 pub fn read_routed_factor(path: &std::path::Path) -> Result<RoutedFactor> {
-    let text = std::fs::read_to_string(path).map_err(|e| LayoutError::io("reading", path, e))?;
-    let refuse = |what: String| LayoutError::Parse {
-        tool: "tofprobe layout",
-        what,
-        path: path.to_path_buf(),
-    };
-    let v: AreaView =
-        serde_json::from_str(&text).map_err(|e| refuse(format!("a layout report ({e})")))?;
-    if v.schema != SCHEMA {
-        return Err(refuse(format!(
-            "a report of schema {SCHEMA} (`schema` is {:?})",
-            v.schema
-        )));
-    }
-    if v.drc_errors != 0 || !v.lvs_match {
-        return Err(refuse(format!(
-            "a clean macro (`drc_errors` = {}, `lvs_match` = {}; DRC 0 and LVS match are needed)",
-            v.drc_errors, v.lvs_match
-        )));
-    }
+    let v: AreaView = read_clean(path)?;
+    let refuse = |what: String| refusal(path, what);
     let k = v
         .bins_per_pitch
         .as_ref()
@@ -367,14 +346,56 @@ pub struct PostRouteTable {
     pub corners: Vec<CornerRow>,
 }
 
+/// What every reader of a layout report checks first: its schema and a clean macro.
+#[derive(Debug, Deserialize)]
+struct CleanHead {
+    schema: String,
+    drc_errors: u64,
+    lvs_match: bool,
+}
+
+/// The refusal of the layout report at `path`: it is not `what`.
+fn refusal(path: &std::path::Path, what: String) -> LayoutError {
+    LayoutError::Parse {
+        tool: "tofprobe layout",
+        what,
+        path: path.to_path_buf(),
+    }
+}
+
+/// The layout report at `path` read as `T` (a partial view), refused unless it is of
+/// [`SCHEMA`] and its macro is clean (DRC 0, LVS match: a dirty macro's figures are not an
+/// answer).
+fn read_clean<T: serde::de::DeserializeOwned>(path: &std::path::Path) -> Result<T> {
+    let text = std::fs::read_to_string(path).map_err(|e| LayoutError::io("reading", path, e))?;
+    let parse_error = |e: serde_json::Error| refusal(path, format!("a layout report ({e})"));
+    let head: CleanHead = serde_json::from_str(&text).map_err(parse_error)?;
+    if head.schema != SCHEMA {
+        return Err(refusal(
+            path,
+            format!(
+                "a report of schema {SCHEMA} (`schema` is {:?})",
+                head.schema
+            ),
+        ));
+    }
+    if head.drc_errors != 0 || !head.lvs_match {
+        return Err(refusal(
+            path,
+            format!(
+                "a clean macro (`drc_errors` = {}, `lvs_match` = {}; DRC 0 and LVS match are needed)",
+                head.drc_errors, head.lvs_match
+            ),
+        ));
+    }
+    serde_json::from_str(&text).map_err(parse_error)
+}
+
 /// What the post-route table reads of a layout report.
 #[derive(Debug, Deserialize)]
 struct CornersView {
-    schema: String,
     tech: String,
     config: String,
-    drc_errors: u64,
-    lvs_match: bool,
     #[serde(default)]
     bins: Option<u64>,
     #[serde(default)]
@@ -392,26 +413,7 @@ pub fn read_post_route(
     bins: u64,
     width: u32,
 ) -> Result<Option<PostRouteTable>> {
-    let text = std::fs::read_to_string(path).map_err(|e| LayoutError::io("reading", path, e))?;
-    let refuse = |what: String| LayoutError::Parse {
-        tool: "tofprobe layout",
-        what,
-        path: path.to_path_buf(),
-    };
-    let v: CornersView =
-        serde_json::from_str(&text).map_err(|e| refuse(format!("a layout report ({e})")))?;
-    if v.schema != SCHEMA {
-        return Err(refuse(format!(
-            "a report of schema {SCHEMA} (`schema` is {:?})",
-            v.schema
-        )));
-    }
-    if v.drc_errors != 0 || !v.lvs_match {
-        return Err(refuse(format!(
-            "a clean macro (`drc_errors` = {}, `lvs_match` = {}; DRC 0 and LVS match are needed)",
-            v.drc_errors, v.lvs_match
-        )));
-    }
+    let v: CornersView = read_clean(path)?;
     if v.bins != Some(bins) || v.width != Some(width) || v.corners.is_empty() {
         return Ok(None);
     }
