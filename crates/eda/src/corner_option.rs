@@ -80,22 +80,15 @@ pub fn candidates(ops: u64, configured_k: u64, laser_hz: f64, f_max_mhz: f64) ->
     out
 }
 
-/// Where a missed corner's candidates are synthesised and timed.
-#[derive(Debug)]
-pub struct CornerLibraries<'a> {
-    /// The library every candidate is mapped on (the row's typical corner).
-    pub map_on: &'a Liberty,
-    /// Whether the row is that library's own corner (no second timing run).
-    pub same_corner: bool,
-}
-
 /// Finds the option for `row` (a corner the configured pixel misses), synthesising at
-/// most `max_trials` candidates from `provider`.
+/// most `max_trials` candidates from `provider`, each mapped on `map_on` (the row's
+/// library at its typical corner) and timed again at the row's corner unless it is that
+/// library's own.
 pub fn find(
     provider: &dyn RtlProvider,
     d: &Design,
     row: &CornerTiming,
-    libs: &CornerLibraries<'_>,
+    map_on: &Liberty,
     clock: &str,
     cache: &Path,
     max_trials: usize,
@@ -117,13 +110,13 @@ pub fn find(
             variant.as_ref(),
             d.bins,
             d.width,
-            libs.map_on,
+            map_on,
             true,
             clock,
             cache,
             Some(1e6 / clock_mhz),
         )?;
-        let sta = match (&point.timing, libs.same_corner) {
+        let sta = match (&point.timing, row.library == map_on.name) {
             (Some(t), true) => t.clone(),
             _ => time_cached(&point.synthesis, &row.liberty, &row.corner, clock)?,
         };

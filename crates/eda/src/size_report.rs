@@ -3,7 +3,7 @@
 //! runs synthesis, timing, the sky130 mapping and the sweeps.
 
 use crate::analysis::{PointResult, RtlProvider, analyse_points};
-use crate::corner_option::{CornerLibraries, CornerOption};
+use crate::corner_option::CornerOption;
 use crate::corners::{CornerTiming, sky130_corners};
 use crate::error::{EdaError, Result};
 use crate::liberty::Liberty;
@@ -384,10 +384,9 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
         };
 
     let mut corner_options = Vec::new();
-    for row in timing_corners.iter().filter(|c| !c.meets_margin) {
-        if req.corner_trials == 0 {
-            break;
-        }
+    let missed = timing_corners.iter().filter(|c| !c.meets_margin);
+    for row in missed.take_while(|_| req.corner_trials > 0) {
+        // The timing liberty's own row, or a sky130 corner (mapped on sky130 tt).
         let map_on = if row.library == lib.name {
             &lib
         } else if let Some(sky) = &sky_typical {
@@ -395,15 +394,11 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
         } else {
             continue;
         };
-        let libs = CornerLibraries {
-            map_on,
-            same_corner: row.library == map_on.name,
-        };
         corner_options.push(crate::corner_option::find(
             req.provider,
             d,
             row,
-            &libs,
+            map_on,
             &req.clock_port,
             &req.cache,
             req.corner_trials,
