@@ -311,6 +311,25 @@ fn default_pixel_fits_its_clock_with_margin() {
             && text.contains(&format!("set `[pixel] adders = {a}`")),
         "{text}"
     );
+    // `--corner-trials 0` reports the miss without the search (every synthesis cached).
+    let mut quiet = args.to_vec();
+    quiet.extend(["--corner-trials", "0", "--json"]);
+    let out = size(&quiet, &[], &dir.join("cache"));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let q: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(q["corner_options"], serde_json::json!([]), "{q}");
+    assert!(
+        q["timing_corners"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| c["corner"] == "ss_n40C_1v40" && c["meets_margin"] == false),
+        "{q}"
+    );
     // No cell the PDK keeps out of synthesis reaches the sky130 netlist.
     let netlists: Vec<_> = walk(&dir.join("cache"))
         .into_iter()
