@@ -2,7 +2,8 @@
 # The whole tofprobe test suite, as CI runs it (.ci/run): the EDA tools the co-simulation
 # and synthesis tests drive, then formatting, lints and every test of the workspace in
 # release mode (the Monte-Carlo and bit-true tests are numeric-heavy), then the Python
-# package's pytest suite and the users' tools checks. Every phase prints its wall time; a
+# package's pytest suite and the users' tools checks (the tools' and the venv's downloads run
+# in the background during the compile). Every phase prints its wall time; a
 # missing EDA tool fails the tests that need it (TOFPROBE_REQUIRE_TOOLS=1:
 # tofprobe_testkit::tools), it never skips them.
 set -euo pipefail
@@ -19,12 +20,53 @@ phase() {
   echo "test.sh: phase ${name}: $(( $(date +%s) - t0 )) s" >&2
 }
 
-phase install-tools scripts/install-tools.sh
+# The two downloads (Debian's EDA packages, the Python venv's wheels) wait on the network
+# and dpkg, not on the cores: they run in the background while cargo compiles, and the
+# tests wait for them. Their output is printed when they are awaited; a failure stops the
+# suite there. Ctrl-C or a failure elsewhere stops them too.
+prep=$(mktemp -d)
+killtree() {
+  local c
+  for c in $(pgrep -P "$1" 2>/dev/null); do killtree "$c"; done
+  kill "$1" 2>/dev/null || true
+}
+trap 'for j in $(jobs -p); do killtree "$j"; done; rm -rf "$prep"' EXIT
+background() {
+  local name=$1
+  shift
+  (
+    t0=$(date +%s)
+    rc=0
+    "$@" >"$prep/$name.out" 2>&1 || rc=$?
+    echo "$rc $(( $(date +%s) - t0 ))" >"$prep/$name.status"
+  ) &
+  echo $! >"$prep/$name.pid"
+}
+await() {
+  local name=$1 rc secs
+  wait "$(cat "$prep/$name.pid")" || true
+  cat "$prep/$name.out" >&2
+  read -r rc secs <"$prep/$name.status"
+  echo "test.sh: phase ${name}: ${secs} s (in the background)" >&2
+  if [ "$rc" != 0 ]; then
+    echo "test.sh: phase ${name} FAILED (exit ${rc})" >&2
+    exit 1
+  fi
+}
+
+background install-tools scripts/install-tools.sh
+# The venv the Python package and the users' tools use (its path printed; nothing else
+# creates it while this runs: the tests below wait for it).
+if command -v python3 >/dev/null 2>&1; then
+  background python-venv scripts/py-venv.sh
+fi
 phase fmt cargo fmt --all --check
 # Release profile, like the tests below: the proc-macros and build scripts clippy compiles are
 # then the ones the test build reuses (in the dev profile they were built twice, ≈ 1 min).
 phase clippy cargo clippy --workspace --all-targets --release -- -D warnings
 phase build-tests cargo test --workspace --release --no-run
+await install-tools
+[ -f "$prep/python-venv.pid" ] && await python-venv
 phase tests cargo test --workspace --release
 # The Python package (crates/python): maturin builds it into the scripts' venv, reusing the
 # library crates just built, and pytest runs its suite against the CLI binary built above.

@@ -41,19 +41,10 @@ pub struct HarnessBuild {
     pub seconds: f64,
 }
 
-/// Where builds are cached: $TOFPROBE_CACHE_DIR, else $XDG_CACHE_HOME/tofprobe, else
-/// ~/.cache/tofprobe, else the system temp dir.
+/// Where builds are cached: the one cache root of every tofprobe cache
+/// ([`tofprobe_io::cache::root`]: `$TOFPROBE_CACHE`, …).
 pub fn cache_root() -> PathBuf {
-    if let Some(d) = std::env::var_os("TOFPROBE_CACHE_DIR") {
-        return PathBuf::from(d);
-    }
-    if let Some(d) = std::env::var_os("XDG_CACHE_HOME") {
-        return PathBuf::from(d).join("tofprobe");
-    }
-    if let Some(d) = std::env::var_os("HOME") {
-        return PathBuf::from(d).join(".cache").join("tofprobe");
-    }
-    std::env::temp_dir().join("tofprobe-cache")
+    tofprobe_io::cache::root()
 }
 
 fn verilog_sources(rtl_dir: &Path) -> Result<Vec<PathBuf>, CosimError> {

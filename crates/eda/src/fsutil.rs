@@ -51,23 +51,15 @@ where
     Ok(v)
 }
 
-/// The synthesis cache: `arg` if given, else `$TOFPROBE_CACHE`, `$XDG_CACHE_HOME/tofprobe`,
-/// `~/.cache/tofprobe` or the temporary directory's `tofprobe-cache`, then `/synth`. One
-/// place, so `tofprobe size` and `adders = "auto"` share their syntheses.
+/// The synthesis cache: `arg` if given, else the one cache root's `synth/`
+/// ([`tofprobe_io::cache::root`]: `$TOFPROBE_CACHE`, `$XDG_CACHE_HOME/tofprobe`,
+/// `~/.cache/tofprobe`, …). One place, so `tofprobe size` and `adders = "auto"` share their
+/// syntheses.
 pub fn synth_cache_dir(arg: Option<&Path>) -> std::path::PathBuf {
     if let Some(p) = arg {
         return p.to_path_buf();
     }
-    let base = std::env::var_os("TOFPROBE_CACHE")
-        .map(std::path::PathBuf::from)
-        .or_else(|| {
-            std::env::var_os("XDG_CACHE_HOME").map(|p| std::path::PathBuf::from(p).join("tofprobe"))
-        })
-        .or_else(|| {
-            std::env::var_os("HOME").map(|p| std::path::PathBuf::from(p).join(".cache/tofprobe"))
-        })
-        .unwrap_or_else(|| std::env::temp_dir().join("tofprobe-cache"));
-    base.join("synth")
+    tofprobe_io::cache::root().join("synth")
 }
 
 #[cfg(test)]

@@ -4,13 +4,15 @@
 //! temporaries left by killed runs ([`stale`]), inputs read within a stated size
 //! ([`bounded`]: regular files only, so `/dev/zero` cannot exhaust memory), the sanitising of user text
 //! before it reaches a generated file ([`text`]) and the FNV-1a content hash ([`fnv1a64`],
-//! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries.
+//! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries, and the one
+//! root of the caches ([`cache::root`]).
 //!
 //! Errors are plain [`std::io::Error`]s: each crate maps them into its own error enum with
 //! the path it was writing.
 
 mod atomic;
 pub mod bounded;
+pub mod cache;
 pub mod live;
 pub mod marker;
 pub mod npy;

@@ -18,6 +18,49 @@ use crate::tech::{Tech, TechFiles};
 pub const MIN_DENSITY: f64 = 0.2;
 /// Placement attempts at most (the asked density, then 0.1 lower each time).
 pub const MAX_ATTEMPTS: usize = 3;
+/// Above this many cells `RouteCleanup::Auto` skips qrouter's stage 3: on the default
+/// pixel (9,248 cells) it re-routed 40–60 nets a minute after stages 1 and 2 had routed
+/// all 9,435 nets in ≈ 47 min, i.e. hours for wirelength alone; the 2-bin pixel (2,627
+/// cells) keeps it (it takes a minute there).
+pub const AUTO_CLEANUP_MAX_CELLS: u64 = 5_000;
+
+/// Whether qrouter runs its stage 3, the cleanup that rips up and re-routes every routed
+/// net to shorten it. Stages 1 and 2 (route, then rip up and re-route the failures) leave
+/// every net routed and legal; stage 3 only improves the wires.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RouteCleanup {
+    /// On up to [`AUTO_CLEANUP_MAX_CELLS`] cells, off above.
+    Auto,
+    /// Always (qflow's own `qrouter::standard_route`).
+    On,
+    /// Never (`qrouter::standard_route` with its `nocleanup` argument).
+    Off,
+}
+
+impl RouteCleanup {
+    /// Parses `auto`, `on` or `off` (the CLI's `--route-cleanup`).
+    pub fn parse(s: &str) -> Result<RouteCleanup> {
+        match s {
+            "auto" => Ok(RouteCleanup::Auto),
+            "on" => Ok(RouteCleanup::On),
+            "off" => Ok(RouteCleanup::Off),
+            _ => Err(LayoutError::Option {
+                option: "route-cleanup",
+                value: s.into(),
+                allowed: "auto, on or off".into(),
+            }),
+        }
+    }
+
+    /// Whether stage 3 runs for a netlist of `cells` cells.
+    pub fn runs(self, cells: u64) -> bool {
+        match self {
+            RouteCleanup::Auto => cells <= AUTO_CLEANUP_MAX_CELLS,
+            RouteCleanup::On => true,
+            RouteCleanup::Off => false,
+        }
+    }
+}
 
 /// What to lay out and how.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,6 +77,8 @@ pub struct LayoutRequest {
     pub node_nm: f64,
     /// Pixel pitches and the paper's bins for them.
     pub pitches: Vec<(f64, Option<u64>)>,
+    /// qrouter's stage 3.
+    pub route_cleanup: RouteCleanup,
 }
 
 /// A finished layout: the report and the files of its output set.
@@ -82,6 +127,15 @@ pub fn run(
 ) -> Result<LayoutRun> {
     check_options(req.density, req.node_nm)?;
     crate::tools::require_all()?;
+    // Absolute paths: qflow's scripts run in the project's subdirectories, and the
+    // technology is linked into the project (a relative `--cache` or PDK broke both).
+    let absolute =
+        |p: &Path| std::path::absolute(p).map_err(|e| LayoutError::io("resolving", p, e));
+    let req = &LayoutRequest {
+        cache: absolute(&req.cache)?,
+        sky130_pdk: req.sky130_pdk.as_deref().map(absolute).transpose()?,
+        ..req.clone()
+    };
     let mut steps = Vec::new();
     let timed = |steps: &mut Vec<Step>, name: &str, t: Instant| {
         steps.push(Step {
@@ -155,6 +209,8 @@ pub fn run(
         .filter_map(|n| n.trim().parse::<u64>().ok())
         .sum();
     timed(&mut steps, "netlist to qflow (BLIF, SPICE)", t);
+    let route_cleanup = req.route_cleanup.runs(syn.cell_count);
+    project.set_route_cleanup(route_cleanup)?;
     let mut attempts = Vec::new();
     let tries = densities(req.density);
     for (i, &d) in tries.iter().enumerate() {
@@ -215,6 +271,11 @@ pub fn run(
             what: "`drc = N`".into(),
             path: dir.join("log/drc.log"),
         })?;
+    let drc_rules = if drc_errors > 0 {
+        project.drc_reasons()?
+    } else {
+        vec![]
+    };
     progress("LVS");
     let t = Instant::now();
     let (lvs_log, _) = project.stage("LVS", "lvs", "lvs.log")?;
@@ -336,9 +397,11 @@ pub fn run(
         bins: b,
         width: w,
         attempts,
+        route_cleanup,
         def,
         synthesis,
         drc_errors,
+        drc_rules,
         lvs_match,
         lvs_result,
         post_route,
@@ -346,7 +409,7 @@ pub fn run(
         steps,
         clock_buffers,
         corners,
-        notes: notes(&tech, other),
+        notes: notes(&tech, other, route_cleanup),
     };
     let ext = |e: &str| project.layout_file(e);
     let files = vec![
@@ -364,13 +427,18 @@ pub fn run(
     })
 }
 
-fn notes(tech: &TechFiles, other_b: u64) -> Vec<String> {
+fn notes(tech: &TechFiles, other_b: u64, route_cleanup: bool) -> Vec<String> {
     let mut n = vec![
         "Synthesis: the project's delay-driven yosys script (tofprobe_eda::synth), mapped for the configuration's clock; qflow only converts that netlist (BLIF, SPICE); its blifFanout buffers nets of fanout > 16 and resizes nothing (`-f -F 16`): the synthesised nets have fanout ≤ 8, so that is the clock's buffer tree. LVS compares the layout with this netlist: the synthesised one plus the clock buffers.".to_string(),
         "Placement: graywolf at the stated target density (qflow's initial_density: fill cells are added until the logic covers that fraction); a routing failure retries 0.1 lower, at most 3 attempts. Power: qflow's addspacers stripes (2 µm every 50 µm on osu018).".into(),
         "Post-route timing: OpenSTA on the placed netlist with qrouter's RC trees written as SPEF (lumped at each route point), the clock propagated through its buffer tree and routed wires (their delays are the skew the hold check sees), inputs at the clock edge, outputs due at the next.".into(),
         format!("Bins per pitch: the synthesis model A(B) fitted to B and {other_b} on this technology's liberty, times the routed factor die / cell area of the configured pixel (assumed to hold for other B), scaled by (target node / technology node)²."),
     ];
+    n.push(if route_cleanup {
+        "Routing: qrouter's stages 1 and 2 (route every net, rip up and re-route the failures) and stage 3 (every net re-routed shorter), qflow's own `qrouter::standard_route`.".into()
+    } else {
+        format!("Routing: qrouter's stages 1 and 2 only (every net routed and legal); stage 3, the cleanup that re-routes each net shorter, was skipped (`--route-cleanup`, auto above {AUTO_CLEANUP_MAX_CELLS} cells): the wirelength and the post-route wires are those of stage 2, a little longer than a cleaned-up route.")
+    });
     if tech.tech == Tech::Osu018 {
         n.push("osu018: Debian's qflow-tech-osu018 has no cell GDS, so the GDS and the picture hold the cells' LEF abstracts (pins and obstructions) with the routing, and magic's DRC checks the routing and the abstracts, not the cells' transistors.".into());
     }
@@ -382,4 +450,25 @@ pub fn project_dir(cache: &Path, tech: Tech, synthesis_key: &str) -> PathBuf {
     cache
         .join("layout")
         .join(format!("{}-{synthesis_key}", tech.name()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn route_cleanup_auto_keeps_stage_3_for_small_pixels_only() {
+        // The 2-bin pixel (2,627 cells) keeps it, the default (9,248 cells) skips it.
+        assert!(RouteCleanup::Auto.runs(2_627));
+        assert!(RouteCleanup::Auto.runs(AUTO_CLEANUP_MAX_CELLS));
+        assert!(!RouteCleanup::Auto.runs(9_248));
+        assert!(RouteCleanup::On.runs(9_248));
+        assert!(!RouteCleanup::Off.runs(10));
+        assert_eq!(RouteCleanup::parse("off").unwrap(), RouteCleanup::Off);
+        let e = RouteCleanup::parse("never").unwrap_err().to_string();
+        assert!(
+            e.contains("route-cleanup") && e.contains("auto, on or off"),
+            "{e}"
+        );
+    }
 }

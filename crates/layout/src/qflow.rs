@@ -29,6 +29,9 @@ fn write(path: &Path, text: &str) -> Result<()> {
 impl Project {
     /// A fresh project in `dir` (removed first if present) holding `netlist`.
     pub fn create(dir: &Path, top: &str, tech: &TechFiles, netlist: &Path) -> Result<Project> {
+        // qflow's scripts run in the project's subdirectories: every path they are given
+        // must be absolute (a relative `--cache` failed in the netlist conversion).
+        let dir = &std::path::absolute(dir).map_err(|e| LayoutError::io("resolving", dir, e))?;
         if dir.exists() {
             std::fs::remove_dir_all(dir).map_err(|e| LayoutError::io("removing", dir, e))?;
         }
@@ -100,6 +103,64 @@ impl Project {
         )
     }
 
+    /// Whether qrouter runs its stage 3 (cleanup). Off, the placement step finds
+    /// `layout/TOP.cfg2` and appends it to the router's script instead of qflow's
+    /// `qrouter::standard_route TOP_route.def false`: the same procedure with its
+    /// `nocleanup` argument (stages 1 and 2, the DEF and RC files, no stage 3).
+    pub fn set_route_cleanup(&self, cleanup: bool) -> Result<()> {
+        let cfg2 = self.layout_file("cfg2");
+        if cleanup {
+            match std::fs::remove_file(&cfg2) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    Err(LayoutError::io("removing", &cfg2, e))
+                }
+                _ => Ok(()),
+            }
+        } else {
+            write(
+                &cfg2,
+                &format!(
+                    "qrouter::standard_route {}_route.def false true\nquit\n",
+                    self.top
+                ),
+            )
+        }
+    }
+
+    /// magic's reasons for the DRC errors of the routed macro: each rule broken and how
+    /// many boxes break it (`drc listall why` on the layout database the DRC stage
+    /// checked), then a line in the DRC log so qflow's GDS stage, which refuses to run
+    /// after a log ending in "error condition", writes the (dirty) GDS the report shows.
+    pub fn drc_reasons(&self) -> Result<Vec<DrcRule>> {
+        let magic = Tool::Magic.locate()?;
+        let script = self
+            .dir
+            .join("layout")
+            .join(format!("why_drc_{}.tcl", self.top));
+        write(
+            &script,
+            &format!(
+                "lef read {lef}\nload {top}\ndrc on\nselect top cell\nexpand\ndrc check\ndrc catchup\n\
+                 foreach {{rule boxes}} [drc listall why] {{ puts stdout \"TOFPROBE-DRC [llength $boxes] $rule\" }}\nquit\n",
+                lef = self.tech.cell_lef.display(),
+                top = self.top
+            ),
+        )?;
+        let out = Command::new(&magic)
+            .args(["-dnull", "-noconsole"])
+            .arg(&script)
+            .current_dir(self.dir.join("layout"))
+            .output()
+            .map_err(|e| LayoutError::io("running", &magic, e))?;
+        let text = String::from_utf8_lossy(&out.stdout);
+        let rules = parse_drc_reasons(&text);
+        let log = self.dir.join("log").join("drc.log");
+        let mut old = std::fs::read_to_string(&log).unwrap_or_default();
+        old.push_str("tofprobe: the DRC errors are in the layout report; LVS and GDS continue.\n");
+        write(&log, &old)?;
+        Ok(rules)
+    }
+
     /// A file of the layout directory: `layout/TOP.EXT`.
     pub fn layout_file(&self, ext: &str) -> PathBuf {
         self.dir.join("layout").join(format!("{}.{ext}", self.top))
@@ -113,7 +174,9 @@ impl Project {
     }
 
     /// Runs qflow's `stage` (its qflow name) and returns its log's text and the seconds
-    /// it took; an error names the stage and the log's tail.
+    /// it took; an error names the stage and the log's tail. A routing or DRC stage that
+    /// stopped on its own verdict (unrouted nets, DRC errors) returns its log: the verdict
+    /// is the report's, not an error.
     pub fn stage(&self, step: &'static str, stage: &str, log: &str) -> Result<(String, f64)> {
         let qflow = Tool::Qflow.locate()?;
         let start = std::time::Instant::now();
@@ -137,7 +200,15 @@ impl Project {
             || text.contains("error condition")
             || text.contains("Premature exit")
             || text.is_empty();
-        if failed && stage != "route" {
+        // The route and DRC stages fail qflow's way when their verdict is bad (unrouted
+        // nets; `drc = N` with N > 0): the caller reads that verdict from the log and
+        // reports it, so only a log without it is a tool failure.
+        let verdict_in_log = match stage {
+            "route" => true,
+            "drc" => text.lines().any(|l| l.trim().starts_with("drc = ")),
+            _ => false,
+        };
+        if failed && !verdict_in_log {
             let both = format!("{text}\n{console}");
             return Err(LayoutError::ToolFailed {
                 step,
@@ -152,6 +223,29 @@ impl Project {
         }
         Ok((text, seconds))
     }
+}
+
+/// A DRC rule the layout breaks and how many error boxes break it.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct DrcRule {
+    /// magic's text of the rule (e.g. `Metal2 spacing < 3 (Mosis #9.2)`).
+    pub rule: String,
+    /// Error boxes.
+    pub boxes: u64,
+}
+
+/// The `TOFPROBE-DRC N RULE` lines of [`Project::drc_reasons`]'s magic script.
+pub fn parse_drc_reasons(text: &str) -> Vec<DrcRule> {
+    text.lines()
+        .filter_map(|l| l.trim().strip_prefix("TOFPROBE-DRC "))
+        .filter_map(|l| {
+            let (n, rule) = l.split_once(' ')?;
+            Some(DrcRule {
+                rule: rule.trim().to_string(),
+                boxes: n.parse().ok()?,
+            })
+        })
+        .collect()
 }
 
 /// qrouter's verdict in a route log: `Ok(())` when every net routed, else the unrouted
@@ -187,6 +281,16 @@ pub fn route_verdict(log: &str) -> std::result::Result<(), (usize, Vec<String>)>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn drc_reasons_are_read_per_rule() {
+        // What the magic script prints for the default pixel's routed macro (2026-11-28).
+        let text = "Loading\nTOFPROBE-DRC 1 Metal2 spacing < 3 (Mosis #9.2)\nTOFPROBE-DRC 2 Metal2 area < 20 (Mosis #+++)\nTOFPROBE-DRC x bad\n";
+        let r = parse_drc_reasons(text);
+        assert_eq!(r.len(), 2);
+        assert_eq!(r[0].rule, "Metal2 spacing < 3 (Mosis #9.2)");
+        assert_eq!(r[1].boxes, 2);
+    }
 
     #[test]
     fn the_route_verdict_reads_the_final_line() {

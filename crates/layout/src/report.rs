@@ -83,12 +83,19 @@ pub struct LayoutReport {
     pub width: u32,
     /// Placement attempts, the routed one last.
     pub attempts: Vec<Attempt>,
+    /// Whether qrouter ran its stage 3 (cleanup: every net re-routed shorter); reports
+    /// written before the option existed all did.
+    #[serde(default = "stage3_ran")]
+    pub route_cleanup: bool,
     /// The routed macro.
     pub def: DefFigures,
     /// Synthesis.
     pub synthesis: SynthFigures,
     /// magic's DRC error count.
     pub drc_errors: u64,
+    /// The rules the errors break (empty when clean).
+    #[serde(default)]
+    pub drc_rules: Vec<crate::qflow::DrcRule>,
     /// netgen's verdict: whether layout and synthesised netlist match.
     pub lvs_match: bool,
     /// netgen's result line.
@@ -105,6 +112,10 @@ pub struct LayoutReport {
     pub corners: Vec<CornerRow>,
     /// What the figures assume.
     pub notes: Vec<String>,
+}
+
+fn stage3_ran() -> bool {
+    true
 }
 
 /// What the options study reads of a layout report: a partial view, so any report of
@@ -193,7 +204,7 @@ impl LayoutReport {
              | figure | value |\n|---|---:|\n\
              | die | {:.2} × {:.2} µm = {:.0} µm² |\n| core (placed cells' extent) | {:.2} × {:.2} µm = {:.0} µm² |\n\
              | logic cells | {} ({:.0} µm², {} of them clock buffers; {} fill cells) |\n| utilisation (cells / core) | {:.1} % |\n\
-             | target density routed | {} |\n| routed wirelength | {:.0} µm |\n| DRC errors (magic) | {} |\n\
+             | target density routed | {} |\n| routed wirelength | {:.0} µm{} |\n| DRC errors (magic) | {} |\n\
              | LVS (netgen, layout vs synthesised netlist) | {} — {} |\n\n",
             self.top,
             self.tech,
@@ -213,10 +224,22 @@ impl LayoutReport {
             100.0 * d.utilisation(),
             self.density(),
             d.wirelength_um,
+            if self.route_cleanup {
+                ""
+            } else {
+                " (qrouter stage 3 skipped)"
+            },
             self.drc_errors,
             if self.lvs_match { "match" } else { "MISMATCH" },
             self.lvs_result,
         );
+        if !self.drc_rules.is_empty() {
+            s += "DRC errors by rule (magic's `drc listall why`):\n\n| rule | error boxes |\n|---|---:|\n";
+            for r in &self.drc_rules {
+                let _ = writeln!(s, "| {} | {} |", r.rule, r.boxes);
+            }
+            s += "\n";
+        }
         if self.attempts.len() > 1 {
             s += "Placement attempts:\n\n| density | unrouted nets |\n|---:|---|\n";
             for a in &self.attempts {

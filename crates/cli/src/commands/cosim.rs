@@ -36,6 +36,11 @@ pub struct CosimArgs {
     /// Write a VCD (around the first mismatch, else of the first 10^5 cycles).
     #[arg(long)]
     pub trace: bool,
+    /// No VCD on a mismatch (by default one is written around the first, which costs a
+    /// second, traced Verilator build): the verdict and the first mismatch only, as a
+    /// mutation campaign or a CI gate wants them.
+    #[arg(long, conflicts_with = "trace")]
+    pub no_vcd: bool,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -200,6 +205,7 @@ pub fn options(p: &PixelParams, a: &CosimArgs) -> CosimOptions {
     o.seed = a.seed;
     o.rtl_dir = a.rtl.clone();
     o.trace = a.trace;
+    o.vcd_on_mismatch = !a.no_vcd;
     o.measure_bare = a.bare;
     o.simulator = a.simulator.into();
     o.x_seed = a.x_seed;

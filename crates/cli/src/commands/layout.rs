@@ -1,4 +1,5 @@
-//! `tofprobe layout [CONFIG] --out DIR [--tech osu018|sky130] [--density D] [--json]`: the
+//! `tofprobe layout [CONFIG] --out DIR [--tech osu018|sky130] [--density D]
+//! [--route-cleanup auto|on|off] [--json]`: the
 //! configured pixel placed, routed, checked (DRC, LVS), timed after routing and drawn
 //! (tofprobe_layout, docs/layout.md). DIR receives one output set, whole or absent: the
 //! DEF, GDS and LEF of the macro, the SPEF and placed netlist, `layout.png`,
@@ -26,6 +27,10 @@ pub struct LayoutArgs {
     /// fails.
     #[arg(long, default_value_t = 0.6)]
     pub density: f64,
+    /// qrouter's stage 3, the cleanup that re-routes every net shorter: auto (on up to
+    /// 5,000 cells, off above: hours on the default pixel), on or off.
+    #[arg(long, default_value = "auto", value_name = "auto|on|off")]
+    pub route_cleanup: String,
     /// Node (nm) the bins-per-pitch answer is scaled to.
     #[arg(long, default_value_t = 40.0)]
     pub node_nm: f64,
@@ -45,6 +50,7 @@ pub struct LayoutArgs {
 /// Runs `tofprobe layout`; the verdict is FAIL when DRC or LVS is not clean.
 pub fn run(a: &LayoutArgs) -> Result<crate::commands::Verdict, CliError> {
     let tech = Tech::parse(&a.tech)?;
+    let route_cleanup = tofprobe_layout::flow::RouteCleanup::parse(&a.route_cleanup)?;
     tofprobe_layout::flow::check_options(a.density, a.node_nm)?;
     let design = crate::commands::load_for_hardware(a.config.as_deref())?;
     design.single_pixel("layout")?;
@@ -55,6 +61,7 @@ pub fn run(a: &LayoutArgs) -> Result<crate::commands::Verdict, CliError> {
         sky130_pdk: a.sky130_pdk.clone(),
         node_nm: a.node_nm,
         pitches: vec![(30.0, Some(6)), (40.0, Some(13))],
+        route_cleanup,
     };
     let quiet = a.json;
     let run = tofprobe_layout::run(&design, &req, &mut |step| {

@@ -137,10 +137,13 @@ fn mismatched_rtl_is_refused_naming_the_parameter() {
         rtl,
         "--frame-pulses",
         "64",
+        "--no-vcd",
         "--out",
         &out_dir("rom"),
     ]);
     assert!(!o.status.success());
+    // `--no-vcd`: the mismatch is reported, no VCD is written (and no traced build made).
+    assert!(!Path::new(&out_dir("rom")).join("cosim.vcd").exists());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
         err.contains("at entry 3: register bit(s) [0] differ"),
@@ -180,6 +183,14 @@ fn a_broken_pixel_fails_alike_in_both_simulators() {
         assert_eq!(o.status.code(), Some(1), "{sim}: exit status");
         let j = json(&o);
         assert_eq!(j["pass"], false);
+        // By default a mismatch gets a VCD around it (a traced Verilator build, whichever
+        // simulator found it): the signals a designer opens first.
+        let vcd = std::fs::read_to_string(j["vcd"].as_str().expect("a VCD path"))
+            .expect("the VCD exists");
+        assert!(
+            vcd.contains("$enddefinitions") && vcd.contains("$var"),
+            "{sim}"
+        );
         for k in ["cycle", "pulse", "signal", "expected", "actual"] {
             assert!(
                 !j[format!("first_mismatch_{k}")].is_null(),

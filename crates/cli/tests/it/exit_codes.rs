@@ -194,6 +194,8 @@ fn cosim_fail_is_exit_status_1() {
                 "64",
                 "--simulator",
                 "icarus",
+                // The verdict only: no traced Verilator build for a VCD of the mismatch.
+                "--no-vcd",
                 "--out",
                 s(&out),
             ],

@@ -184,6 +184,8 @@ fn cosim(rtl: &Path, out: &Path, junit: &Path, extra: &[&str]) -> std::process::
         "3".into(),
         "--simulator".into(),
         "icarus".into(),
+        // The report only: no traced Verilator build for a VCD of a mismatch.
+        "--no-vcd".into(),
         "--json".into(),
         "--out".into(),
         out.join("work").display().to_string(),

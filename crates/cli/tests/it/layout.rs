@@ -29,15 +29,26 @@ fn a_two_bin_pixel_routes_drc_and_lvs_clean_on_osu018() {
     std::fs::write(&cfg, text).unwrap();
     let out = dir.path().join("layout");
     let cache = dir.path().join("cache");
-    let run = tofprobe(&[
-        "layout",
-        cfg.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--cache",
-        cache.to_str().unwrap(),
-        "--json",
-    ]);
+    // Relative spellings, run from the directory: qflow's scripts run in the project's
+    // subdirectories, so the flow must hand them absolute paths (a relative `--cache`
+    // once failed in the netlist conversion).
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .current_dir(dir.path())
+        .args([
+            "layout",
+            "two.toml",
+            "--out",
+            "layout",
+            "--cache",
+            "cache",
+            // Stage 3 skipped, as `auto` does for the default pixel (the path its full
+            // layout takes); it also saves the CI a minute of re-routing for wirelength.
+            "--route-cleanup",
+            "off",
+            "--json",
+        ])
+        .output()
+        .expect("run tofprobe");
     assert!(
         run.status.success(),
         "{}\n{}",
@@ -46,6 +57,20 @@ fn a_two_bin_pixel_routes_drc_and_lvs_clean_on_osu018() {
     );
     let r = common::last_json(&run);
     assert_eq!(r["schema"], "tofprobe-layout-1");
+    assert_eq!(r["route_cleanup"], false, "{r}");
+    // qrouter itself says it bypassed stage 3 (the script `--route-cleanup off` gave it).
+    let key = r["synthesis"]["key"].as_str().unwrap();
+    let route_log = std::fs::read_to_string(
+        cache
+            .join("layout")
+            .join(format!("osu018-{key}"))
+            .join("log/route.log"),
+    )
+    .unwrap();
+    assert!(
+        route_log.contains("Cleanup stage (stage3) bypassed"),
+        "{route_log}"
+    );
     assert_eq!(r["drc_errors"], 0, "{r}");
     assert_eq!(r["lvs_match"], true, "{r}");
     assert!(
@@ -162,6 +187,7 @@ fn bad_layout_options_are_refused_naming_a_value_that_works() {
         (vec!["--density", "NaN"], "0.6 routes"),
         (vec!["--tech", "gf180"], "osu018 or sky130"),
         (vec!["--node-nm", "0"], "--node-nm = 0"),
+        (vec!["--route-cleanup", "sometimes"], "auto, on or off"),
     ] {
         let mut a = vec!["layout", "--out", out.to_str().unwrap()];
         a.extend(args);

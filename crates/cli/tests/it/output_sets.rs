@@ -278,7 +278,7 @@ fn a_failed_flow_removes_the_directory_it_created() {
             "64",
         ])
         .env("PATH", "")
-        .env("TOFPROBE_CACHE_DIR", tmp.join("empty-cache"))
+        .env("TOFPROBE_CACHE", tmp.join("empty-cache"))
         .output()
         .unwrap();
     let t = text(&o);

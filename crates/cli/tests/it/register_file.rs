@@ -68,6 +68,8 @@ fn cosim(cfg: &Path, n: u32, out: &Path, rtl: Option<&Path>, simulator: &str) ->
         "2".into(),
         "--simulator".into(),
         simulator.into(),
+        // The verdict and first mismatch only: no traced Verilator build for a VCD.
+        "--no-vcd".into(),
         "--out".into(),
         out.to_str().unwrap().to_string(),
     ];

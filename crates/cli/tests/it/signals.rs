@@ -150,7 +150,7 @@ fn an_interrupted_verilator_build_leaves_no_build_directory() {
         let mut child = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
             .args(["cosim", "--frame-pulses", "256", "--out"])
             .arg(tmp.path().join("work"))
-            .env("TOFPROBE_CACHE_DIR", &cache)
+            .env("TOFPROBE_CACHE", &cache)
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()
