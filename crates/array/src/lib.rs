@@ -16,8 +16,10 @@ pub mod model;
 pub mod output;
 pub mod plot;
 pub mod rtl;
+mod rtl_run;
 pub mod rtl_vectors;
 pub mod shard;
+pub mod shadow;
 pub mod uff;
 
 pub use error::ArrayError;

@@ -47,6 +47,7 @@ fn spec(p: &PixelParams, rows: usize, cols: usize, bits: u32, g: u64) -> ArraySp
         fault: None,
         tile: None,
         superpixel: 1,
+        double_buffer: false,
     }
 }
 
