@@ -52,7 +52,9 @@ module {{ name }} (
     // The shadow copy (docs/pixel-contract.md "Double buffer"): the registers and the
     // status word as they stood at the last `swap` edge, which the readout streams while
     // the registers accumulate the next frame. No reset: the first readout follows a swap.
-    reg [{{ w - 1 }}:0] sh [0:{{ r - 1 }}];
+{%- for g in regs %}
+    reg [{{ w - 1 }}:0] sh_{{ g.r }};
+{%- endfor %}
     reg [{{ w - 1 }}:0] sh_status;
 {%- endif %}
 
@@ -311,7 +313,7 @@ module {{ name }} (
     always @* begin
         case (rd_ptr)
 {%- for g in regs %}
-            {{ ib }}'d{{ g.r }}: rd_mux = {% if dbuf %}sh{% else %}y{% endif %}[{{ g.r }}];
+            {{ ib }}'d{{ g.r }}: rd_mux = {% if dbuf %}sh_{{ g.r }}{% else %}y[{{ g.r }}]{% endif %};
 {%- endfor %}
             default: rd_mux = {{ w }}'d0;
         endcase
@@ -433,7 +435,7 @@ module {{ name }} (
     always @(posedge clk) begin
         if (swap) begin
 {%- for g in regs %}
-            sh[{{ g.r }}] <= y[{{ g.r }}];
+            sh_{{ g.r }} <= y[{{ g.r }}];
 {%- endfor %}
             sh_status <= refused;
         end

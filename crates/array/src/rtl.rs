@@ -128,6 +128,12 @@ impl ArrayModel {
                 tile.row0, tile.rows, tile.col0, tile.cols, readout.rows, readout.cols
             )));
         }
+        if fault == Some(ArrayFault::SwapLate) && !readout.double_buffer {
+            return Err(ArrayError::Shape(
+                "the swap_late fault needs a double-buffered array (array.double_buffer = true)"
+                    .into(),
+            ));
+        }
         let fourier = p.mode == Mode::Fourier;
         let words = if fourier {
             p.registers().div_ceil(64)
