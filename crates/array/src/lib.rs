@@ -18,8 +18,8 @@ pub mod plot;
 pub mod rtl;
 mod rtl_run;
 pub mod rtl_vectors;
-pub mod shard;
 pub mod shadow;
+pub mod shard;
 pub mod uff;
 
 pub use error::ArrayError;

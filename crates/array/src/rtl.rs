@@ -5,7 +5,9 @@
 //! one rising edge; [`run`] drives frames of per-pixel detections through it and records
 //! what the array's ports show every cycle (the golden vectors of `tofprobe cosim` on an
 //! array). The array's faults ([`ArrayFault`]) are carried exactly, so the cycle where a
-//! broken RTL first differs is predicted by the model.
+//! broken RTL first differs is predicted by the model. Double-buffered (`Readout::
+//! double_buffer`), the sequencer overlaps the readout with the next frame's pulses and
+//! each pixel's readout streams its [`crate::shadow::Shadow`], loaded by the broadcast swap.
 
 use tofprobe_design::readout::ArrayTile;
 use tofprobe_design::readout::{ArrayFault, Readout};

@@ -117,7 +117,10 @@ fn the_shadow_taken_a_cycle_late_is_caught_at_the_first_beat() {
     let good = run(&mut ArrayModel::new(&ro, &p, &rom, None).unwrap(), &d, 3).unwrap();
     let late = Some(ArrayFault::SwapLate);
     let bad = run(&mut ArrayModel::new(&ro, &p, &rom, late).unwrap(), &d, 3).unwrap();
-    assert_ne!(good.words[0][0][0], 0, "register 0 of pixel (0, 0) is not 0");
+    assert_ne!(
+        good.words[0][0][0], 0,
+        "register 0 of pixel (0, 0) is not 0"
+    );
     let first = (0..good.pins.len())
         .find(|&cy| good.pins[cy] != bad.pins[cy])
         .expect("a late swap changes the stream") as u64;

@@ -475,5 +475,8 @@ fn a_double_buffered_array_is_bit_exact_and_a_late_shadow_is_caught() {
     assert!(!r.pass && r.mismatches > 0, "the late shadow is not caught");
     assert_eq!(r.first_cycle, Some(predicted), "{:?}", r.first);
     let first = format!("{:?}", r.first);
-    assert!(first.contains("pixel (0, 0)") && first.contains("register 0"), "{first}");
+    assert!(
+        first.contains("pixel (0, 0)") && first.contains("register 0"),
+        "{first}"
+    );
 }

@@ -114,7 +114,11 @@ fn configs() -> Vec<(String, PixelParams, ArraySpec)> {
         ..s
     };
     v.push(("2x2-dbuf".to_string(), f.clone(), db(spec(&f, 2, 2, 24, 1))));
-    v.push(("3x5-haar-dbuf-k3".to_string(), h4.clone(), db(spec(&h4, 3, 5, 5, 1))));
+    v.push((
+        "3x5-haar-dbuf-k3".to_string(),
+        h4.clone(),
+        db(spec(&h4, 3, 5, 5, 1)),
+    ));
     v.push((
         "2x2-dbuf-swap_late".to_string(),
         f.clone(),
@@ -357,7 +361,10 @@ fn the_double_buffer_is_rendered_only_when_on() {
     }
     let (pix_off, pix_on) = (&off[0].contents, &on[0].contents);
     assert!(pix_on.contains("input  wire swap,") && pix_on.contains("sh_0 <= y[0];"));
-    assert!(!pix_on.contains("!rd_active && (!active"), "the readout blocks no pulse");
+    assert!(
+        !pix_on.contains("!rd_active && (!active"),
+        "the readout blocks no pulse"
+    );
     assert!(pix_off.contains("!rd_active && (!active"));
     assert_eq!(on[1].contents, off[1].contents, "the ROM is the same");
     assert_eq!(on[2].contents.matches(".swap(r_swap[").count(), 4);
