@@ -2,8 +2,9 @@
 //! zero warnings, `iverilog -g2005 -Wall` compiles, yosys `synth` with no latch and no
 //! warning beyond the pixel's register-file note, for a 2 × 2 Fourier array on a one-word
 //! port, a 3 × 5 Haar array on a 5-bit port (3 beats per word), a 2 × 3 array with beats
-//! 3 cycles apart, superpixel arrays (G = 2, and a tile at G = 3) and each array mutant;
-//! and the renderer's refusals.
+//! 3 cycles apart, superpixel arrays (G = 2, and a tile at G = 3), double-buffered arrays
+//! (Fourier, Haar: the synthesised shadow is (R+1)·W flops per pixel) and each array
+//! mutant; and the renderer's refusals.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -167,6 +168,7 @@ fn top() -> String {
 #[test]
 fn array_lint_iverilog_and_yosys_are_clean() {
     let (v, i, y) = (have("verilator"), have("iverilog"), have("yosys"));
+    let mut flops = std::collections::HashMap::new();
     for (name, p, s) in configs() {
         let (dir, sources) = render_to(&name, &p, &s);
         if v {
@@ -236,8 +238,23 @@ fn array_lint_iverilog_and_yosys_are_clean() {
             let copies = if s.double_buffer { 2 } else { 1 };
             let need = (copies * present * p.registers()) as u64 * u64::from(p.width);
             assert!(dff >= need, "{name}: {dff} flip-flops < {need}");
+            flops.insert(name.clone(), (dff, p.registers(), p.width));
         }
         let _ = std::fs::remove_dir_all(&dir);
+    }
+    // The rendered shadow costs what the size report's estimate counts: (R+1)·W flops per
+    // pixel (the registers and the status word), plus the array's swap broadcast and hold
+    // (b_swap, one r_swap per row, `hold` and its 1-bit `wt` here: at most 5 flops). The
+    // summed `stat` lists the pixel module once, the array module's own flops, and the
+    // hierarchy's total (P pixels and the array's own again): the shadow shows (1 + P)
+    // times, the array's part twice.
+    if let (Some(&(single, r, w)), Some(&(double, ..))) = (flops.get("2x2"), flops.get("2x2-dbuf"))
+    {
+        let shadow = (1 + 4) * (r as u64 + 1) * u64::from(w);
+        assert!(
+            (shadow..=shadow + 2 * 5).contains(&(double - single)),
+            "{double} - {single} flops is not 5 × (R+1)·W = {shadow} (+ ≤ 2 × 5)"
+        );
     }
 }
 
