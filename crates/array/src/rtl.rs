@@ -377,11 +377,7 @@ impl ArrayModel {
                 if swap && !rst {
                     px.swap_clear();
                 }
-                sh.step(
-                    rst,
-                    readout,
-                    sampled.as_ref().filter(|_| !rst).map(|(y, f)| (&y[..], *f)),
-                );
+                sh.step(rst, readout, sampled.as_ref().map(|(y, f)| (&y[..], *f)));
             }
         }
         // The buffer (no reset) and the port.

@@ -58,14 +58,28 @@ impl Shadow {
 
     /// One rising edge: `rst`, the `readout` strobe and the `swap` strobe, with `pixel`'s
     /// registers and counter as they stood before this edge (`sampled`; `None` when no
-    /// swap). The readout reads the old shadow at the edge that loads the new one.
+    /// swap). The readout reads the old shadow at the edge that loads the new one. The
+    /// shadow has no reset and its load is not gated by it (as in the RTL: a swap during
+    /// reset loads it; nothing reads it before the next swap).
     pub fn step(&mut self, rst: bool, readout: bool, sampled: Option<(&[i64], u64)>) {
         if rst {
-            // The pixel's readout control resets; the shadow itself has no reset.
+            // The pixel's readout control resets.
             (self.rd_active, self.rd_ptr) = (false, 0);
             (self.rd_valid, self.rd_index, self.rd_data) = (false, 0, 0);
-            return;
+        } else {
+            self.readout_edge(readout);
         }
+        if let Some((y, refused)) = sampled {
+            for (s, &v) in self.words.iter_mut().zip(y) {
+                *s = v as u64 & self.mask;
+            }
+            self.status = refused & self.mask;
+        }
+    }
+
+    /// The readout's edge: the next shadow word out, or the status word, which ends it; a
+    /// strobe (re)starts it.
+    fn readout_edge(&mut self, readout: bool) {
         let r = self.words.len();
         if self.rd_active {
             self.rd_valid = true;
@@ -83,12 +97,6 @@ impl Shadow {
         }
         if readout {
             (self.rd_active, self.rd_ptr) = (true, 0);
-        }
-        if let Some((y, refused)) = sampled {
-            for (s, &v) in self.words.iter_mut().zip(y) {
-                *s = v as u64 & self.mask;
-            }
-            self.status = refused & self.mask;
         }
     }
 }
