@@ -35,7 +35,18 @@ module {{ name }} (
     reg [{{ scw - 1 }}:0] sc;
     reg [{{ rw - 1 }}:0] qr;
     reg [{{ cw - 1 }}:0] qc;
+{%- if dbuf %}
+    // Double-buffered (docs/pixel-contract.md "Double buffer"): after the frame's
+    // {{ n }} pulses the sequencer holds {{ idle + 1 }} cycle(s) (the swap cycle, then the wait until
+    // the last frame's readout is done), while the readout walks the pixels beside the
+    // next frame's pulses; the swap is its first cycle.
+    reg hold;
+    reg [{{ hw - 1 }}:0] wt;
+    wire s_pulse = !rst && !hold && (ph == {{ pw }}'d0);
+    wire s_swap = !rst && ro_phase && (q == {{ qw }}'d0) && (sc == {{ scw }}'d0);
+{%- else %}
     wire s_pulse = !rst && !ro_phase && (ph == {{ pw }}'d0);
+{%- endif %}
     wire s_ro = !rst && ro_phase && (sc == {{ scw }}'d0) && (q != {{ qw }}'d{{ np }});
 {%- if mutation == "order_swap" %}
     // DELIBERATELY BROKEN: the readout order swaps its first two pixels.
@@ -50,6 +61,72 @@ module {{ name }} (
     wire [{{ r - 1 }}:0] rom_word;
     {{ rom_name }} u_rom (.addr(addr), .word(rom_word));
 {%- endif %}
+
+{%- if dbuf %}
+
+    always @(posedge clk) begin
+        if (rst) begin
+            ro_phase <= 1'b0;
+            ph <= {{ pw }}'d0;
+            pidx <= {{ nw }}'d0;
+            q <= {{ qw }}'d0;
+            sc <= {{ scw }}'d0;
+            qr <= {{ rw }}'d0;
+            qc <= {{ cw }}'d0;
+            hold <= 1'b0;
+            wt <= {{ hw }}'d0;
+{%- if fourier %}
+            addr <= {{ aw }}'d0;
+{%- endif %}
+        end else begin
+            // The readout walker.
+            if (ro_phase) begin
+                if (q == {{ qw }}'d{{ np }}) begin
+                    ro_phase <= 1'b0;
+                end else if (sc == {{ scw }}'d{{ s - 1 }}) begin
+                    sc <= {{ scw }}'d0;
+                    q <= q + {{ qw }}'d1;
+                    if (qc == {{ cw }}'d{{ cols - 1 }}) begin
+                        qc <= {{ cw }}'d0;
+                        qr <= qr + {{ rw }}'d1;
+                    end else begin
+                        qc <= qc + {{ cw }}'d1;
+                    end
+                end else begin
+                    sc <= sc + {{ scw }}'d1;
+                end
+            end
+            // The pulses; the frame's end starts the walker (it has finished: D <= the
+            // frame period), after it in the block so the restart wins.
+            if (hold) begin
+                if (wt == {{ hw }}'d0) hold <= 1'b0;
+                else wt <= wt - {{ hw }}'d1;
+            end else if (ph == {{ pw }}'d{{ c - 1 }}) begin
+                ph <= {{ pw }}'d0;
+{%- if fourier %}
+                addr <= (addr == {{ aw }}'d{{ l - 1 }}) ? {{ aw }}'d0 : addr + {{ aw }}'d1;
+{%- endif %}
+                if (pidx == {{ nw }}'d{{ n - 1 }}) begin
+                    pidx <= {{ nw }}'d0;
+                    hold <= 1'b1;
+                    wt <= {{ hw }}'d{{ idle }};
+                    ro_phase <= 1'b1;
+                    q <= {{ qw }}'d0;
+                    sc <= {{ scw }}'d0;
+                    qr <= {{ rw }}'d0;
+                    qc <= {{ cw }}'d0;
+{%- if fourier %}
+                    addr <= {{ aw }}'d0;
+{%- endif %}
+                end else begin
+                    pidx <= pidx + {{ nw }}'d1;
+                end
+            end else begin
+                ph <= ph + {{ pw }}'d1;
+            end
+        end
+    end
+{%- else %}
 
     always @(posedge clk) begin
         if (rst) begin
@@ -100,10 +177,14 @@ module {{ name }} (
             sc <= sc + {{ scw }}'d1;
         end
     end
+{%- endif %}
 
     // ---- broadcast stage 1: the root's registers ----
     reg b_pulse;
     reg b_ro;
+{%- if dbuf %}
+    reg b_swap;
+{%- endif %}
     reg [{{ rw - 1 }}:0] b_row;
     reg [{{ cw - 1 }}:0] b_col;
 {%- if fourier %}
@@ -113,6 +194,9 @@ module {{ name }} (
         if (rst) begin
             b_pulse <= 1'b0;
             b_ro <= 1'b0;
+{%- if dbuf %}
+            b_swap <= 1'b0;
+{%- endif %}
             b_row <= {{ rw }}'d0;
             b_col <= {{ cw }}'d0;
 {%- if fourier %}
@@ -121,6 +205,9 @@ module {{ name }} (
         end else begin
             b_pulse <= s_pulse;
             b_ro <= s_ro;
+{%- if dbuf %}
+            b_swap <= s_swap;
+{%- endif %}
             b_row <= s_row;
             b_col <= s_col;
 {%- if fourier %}
@@ -134,6 +221,17 @@ module {{ name }} (
     assign pulse_o = o_pulse;
     reg [{{ trows - 1 }}:0] r_pulse;
     reg [{{ trows - 1 }}:0] r_ro;
+{%- if dbuf %}
+    reg [{{ trows - 1 }}:0] r_swap;
+{%- endif %}
+{%- if mutation == "swap_late" %}
+    // DELIBERATELY BROKEN: the swap passes one extra register (the shadow a cycle late).
+    reg late_swap;
+    always @(posedge clk) begin
+        if (rst) late_swap <= 1'b0;
+        else late_swap <= b_swap;
+    end
+{%- endif %}
     reg [{{ trows * cw - 1 }}:0] r_col;
 {%- if fourier %}
     reg [{{ trows * r - 1 }}:0] r_word;
@@ -157,6 +255,9 @@ module {{ name }} (
         if (rst) begin
             r_pulse[{{ row.lr }}] <= 1'b0;
             r_ro[{{ row.lr }}] <= 1'b0;
+{%- if dbuf %}
+            r_swap[{{ row.lr }}] <= 1'b0;
+{%- endif %}
             r_col[{{ row.lr * cw }} +: {{ cw }}] <= {{ cw }}'d0;
 {%- if fourier %}
             r_word[{{ row.lr * r }} +: {{ r }}] <= {{ r }}'d0;
@@ -175,6 +276,11 @@ module {{ name }} (
             r_pulse[{{ row.lr }}] <= b_pulse;
 {%- endif %}
             r_ro[{{ row.lr }}] <= b_ro && (b_row == {{ rw }}'d{{ row.row }});
+{%- if mutation == "swap_late" %}
+            r_swap[{{ row.lr }}] <= late_swap;
+{%- else if dbuf %}
+            r_swap[{{ row.lr }}] <= b_swap;
+{%- endif %}
             r_col[{{ row.lr * cw }} +: {{ cw }}] <= b_col;
 {%- if fourier %}
 {%- if row.late %}
@@ -218,6 +324,9 @@ module {{ name }} (
         .rom_word(r_word[{{ px.lr * r }} +: {{ r }}]),
 {%- endif %}
         .readout(r_ro[{{ px.lr }}] && (r_col[{{ px.lr * cw }} +: {{ cw }}] == {{ cw }}'d{{ px.col }})),
+{%- if dbuf %}
+        .swap(r_swap[{{ px.lr }}]),
+{%- endif %}
         .ready(p_ready[{{ px.i }}]),
         .rd_valid(p_valid[{{ px.i }}]),
         .rd_index(p_index[{{ px.i * ib }} +: {{ ib }}]),

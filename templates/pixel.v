@@ -13,6 +13,9 @@ module {{ name }} (
     input  wire [{{ r - 1 }}:0] rom_word,
 {%- endif %}
     input  wire readout,
+{%- if dbuf %}
+    input  wire swap,
+{%- endif %}
     output wire ready,
     output reg  rd_valid,
     output reg  [{{ ib - 1 }}:0] rd_index,
@@ -45,18 +48,35 @@ module {{ name }} (
 {%- else %}
     reg [{{ w - 1 }}:0] y [0:{{ r - 1 }}] /*verilator public_flat_rd*/;
 {%- endif %}
+{%- if dbuf %}
+    // The shadow copy (docs/pixel-contract.md "Double buffer"): the registers and the
+    // status word as they stood at the last `swap` edge, which the readout streams while
+    // the registers accumulate the next frame. No reset: the first readout follows a swap.
+{%- for g in regs %}
+    reg [{{ w - 1 }}:0] sh_{{ g.r }};
+{%- endfor %}
+    reg [{{ w - 1 }}:0] sh_status;
+{%- endif %}
 
     // ---- accept rule ----
+{%- if dbuf %}
+    // Double-buffered: the readout reads the shadow, so it neither waits for nor blocks
+    // the pipeline, and a pulse during it is accepted.
+    wire free = !active || slot == {{ sw }}'d{{ k - 1 }};
+    assign ready = free;
+    wire accept_ro = readout;
+{%- else %}
     wire free = !rd_active && (!active || slot == {{ sw }}'d{{ k - 1 }});
     assign ready = free;
     wire accept_ro = readout && free;
+{%- endif %}
 {%- if fourier %}
-    wire accept_pulse = pulse && free && !readout;
+    wire accept_pulse = pulse && free{% if !dbuf %} && !readout{% endif %};
 {%- else %}
 {%- if mutation == "haar_frame_limit" %}
-    wire accept_pulse = pulse && free && !readout;
+    wire accept_pulse = pulse && free{% if !dbuf %} && !readout{% endif %};
 {%- else %}
-    wire accept_pulse = pulse && free && !readout && (pcount != {{ ln + 1 }}'d{{ n }});
+    wire accept_pulse = pulse && free{% if !dbuf %} && !readout{% endif %} && (pcount != {{ ln + 1 }}'d{{ n }});
 {%- endif %}
 {%- endif %}
     wire refuse = pulse && !accept_pulse;
@@ -182,7 +202,10 @@ module {{ name }} (
     // ---- register writes: accumulate (slot's adder) or readout clear ----
     wire [{{ r - 1 }}:0] we_c;
 {%- for g in regs %}
-{%- if mutation == "readout_clear" %}
+{%- if dbuf %}
+    // Double-buffered: the swap clears the register (it was copied to the shadow).
+    assign we_c[{{ g.r }}] = (active && acc_en && {{ g.sel }}) || swap;
+{%- else if mutation == "readout_clear" %}
     assign we_c[{{ g.r }}] = active && acc_en && {{ g.sel }};
 {%- else if mutation == "enable_decode" %}
     assign we_c[{{ g.r }}] = (active && {{ g.sel }}) || (rd_active && rd_ptr == {{ ib }}'d{{ g.r }});
@@ -190,7 +213,7 @@ module {{ name }} (
     assign we_c[{{ g.r }}] = (active && acc_en && {{ g.sel }}) || (rd_active && rd_ptr == {{ ib }}'d{{ g.r }});
 {%- endif %}
 {%- if !latch || mutation == "schedule_late" %}
-    wire [{{ w - 1 }}:0] wval_{{ g.r }} = rd_active ? {{ w }}'d0 : sum_{{ g.adder }};
+    wire [{{ w - 1 }}:0] wval_{{ g.r }} = {% if dbuf %}swap{% else %}rd_active{% endif %} ? {{ w }}'d0 : sum_{{ g.adder }};
 {%- endif %}
 {%- endfor %}
 {%- if mutation == "schedule_late" %}
@@ -249,7 +272,7 @@ module {{ name }} (
     always @(posedge clk) begin
         we_q <= we | { {{- r }}{rst}};
 {%- for ad in adders %}
-        wd_{{ ad.a }} <= (rst || rd_active) ? {{ w }}'d0 : sum_{{ ad.a }};
+        wd_{{ ad.a }} <= (rst || {% if dbuf %}swap{% else %}rd_active{% endif %}) ? {{ w }}'d0 : sum_{{ ad.a }};
 {%- endfor %}
     end
 {%- for g in regs %}
@@ -290,7 +313,7 @@ module {{ name }} (
     always @* begin
         case (rd_ptr)
 {%- for g in regs %}
-            {{ ib }}'d{{ g.r }}: rd_mux = y[{{ g.r }}];
+            {{ ib }}'d{{ g.r }}: rd_mux = {% if dbuf %}sh_{{ g.r }}{% else %}y[{{ g.r }}]{% endif %};
 {%- endfor %}
             default: rd_mux = {{ w }}'d0;
         endcase
@@ -335,11 +358,11 @@ module {{ name }} (
 {%- if mutation == "status_word" %}
                     rd_data <= rd_mux;
 {%- else %}
-                    rd_data <= refused;
+                    rd_data <= {% if dbuf %}sh_status{% else %}refused{% endif %};
 {%- endif %}
                     rd_index <= {{ ib }}'d{{ r }};
                     rd_active <= 1'b0;
-{%- if !fourier %}
+{%- if !fourier && !dbuf %}
                     pcount <= {{ ln + 1 }}'d0;
 {%- endif %}
                 end
@@ -350,8 +373,13 @@ module {{ name }} (
                 rd_active <= 1'b1;
                 rd_ptr <= {{ ib }}'d0;
             end
+{%- if dbuf %}
+            if (swap) begin
+                refused <= {{ w }}'d0;
+{%- else %}
             if (status_edge) begin
                 refused <= { {{- w - 1 }}'d0, refuse};
+{%- endif %}
 {%- if mutation != "refused_counter" %}
             end else if (refuse && refused != {{ "{" }}{{ w }}{1'b1}}) begin
                 refused <= refused + {{ w }}'d1;
@@ -395,8 +423,24 @@ module {{ name }} (
                 active <= 1'b1;
                 slot <= {{ sw }}'d0;
             end
+{%- if dbuf && !fourier %}
+            // The next frame's pulse count starts at the swap.
+            if (swap) pcount <= {{ ln + 1 }}'d0;
+{%- endif %}
         end
     end
+{%- if dbuf %}
+
+    // ---- the swap: the registers and the status word into the shadow ----
+    always @(posedge clk) begin
+        if (swap) begin
+{%- for g in regs %}
+            sh_{{ g.r }} <= y[{{ g.r }}];
+{%- endfor %}
+            sh_status <= refused;
+        end
+    end
+{%- endif %}
 endmodule
 {%- if clock_gated || latch %}
 

@@ -16,7 +16,9 @@ pub mod model;
 pub mod output;
 pub mod plot;
 pub mod rtl;
+mod rtl_run;
 pub mod rtl_vectors;
+pub mod shadow;
 pub mod shard;
 pub mod uff;
 

@@ -5,14 +5,16 @@
 //! one rising edge; [`run`] drives frames of per-pixel detections through it and records
 //! what the array's ports show every cycle (the golden vectors of `tofprobe cosim` on an
 //! array). The array's faults ([`ArrayFault`]) are carried exactly, so the cycle where a
-//! broken RTL first differs is predicted by the model.
+//! broken RTL first differs is predicted by the model. Double-buffered (`Readout::
+//! double_buffer`), the sequencer overlaps the readout with the next frame's pulses and
+//! each pixel's readout streams its [`crate::shadow::Shadow`], loaded by the broadcast swap.
 
 use tofprobe_design::readout::ArrayTile;
 use tofprobe_design::readout::{ArrayFault, Readout};
-use tofprobe_pixel::sequencer::RESET_CYCLES;
 use tofprobe_pixel::{CycleModel, Mode, NO_DETECTION, PinsIn, PixelParams, Superpixel};
 
 use crate::error::ArrayError;
+use crate::shadow::{Shadow, sample};
 
 /// Cycles recorded after the last frame: its last beat is at most 5 cycles after the
 /// frame's end (the slot's last beat is 6 cycles after its strobe, 1 before the next).
@@ -46,8 +48,13 @@ pub struct ArrayModel {
     superpixel: Option<Superpixel>,
     /// Per pixel present, its (valid, tdc) after the superpixel (scratch of `step`).
     combined: Vec<(bool, u32)>,
-    // Root sequencer.
+    /// `[array] double_buffer`: per pixel present, its shadow and the shadow's readout
+    /// (empty when single-buffered).
+    shadows: Vec<Shadow>,
+    // Root sequencer (`hold`, `wt`: double-buffered, the hold after a frame's pulses).
     ro_phase: bool,
+    hold: bool,
+    wt: u64,
     ph: u64,
     pidx: u64,
     q: usize,
@@ -58,6 +65,7 @@ pub struct ArrayModel {
     // Broadcast stage 1.
     b_pulse: bool,
     b_ro: bool,
+    b_swap: bool,
     b_row: usize,
     b_col: usize,
     b_word: Vec<u64>,
@@ -65,6 +73,8 @@ pub struct ArrayModel {
     o_pulse: bool,
     r_pulse: Vec<bool>,
     r_ro: Vec<bool>,
+    r_swap: Vec<bool>,
+    late_swap: bool,
     r_col: Vec<usize>,
     r_word: Vec<Vec<u64>>,
     late_pulse: bool,
@@ -120,6 +130,12 @@ impl ArrayModel {
                 tile.row0, tile.rows, tile.col0, tile.cols, readout.rows, readout.cols
             )));
         }
+        if fault == Some(ArrayFault::SwapLate) && !readout.double_buffer {
+            return Err(ArrayError::Shape(
+                "the swap_late fault needs a double-buffered array (array.double_buffer = true)"
+                    .into(),
+            ));
+        }
         let fourier = p.mode == Mode::Fourier;
         let words = if fourier {
             p.registers().div_ceil(64)
@@ -151,7 +167,14 @@ impl ArrayModel {
             tile,
             superpixel: None,
             combined: vec![(false, 0); tile.pixels()],
+            shadows: if readout.double_buffer {
+                vec![Shadow::new(p.registers(), p.width); tile.pixels()]
+            } else {
+                Vec::new()
+            },
             ro_phase: false,
+            hold: false,
+            wt: 0,
             ph: 0,
             pidx: 0,
             q: 0,
@@ -161,12 +184,15 @@ impl ArrayModel {
             addr: 0,
             b_pulse: false,
             b_ro: false,
+            b_swap: false,
             b_row: 0,
             b_col: 0,
             b_word: vec![0; words],
             o_pulse: false,
             r_pulse: vec![false; rows],
             r_ro: vec![false; rows],
+            r_swap: vec![false; rows],
+            late_swap: false,
             r_col: vec![0; rows],
             r_word: vec![vec![0; words]; rows],
             late_pulse: false,
@@ -249,7 +275,11 @@ impl ArrayModel {
         let lc = self.m_col - t.col0;
         let mut m = (false, 0usize, 0u64);
         for (lr, _) in self.m_row.iter().enumerate().filter(|(_, s)| **s) {
-            let o = self.pixels[lr * t.cols + lc].outputs();
+            let i = lr * t.cols + lc;
+            let o = match self.shadows.get(i) {
+                Some(sh) => sh.outputs(true),
+                None => self.pixels[i].outputs(),
+            };
             m = (m.0 | o.rd_valid, m.1 | o.rd_index as usize, m.2 | o.rd_data);
         }
         m
@@ -301,7 +331,9 @@ impl ArrayModel {
         let npt = t.pixels();
         let (reg, k, g) = (ro.registers, ro.beats_per_word, ro.beat_cycles);
         // Root, combinational.
-        let s_pulse = !rst && !self.ro_phase && self.ph == 0;
+        let dbuf = ro.double_buffer;
+        let s_pulse = !rst && !(if dbuf { self.hold } else { self.ro_phase }) && self.ph == 0;
+        let s_swap = dbuf && !rst && self.ro_phase && self.q == 0 && self.sc == 0;
         let s_ro = !rst && self.ro_phase && self.sc == 0 && self.q != np;
         let (s_row, s_col) = match (self.fault, self.q) {
             (Some(ArrayFault::OrderSwap), 0) => ro.order(1),
@@ -328,14 +360,25 @@ impl ArrayModel {
                 Some(n) if (n + 1) % npt == i => n,
                 _ => i,
             };
+            let readout = self.r_ro[r] && self.r_col[r] == c;
+            // Double-buffered: the readout is the shadow's; the swap samples the registers
+            // before this edge and clears them after its writes.
+            let swap = dbuf && self.r_swap[r];
+            let sampled = swap.then(|| sample(px));
             px.step(&PinsIn {
                 rst,
                 pulse: self.r_pulse[r],
                 valid: self.combined[i].0,
                 tdc: self.combined[src].1,
                 rom_word: &self.r_word[r],
-                readout: self.r_ro[r] && self.r_col[r] == c,
+                readout: readout && !dbuf,
             });
+            if let Some(sh) = self.shadows.get_mut(i) {
+                if swap && !rst {
+                    px.swap_clear();
+                }
+                sh.step(rst, readout, sampled.as_ref().map(|(y, f)| (&y[..], *f)));
+            }
         }
         // The buffer (no reset) and the port.
         let beat = self.dr_act && (g == 1 || self.dg == 0);
@@ -398,12 +441,19 @@ impl ArrayModel {
                 self.r_word[lr].clone_from(&self.b_word);
             }
             self.r_ro[lr] = self.b_ro && self.b_row == t.row0 + lr;
+            self.r_swap[lr] = if self.fault == Some(ArrayFault::SwapLate) {
+                self.late_swap
+            } else {
+                self.b_swap
+            };
             self.r_col[lr] = self.b_col;
         }
         self.late_pulse = self.b_pulse;
+        self.late_swap = self.b_swap;
         self.late_word.clone_from(&self.b_word);
         // Stage 1 (from the root).
         (self.b_pulse, self.b_ro, self.b_row, self.b_col) = (s_pulse, s_ro, s_row, s_col);
+        self.b_swap = s_swap;
         self.b_word = rom_word;
         self.sequencer_edge();
         out
@@ -411,8 +461,10 @@ impl ArrayModel {
 
     /// The root sequencer's edge (not in reset).
     fn sequencer_edge(&mut self) {
+        if self.ro.double_buffer {
+            return self.sequencer_edge_double();
+        }
         let ro = self.ro;
-        let np = ro.pixels();
         if !self.ro_phase {
             if self.ph == ro.cycles_per_pulse - 1 {
                 self.ph = 0;
@@ -427,7 +479,47 @@ impl ArrayModel {
             } else {
                 self.ph += 1;
             }
-        } else if self.q == np {
+        } else {
+            self.walker_edge();
+        }
+    }
+
+    /// The double-buffered sequencer's edge: the readout walker beside the pulses; the
+    /// frame's end (after its N pulses) starts the walker — which has finished, D being at
+    /// most the frame period — and holds the pulses for max(N·C + 1, D) − N·C cycles.
+    fn sequencer_edge_double(&mut self) {
+        let ro = self.ro;
+        if self.ro_phase {
+            self.walker_edge();
+        }
+        if self.hold {
+            if self.wt == 0 {
+                self.hold = false;
+            } else {
+                self.wt -= 1;
+            }
+        } else if self.ph == ro.cycles_per_pulse - 1 {
+            self.ph = 0;
+            self.addr = (self.addr + 1) % self.rom_depth;
+            if self.pidx == ro.frame_pulses - 1 {
+                self.pidx = 0;
+                self.hold = true;
+                self.wt = ro.frame_cycles() - ro.accumulate_cycles() - 1;
+                self.ro_phase = true;
+                (self.q, self.sc, self.qr, self.qc, self.addr) = (0, 0, 0, 0, 0);
+            } else {
+                self.pidx += 1;
+            }
+        } else {
+            self.ph += 1;
+        }
+    }
+
+    /// The readout walker's edge during the readout phase: a slot of S cycles per pixel,
+    /// row-major, then the phase's last cycle.
+    fn walker_edge(&mut self) {
+        let ro = self.ro;
+        if self.q == ro.pixels() {
             self.ro_phase = false;
         } else if self.sc == ro.slot_cycles() - 1 {
             self.sc = 0;
@@ -446,6 +538,8 @@ impl ArrayModel {
     fn reset_registers(&mut self) {
         let words = self.words;
         (self.ro_phase, self.ph, self.pidx, self.q, self.sc) = (false, 0, 0, 0, 0);
+        (self.hold, self.wt, self.b_swap, self.late_swap) = (false, 0, false, false);
+        self.r_swap.fill(false);
         (self.qr, self.qc, self.addr) = (0, 0, 0);
         (self.b_pulse, self.b_ro, self.b_row, self.b_col) = (false, false, 0, 0);
         self.b_word = vec![0; words];
@@ -465,177 +559,4 @@ impl ArrayModel {
     }
 }
 
-/// What the array's ports showed over a run, cycle by cycle.
-#[derive(Debug, Clone)]
-pub struct ArrayRun {
-    /// The readout followed.
-    pub readout: Readout,
-    /// G: SPADs per pixel side (the inputs are the pixels' × G²).
-    pub superpixel: usize,
-    /// Frames run.
-    pub frames: u64,
-    /// The outputs of every cycle.
-    pub pins: Vec<ArrayPins>,
-    /// Per `pulse_o` cycle (in order): the cycle.
-    pub pulse_cycles: Vec<u64>,
-    /// The readout positions of the pixels present (all of them unless a tile), in order.
-    pub positions: Vec<usize>,
-    /// Per frame, per pixel present (readout order: `positions`), the R + 1 words the
-    /// stream carried (raw W bits, reassembled from the beats).
-    pub words: Vec<Vec<Vec<u64>>>,
-}
-
-/// A frame's period in cycles and the cycles before the first frame.
-fn frame_start(ro: &Readout, frame: u64) -> u64 {
-    RESET_CYCLES + frame * ro.frame_cycles()
-}
-
-impl ArrayRun {
-    /// The cycles run.
-    pub fn cycles(&self) -> u64 {
-        self.pins.len() as u64
-    }
-
-    /// The cycle of beat (frame, q, word, part) by the contract's formula.
-    pub fn beat_cycle(&self, frame: u64, q: usize, word: usize, part: usize) -> u64 {
-        let ro = &self.readout;
-        frame_start(ro, frame) + ro.accumulate_cycles() + ro.beat_offset(q, word, part)
-    }
-
-    /// Says what the array was doing at `cycle`, in the contract's terms: the beat on the
-    /// port (pixel (r, c), register or status word, part, frame and its pulses), or the
-    /// pulse being presented, or the phase.
-    pub fn explain(&self, cycle: u64) -> String {
-        let ro = &self.readout;
-        let f = ro.frame_cycles();
-        let n = ro.frame_pulses;
-        let frame_of = |c: u64| c.saturating_sub(RESET_CYCLES) / f;
-        if cycle < RESET_CYCLES {
-            return format!("cycle {cycle}: reset");
-        }
-        // The beat whose slot holds this cycle (the latest beat at or before it).
-        for fr in (0..=frame_of(cycle)).rev().take(2) {
-            let base = frame_start(ro, fr) + ro.accumulate_cycles() + ro.beat_offset(0, 0, 0);
-            if cycle < base {
-                continue;
-            }
-            let idx = (cycle - base) / ro.beat_cycles;
-            if idx < ro.beats_per_frame() && fr < self.frames {
-                let b = ro.beat(idx);
-                let word = if b.word == ro.registers {
-                    "status word (refused pulses)".to_string()
-                } else {
-                    format!("register {}", b.word)
-                };
-                return format!(
-                    "cycle {cycle}: frame {fr}'s readout, pixel ({}, {}) (position {} of the order), \
-                     {word}, beat {} of {}; its frame is pulses {}..{}",
-                    b.row,
-                    b.col,
-                    b.position,
-                    b.part,
-                    ro.beats_per_word,
-                    fr * n,
-                    fr * n + n - 1
-                );
-            }
-        }
-        let fr = frame_of(cycle);
-        let within = cycle - frame_start(ro, fr);
-        let lat = tofprobe_design::readout::BROADCAST_LATENCY;
-        if within >= lat && within < ro.accumulate_cycles() + lat {
-            // The pulse the pixels are working on: presented `lat` cycles after the sequencer's.
-            let k = (within - lat) / ro.cycles_per_pulse;
-            let pulse = fr * n + k;
-            format!(
-                "cycle {cycle}: frame {fr}, pulse {pulse} (presented to the pixels at cycle {}, \
-                 slot {} of its {} cycles)",
-                frame_start(ro, fr) + lat + k * ro.cycles_per_pulse,
-                (within - lat) % ro.cycles_per_pulse,
-                ro.cycles_per_pulse
-            )
-        } else {
-            format!("cycle {cycle}: frame {fr}'s readout phase")
-        }
-    }
-}
-
-/// Runs `frames` frames: reset, then every cycle the detections of the pulse the pixels
-/// sample (`detections[i]` is input i's — pixel i's, row-major over the pixels present, or
-/// with G > 1 SPAD i's, row-major over their SPAD grid — one per pulse of the run; pulses
-/// beyond present no detection).
-pub fn run(
-    model: &mut ArrayModel,
-    detections: &[Vec<Option<u32>>],
-    frames: u64,
-) -> Result<ArrayRun, ArrayError> {
-    let ro = *model.readout();
-    let tile = model.present();
-    let np = model.inputs();
-    if detections.len() != np {
-        return Err(ArrayError::Shape(format!(
-            "{} inputs' detections for the {} × {} pixels present of {g} × {g} SPADs ({np})",
-            detections.len(),
-            tile.rows,
-            tile.cols,
-            g = model.superpixel()
-        )));
-    }
-    let total = frame_start(&ro, frames) + TAIL_CYCLES;
-    let mut pins = Vec::with_capacity(total as usize);
-    let mut pulse_cycles = Vec::new();
-    let (mut valid, mut tdc) = (vec![false; np], vec![0u32; np]);
-    for cycle in 0..total {
-        let rst = cycle < RESET_CYCLES;
-        let pulse_o = model.outputs().pulse_o;
-        let n = pulse_cycles.len();
-        for i in 0..np {
-            let d = if pulse_o {
-                detections[i].get(n).copied().flatten()
-            } else {
-                None
-            };
-            (valid[i], tdc[i]) = (d.is_some(), d.unwrap_or(0));
-        }
-        if pulse_o {
-            pulse_cycles.push(cycle);
-        }
-        pins.push(model.step(rst, &valid, &tdc));
-    }
-    let positions: Vec<usize> = (0..ro.pixels())
-        .filter(|&q| {
-            let (r, c) = ro.order(q);
-            tile.contains(r, c)
-        })
-        .collect();
-    let mut run = ArrayRun {
-        readout: ro,
-        superpixel: model.superpixel(),
-        frames,
-        pins,
-        pulse_cycles,
-        positions,
-        words: Vec::new(),
-    };
-    run.words = (0..frames)
-        .map(|fr| {
-            run.positions
-                .iter()
-                .map(|&q| {
-                    (0..ro.words_per_pixel())
-                        .map(|j| {
-                            let beats: Vec<u64> = (0..ro.beats_per_word)
-                                .map(|m| {
-                                    let c = run.beat_cycle(fr, q, j, m) as usize;
-                                    run.pins.get(c).map(|p| p.ro_data).unwrap_or(0)
-                                })
-                                .collect();
-                            ro.word_of(&beats)
-                        })
-                        .collect()
-                })
-                .collect()
-        })
-        .collect();
-    Ok(run)
-}
+pub use crate::rtl_run::{ArrayRun, run};

@@ -129,6 +129,7 @@ impl Chip {
             fault,
             tile,
             superpixel: self.superpixel as u32,
+            double_buffer: r.double_buffer,
         })
     }
 

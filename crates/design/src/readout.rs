@@ -119,6 +119,15 @@ impl Readout {
             ));
         }
         let c = pixel.cycles_per_pulse as u64;
+        if keys.double_buffer && pixel.cycles_per_pulse <= pixel.slots() {
+            return Err(format!(
+                "array.double_buffer = true needs pixel.cycles_per_pulse > {k} (the slots per \
+                 pulse; it is {c}): the swap edge must follow the last pulse's last register \
+                 write; cycles_per_pulse = {} works",
+                pixel.slots() + 1,
+                k = pixel.slots()
+            ));
+        }
         let clock_hz = c as f64 * laser_rate_hz;
         let port = f64::from(b) * clock_hz;
         let beat_cycles = match keys.readout_bits_per_s {

@@ -1,9 +1,11 @@
 //! Two options of the array's pixel, sized for `tofprobe size` (issue 27 points 1 and 7):
 //!
 //! - **The double buffer** (`[array] double_buffer`): a shadow copy of the R·W register
-//!   bits, loaded on the frame's swap while the next frame accumulates, read out instead of
-//!   the live registers. Its area is an *estimate* from the synthesised pixel's register-file
-//!   split (`tofprobe_eda::split`): R·W flops at the register file's own area per flop (the
+//!   bits and the W-bit status word, loaded on the frame's swap while the next frame
+//!   accumulates, read out instead of the live registers (rendered by `templates/pixel.v`
+//!   and co-simulated: docs/pixel-contract.md "Double buffer"). Its area here is an
+//!   *estimate*, not a synthesis of that RTL, from the synthesised pixel's register-file
+//!   split (`tofprobe_eda::split`): (R+1)·W flops at the register file's own area per flop (the
 //!   flop and its private write-enable logic, as the shadow's load enable is), beside the
 //!   bare flops at the liberty's smallest flop. The readout's select multiplexer reads the
 //!   shadow instead of the live registers: it moves, it is not added. Reported for every
@@ -32,9 +34,9 @@ pub struct DoubleBufferArea {
     pub register_file_um2: f64,
     /// Its flops.
     pub register_file_flops: u64,
-    /// The shadow copy: R·W flops × the register file's area per flop (µm², estimate).
+    /// The shadow copy: (R+1)·W flops × the register file's area per flop (µm², estimate).
     pub shadow_um2: f64,
-    /// The shadow's bare flops: R·W × the liberty's smallest flop (µm², a lower bound).
+    /// The shadow's bare flops: (R+1)·W × the liberty's smallest flop (µm², a lower bound).
     pub shadow_flops_only_um2: Option<f64>,
     /// The pixel's cell area without the shadow (µm²).
     pub pixel_um2: f64,
@@ -51,7 +53,7 @@ pub struct DoubleBufferArea {
 pub struct DoubleBuffer {
     /// Whether `[array] double_buffer` is on (the frame period is then max(N·C + 1, D)).
     pub enabled: bool,
-    /// Shadow bits per pixel: R·W.
+    /// Shadow bits per pixel: (R+1)·W (the registers and the status word).
     pub shadow_bits_per_pixel: u64,
     /// Per library.
     pub areas: Vec<DoubleBufferArea>,
@@ -59,8 +61,9 @@ pub struct DoubleBuffer {
     pub basis: String,
 }
 
-/// The double buffer of an array of `pixels` pixels of `registers` × `width` bits, from
-/// each library's synthesised pixel (`libs`) and the array's totals there.
+/// The double buffer of an array of `pixels` pixels of `registers` × `width` bits (the
+/// shadow holds them and the status word), from each library's synthesised pixel (`libs`)
+/// and the array's totals there.
 pub fn double_buffer(
     enabled: bool,
     registers: u64,
@@ -69,7 +72,7 @@ pub fn double_buffer(
     libs: &[&AreaSection],
     totals: &[ArrayTotal],
 ) -> DoubleBuffer {
-    let bits = registers * u64::from(width);
+    let bits = (registers + 1) * u64::from(width);
     let areas = libs
         .iter()
         .map(|a| {
@@ -103,10 +106,12 @@ pub fn double_buffer(
         enabled,
         shadow_bits_per_pixel: bits,
         areas,
-        basis: "estimate: R·W shadow flops at the synthesised register file's area per flop \
-                (flop + private write enable, as the shadow's load enable), from the pixel's \
+        basis: "estimate (not a synthesis of the rendered shadow): (R+1)·W shadow flops — the \
+                registers and the status word, as templates/pixel.v renders them with \
+                double_buffer — at the synthesised register file's area per flop (flop + \
+                private write enable, as the shadow's load enable), from the pixel's \
                 register-file split on the same liberty; the readout select moves to the \
-                shadow (not added); the RTL renders the plain registers"
+                shadow and the swap's clear reuses the registers' write path (neither added)"
             .into(),
     }
 }
@@ -233,7 +238,7 @@ pub fn libraries(size: &SizeReport) -> Vec<&AreaSection> {
 pub fn markdown(db: &DoubleBuffer, sp: Option<&SuperpixelSize>) -> String {
     let mut m = format!(
         "\n### Double buffer ({}): a shadow copy of the registers\n\n\
-         {} shadow bits per pixel (R·W). Area: {}.\n\n\
+         {} shadow bits per pixel ((R+1)·W: the registers and the status word). Area: {}.\n\n\
          | library | register file (µm², flops) | shadow (µm², estimate) | bare flops (µm²) | pixel without → with (µm²) | array without → with (mm²) |\n|---|---|---|---|---|---|\n",
         if db.enabled { "on" } else { "off" },
         db.shadow_bits_per_pixel,

@@ -240,6 +240,7 @@ fn time_on(
         fault: None,
         tile: None,
         superpixel: 1,
+        double_buffer: false,
     };
     // The ROM's contents do not reach the top's logic (a black box): render a 1-entry one.
     let mut p1 = p.clone();

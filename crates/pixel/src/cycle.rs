@@ -196,6 +196,17 @@ impl CycleModel {
         self.refused
     }
 
+    /// The double-buffered array's swap, after this edge's [`CycleModel::step`] (docs/
+    /// pixel-contract.md "Double buffer"): the registers, the refused-pulse counter and
+    /// the Haar pulse count clear, winning over any write of the same edge, as the RTL's
+    /// swap does. The caller copies [`CycleModel::registers`] and [`CycleModel::refused`]
+    /// into the shadow *before* that step (the values the swap edge samples).
+    pub fn swap_clear(&mut self) {
+        self.y.fill(0);
+        self.refused = 0;
+        self.pcount = 0;
+    }
+
     /// Whether the accumulate pipeline is working on a pulse.
     pub fn busy(&self) -> bool {
         self.active || self.rd_active

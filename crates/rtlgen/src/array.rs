@@ -9,7 +9,7 @@ use tofprobe_pixel::{Mode, PixelParams};
 
 use crate::error::RtlError;
 use crate::naming::clog2;
-use crate::render::{RenderOptions, RtlFile, header, render};
+use crate::render::{RenderOptions, RtlFile, header, render_set};
 
 /// A deliberate fault of the array, for the mutation tests only.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -34,6 +34,10 @@ pub enum ArrayFault {
         /// The stuck row.
         row: usize,
     },
+    /// Double-buffered arrays only: the swap strobe passes one extra register, so every
+    /// pixel's shadow copy is taken a cycle late (after the first readout has begun and
+    /// together with the next frame's first pulse).
+    SwapLate,
 }
 
 impl ArrayFault {
@@ -44,6 +48,7 @@ impl ArrayFault {
             ArrayFault::NeighbourTdc { .. } => "neighbour_tdc",
             ArrayFault::OrderSwap => "order_swap",
             ArrayFault::RowStuck { .. } => "row_stuck",
+            ArrayFault::SwapLate => "swap_late",
         }
     }
 }
@@ -72,6 +77,10 @@ pub struct ArraySpec {
     /// the array's `valid`/`tdc` are per SPAD (row-major over the SPAD grid of the pixels
     /// rendered) and each pixel is fed through one `<prefix>_superpixel` averaging module.
     pub superpixel: u32,
+    /// `[array] double_buffer`: each pixel's shadow registers, loaded by a broadcast
+    /// `swap` at the frame's end, are what the readout streams while the next frame
+    /// accumulates (docs/pixel-contract.md "Double buffer").
+    pub double_buffer: bool,
 }
 
 /// A rectangle of an array's pixels: the part of an array too large to co-simulate whole
@@ -208,6 +217,11 @@ struct ArrayT<'a> {
     nin: usize,
     /// SPAD columns of the rendered grid (tcols · G).
     scols: usize,
+    dbuf: bool,
+    /// Double-buffered: the hold after the frame's pulses beyond its swap cycle,
+    /// max(D − N·C − 1, 0) cycles, and its counter's width.
+    idle: u64,
+    hw: usize,
 }
 
 /// The array module's name for a module prefix.
@@ -326,6 +340,13 @@ pub fn render_array(
                 format!("{}..{}", tile.row0, tile.row0 + tile.rows),
             ));
         }
+        Some(ArrayFault::SwapLate) if !a.double_buffer => {
+            return Err(bad(
+                "mutation",
+                "swap_late".into(),
+                "a double-buffered array (array.double_buffer = true)".into(),
+            ));
+        }
         Some(ArrayFault::NeighbourTdc { row, col }) if !tile.contains(row, col) || npt < 2 => {
             return Err(bad(
                 "mutation pixel",
@@ -338,8 +359,20 @@ pub fn render_array(
         }
         _ => {}
     }
-    // The pixel and the ROM exactly as the single pixel's set has them.
-    let mut files: Vec<RtlFile> = render(p, rom, o)?
+    if a.double_buffer && p.cycles_per_pulse <= p.slots() {
+        return Err(bad(
+            "pixel.cycles_per_pulse",
+            p.cycles_per_pulse.to_string(),
+            format!(
+                "more than the {} slot(s) per pulse with array.double_buffer (the swap edge \
+                 must follow the last pulse's last register write)",
+                p.slots()
+            ),
+        ));
+    }
+    // The pixel and the ROM exactly as the single pixel's set has them (the pixel with its
+    // shadow registers when double-buffered).
+    let mut files: Vec<RtlFile> = render_set(p, rom, o, a.double_buffer)?
         .into_iter()
         .filter(|f| f.template != "top.v")
         .collect();
@@ -436,6 +469,17 @@ pub fn render_array(
             crate::superpixel::module_name(&o.module_prefix)
         ));
     }
+    // D = P·S + 1; double-buffered, the frame is max(N·C + 1, D) cycles.
+    let d = (np as u64).saturating_mul(a.slot_cycles).saturating_add(1);
+    let acc = p.frame_pulses.saturating_mul(p.cycles_per_pulse as u64);
+    let idle = d.saturating_sub(acc + 1);
+    if a.double_buffer {
+        h.push_str(&format!(
+            "\n// Double-buffered: the readout streams each pixel's shadow while the next frame \
+             accumulates; a frame is max(N·C + 1, D) = {} cycles (docs/pixel-contract.md \"Double buffer\").",
+            (acc + 1).max(d)
+        ));
+    }
     if let Some(f) = a.fault {
         h.push_str(&format!(
             "\n// DELIBERATELY BROKEN ({}: {f:?}) for the array mutation tests.",
@@ -502,6 +546,9 @@ pub fn render_array(
         sp_name: crate::superpixel::module_name(&o.module_prefix),
         nin: npt * g * g,
         scols,
+        dbuf: a.double_buffer,
+        idle,
+        hw: clog2(idle + 1) as usize,
     };
     if let Some(sp) = &sp {
         files.push(crate::superpixel::render_superpixel(p, sp, o)?);

@@ -198,6 +198,9 @@ struct PixelT<'a> {
     /// clock gate per register (on the inverted clock) from the words captured at the edge.
     latch: bool,
     mutation: &'a str,
+    /// The array's double buffer: a shadow copy of the registers and the status word,
+    /// loaded on `swap`, which the readout reads (docs/pixel-contract.md "Double buffer").
+    dbuf: bool,
 }
 
 #[derive(Template)]
@@ -355,6 +358,18 @@ fn schedule(p: &PixelParams, sw: u32) -> (Vec<Adder>, Vec<Reg>) {
 /// Renders every file of the configuration. `rom` is the ROM image (`ceil(R/64)` words per
 /// address, L addresses; ignored in Haar mode).
 pub fn render(p: &PixelParams, rom: &[u64], o: &RenderOptions) -> Result<Vec<RtlFile>, RtlError> {
+    render_set(p, rom, o, false)
+}
+
+/// [`render`], the pixel with its shadow registers when `double_buffer` (the array's
+/// `[array] double_buffer`: docs/pixel-contract.md "Double buffer"); `false` renders the
+/// single pixel's files byte for byte.
+pub(crate) fn render_set(
+    p: &PixelParams,
+    rom: &[u64],
+    o: &RenderOptions,
+    double_buffer: bool,
+) -> Result<Vec<RtlFile>, RtlError> {
     p.validate()?;
     validate_identifier("module_prefix", &o.module_prefix)?;
     let (pixel_name, rom_name, top_name) = module_names(&o.module_prefix);
@@ -373,7 +388,12 @@ pub fn render(p: &PixelParams, rom: &[u64], o: &RenderOptions) -> Result<Vec<Rtl
     let (adders, regs) = schedule(p, sw);
     let mut files = Vec::new();
     let pixel = PixelT {
-        header: header(p, "pixel.v", o),
+        header: if double_buffer {
+            header(p, "pixel.v", o)
+                + "\n// Double-buffered ([array] double_buffer): shadow registers loaded on `swap`."
+        } else {
+            header(p, "pixel.v", o)
+        },
         name: &pixel_name,
         fourier,
         t: p.tdc_bits,
@@ -406,6 +426,7 @@ pub fn render(p: &PixelParams, rom: &[u64], o: &RenderOptions) -> Result<Vec<Rtl
         clock_gated: p.register_file == RegisterFile::ClockGated,
         latch: p.register_file == RegisterFile::Latch,
         mutation: o.mutation.map(Fault::name).unwrap_or(""),
+        dbuf: double_buffer,
     };
     files.push(RtlFile {
         name: format!("{pixel_name}.v"),

@@ -3,6 +3,7 @@
 
 mod common;
 mod determinism;
+mod double_buffer;
 mod rtl;
 mod shard;
 mod superpixel;

@@ -60,7 +60,7 @@ pub fn detections(p: &PixelParams, np: usize, pulses: u64, seed: u64) -> Vec<Vec
 
 /// One pixel driven alone by the pixel contract's reference sequence (N pulses every C
 /// cycles, the readout strobe, R + 1 idle cycles): its R + 1 readout words per frame.
-fn pixel_alone(p: &PixelParams, rom: &[u64], d: &[Option<u32>], frames: u64) -> Vec<Vec<u64>> {
+pub fn pixel_alone(p: &PixelParams, rom: &[u64], d: &[Option<u32>], frames: u64) -> Vec<Vec<u64>> {
     let mut m = CycleModel::new(p).unwrap();
     let idle = PinsIn::default();
     let mut out = Vec::new();
@@ -111,7 +111,7 @@ fn pixel_alone(p: &PixelParams, rom: &[u64], d: &[Option<u32>], frames: u64) -> 
     out
 }
 
-fn readout(
+pub fn readout(
     p: &PixelParams,
     rows: usize,
     cols: usize,

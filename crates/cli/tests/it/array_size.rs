@@ -135,14 +135,18 @@ fn a_three_by_five_array_is_sized_against_the_readout_contract() {
     double_buffer_is_the_register_file_again(&v, 15.0, false);
 }
 
-/// The double buffer's shadow (reported whether the option is on or off): R·W flops — the synthesised
-/// register file holds exactly that many — at the file's own area per flop, added to every
-/// pixel and to the array's total.
+/// The double buffer's shadow (reported whether the option is on or off): (R+1)·W flops —
+/// the registers, which the synthesised register file holds exactly, and the status word —
+/// at the file's own area per flop, added to every pixel and to the array's total.
 fn double_buffer_is_the_register_file_again(v: &serde_json::Value, pixels: f64, enabled: bool) {
     let db = &v["array"]["double_buffer"];
     assert_eq!(db["enabled"], enabled);
-    let bits = num(v, &["design", "registers"]) * num(v, &["design", "width"]);
-    assert_eq!(num(db, &["shadow_bits_per_pixel"]), bits);
+    let (r, w) = (
+        num(v, &["design", "registers"]),
+        num(v, &["design", "width"]),
+    );
+    let bits = r * w;
+    assert_eq!(num(db, &["shadow_bits_per_pixel"]), (r + 1.0) * w);
     let a = &db["areas"][0];
     let rf = &v["area"]["split"]["register_file"];
     assert_eq!(
@@ -151,10 +155,11 @@ fn double_buffer_is_the_register_file_again(v: &serde_json::Value, pixels: f64, 
         "R·W flops in the file"
     );
     assert_eq!(num(rf, &["flops"]), bits);
-    let shadow = num(rf, &["area_um2"]);
+    // The file's area per flop, times (R+1)·W.
+    let shadow = num(rf, &["area_um2"]) * (r + 1.0) / r;
     assert!((num(a, &["shadow_um2"]) - shadow).abs() < 1e-6 * shadow);
     let flop = v["area"]["smallest_flop"][1].as_f64().expect("a flop");
-    assert!((num(a, &["shadow_flops_only_um2"]) - bits * flop).abs() < 1e-6);
+    assert!((num(a, &["shadow_flops_only_um2"]) - (r + 1.0) * w * flop).abs() < 1e-6);
     assert!(num(a, &["shadow_flops_only_um2"]) < num(a, &["shadow_um2"]));
     let pixel = num(v, &["area", "total_area_um2"]);
     assert!((num(a, &["pixel_with_um2"]) - (pixel + shadow)).abs() < 1e-6);

@@ -184,3 +184,29 @@ fn the_document_resolution_checks_the_readout() {
     assert!(single.readout().unwrap().is_none());
     let _ = DEFAULT_ORIGIN;
 }
+
+/// Double-buffered, the swap edge must come after the last pulse's last register write:
+/// a pixel at C = K is refused naming both
+/// keys and the C that works; C = K + 1 is accepted.
+#[test]
+fn a_double_buffer_needs_more_cycles_than_slots() {
+    let mut p = pixel(64);
+    let k = p.slots();
+    p.cycles_per_pulse = k;
+    p.validate().unwrap();
+    let db = ReadoutKeys {
+        double_buffer: true,
+        ..keys(None, None, None)
+    };
+    let e = Readout::new(&db, 2, 2, &p, LASER).unwrap_err();
+    assert!(
+        e.contains("array.double_buffer = true")
+            && e.contains(&format!("pixel.cycles_per_pulse > {k}"))
+            && e.contains(&format!("cycles_per_pulse = {} works", k + 1)),
+        "{e}"
+    );
+    // Single-buffered the same pixel is fine; C = K + 1 is fine double-buffered.
+    assert!(Readout::new(&keys(None, None, None), 2, 2, &p, LASER).is_ok());
+    p.cycles_per_pulse = k + 1;
+    assert!(Readout::new(&db, 2, 2, &p, LASER).unwrap().double_buffer);
+}

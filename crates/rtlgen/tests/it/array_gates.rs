@@ -2,8 +2,9 @@
 //! zero warnings, `iverilog -g2005 -Wall` compiles, yosys `synth` with no latch and no
 //! warning beyond the pixel's register-file note, for a 2 × 2 Fourier array on a one-word
 //! port, a 3 × 5 Haar array on a 5-bit port (3 beats per word), a 2 × 3 array with beats
-//! 3 cycles apart, superpixel arrays (G = 2, and a tile at G = 3) and each array mutant;
-//! and the renderer's refusals.
+//! 3 cycles apart, superpixel arrays (G = 2, and a tile at G = 3), double-buffered arrays
+//! (Fourier, Haar: the synthesised shadow is (R+1)·W flops per pixel) and each array
+//! mutant; and the renderer's refusals.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -47,6 +48,7 @@ fn spec(p: &PixelParams, rows: usize, cols: usize, bits: u32, g: u64) -> ArraySp
         fault: None,
         tile: None,
         superpixel: 1,
+        double_buffer: false,
     }
 }
 
@@ -104,6 +106,28 @@ fn configs() -> Vec<(String, PixelParams, ArraySpec)> {
             },
         ),
     ];
+    // Double-buffered (the shadow registers and the swap): Fourier, and Haar at C = 4 (the
+    // swap needs C above its 3 slots), and the shadow taken a cycle late.
+    let mut h4 = h.clone();
+    h4.cycles_per_pulse = 4;
+    let db = |s: ArraySpec| ArraySpec {
+        double_buffer: true,
+        ..s
+    };
+    v.push(("2x2-dbuf".to_string(), f.clone(), db(spec(&f, 2, 2, 24, 1))));
+    v.push((
+        "3x5-haar-dbuf-k3".to_string(),
+        h4.clone(),
+        db(spec(&h4, 3, 5, 5, 1)),
+    ));
+    v.push((
+        "2x2-dbuf-swap_late".to_string(),
+        f.clone(),
+        ArraySpec {
+            fault: Some(ArrayFault::SwapLate),
+            ..db(spec(&f, 2, 2, 24, 1))
+        },
+    ));
     for fault in [
         ArrayFault::RowLate { row: 1 },
         ArrayFault::NeighbourTdc { row: 0, col: 1 },
@@ -144,6 +168,7 @@ fn top() -> String {
 #[test]
 fn array_lint_iverilog_and_yosys_are_clean() {
     let (v, i, y) = (have("verilator"), have("iverilog"), have("yosys"));
+    let mut flops = std::collections::HashMap::new();
     for (name, p, s) in configs() {
         let (dir, sources) = render_to(&name, &p, &s);
         if v {
@@ -199,7 +224,8 @@ fn array_lint_iverilog_and_yosys_are_clean() {
                     "{name}: {line}"
                 );
             }
-            // Every pixel's register file survives: at least R·C·registers·W flip-flops.
+            // Every pixel's register file survives: at least R·C·registers·W flip-flops,
+            // twice that double-buffered (the shadow is kept: the readout reads it).
             let stat = std::fs::read_to_string(dir.join("stat.txt")).unwrap();
             let dff: u64 = stat
                 .lines()
@@ -209,10 +235,26 @@ fn array_lint_iverilog_and_yosys_are_clean() {
                 .filter_map(|l| l.split_whitespace().last()?.parse::<u64>().ok())
                 .sum();
             let present = s.tile.map_or(s.rows * s.cols, |t| t.pixels());
-            let need = (present * p.registers()) as u64 * u64::from(p.width);
+            let copies = if s.double_buffer { 2 } else { 1 };
+            let need = (copies * present * p.registers()) as u64 * u64::from(p.width);
             assert!(dff >= need, "{name}: {dff} flip-flops < {need}");
+            flops.insert(name.clone(), (dff, p.registers(), p.width));
         }
         let _ = std::fs::remove_dir_all(&dir);
+    }
+    // The rendered shadow costs what the size report's estimate counts: (R+1)·W flops per
+    // pixel (the registers and the status word), plus the array's swap broadcast and hold
+    // (b_swap, one r_swap per row, `hold` and its 1-bit `wt` here: at most 5 flops). The
+    // summed `stat` lists the pixel module once, the array module's own flops, and the
+    // hierarchy's total (P pixels and the array's own again): the shadow shows (1 + P)
+    // times, the array's part twice.
+    if let (Some(&(single, r, w)), Some(&(double, ..))) = (flops.get("2x2"), flops.get("2x2-dbuf"))
+    {
+        let shadow = (1 + 4) * (r as u64 + 1) * u64::from(w);
+        assert!(
+            (shadow..=shadow + 2 * 5).contains(&(double - single)),
+            "{double} - {single} flops is not 5 × (R+1)·W = {shadow} (+ ≤ 2 × 5)"
+        );
     }
 }
 
@@ -280,6 +322,13 @@ fn bad_array_specs_are_refused() {
             },
             "array.superpixel = 5",
         ),
+        (
+            ArraySpec {
+                fault: Some(ArrayFault::SwapLate),
+                ..spec(&p, 2, 2, 24, 1)
+            },
+            "mutation = swap_late",
+        ),
     ];
     for (s, want) in cases {
         let e = render_array(&p, &rom, &o, &s).unwrap_err();
@@ -288,4 +337,52 @@ fn bad_array_specs_are_refused() {
             "{e}"
         );
     }
+    // Double-buffered with C = K: the swap edge would meet the last slot's write.
+    let mut pk = p.clone();
+    pk.cycles_per_pulse = pk.slots();
+    let s = ArraySpec {
+        double_buffer: true,
+        ..spec(&pk, 2, 2, 24, 1)
+    };
+    let e = render_array(&pk, &sign_probe_rom(&pk), &o, &s).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains(&format!("pixel.cycles_per_pulse = {}", pk.slots())),
+        "{e}"
+    );
+}
+
+/// Double-buffer off renders the pixel and the array byte for byte as before the option
+/// existed (the committed testbench/array-2x2 is the check of record:
+/// scripts/check-generated.sh); on, the pixel gains the `swap` port and the shadow, and
+/// the array the swap broadcast, and nothing else changes in the pixel's file header but
+/// its double-buffer line.
+#[test]
+fn the_double_buffer_is_rendered_only_when_on() {
+    let p = small(Mode::Fourier);
+    let rom = sign_probe_rom(&p);
+    let o = RenderOptions::default();
+    let off = render_array(&p, &rom, &o, &spec(&p, 2, 2, 24, 1)).unwrap();
+    let on = render_array(
+        &p,
+        &rom,
+        &o,
+        &ArraySpec {
+            double_buffer: true,
+            ..spec(&p, 2, 2, 24, 1)
+        },
+    )
+    .unwrap();
+    for f in &off {
+        assert!(!f.contents.contains("swap"), "{}", f.name);
+    }
+    let (pix_off, pix_on) = (&off[0].contents, &on[0].contents);
+    assert!(pix_on.contains("input  wire swap,") && pix_on.contains("sh_0 <= y[0];"));
+    assert!(
+        !pix_on.contains("!rd_active && (!active"),
+        "the readout blocks no pulse"
+    );
+    assert!(pix_off.contains("!rd_active && (!active"));
+    assert_eq!(on[1].contents, off[1].contents, "the ROM is the same");
+    assert_eq!(on[2].contents.matches(".swap(r_swap[").count(), 4);
 }

@@ -1,0 +1,190 @@
+//! Frames through the array at the clock edge ([`run`]): reset, then every pulse's
+//! per-pixel detections presented while `pulse_o`, the array's ports recorded every cycle,
+//! each frame's words reassembled from the stream at the contract's beat cycles
+//! ([`ArrayRun`], the golden vectors of `tofprobe cosim` on an array).
+
+use tofprobe_design::readout::Readout;
+use tofprobe_pixel::sequencer::RESET_CYCLES;
+
+use crate::error::ArrayError;
+use crate::rtl::{ArrayModel, ArrayPins, TAIL_CYCLES};
+
+/// What the array's ports showed over a run, cycle by cycle.
+#[derive(Debug, Clone)]
+pub struct ArrayRun {
+    /// The readout followed.
+    pub readout: Readout,
+    /// G: SPADs per pixel side (the inputs are the pixels' × G²).
+    pub superpixel: usize,
+    /// Frames run.
+    pub frames: u64,
+    /// The outputs of every cycle.
+    pub pins: Vec<ArrayPins>,
+    /// Per `pulse_o` cycle (in order): the cycle.
+    pub pulse_cycles: Vec<u64>,
+    /// The readout positions of the pixels present (all of them unless a tile), in order.
+    pub positions: Vec<usize>,
+    /// Per frame, per pixel present (readout order: `positions`), the R + 1 words the
+    /// stream carried (raw W bits, reassembled from the beats).
+    pub words: Vec<Vec<Vec<u64>>>,
+}
+
+/// A frame's period in cycles and the cycles before the first frame.
+fn frame_start(ro: &Readout, frame: u64) -> u64 {
+    RESET_CYCLES + frame * ro.frame_cycles()
+}
+
+impl ArrayRun {
+    /// The cycles run.
+    pub fn cycles(&self) -> u64 {
+        self.pins.len() as u64
+    }
+
+    /// The cycle of beat (frame, q, word, part) by the contract's formula.
+    pub fn beat_cycle(&self, frame: u64, q: usize, word: usize, part: usize) -> u64 {
+        let ro = &self.readout;
+        frame_start(ro, frame) + ro.accumulate_cycles() + ro.beat_offset(q, word, part)
+    }
+
+    /// Says what the array was doing at `cycle`, in the contract's terms: the beat on the
+    /// port (pixel (r, c), register or status word, part, frame and its pulses), or the
+    /// pulse being presented, or the phase.
+    pub fn explain(&self, cycle: u64) -> String {
+        let ro = &self.readout;
+        let f = ro.frame_cycles();
+        let n = ro.frame_pulses;
+        let frame_of = |c: u64| c.saturating_sub(RESET_CYCLES) / f;
+        if cycle < RESET_CYCLES {
+            return format!("cycle {cycle}: reset");
+        }
+        // The beat whose slot holds this cycle (the latest beat at or before it).
+        for fr in (0..=frame_of(cycle)).rev().take(2) {
+            let base = frame_start(ro, fr) + ro.accumulate_cycles() + ro.beat_offset(0, 0, 0);
+            if cycle < base {
+                continue;
+            }
+            let idx = (cycle - base) / ro.beat_cycles;
+            if idx < ro.beats_per_frame() && fr < self.frames {
+                let b = ro.beat(idx);
+                let word = if b.word == ro.registers {
+                    "status word (refused pulses)".to_string()
+                } else {
+                    format!("register {}", b.word)
+                };
+                return format!(
+                    "cycle {cycle}: frame {fr}'s readout, pixel ({}, {}) (position {} of the order), \
+                     {word}, beat {} of {}; its frame is pulses {}..{}",
+                    b.row,
+                    b.col,
+                    b.position,
+                    b.part,
+                    ro.beats_per_word,
+                    fr * n,
+                    fr * n + n - 1
+                );
+            }
+        }
+        let fr = frame_of(cycle);
+        let within = cycle - frame_start(ro, fr);
+        let lat = tofprobe_design::readout::BROADCAST_LATENCY;
+        if within >= lat && within < ro.accumulate_cycles() + lat {
+            // The pulse the pixels are working on: presented `lat` cycles after the sequencer's.
+            let k = (within - lat) / ro.cycles_per_pulse;
+            let pulse = fr * n + k;
+            format!(
+                "cycle {cycle}: frame {fr}, pulse {pulse} (presented to the pixels at cycle {}, \
+                 slot {} of its {} cycles)",
+                frame_start(ro, fr) + lat + k * ro.cycles_per_pulse,
+                (within - lat) % ro.cycles_per_pulse,
+                ro.cycles_per_pulse
+            )
+        } else {
+            format!("cycle {cycle}: frame {fr}'s readout phase")
+        }
+    }
+}
+
+/// Runs `frames` frames: reset, then every cycle the detections of the pulse the pixels
+/// sample (`detections[i]` is input i's — pixel i's, row-major over the pixels present, or
+/// with G > 1 SPAD i's, row-major over their SPAD grid — one per pulse of the run; pulses
+/// beyond present no detection).
+pub fn run(
+    model: &mut ArrayModel,
+    detections: &[Vec<Option<u32>>],
+    frames: u64,
+) -> Result<ArrayRun, ArrayError> {
+    let ro = *model.readout();
+    let tile = model.present();
+    let np = model.inputs();
+    if detections.len() != np {
+        return Err(ArrayError::Shape(format!(
+            "{} inputs' detections for the {} × {} pixels present of {g} × {g} SPADs ({np})",
+            detections.len(),
+            tile.rows,
+            tile.cols,
+            g = model.superpixel()
+        )));
+    }
+    // The last frame's readout ends N·C + D cycles after its start (double-buffered, that
+    // is past the next frame's start when D > 1).
+    let total = match frames {
+        0 => RESET_CYCLES,
+        f => frame_start(&ro, f - 1) + ro.accumulate_cycles() + ro.readout_cycles(),
+    } + TAIL_CYCLES;
+    let mut pins = Vec::with_capacity(total as usize);
+    let mut pulse_cycles = Vec::new();
+    let (mut valid, mut tdc) = (vec![false; np], vec![0u32; np]);
+    for cycle in 0..total {
+        let rst = cycle < RESET_CYCLES;
+        let pulse_o = model.outputs().pulse_o;
+        let n = pulse_cycles.len();
+        for i in 0..np {
+            let d = if pulse_o {
+                detections[i].get(n).copied().flatten()
+            } else {
+                None
+            };
+            (valid[i], tdc[i]) = (d.is_some(), d.unwrap_or(0));
+        }
+        if pulse_o {
+            pulse_cycles.push(cycle);
+        }
+        pins.push(model.step(rst, &valid, &tdc));
+    }
+    let positions: Vec<usize> = (0..ro.pixels())
+        .filter(|&q| {
+            let (r, c) = ro.order(q);
+            tile.contains(r, c)
+        })
+        .collect();
+    let mut run = ArrayRun {
+        readout: ro,
+        superpixel: model.superpixel(),
+        frames,
+        pins,
+        pulse_cycles,
+        positions,
+        words: Vec::new(),
+    };
+    run.words = (0..frames)
+        .map(|fr| {
+            run.positions
+                .iter()
+                .map(|&q| {
+                    (0..ro.words_per_pixel())
+                        .map(|j| {
+                            let beats: Vec<u64> = (0..ro.beats_per_word)
+                                .map(|m| {
+                                    let c = run.beat_cycle(fr, q, j, m) as usize;
+                                    run.pins.get(c).map(|p| p.ro_data).unwrap_or(0)
+                                })
+                                .collect();
+                            ro.word_of(&beats)
+                        })
+                        .collect()
+                })
+                .collect()
+        })
+        .collect();
+    Ok(run)
+}
