@@ -397,7 +397,10 @@ mod tests {
         };
         let e = choose(&px, &ctx, "t", &t).unwrap_err().to_string();
         assert_eq!(t.calls.get(), MAX_ADDER_TRIALS, "{e}");
-        assert!(e.contains("stopped after") && e.contains("A > 4 not tried"), "{e}");
+        assert!(
+            e.contains("stopped after") && e.contains("A > 4 not tried"),
+            "{e}"
+        );
     }
 
     /// The default on sky130 ss as measured (f_max 46.0 MHz at A = 1, 43.0 at A = 7, 42.3
