@@ -87,28 +87,35 @@ impl Lanes {
     /// Fills `out` (a multiple of `LANES` long) with the streams' next words.
     #[inline(always)]
     fn fill(&mut self, out: &mut [u64]) {
-        let [mut s0, mut s1, mut s2, mut s3] = self.s;
+        let mut s = self.s;
         for chunk in out.chunks_exact_mut(LANES) {
-            for l in 0..LANES {
-                chunk[l] = rotl(s0[l].wrapping_add(s3[l]), 23).wrapping_add(s0[l]);
-                let t = s1[l] << 17;
-                s2[l] ^= s0[l];
-                s3[l] ^= s1[l];
-                s1[l] ^= s2[l];
-                s0[l] ^= s3[l];
-                s2[l] ^= t;
-                s3[l] = rotl(s3[l], 45);
-            }
+            chunk.copy_from_slice(&step(&mut s));
         }
-        self.s = [s0, s1, s2, s3];
+        self.s = s;
     }
 }
 
-/// x rotated left by k, as two shifts and an or: AVX2 has no 64-bit rotate, and LLVM's
-/// rotate of a vector is lowered lane by lane there.
+/// One xoshiro256++ step of every lane: the lanes' outputs (whole-array operations, which
+/// the compiler keeps in one vector register each).
+#[inline(always)]
+fn step(s: &mut [[u64; LANES]; 4]) -> [u64; LANES] {
+    let [s0, s1, s2, s3] = *s;
+    let out = std::array::from_fn(|l| rotl(s0[l].wrapping_add(s3[l]), 23).wrapping_add(s0[l]));
+    let t: [u64; LANES] = std::array::from_fn(|l| s1[l] << 17);
+    let s2: [u64; LANES] = std::array::from_fn(|l| s2[l] ^ s0[l]);
+    let s3: [u64; LANES] = std::array::from_fn(|l| s3[l] ^ s1[l]);
+    let s1: [u64; LANES] = std::array::from_fn(|l| s1[l] ^ s2[l]);
+    let s0: [u64; LANES] = std::array::from_fn(|l| s0[l] ^ s3[l]);
+    let s2: [u64; LANES] = std::array::from_fn(|l| s2[l] ^ t[l]);
+    let s3: [u64; LANES] = std::array::from_fn(|l| rotl(s3[l], 45));
+    *s = [s0, s1, s2, s3];
+    out
+}
+
+/// x rotated left by k (one `vprolq` with AVX-512, two shifts and an or elsewhere).
 #[inline(always)]
 fn rotl(x: u64, k: u32) -> u64 {
-    (x << k) ^ (x >> (64 - k))
+    x.rotate_left(k)
 }
 
 /// A sine motion's per-sub-block tables.
@@ -216,18 +223,59 @@ pub(crate) struct Block {
     pub n: usize,
 }
 
-/// Per-thread scratch of one block.
+/// Pulses per pass of the kernel: the pass's buffers (≈ 13 bytes a pulse) stay in L1.
+const PASS: usize = 512;
+
+/// Per-thread scratch of one block: the block's depths and one pass's buffers.
 #[derive(Debug, Default)]
 pub(crate) struct Scratch {
     depth: Vec<f64>,
+    pass: PassBuffers,
+}
+
+/// The buffers of one pass of [`PASS`] pulses.
+#[derive(Debug, Default)]
+struct PassBuffers {
     z: Vec<f64>,
+    /// The jitter, signal and background streams' words.
     words: Vec<u64>,
+    signal_words: Vec<u64>,
+    background_words: Vec<u64>,
     flags: Vec<u8>,
     rejects: Vec<u32>,
     /// The earliest in-window arrival of each pulse, code units (∞ when none).
-    pub best: Vec<f64>,
+    best: Vec<f64>,
     /// Whether a background photon won the pulse.
-    pub from_bg: Vec<bool>,
+    from_bg: Vec<bool>,
+}
+
+/// A block's generators: the three lane sets (the scalar stream of the ziggurat's slow
+/// path is apart, its address passed to the slow path: these stay in registers).
+struct Streams {
+    jitter: Lanes,
+    signal: Lanes,
+    background: Lanes,
+}
+
+impl Streams {
+    /// Fills `j`, `s` and `b` with the jitter, signal and background streams' next words
+    /// (the same length, a multiple of [`LANES`]). The three lane sets step in one loop:
+    /// each set's step depends on its last, so one set alone waits on that chain's
+    /// latency, three interleaved overlap it.
+    #[inline(always)]
+    fn fill_all(&mut self, j: &mut [u64], s: &mut [u64], b: &mut [u64]) {
+        let (mut sj, mut ss, mut sb) = (self.jitter.s, self.signal.s, self.background.s);
+        for ((x, y), z) in j
+            .chunks_exact_mut(LANES)
+            .zip(s.chunks_exact_mut(LANES))
+            .zip(b.chunks_exact_mut(LANES))
+        {
+            x.copy_from_slice(&step(&mut sj));
+            y.copy_from_slice(&step(&mut ss));
+            z.copy_from_slice(&step(&mut sb));
+        }
+        (self.jitter.s, self.signal.s, self.background.s) = (sj, ss, sb);
+    }
 }
 
 #[cfg(test)]
@@ -280,7 +328,15 @@ mod tests {
                 n: 4096,
             };
             let ca = generate(&p, &scene, &depths, blk, &mut sa, (0, 79, &mut a));
-            let cb = generate_body(&p, &scene, &depths, blk, &mut sb, (0, 79, &mut b));
+            let cb = generate_body(
+                &p,
+                &scene,
+                &depths,
+                blk,
+                &mut sb,
+                (0, 79, &mut b),
+                FILL_BASELINE,
+            );
             assert_eq!(ca, cb, "block {block}");
             assert_eq!(a, b, "block {block}");
             // The AVX2 copy too where the CPU has it (on an AVX-512 machine the dispatch
@@ -325,7 +381,7 @@ mod tests {
     }
 }
 
-/// Generates pulses 0 .. n of a block (n ≤ the block length) into `sc.best` / `sc.from_bg`,
+/// Generates pulses 0 .. n of a block (n ≤ the block length), in passes of [`PASS`] pulses,
 /// and writes pulses `offset .. offset + out.len()` of them as codes into `out` (returns
 /// its detections and background wins):
 /// the AVX2 copy of the kernel where the CPU has it (the same IEEE operations, no fused
@@ -359,7 +415,15 @@ pub(crate) fn generate<O: Slot>(
             return generate_avx2(p, scene, depths, block, sc, (offset, last, out));
         }
     }
-    generate_body(p, scene, depths, block, sc, (offset, last, out))
+    generate_body(
+        p,
+        scene,
+        depths,
+        block,
+        sc,
+        (offset, last, out),
+        FILL_BASELINE,
+    )
 }
 
 /// [`generate_body`] compiled for AVX-512 (64-bit rotates, gathers and integer-to-float
@@ -374,7 +438,18 @@ fn generate_avx512<O: Slot>(
     sc: &mut Scratch,
     (offset, last, out): (usize, u32, &mut [O]),
 ) -> (u64, u64) {
-    generate_body(p, scene, depths, block, sc, (offset, last, out))
+    generate_body(
+        p,
+        scene,
+        depths,
+        block,
+        sc,
+        (offset, last, out),
+        Fill {
+            one: one_avx512,
+            all: all_avx512,
+        },
+    )
 }
 
 /// [`generate_body`] compiled for AVX2.
@@ -388,7 +463,80 @@ fn generate_avx2<O: Slot>(
     sc: &mut Scratch,
     (offset, last, out): (usize, u32, &mut [O]),
 ) -> (u64, u64) {
-    generate_body(p, scene, depths, block, sc, (offset, last, out))
+    generate_body(
+        p,
+        scene,
+        depths,
+        block,
+        sc,
+        (offset, last, out),
+        Fill {
+            one: one_avx2,
+            all: all_avx2,
+        },
+    )
+}
+
+/// How a copy of the kernel fills a pass's words from a lane set: a function of its own,
+/// never inlined, so the compiler vectorises the lanes' step there whatever the
+/// register pressure of the pass around it (inlined, it fell back to scalar code at some
+/// call sites).
+#[derive(Clone, Copy)]
+struct Fill {
+    /// The jitter stream alone ([`Lanes::fill`]).
+    one: fn(&mut Lanes, &mut [u64]),
+    /// The three streams ([`Streams::fill_all`]).
+    all: fn(&mut Streams, &mut [u64], &mut [u64], &mut [u64]),
+}
+
+/// The AVX-512 copy's fills: built in that copy (a target-feature function is a
+/// safe function pointer only where its features are enabled).
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq")]
+#[inline(never)]
+fn one_avx512(l: &mut Lanes, j: &mut [u64]) {
+    l.fill(j);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq")]
+#[inline(never)]
+fn all_avx512(g: &mut Streams, j: &mut [u64], s: &mut [u64], b: &mut [u64]) {
+    g.fill_all(j, s, b);
+}
+
+/// The AVX2 copy's fills: built in that copy (a target-feature function is a
+/// safe function pointer only where its features are enabled).
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline(never)]
+fn one_avx2(l: &mut Lanes, j: &mut [u64]) {
+    l.fill(j);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline(never)]
+fn all_avx2(g: &mut Streams, j: &mut [u64], s: &mut [u64], b: &mut [u64]) {
+    g.fill_all(j, s, b);
+}
+
+/// The baseline copy's fills.
+const FILL_BASELINE: Fill = Fill {
+    one: one_baseline,
+    all: all_baseline,
+};
+
+#[inline(never)]
+fn one_baseline(l: &mut Lanes, j: &mut [u64]) {
+    l.fill(j);
+}
+
+#[inline(never)]
+fn all_baseline(g: &mut Streams, j: &mut [u64], s: &mut [u64], b: &mut [u64]) {
+    g.fill_all(j, s, b);
 }
 
 #[inline(always)]
@@ -399,6 +547,7 @@ fn generate_body<O: Slot>(
     block: Block,
     sc: &mut Scratch,
     (offset, last, out): (usize, u32, &mut [O]),
+    fill: Fill,
 ) -> (u64, u64) {
     let Block {
         seed: block_seed,
@@ -407,29 +556,86 @@ fn generate_body<O: Slot>(
     } = block;
     let padded = n.div_ceil(LANES) * LANES;
     sc.depth.resize(padded, 0.0);
-    sc.z.resize(padded, 0.0);
-    sc.words.resize(padded, 0);
-    sc.best.resize(padded, 0.0);
-    sc.from_bg.resize(padded, false);
-    sc.rejects.clear();
     depths.fill(scene, first_pulse, p.period_s, &mut sc.depth[..n]);
+    let b = &mut sc.pass;
+    b.z.resize(PASS, 0.0);
+    b.best.resize(PASS, 0.0);
+    b.words.resize(PASS, 0);
+    b.from_bg.resize(PASS, false);
 
     let mut seeder = SplitMix64::new(block_seed);
-    let mut jitter = Lanes::new(&mut seeder);
-    let mut signal = Lanes::new(&mut seeder);
-    let mut background = Lanes::new(&mut seeder);
+    let mut g = Streams {
+        jitter: Lanes::new(&mut seeder),
+        signal: Lanes::new(&mut seeder),
+        background: Lanes::new(&mut seeder),
+    };
     let mut slow = Xoshiro256PlusPlus::seed_from_u64(seeder.next_u64());
-
-    let t: &Tables = tables();
-    jitter.fill(&mut sc.words);
-    fast_pass(t, &sc.words, &mut sc.z, &mut sc.flags, &mut sc.rejects);
-    for &k in &sc.rejects {
-        sc.z[k as usize] = finish(t, sc.words[k as usize], &mut slow);
+    let mut counts = (0, 0);
+    // The block in passes of PASS pulses, each pass's buffers in L1: pulse k still takes
+    // word k of each stream and the rejects are finished in pulse order, so the stream is
+    // the one a single pass over the whole block draws.
+    for first in (0..padded).step_by(PASS) {
+        let m = (padded - first).min(PASS);
+        // Pulses first + lo .. first + hi of this pass are the request's.
+        let lo = offset.saturating_sub(first).min(m);
+        let hi = n.saturating_sub(first).min(m).max(lo);
+        let o = (first + lo).saturating_sub(offset);
+        let c = pass(
+            p,
+            (&mut g, &mut slow, fill),
+            b,
+            &sc.depth[first..first + m],
+            (lo, hi),
+            (last, &mut out[o..o + hi - lo]),
+        );
+        counts.0 += c.0;
+        counts.1 += c.1;
     }
+    counts
+}
 
+/// One pass of `depth.len()` pulses (a multiple of [`LANES`]): every stream advanced by
+/// that many words, the rejects finished, and pulses `lo .. hi` of the pass written to `out`
+/// (returns their detections and background wins).
+#[inline(always)]
+fn pass<O: Slot>(
+    p: &Params,
+    (g, slow, fill): (&mut Streams, &mut Xoshiro256PlusPlus, Fill),
+    b: &mut PassBuffers,
+    depth: &[f64],
+    (lo, hi): (usize, usize),
+    (last, out): (u32, &mut [O]),
+) -> (u64, u64) {
+    let m = depth.len();
+    let t: &Tables = tables();
+    let bern = p.signal_rate < 1.0;
+    let bg = p.background_rate > 0.0;
+    let (words, z) = (&mut b.words[..m], &mut b.z[..m]);
+    for v in [&mut b.signal_words, &mut b.background_words] {
+        v.resize(PASS, 0);
+    }
+    let (sw, bw) = (&mut b.signal_words[..m], &mut b.background_words[..m]);
+    // The unused streams are filled too when any is used: they are independent of the
+    // used ones, and stepping them beside the others costs little (see Streams::fill).
+    // Through `black_box`: a direct call would be inlined into the pass (despite
+    // `inline(never)`), where the lanes' step is left scalar.
+    if bern || bg {
+        std::hint::black_box(fill.all)(g, words, sw, bw);
+    } else {
+        std::hint::black_box(fill.one)(&mut g.jitter, words);
+    }
+    fast_pass(t, words, z, &mut b.flags, &mut b.rejects);
+    for &k in &b.rejects {
+        z[k as usize] = finish(t, words[k as usize], slow);
+    }
+    if lo == hi {
+        // A pass before the request's start: its streams advanced, nothing is computed.
+        return (0, 0);
+    }
     // Signal: t = δ·code_per_mm + σ z − start, kept when inside [0, length).
     let (cpm, sigma, start, len) = (p.code_per_mm, p.sigma, p.start, p.length);
-    for ((b, &d), &z) in sc.best.iter_mut().zip(&sc.depth).zip(&sc.z) {
+    let best = &mut b.best[..m];
+    for ((b, &d), &z) in best.iter_mut().zip(depth).zip(z.iter()) {
         let x = d * cpm + sigma * z - start;
         *b = if x >= 0.0 && x < len {
             x
@@ -437,11 +643,10 @@ fn generate_body<O: Slot>(
             f64::INFINITY
         };
     }
-    if p.signal_rate < 1.0 {
-        signal.fill(&mut sc.words);
+    if bern {
         // Both sides < 2^53: the signed compare (the one AVX2 has) is exact.
         let thr = p.signal_threshold.min(1 << 53) as i64;
-        for (b, &w) in sc.best.iter_mut().zip(&sc.words) {
+        for (b, &w) in best.iter_mut().zip(sw.iter()) {
             *b = if ((w >> 11) as i64) < thr {
                 *b
             } else {
@@ -449,12 +654,11 @@ fn generate_body<O: Slot>(
             };
         }
     }
-    sc.from_bg.fill(false);
-    if p.background_rate > 0.0 {
-        background.fill(&mut sc.words);
+    let from_bg = &mut b.from_bg[..m];
+    if bg {
         let scale = len / p.background_rate;
         let nb = p.no_background;
-        for ((b, bg), &w) in sc.best.iter_mut().zip(sc.from_bg.iter_mut()).zip(&sc.words) {
+        for ((b, bg), &w) in best.iter_mut().zip(from_bg.iter_mut()).zip(bw.iter()) {
             // u ∈ (0, 1] on the 2^−52 grid, by the exponent trick (no integer-to-float
             // conversion, which AVX2 lacks for 64-bit lanes).
             let u = 2.0 - f64::from_bits((w >> 12) | 0x3FF0_0000_0000_0000);
@@ -463,9 +667,10 @@ fn generate_body<O: Slot>(
             *b = if wins { tb } else { *b };
             *bg = wins;
         }
+        codes::<O, true>(&best[lo..hi], &from_bg[lo..hi], last, out)
+    } else {
+        codes::<O, false>(&best[lo..hi], &from_bg[lo..hi], last, out)
     }
-    let r = offset..offset + out.len();
-    codes(&sc.best[r.clone()], &sc.from_bg[r], last, out)
 }
 
 /// ln(u) for u ∈ [2^−53, 1] (normal, positive), branch-free so a batch vectorises: the
@@ -501,20 +706,30 @@ pub(crate) fn ln(u: f64) -> f64 {
 }
 
 /// Writes `best` as TDC codes into `out` (no detection outside the window); returns the
-/// detections and the background wins among them.
+/// detections and the background wins among them (none read unless `BG`).
 #[inline(always)]
-fn codes<O: Slot>(best: &[f64], from_bg: &[bool], last: u32, out: &mut [O]) -> (u64, u64) {
+fn codes<O: Slot, const BG: bool>(
+    best: &[f64],
+    from_bg: &[bool],
+    last: u32,
+    out: &mut [O],
+) -> (u64, u64) {
     let mut detections = 0u64;
     let mut wins = 0u64;
     let last_f = f64::from(last);
-    for ((o, &b), &g) in out.iter_mut().zip(best).zip(from_bg) {
+    // 2^52: a float in [0, 2^32) truncated and added to it holds its integer value in the
+    // low mantissa bits (a vector conversion where `as u32`'s saturating one is not).
+    const MAGIC: f64 = 4_503_599_627_370_496.0;
+    for (i, (o, &b)) in out.iter_mut().zip(best).enumerate() {
         // b ∈ [0, length) when hit, ∞ otherwise; the clamp is a float min (an integer min
         // compiles to a branch that a 50 % detection rate would mispredict).
         let hit = b < f64::INFINITY;
-        let c = b.min(last_f) as u32;
+        let c = (b.min(last_f).trunc() + MAGIC).to_bits() as u32;
         *o = O::detection(hit, c);
         detections += u64::from(hit);
-        wins += u64::from(g);
+        if BG {
+            wins += u64::from(from_bg[i]);
+        }
     }
     (detections, wins)
 }
