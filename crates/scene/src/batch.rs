@@ -491,7 +491,6 @@ struct Fill {
 
 /// The AVX-512 copy's fills: built in that copy (a target-feature function is a
 /// safe function pointer only where its features are enabled).
-
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512dq")]
 #[inline(never)]
@@ -508,7 +507,6 @@ fn all_avx512(g: &mut Streams, j: &mut [u64], s: &mut [u64], b: &mut [u64]) {
 
 /// The AVX2 copy's fills: built in that copy (a target-feature function is a
 /// safe function pointer only where its features are enabled).
-
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
