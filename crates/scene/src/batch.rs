@@ -22,6 +22,9 @@ use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
 use crate::MotionConfig;
+use crate::lanes::{FILL_BASELINE, Fill, LANES, Lanes, Streams};
+#[cfg(target_arch = "x86_64")]
+use crate::lanes::{all_avx2, all_avx512, one_avx2, one_avx512};
 use crate::scene::Scene;
 use crate::splitmix::SplitMix64;
 use crate::ziggurat::{Tables, fast_pass, finish, tables};
@@ -62,54 +65,8 @@ impl Slot for u32 {
 /// bits); the pixel's drivers read the same sentinel (`tofprobe_pixel::NO_DETECTION`).
 pub const NO_DETECTION: u32 = u32::MAX;
 
-/// Interleaved generators per stream.
-pub(crate) const LANES: usize = 4;
 /// Pulses per sine sub-block (one table of cos kΔ, sin kΔ).
 pub(crate) const SUB: usize = 64;
-
-/// `LANES` xoshiro256++ generators side by side (state word j of lane l is `s[j][l]`).
-#[derive(Debug, Clone)]
-struct Lanes {
-    s: [[u64; LANES]; 4],
-}
-
-impl Lanes {
-    fn new(seeder: &mut SplitMix64) -> Lanes {
-        let mut s = [[0u64; LANES]; 4];
-        for l in 0..LANES {
-            for w in &mut s {
-                w[l] = seeder.next_u64();
-            }
-        }
-        Lanes { s }
-    }
-
-    /// Fills `out` (a multiple of `LANES` long) with the streams' next words.
-    #[inline(always)]
-    fn fill(&mut self, out: &mut [u64]) {
-        let [mut s0, mut s1, mut s2, mut s3] = self.s;
-        for chunk in out.chunks_exact_mut(LANES) {
-            for l in 0..LANES {
-                chunk[l] = rotl(s0[l].wrapping_add(s3[l]), 23).wrapping_add(s0[l]);
-                let t = s1[l] << 17;
-                s2[l] ^= s0[l];
-                s3[l] ^= s1[l];
-                s1[l] ^= s2[l];
-                s0[l] ^= s3[l];
-                s2[l] ^= t;
-                s3[l] = rotl(s3[l], 45);
-            }
-        }
-        self.s = [s0, s1, s2, s3];
-    }
-}
-
-/// x rotated left by k, as two shifts and an or: AVX2 has no 64-bit rotate, and LLVM's
-/// rotate of a vector is lowered lane by lane there.
-#[inline(always)]
-fn rotl(x: u64, k: u32) -> u64 {
-    (x << k) ^ (x >> (64 - k))
-}
 
 /// A sine motion's per-sub-block tables.
 #[derive(Debug, Clone)]
@@ -216,18 +173,30 @@ pub(crate) struct Block {
     pub n: usize,
 }
 
-/// Per-thread scratch of one block.
+/// Pulses per pass of the kernel: the pass's buffers (≈ 13 bytes a pulse) stay in L1.
+const PASS: usize = 512;
+
+/// Per-thread scratch of one block: the block's depths and one pass's buffers.
 #[derive(Debug, Default)]
 pub(crate) struct Scratch {
     depth: Vec<f64>,
+    pass: PassBuffers,
+}
+
+/// The buffers of one pass of [`PASS`] pulses.
+#[derive(Debug, Default)]
+struct PassBuffers {
     z: Vec<f64>,
+    /// The jitter, signal and background streams' words.
     words: Vec<u64>,
+    signal_words: Vec<u64>,
+    background_words: Vec<u64>,
     flags: Vec<u8>,
     rejects: Vec<u32>,
     /// The earliest in-window arrival of each pulse, code units (∞ when none).
-    pub best: Vec<f64>,
+    best: Vec<f64>,
     /// Whether a background photon won the pulse.
-    pub from_bg: Vec<bool>,
+    from_bg: Vec<bool>,
 }
 
 #[cfg(test)]
@@ -280,7 +249,15 @@ mod tests {
                 n: 4096,
             };
             let ca = generate(&p, &scene, &depths, blk, &mut sa, (0, 79, &mut a));
-            let cb = generate_body(&p, &scene, &depths, blk, &mut sb, (0, 79, &mut b));
+            let cb = generate_body(
+                &p,
+                &scene,
+                &depths,
+                blk,
+                &mut sb,
+                (0, 79, &mut b),
+                FILL_BASELINE,
+            );
             assert_eq!(ca, cb, "block {block}");
             assert_eq!(a, b, "block {block}");
             // The AVX2 copy too where the CPU has it (on an AVX-512 machine the dispatch
@@ -325,7 +302,7 @@ mod tests {
     }
 }
 
-/// Generates pulses 0 .. n of a block (n ≤ the block length) into `sc.best` / `sc.from_bg`,
+/// Generates pulses 0 .. n of a block (n ≤ the block length), in passes of [`PASS`] pulses,
 /// and writes pulses `offset .. offset + out.len()` of them as codes into `out` (returns
 /// its detections and background wins):
 /// the AVX2 copy of the kernel where the CPU has it (the same IEEE operations, no fused
@@ -359,7 +336,15 @@ pub(crate) fn generate<O: Slot>(
             return generate_avx2(p, scene, depths, block, sc, (offset, last, out));
         }
     }
-    generate_body(p, scene, depths, block, sc, (offset, last, out))
+    generate_body(
+        p,
+        scene,
+        depths,
+        block,
+        sc,
+        (offset, last, out),
+        FILL_BASELINE,
+    )
 }
 
 /// [`generate_body`] compiled for AVX-512 (64-bit rotates, gathers and integer-to-float
@@ -374,7 +359,18 @@ fn generate_avx512<O: Slot>(
     sc: &mut Scratch,
     (offset, last, out): (usize, u32, &mut [O]),
 ) -> (u64, u64) {
-    generate_body(p, scene, depths, block, sc, (offset, last, out))
+    generate_body(
+        p,
+        scene,
+        depths,
+        block,
+        sc,
+        (offset, last, out),
+        Fill {
+            one: one_avx512,
+            all: all_avx512,
+        },
+    )
 }
 
 /// [`generate_body`] compiled for AVX2.
@@ -388,7 +384,18 @@ fn generate_avx2<O: Slot>(
     sc: &mut Scratch,
     (offset, last, out): (usize, u32, &mut [O]),
 ) -> (u64, u64) {
-    generate_body(p, scene, depths, block, sc, (offset, last, out))
+    generate_body(
+        p,
+        scene,
+        depths,
+        block,
+        sc,
+        (offset, last, out),
+        Fill {
+            one: one_avx2,
+            all: all_avx2,
+        },
+    )
 }
 
 #[inline(always)]
@@ -399,6 +406,7 @@ fn generate_body<O: Slot>(
     block: Block,
     sc: &mut Scratch,
     (offset, last, out): (usize, u32, &mut [O]),
+    fill: Fill,
 ) -> (u64, u64) {
     let Block {
         seed: block_seed,
@@ -407,29 +415,86 @@ fn generate_body<O: Slot>(
     } = block;
     let padded = n.div_ceil(LANES) * LANES;
     sc.depth.resize(padded, 0.0);
-    sc.z.resize(padded, 0.0);
-    sc.words.resize(padded, 0);
-    sc.best.resize(padded, 0.0);
-    sc.from_bg.resize(padded, false);
-    sc.rejects.clear();
     depths.fill(scene, first_pulse, p.period_s, &mut sc.depth[..n]);
+    let b = &mut sc.pass;
+    b.z.resize(PASS, 0.0);
+    b.best.resize(PASS, 0.0);
+    b.words.resize(PASS, 0);
+    b.from_bg.resize(PASS, false);
 
     let mut seeder = SplitMix64::new(block_seed);
-    let mut jitter = Lanes::new(&mut seeder);
-    let mut signal = Lanes::new(&mut seeder);
-    let mut background = Lanes::new(&mut seeder);
+    let mut g = Streams {
+        jitter: Lanes::new(&mut seeder),
+        signal: Lanes::new(&mut seeder),
+        background: Lanes::new(&mut seeder),
+    };
     let mut slow = Xoshiro256PlusPlus::seed_from_u64(seeder.next_u64());
-
-    let t: &Tables = tables();
-    jitter.fill(&mut sc.words);
-    fast_pass(t, &sc.words, &mut sc.z, &mut sc.flags, &mut sc.rejects);
-    for &k in &sc.rejects {
-        sc.z[k as usize] = finish(t, sc.words[k as usize], &mut slow);
+    let mut counts = (0, 0);
+    // The block in passes of PASS pulses, each pass's buffers in L1: pulse k still takes
+    // word k of each stream and the rejects are finished in pulse order, so the stream is
+    // the one a single pass over the whole block draws.
+    for first in (0..padded).step_by(PASS) {
+        let m = (padded - first).min(PASS);
+        // Pulses first + lo .. first + hi of this pass are the request's.
+        let lo = offset.saturating_sub(first).min(m);
+        let hi = n.saturating_sub(first).min(m).max(lo);
+        let o = (first + lo).saturating_sub(offset);
+        let c = pass(
+            p,
+            (&mut g, &mut slow, fill),
+            b,
+            &sc.depth[first..first + m],
+            (lo, hi),
+            (last, &mut out[o..o + hi - lo]),
+        );
+        counts.0 += c.0;
+        counts.1 += c.1;
     }
+    counts
+}
 
+/// One pass of `depth.len()` pulses (a multiple of [`LANES`]): every stream advanced by
+/// that many words, the rejects finished, and pulses `lo .. hi` of the pass written to `out`
+/// (returns their detections and background wins).
+#[inline(always)]
+fn pass<O: Slot>(
+    p: &Params,
+    (g, slow, fill): (&mut Streams, &mut Xoshiro256PlusPlus, Fill),
+    b: &mut PassBuffers,
+    depth: &[f64],
+    (lo, hi): (usize, usize),
+    (last, out): (u32, &mut [O]),
+) -> (u64, u64) {
+    let m = depth.len();
+    let t: &Tables = tables();
+    let bern = p.signal_rate < 1.0;
+    let bg = p.background_rate > 0.0;
+    let (words, z) = (&mut b.words[..m], &mut b.z[..m]);
+    for v in [&mut b.signal_words, &mut b.background_words] {
+        v.resize(PASS, 0);
+    }
+    let (sw, bw) = (&mut b.signal_words[..m], &mut b.background_words[..m]);
+    // The unused streams are filled too when any is used: they are independent of the
+    // used ones, and stepping them beside the others costs little (see Streams::fill).
+    // Through `black_box`: a direct call would be inlined into the pass (despite
+    // `inline(never)`), where the lanes' step is left scalar.
+    if bern || bg {
+        std::hint::black_box(fill.all)(g, words, sw, bw);
+    } else {
+        std::hint::black_box(fill.one)(&mut g.jitter, words);
+    }
+    fast_pass(t, words, z, &mut b.flags, &mut b.rejects);
+    for &k in &b.rejects {
+        z[k as usize] = finish(t, words[k as usize], slow);
+    }
+    if lo == hi {
+        // A pass before the request's start: its streams advanced, nothing is computed.
+        return (0, 0);
+    }
     // Signal: t = δ·code_per_mm + σ z − start, kept when inside [0, length).
     let (cpm, sigma, start, len) = (p.code_per_mm, p.sigma, p.start, p.length);
-    for ((b, &d), &z) in sc.best.iter_mut().zip(&sc.depth).zip(&sc.z) {
+    let best = &mut b.best[..m];
+    for ((b, &d), &z) in best.iter_mut().zip(depth).zip(z.iter()) {
         let x = d * cpm + sigma * z - start;
         *b = if x >= 0.0 && x < len {
             x
@@ -437,11 +502,10 @@ fn generate_body<O: Slot>(
             f64::INFINITY
         };
     }
-    if p.signal_rate < 1.0 {
-        signal.fill(&mut sc.words);
+    if bern {
         // Both sides < 2^53: the signed compare (the one AVX2 has) is exact.
         let thr = p.signal_threshold.min(1 << 53) as i64;
-        for (b, &w) in sc.best.iter_mut().zip(&sc.words) {
+        for (b, &w) in best.iter_mut().zip(sw.iter()) {
             *b = if ((w >> 11) as i64) < thr {
                 *b
             } else {
@@ -449,12 +513,11 @@ fn generate_body<O: Slot>(
             };
         }
     }
-    sc.from_bg.fill(false);
-    if p.background_rate > 0.0 {
-        background.fill(&mut sc.words);
+    let from_bg = &mut b.from_bg[..m];
+    if bg {
         let scale = len / p.background_rate;
         let nb = p.no_background;
-        for ((b, bg), &w) in sc.best.iter_mut().zip(sc.from_bg.iter_mut()).zip(&sc.words) {
+        for ((b, bg), &w) in best.iter_mut().zip(from_bg.iter_mut()).zip(bw.iter()) {
             // u ∈ (0, 1] on the 2^−52 grid, by the exponent trick (no integer-to-float
             // conversion, which AVX2 lacks for 64-bit lanes).
             let u = 2.0 - f64::from_bits((w >> 12) | 0x3FF0_0000_0000_0000);
@@ -463,9 +526,10 @@ fn generate_body<O: Slot>(
             *b = if wins { tb } else { *b };
             *bg = wins;
         }
+        codes::<O, true>(&best[lo..hi], &from_bg[lo..hi], last, out)
+    } else {
+        codes::<O, false>(&best[lo..hi], &from_bg[lo..hi], last, out)
     }
-    let r = offset..offset + out.len();
-    codes(&sc.best[r.clone()], &sc.from_bg[r], last, out)
 }
 
 /// ln(u) for u ∈ [2^−53, 1] (normal, positive), branch-free so a batch vectorises: the
@@ -501,20 +565,30 @@ pub(crate) fn ln(u: f64) -> f64 {
 }
 
 /// Writes `best` as TDC codes into `out` (no detection outside the window); returns the
-/// detections and the background wins among them.
+/// detections and the background wins among them (none read unless `BG`).
 #[inline(always)]
-fn codes<O: Slot>(best: &[f64], from_bg: &[bool], last: u32, out: &mut [O]) -> (u64, u64) {
+fn codes<O: Slot, const BG: bool>(
+    best: &[f64],
+    from_bg: &[bool],
+    last: u32,
+    out: &mut [O],
+) -> (u64, u64) {
     let mut detections = 0u64;
     let mut wins = 0u64;
     let last_f = f64::from(last);
-    for ((o, &b), &g) in out.iter_mut().zip(best).zip(from_bg) {
+    // 2^52: a float in [0, 2^32) truncated and added to it holds its integer value in the
+    // low mantissa bits (a vector conversion where `as u32`'s saturating one is not).
+    const MAGIC: f64 = 4_503_599_627_370_496.0;
+    for (i, (o, &b)) in out.iter_mut().zip(best).enumerate() {
         // b ∈ [0, length) when hit, ∞ otherwise; the clamp is a float min (an integer min
         // compiles to a branch that a 50 % detection rate would mispredict).
         let hit = b < f64::INFINITY;
-        let c = b.min(last_f) as u32;
+        let c = (b.min(last_f).trunc() + MAGIC).to_bits() as u32;
         *o = O::detection(hit, c);
         detections += u64::from(hit);
-        wins += u64::from(g);
+        if BG {
+            wins += u64::from(from_bg[i]);
+        }
     }
     (detections, wins)
 }

@@ -8,6 +8,7 @@
 mod acquisition;
 mod batch;
 mod error;
+mod lanes;
 mod motion;
 mod scene;
 mod sensor;
