@@ -286,6 +286,7 @@ pub fn run(
         .map(|l| l.trim_start_matches("Result:").trim().to_string())
         .unwrap_or_else(|| "no result line".into());
     let lvs_match = lvs_log.contains("Total errors = 0") && lvs_result.contains("match uniquely");
+    let lvs_errors = crate::qflow::lvs_counts(&lvs_log);
     progress("GDS");
     let t = Instant::now();
     project.stage("GDS", "gdsii", "gdsii.log")?;
@@ -404,6 +405,7 @@ pub fn run(
         drc_rules,
         lvs_match,
         lvs_result,
+        lvs_errors,
         post_route,
         bins_per_pitch,
         steps,

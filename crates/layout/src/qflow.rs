@@ -174,9 +174,9 @@ impl Project {
     }
 
     /// Runs qflow's `stage` (its qflow name) and returns its log's text and the seconds
-    /// it took; an error names the stage and the log's tail. A routing or DRC stage that
-    /// stopped on its own verdict (unrouted nets, DRC errors) returns its log: the verdict
-    /// is the report's, not an error.
+    /// it took; an error names the stage and the log's tail. A routing, DRC or LVS stage
+    /// that stopped on its own verdict (unrouted nets, DRC errors, a mismatch) returns its
+    /// log: the verdict is the report's, not an error.
     pub fn stage(&self, step: &'static str, stage: &str, log: &str) -> Result<(String, f64)> {
         let qflow = Tool::Qflow.locate()?;
         let start = std::time::Instant::now();
@@ -200,12 +200,14 @@ impl Project {
             || text.contains("error condition")
             || text.contains("Premature exit")
             || text.is_empty();
-        // The route and DRC stages fail qflow's way when their verdict is bad (unrouted
-        // nets; `drc = N` with N > 0): the caller reads that verdict from the log and
-        // reports it, so only a log without it is a tool failure.
+        // The route, DRC and LVS stages fail qflow's way when their verdict is bad
+        // (unrouted nets; `drc = N` with N > 0; netgen's "Netlists do not match"): the
+        // caller reads that verdict from the log and reports it, so only a log without it
+        // is a tool failure.
         let verdict_in_log = match stage {
             "route" => true,
             "drc" => text.lines().any(|l| l.trim().starts_with("drc = ")),
+            "lvs" => text.lines().any(|l| l.starts_with("Result:")),
             _ => false,
         };
         if failed && !verdict_in_log {
@@ -248,6 +250,20 @@ pub fn parse_drc_reasons(text: &str) -> Vec<DrcRule> {
         .collect()
 }
 
+/// The nonzero counts of qflow's LVS summary (`count_lvs.py`: "net count difference = 1",
+/// "unmatched nets = 1", …), empty when the netlists match.
+pub fn lvs_counts(log: &str) -> Vec<String> {
+    log.lines()
+        .skip_while(|l| !l.starts_with("LVS reports:"))
+        .skip(1)
+        .take_while(|l| !l.starts_with("Total errors"))
+        .filter_map(|l| {
+            let (what, n) = l.trim().rsplit_once(" = ")?;
+            (n.trim().parse::<u64>().ok()? > 0).then(|| format!("{what} = {}", n.trim()))
+        })
+        .collect()
+}
+
 /// qrouter's verdict in a route log: `Ok(())` when every net routed, else the unrouted
 /// nets' count and the names qrouter reported as failing in its last pass.
 pub fn route_verdict(log: &str) -> std::result::Result<(), (usize, Vec<String>)> {
@@ -281,6 +297,17 @@ pub fn route_verdict(log: &str) -> std::result::Result<(), (usize, Vec<String>)>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lvs_counts_keep_the_nonzero_lines() {
+        // The default pixel's LVS with one net open (2026-11-28).
+        let log = "Result: Netlists do not match.\nLVS reports:\n    net count difference = 1\n    device count difference = 0\n    unmatched nets = 1\n\nTotal errors = 2\n";
+        assert_eq!(
+            lvs_counts(log),
+            vec!["net count difference = 1", "unmatched nets = 1"]
+        );
+        assert!(lvs_counts("LVS reports:\n    unmatched nets = 0\nTotal errors = 0\n").is_empty());
+    }
 
     #[test]
     fn drc_reasons_are_read_per_rule() {

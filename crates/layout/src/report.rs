@@ -100,6 +100,9 @@ pub struct LayoutReport {
     pub lvs_match: bool,
     /// netgen's result line.
     pub lvs_result: String,
+    /// The nonzero counts of the LVS summary (empty when it matches).
+    #[serde(default)]
+    pub lvs_errors: Vec<String>,
     /// Post-route timing.
     pub post_route: PostRoute,
     /// Bins per pitch (None when the B sweep's model could not be fitted).
@@ -231,7 +234,11 @@ impl LayoutReport {
             },
             self.drc_errors,
             if self.lvs_match { "match" } else { "MISMATCH" },
-            self.lvs_result,
+            if self.lvs_errors.is_empty() {
+                self.lvs_result.clone()
+            } else {
+                format!("{} ({})", self.lvs_result, self.lvs_errors.join(", "))
+            },
         );
         if !self.drc_rules.is_empty() {
             s += "DRC errors by rule (magic's `drc listall why`):\n\n| rule | error boxes |\n|---|---:|\n";
