@@ -25,8 +25,9 @@ pub const MAX_ATTEMPTS: usize = 3;
 pub const AUTO_CLEANUP_MAX_CELLS: u64 = 5_000;
 
 /// Whether qrouter runs its stage 3, the cleanup that rips up and re-routes every routed
-/// net to shorten it. Stages 1 and 2 (route, then rip up and re-route the failures) leave
-/// every net routed and legal; stage 3 only improves the wires.
+/// net. Stages 1 and 2 (route, then rip up and re-route the failures) leave every net
+/// routed; stage 3 shortens the wires and removes defects stage 2 can leave (the default
+/// pixel's stage-2 route had 3 DRC errors and one open net, docs/layout.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RouteCleanup {
     /// On up to [`AUTO_CLEANUP_MAX_CELLS`] cells, off above.
@@ -439,7 +440,7 @@ fn notes(tech: &TechFiles, other_b: u64, route_cleanup: bool) -> Vec<String> {
     n.push(if route_cleanup {
         "Routing: qrouter's stages 1 and 2 (route every net, rip up and re-route the failures) and stage 3 (every net re-routed shorter), qflow's own `qrouter::standard_route`.".into()
     } else {
-        format!("Routing: qrouter's stages 1 and 2 only (every net routed and legal); stage 3, the cleanup that re-routes each net shorter, was skipped (`--route-cleanup`, auto above {AUTO_CLEANUP_MAX_CELLS} cells): the wirelength and the post-route wires are those of stage 2, a little longer than a cleaned-up route.")
+        format!("Routing: qrouter's stages 1 and 2 only (every net routed); stage 3, the cleanup that re-routes each net, was skipped (`--route-cleanup`, auto above {AUTO_CLEANUP_MAX_CELLS} cells): the wirelength and the post-route wires are those of stage 2, a little longer than a cleaned-up route, and defects stage 3 would remove show in the DRC and LVS verdicts.")
     });
     if tech.tech == Tech::Osu018 {
         n.push("osu018: Debian's qflow-tech-osu018 has no cell GDS, so the GDS and the picture hold the cells' LEF abstracts (pins and obstructions) with the routing, and magic's DRC checks the routing and the abstracts, not the cells' transistors.".into());
