@@ -118,6 +118,9 @@ fn parse_point(toks: &[&str], pos: &mut usize, points: &mut Vec<Point>) -> Optio
                 let child = parse_point(toks, pos, points)?;
                 points[me].children.push(child);
             }
+            // qrouter writes ERROR where its walk of a route found no pin: a broken route
+            // (an open net, which LVS reports); the wire up to there is kept, no pin named.
+            "ERROR" => *pos += 1,
             name => {
                 points[me].sinks.push(name.to_string());
                 *pos += 1;
@@ -308,6 +311,19 @@ mod tests {
             n.total_cap_pf()
         );
         assert_eq!(n.points[0].children.len(), 3);
+    }
+
+    #[test]
+    fn a_broken_route_keeps_its_wire_and_names_no_error_pin() {
+        // The shape of the default pixel's open net (2026-11-28): qrouter's walk ends in
+        // ERROR where no pin is reached. The wire is kept, the sink not counted, and the
+        // SPEF names no pin `ERROR` (OpenSTA would not find it).
+        let line = "n 1 A/Y 2 ( 1.0 0.001 ( 2.0 0.002 B/A ) , ( 0.5 0.0005 ERROR ) )\n";
+        let nets = parse_rc(line, Path::new("x.rc")).unwrap();
+        assert_eq!(nets[0].tree_sinks(), 1);
+        assert_eq!(nets[0].points.len(), 3);
+        assert!((nets[0].total_cap_pf() - 0.0035).abs() < 1e-15);
+        assert!(!write_spef("top", &nets).contains("ERROR"));
     }
 
     #[test]
