@@ -273,6 +273,7 @@ pub fn run(
             path: dir.join("log/drc.log"),
         })?;
     let drc_rules = if drc_errors > 0 {
+        project.continue_after_drc()?;
         project.drc_reasons()?
     } else {
         vec![]

@@ -28,10 +28,9 @@ fn write(path: &Path, text: &str) -> Result<()> {
 
 impl Project {
     /// A fresh project in `dir` (removed first if present) holding `netlist`.
+    /// `dir` and the technology's paths must be absolute: qflow's scripts run in the
+    /// project's subdirectories (the flow resolves them once, at its entry).
     pub fn create(dir: &Path, top: &str, tech: &TechFiles, netlist: &Path) -> Result<Project> {
-        // qflow's scripts run in the project's subdirectories: every path they are given
-        // must be absolute (a relative `--cache` failed in the netlist conversion).
-        let dir = &std::path::absolute(dir).map_err(|e| LayoutError::io("resolving", dir, e))?;
         if dir.exists() {
             std::fs::remove_dir_all(dir).map_err(|e| LayoutError::io("removing", dir, e))?;
         }
@@ -129,8 +128,7 @@ impl Project {
 
     /// magic's reasons for the DRC errors of the routed macro: each rule broken and how
     /// many boxes break it (`drc listall why` on the layout database the DRC stage
-    /// checked), then a line in the DRC log so qflow's GDS stage, which refuses to run
-    /// after a log ending in "error condition", writes the (dirty) GDS the report shows.
+    /// checked).
     pub fn drc_reasons(&self) -> Result<Vec<DrcRule>> {
         let magic = Tool::Magic.locate()?;
         let script = self
@@ -152,13 +150,17 @@ impl Project {
             .current_dir(self.dir.join("layout"))
             .output()
             .map_err(|e| LayoutError::io("running", &magic, e))?;
-        let text = String::from_utf8_lossy(&out.stdout);
-        let rules = parse_drc_reasons(&text);
+        Ok(parse_drc_reasons(&String::from_utf8_lossy(&out.stdout)))
+    }
+
+    /// Lets qflow's later stages run after a DRC failure: its GDS stage refuses to run
+    /// after a DRC log ending in "error condition", so a line saying where the errors went
+    /// (the report) ends the log instead.
+    pub fn continue_after_drc(&self) -> Result<()> {
         let log = self.dir.join("log").join("drc.log");
-        let mut old = std::fs::read_to_string(&log).unwrap_or_default();
-        old.push_str("tofprobe: the DRC errors are in the layout report; LVS and GDS continue.\n");
-        write(&log, &old)?;
-        Ok(rules)
+        let mut text = std::fs::read_to_string(&log).unwrap_or_default();
+        text.push_str("tofprobe: the DRC errors are in the layout report; LVS and GDS continue.\n");
+        write(&log, &text)
     }
 
     /// A file of the layout directory: `layout/TOP.EXT`.
