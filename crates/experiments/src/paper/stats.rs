@@ -17,6 +17,7 @@
 //!   noise rows use the larger of the measured sd and this prediction.
 
 use tofprobe_dsp::Window;
+use tofprobe_dsp::closed_form::horner;
 
 /// The seeds of every Table 2 row (≥ 5).
 pub const SEEDS: &[u64] = &[0, 1, 2, 3, 4];
@@ -53,37 +54,50 @@ pub fn floor_rel_sd(m: usize, w: Window) -> f64 {
 fn bessel_i01_scaled(y: f64) -> (f64, f64) {
     if y <= 3.75 {
         let t = (y / 3.75).powi(2);
-        let i0 = 1.0
-            + t * (3.5156229
-                + t * (3.0899424
-                    + t * (1.2067492 + t * (0.2659732 + t * (0.0360768 + t * 0.0045813)))));
-        let i1 = y
-            * (0.5
-                + t * (0.87890594
-                    + t * (0.51498869
-                        + t * (0.15084934
-                            + t * (0.02658733 + t * (0.00301532 + t * 0.00032411))))));
+        let i0 = horner(t, &I0_SMALL);
+        let i1 = y * horner(t, &I1_SMALL);
         let e = (-y).exp();
         (i0 * e, i1 * e)
     } else {
         let u = 3.75 / y;
-        let i0 = 0.39894228
-            + u * (0.01328592
-                + u * (0.00225319
-                    + u * (-0.00157565
-                        + u * (0.00916281
-                            + u * (-0.02057706
-                                + u * (0.02635537 + u * (-0.01647633 + u * 0.00392377)))))));
-        let i1 = 0.39894228
-            + u * (-0.03988024
-                + u * (-0.00362018
-                    + u * (0.00163801
-                        + u * (-0.01031555
-                            + u * (0.02282967
-                                + u * (-0.02895312 + u * (0.01787654 - u * 0.00420059)))))));
+        let i0 = horner(u, &I0_LARGE);
+        let i1 = horner(u, &I1_LARGE);
         (i0 / y.sqrt(), i1 / y.sqrt())
     }
 }
+
+/// Abramowitz & Stegun 9.8.1: I0(y) = Σ cₖ (y/3.75)^(2k), |y| ≤ 3.75.
+const I0_SMALL: [f64; 7] = [
+    1.0, 3.5156229, 3.0899424, 1.2067492, 0.2659732, 0.0360768, 0.0045813,
+];
+/// 9.8.3: I1(y)/y = Σ cₖ (y/3.75)^(2k), |y| ≤ 3.75.
+const I1_SMALL: [f64; 7] = [
+    0.5, 0.87890594, 0.51498869, 0.15084934, 0.02658733, 0.00301532, 0.00032411,
+];
+/// 9.8.2: √y e^(−y) I0(y) = Σ cₖ (3.75/y)^k, y ≥ 3.75.
+const I0_LARGE: [f64; 9] = [
+    0.39894228,
+    0.01328592,
+    0.00225319,
+    -0.00157565,
+    0.00916281,
+    -0.02057706,
+    0.02635537,
+    -0.01647633,
+    0.00392377,
+];
+/// 9.8.4: √y e^(−y) I1(y) = Σ cₖ (3.75/y)^k, y ≥ 3.75.
+const I1_LARGE: [f64; 9] = [
+    0.39894228,
+    -0.03988024,
+    -0.00362018,
+    0.00163801,
+    -0.01031555,
+    0.02282967,
+    -0.02895312,
+    0.01787654,
+    -0.00420059,
+];
 
 /// E|A + n| for a tone of amplitude `a` plus complex Gaussian noise whose mean magnitude
 /// (the noise floor) is `floor`: the Rician mean s·sqrt(π/2)·L_½(−ν), ν = A²/(2s²),
