@@ -51,7 +51,7 @@ pub fn build(rtl_dir: &Path, top: &str, profile: BuildProfile) -> Result<Harness
         let cpp = tmp.join("array_harness.cpp");
         std::fs::write(&cpp, ARRAY_HARNESS_CPP).map_err(|e| CosimError::io(&cpp, e))?;
         let cflags = "-DTOP_HEADER='\"Vtop.h\"' -DTOP_CLASS=Vtop";
-        verilate(&verilator, tmp, top, profile, cflags, &[], &srcs, &cpp)
+        verilate(&verilator, tmp, top, profile, cflags, &[], &srcs, &cpp).map(|_| ())
     })?;
     Ok(HarnessBuild {
         exe,

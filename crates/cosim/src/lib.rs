@@ -12,6 +12,7 @@ pub mod harness;
 pub mod icarus;
 pub mod junit;
 pub mod random;
+mod runtime;
 pub mod soak;
 pub mod tools;
 pub mod verilator;

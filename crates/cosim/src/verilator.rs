@@ -171,6 +171,7 @@ pub fn build_with(
         verilate(
             &verilator, tmp, top, profile, &cflags, &extra, &sources, &cpp,
         )
+        .map(|_| ())
     })?;
     Ok(HarnessBuild {
         exe,
@@ -209,7 +210,10 @@ pub(crate) fn build_key(
 
 /// Verilates `sources` with the harness `cpp` (top `top`, the class `Vtop`) into the
 /// executable `tmp/harness`, compiled at `profile`'s optimisation with `cflags` and the
-/// `extra` Verilator options; the object directory is removed afterwards.
+/// `extra` Verilator options; the object directory is removed afterwards. `tmp` is a
+/// directory of the cache root ([`cached_entry`]): the run-time library's objects are
+/// shared through that root ([`crate::runtime`]), so Verilator only generates and make
+/// is run here. Returns whether those objects came from the cache.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn verilate(
     verilator: &Path,
@@ -220,10 +224,10 @@ pub(crate) fn verilate(
     extra: &[&str],
     sources: &[PathBuf],
     cpp: &Path,
-) -> Result<(), CosimError> {
+) -> Result<bool, CosimError> {
     let obj = tmp.join("obj");
     let out = Command::new(verilator)
-        .args(["--cc", "--exe", "--build", "-j", "2", "--prefix", "Vtop"])
+        .args(["--cc", "--exe", "--prefix", "Vtop"])
         .args(VERILATOR_FLAGS)
         .args(["--top-module", top, "-Mdir"])
         .arg(&obj)
@@ -235,32 +239,52 @@ pub(crate) fn verilate(
                 BuildProfile::Speed => "-O2",
             }
         ))
-        .arg("-MAKEFLAGS")
-        .arg(match profile {
-            // CI: verilator's C++ compile dominates, so compile cheaply.
-            BuildProfile::Check => "OPT_FAST=-O1 OPT_SLOW=-O0 OPT_GLOBAL=-O1",
-            BuildProfile::Speed => "OPT_FAST=-O2 OPT_SLOW=-O1 OPT_GLOBAL=-O2",
-        })
         .args(extra)
         .args(sources)
         .arg(cpp)
         .output()
         .map_err(|e| CosimError::io(verilator, e))?;
-    if !out.status.success() {
-        return Err(CosimError::ToolFailed {
-            tool: "verilator",
-            status: out.status.to_string(),
-            output: format!(
-                "{}{}",
-                String::from_utf8_lossy(&out.stdout),
-                String::from_utf8_lossy(&out.stderr)
-            ),
-        });
+    tool_succeeded("verilator", &out)?;
+    let make_flags: &[&str] = match profile {
+        // CI: verilator's C++ compile dominates, so compile cheaply.
+        BuildProfile::Check => &["OPT_FAST=-O1", "OPT_SLOW=-O0", "OPT_GLOBAL=-O1"],
+        BuildProfile::Speed => &["OPT_FAST=-O2", "OPT_SLOW=-O1", "OPT_GLOBAL=-O2"],
+    };
+    let runtime = tmp
+        .parent()
+        .and_then(|root| crate::runtime::seed(root, verilator, &obj, tmp, make_flags));
+    let out = Command::new("make")
+        .arg("-C")
+        .arg(&obj)
+        .args(["-f", "Vtop.mk", "-j", "2"])
+        .args(make_flags)
+        .output()
+        .map_err(|e| CosimError::io(Path::new("make"), e))?;
+    tool_succeeded("make", &out)?;
+    let reused = runtime.as_ref().is_some_and(|r| r.reused);
+    if let Some(r) = runtime {
+        r.publish(&obj);
     }
     let built = obj.join("harness");
     std::fs::rename(&built, tmp.join("harness")).map_err(|e| CosimError::io(&built, e))?;
     let _ = std::fs::remove_dir_all(&obj);
-    Ok(())
+    Ok(reused)
+}
+
+/// A tool's failure with its output, or nothing.
+fn tool_succeeded(tool: &'static str, out: &std::process::Output) -> Result<(), CosimError> {
+    if out.status.success() {
+        return Ok(());
+    }
+    Err(CosimError::ToolFailed {
+        tool,
+        status: out.status.to_string(),
+        output: format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        ),
+    })
 }
 
 /// The cache entry `root/<hash>` (an executable `harness` and its checksum): reused when
@@ -357,5 +381,80 @@ mod tests {
         assert!(!root.join("j").exists());
         assert!(!cached_entry(&root, "j", build).unwrap().1);
         let _ = std::fs::remove_dir_all(&root);
+    }
+
+    /// The run-time library objects shared between builds ([`crate::runtime`]): a first
+    /// build compiles and publishes them, a build of another design with the same flags
+    /// links them from the cache, and its executable is byte-identical to the one of a
+    /// build that compiled them itself (a fresh root). (That other flags key another entry
+    /// is `runtime::tests::the_key_ignores_the_build_directory_but_not_the_flags`.)
+    #[test]
+    fn library_objects_are_shared_and_change_no_byte() {
+        if !tofprobe_testkit::tools::have(&["verilator", "make"], "library_objects_are_shared") {
+            return;
+        }
+        let verilator = tofprobe_testkit::tools::find("verilator").unwrap();
+        let base = std::env::temp_dir().join(format!("tofprobe-vrt-build-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&base);
+        let src = base.join("src");
+        std::fs::create_dir_all(&src).unwrap();
+        let design = |n: u32| {
+            let v = src.join(format!("top{n}.v"));
+            std::fs::write(
+                &v,
+                format!(
+                    "module top(input wire clk, output reg [7:0] q);\n\
+                     initial q = 0;\n\
+                     always @(posedge clk) q <= q + 8'd{n};\nendmodule\n"
+                ),
+            )
+            .unwrap();
+            v
+        };
+        let cpp = src.join("main.cpp");
+        std::fs::write(
+            &cpp,
+            "#include \"Vtop.h\"\n#include \"verilated.h\"\n\
+             int main(int argc, char** argv) { VerilatedContext c; c.commandArgs(argc, argv);\n\
+             Vtop t(&c); for (int i = 0; i < 6; i++) { t.clk = !t.clk; t.eval(); }\n\
+             return t.q > 0 && t.q % 5 == 0 ? 0 : 1; }\n",
+        )
+        .unwrap();
+        let build = |root: &Path, name: &str, v: &Path, extra: &[&str]| {
+            let tmp = root.join(name);
+            std::fs::create_dir_all(&tmp).unwrap();
+            let reused = verilate(
+                &verilator,
+                &tmp,
+                "top",
+                BuildProfile::Check,
+                "",
+                extra,
+                &[v.to_path_buf()],
+                &cpp,
+            )
+            .expect("builds");
+            (std::fs::read(tmp.join("harness")).unwrap(), reused)
+        };
+        let (root_a, root_b) = (base.join("a"), base.join("b"));
+        let (_, reused) = build(&root_a, "first", &design(1), &[]);
+        assert!(!reused, "an empty cache has no objects to lend");
+        let five = design(5);
+        let (shared, reused) = build(&root_a, "second", &five, &[]);
+        assert!(
+            reused,
+            "another design with the same flags links the shared objects"
+        );
+        let (fresh, reused) = build(&root_b, "fresh", &five, &[]);
+        assert!(!reused);
+        assert!(shared == fresh, "shared objects changed the executable");
+        let ran = Command::new(root_a.join("second").join("harness"))
+            .status()
+            .unwrap();
+        assert!(
+            ran.success(),
+            "the linked harness runs: q a positive multiple of 5"
+        );
+        let _ = std::fs::remove_dir_all(&base);
     }
 }
