@@ -286,7 +286,11 @@ fn cache_key(
         ..spec.clone()
     };
     let models_role = Path::new("icg_models.v");
-    h.feed(recipe.script(&roles, models.map(|_| models_role)).as_bytes());
+    h.feed(
+        recipe
+            .script(&roles, models.map(|_| models_role))
+            .as_bytes(),
+    );
     for path in spec.rtl.iter().chain([&spec.netlist, &spec.liberty]) {
         let bytes = std::fs::read(path).map_err(|e| EdaError::io("reading", path, e))?;
         h.feed(&bytes);
@@ -485,7 +489,11 @@ mod tests {
         assert_eq!(Recipe::of(&spec(&latch)).unwrap(), Recipe::Latch);
         let s = Recipe::Latch.script(&spec(&latch), Some(Path::new("icg.v")));
         // Both sides: latches by async2sync, flops by clk2fflogic, in that order.
-        assert_eq!(s.matches("async2sync\ndffunmap\nclk2fflogic\n").count(), 2, "{s}");
+        assert_eq!(
+            s.matches("async2sync\ndffunmap\nclk2fflogic\n").count(),
+            2,
+            "{s}"
+        );
         // Gold keeps ports and register outputs; gate keeps the netlist's own names.
         assert!(s.contains("rename -hide w:* x:* %d t:* %co1:+[Q] w:* %i %d\n"));
         assert!(s.contains("setattr -set tofprobe_net 1 pix/w:*\nprep -top pix -flatten\n"));
@@ -493,7 +501,12 @@ mod tests {
         assert!(s.ends_with("equiv_induct -seq 2\nequiv_status -assert\n"));
         assert_ne!(Recipe::Latch.cache_tag(), Recipe::Flops.cache_tag());
         let missing = spec(&dir.join("absent.v"));
-        assert!(Recipe::of(&missing).unwrap_err().to_string().contains("absent.v"));
+        assert!(
+            Recipe::of(&missing)
+                .unwrap_err()
+                .to_string()
+                .contains("absent.v")
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
