@@ -6,8 +6,9 @@
 //! register-to-register logic delay of the pixel in isolation: an optimistic f_max. With a
 //! clock-gated register file the clock propagates through the gates (ideal: no insertion
 //! delay), the integrated gate's enable is checked like a flop's D, and a latch-and-AND
-//! gate adds OpenSTA's clock-gating checks on the AND, launched half a cycle later (see
-//! [`parse_report`]).
+//! gate adds OpenSTA's clock-gating checks on the AND, launched half a cycle later — or,
+//! for a gate on the inverted clock (a latch register file's), captured half a cycle
+//! earlier (see [`parse_report`]).
 
 use crate::error::{EdaError, Result};
 use crate::fsutil::write_atomic;
