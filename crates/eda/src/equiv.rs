@@ -21,6 +21,20 @@
 //! unproven `cg_<r>.en_l` pair. An integrated clock-gating cell is read as the behaviour its
 //! liberty declares (`latch_posedge`: latch open while CLK is low, AND with CLK), so the
 //! proof covers the netlist's wiring of the cells, not the cells' transistors.
+//!
+//! A latch register file (`register_file = "latch"`, the RTL carries
+//! [`crate::latch::MARKER`]) is proven by its own script, [`latch_equiv_script`]: SAT steps
+//! `$dff`/`$ff` only, so both sides are first put on one global step — `async2sync` turns
+//! each latch (`$dlatch`, and the liberty's latch cells as read) into "Q = EN ? D : Q of
+//! the step before", and `clk2fflogic` each flop into "Q = D of the step before where `clk`
+//! rose between the steps, else Q of the step before" — so `clk` is an input like any
+//! other, its two phases are steps, and a latch open in the wrong phase or on the wrong
+//! enable differs. Names are paired for state and ports only (registers, latches, the
+//! clock gates' enable latches, inputs and outputs), not combinational wires: synthesis
+//! may leave a wire's name on a net that carries it only where it is read (a Haar
+//! pixel's `h_new` becomes `tdc` because it is read only when `valid`), which is no state
+//! and would stay unproven. `equiv_induct` proves the pairs by induction over the
+//! register correspondence.
 
 use crate::error::{EdaError, Result};
 use crate::fsutil::{Fnv64, write_atomic};
@@ -114,6 +128,107 @@ pub fn equiv_script_with(spec: &EquivSpec, icg_models: Option<&Path>) -> String 
     s
 }
 
+/// Which script proves a netlist: it follows the RTL's register file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Recipe {
+    /// Flops, plain or clock-gated: [`equiv_script_with`].
+    Flops,
+    /// A latch register file: [`latch_equiv_script`].
+    Latch,
+}
+
+impl Recipe {
+    /// The recipe for `spec`: [`Recipe::Latch`] when one of its RTL sources is a pixel
+    /// rendered with `register_file = "latch"` ([`crate::latch::in_source`], as synthesis
+    /// decides to map latches).
+    pub fn of(spec: &EquivSpec) -> Result<Self> {
+        for src in &spec.rtl {
+            let text = std::fs::read_to_string(src).map_err(|e| EdaError::io("reading", src, e))?;
+            if crate::latch::in_source(&text) {
+                return Ok(Self::Latch);
+            }
+        }
+        Ok(Self::Flops)
+    }
+
+    /// The yosys script of this recipe for `spec` (`icg_models` as [`equiv_script_with`]).
+    pub fn script(self, spec: &EquivSpec, icg_models: Option<&Path>) -> String {
+        match self {
+            Self::Flops => equiv_script_with(spec, icg_models),
+            Self::Latch => latch_equiv_script(spec, icg_models),
+        }
+    }
+
+    /// The cache key's tag: a latch proof never reuses a verdict cached for the other
+    /// script (nor one cached before this recipe existed, which failed).
+    fn cache_tag(self) -> &'static [u8] {
+        match self {
+            Self::Flops => b"tofprobe-equiv-v1",
+            Self::Latch => b"tofprobe-equiv-latch-v1",
+        }
+    }
+}
+
+/// The yosys script proving a latch register file's netlist (see the module header).
+///
+/// Gold: the coarse RTL as in [`equiv_script_with`], with every wire that is neither a port
+/// nor driven by a register's or latch's `Q` renamed private (`rename -hide`), so that
+/// `equiv_make` pairs state and ports only. Gate: the netlist with the liberty's functions
+/// (and `icg_models`); the wires the liberty cells' flattening adds (`<inst>.DS0000`,
+/// `<inst>.A`) are renamed private likewise, so the netlist's own name of each net (`y[1]`,
+/// `wd_0`) is the one pairs are made on. Then `async2sync; dffunmap; clk2fflogic` on both.
+pub fn latch_equiv_script(spec: &EquivSpec, icg_models: Option<&Path>) -> String {
+    let top = &spec.top;
+    let mut s = String::new();
+    for src in &spec.rtl {
+        s += &format!("read_verilog -sv {}\n", src.display());
+    }
+    if !spec.params.is_empty() {
+        s += "chparam";
+        for (k, v) in &spec.params {
+            s += &format!(" -set {k} {v}");
+        }
+        s += &format!(" {top}\n");
+    }
+    s += &format!(
+        "synth -top {top} -flatten -run begin:fine\n\
+         rename -hide w:* x:* %d t:* %co1:+[Q] w:* %i %d\n\
+         async2sync\n\
+         dffunmap\n\
+         clk2fflogic\n\
+         memory_map\n\
+         opt_clean\n\
+         rename {top} gold\n\
+         design -stash gold\n\
+         read_liberty -ignore_miss_func {lib}\n\
+         {icg}read_verilog {net}\n\
+         hierarchy -top {top}\n\
+         setattr -set tofprobe_net 1 {top}/w:*\n\
+         prep -top {top} -flatten\n\
+         rename -hide w:* a:tofprobe_net %d\n\
+         async2sync\n\
+         dffunmap\n\
+         clk2fflogic\n\
+         opt_clean\n\
+         rename {top} gate\n\
+         design -stash gate\n\
+         design -copy-from gold -as gold gold\n\
+         design -copy-from gate -as gate gate\n\
+         equiv_make gold gate equiv\n\
+         hierarchy -top equiv\n\
+         equiv_simple -seq 2\n\
+         equiv_induct -seq 2\n\
+         equiv_status -assert\n",
+        lib = spec.liberty.display(),
+        net = spec.netlist.display(),
+        icg = icg_models.map_or(String::new(), |m| format!(
+            "read_verilog -overwrite {}\n",
+            m.display()
+        )),
+    );
+    s
+}
+
 /// Parses `equiv_status`: (points, unproven, first unproven pair).
 pub fn parse_status(log: &str) -> Option<(u64, u64, String)> {
     let pos = log.rfind("Executing EQUIV_STATUS pass")?;
@@ -153,9 +268,14 @@ pub fn equiv_cache_dir() -> PathBuf {
 /// The cache key of `spec`: everything the proof's outcome depends on — the yosys version,
 /// the script (with the files named by role, their paths do not matter), and the bytes of
 /// the RTL sources, the netlist, the liberty and the clock-gate models read with it.
-fn cache_key(spec: &EquivSpec, yosys: &Path, models: Option<&str>) -> Result<String> {
+fn cache_key(
+    spec: &EquivSpec,
+    recipe: Recipe,
+    yosys: &Path,
+    models: Option<&str>,
+) -> Result<String> {
     let mut h = Fnv64::default();
-    h.feed(b"tofprobe-equiv-v1")
+    h.feed(recipe.cache_tag())
         .feed(crate::synth::yosys_version(yosys).as_bytes());
     let roles = EquivSpec {
         rtl: (0..spec.rtl.len())
@@ -166,7 +286,11 @@ fn cache_key(spec: &EquivSpec, yosys: &Path, models: Option<&str>) -> Result<Str
         ..spec.clone()
     };
     let models_role = Path::new("icg_models.v");
-    h.feed(equiv_script_with(&roles, models.map(|_| models_role)).as_bytes());
+    h.feed(
+        recipe
+            .script(&roles, models.map(|_| models_role))
+            .as_bytes(),
+    );
     for path in spec.rtl.iter().chain([&spec.netlist, &spec.liberty]) {
         let bytes = std::fs::read(path).map_err(|e| EdaError::io("reading", path, e))?;
         h.feed(&bytes);
@@ -208,14 +332,15 @@ pub fn check_equivalence_cached(
     let netlist = std::fs::read_to_string(&spec.netlist)
         .map_err(|e| EdaError::io("reading", &spec.netlist, e))?;
     let models = crate::clock_gate::icg_models(&lib, &netlist);
+    let recipe = Recipe::of(spec)?;
     let entry = match cache {
-        Some(dir) => Some(dir.join(cache_key(spec, &yosys, models.as_deref())?)),
+        Some(dir) => Some(dir.join(cache_key(spec, recipe, &yosys, models.as_deref())?)),
         None => None,
     };
     if let Some(hit) = entry.as_deref().and_then(read_entry) {
         return Ok(hit);
     }
-    let proven = prove(spec, work, &yosys, models.as_deref())?;
+    let proven = prove(spec, recipe, work, &yosys, models.as_deref())?;
     if let Some(dir) = &entry {
         store_entry(dir, &proven)?;
     }
@@ -249,7 +374,13 @@ fn store_entry(dir: &Path, proven: &Equivalence) -> Result<()> {
 }
 
 /// Runs yosys's proof of `spec` in `work`.
-fn prove(spec: &EquivSpec, work: &Path, yosys: &Path, models: Option<&str>) -> Result<Equivalence> {
+fn prove(
+    spec: &EquivSpec,
+    recipe: Recipe,
+    work: &Path,
+    yosys: &Path,
+    models: Option<&str>,
+) -> Result<Equivalence> {
     let models_path = work.join("icg_models.v");
     if let Some(m) = models {
         write_atomic(&models_path, m.as_bytes())?;
@@ -257,7 +388,9 @@ fn prove(spec: &EquivSpec, work: &Path, yosys: &Path, models: Option<&str>) -> R
     let script = work.join("equiv.ys");
     write_atomic(
         &script,
-        equiv_script_with(spec, models.map(|_| models_path.as_path())).as_bytes(),
+        recipe
+            .script(spec, models.map(|_| models_path.as_path()))
+            .as_bytes(),
     )?;
     let log_path = work.join("equiv.log");
     let start = std::time::Instant::now();
@@ -331,5 +464,49 @@ mod tests {
         assert!(s.contains("synth -top pix -flatten -run begin:fine"));
         assert!(s.contains("read_liberty -ignore_miss_func c.lib\nread_verilog n.v"));
         assert!(s.ends_with("equiv_status -assert\n"));
+        assert!(!s.contains("clk2fflogic"), "the flop script is unchanged");
+    }
+
+    #[test]
+    fn latch_recipe_steps_both_sides_on_one_clock_and_pairs_state_only() {
+        let dir = std::env::temp_dir().join(format!("tofprobe-recipe-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (flops, latch) = (dir.join("flops.v"), dir.join("latch.v"));
+        std::fs::write(&flops, "// Register file: flops\nmodule pix; endmodule\n").unwrap();
+        std::fs::write(
+            &latch,
+            format!("// {}\nmodule pix; endmodule\n", crate::latch::MARKER),
+        )
+        .unwrap();
+        let spec = |rtl: &Path| EquivSpec {
+            rtl: vec![rtl.to_path_buf()],
+            top: "pix".into(),
+            params: vec![],
+            netlist: "n.v".into(),
+            liberty: "c.lib".into(),
+        };
+        assert_eq!(Recipe::of(&spec(&flops)).unwrap(), Recipe::Flops);
+        assert_eq!(Recipe::of(&spec(&latch)).unwrap(), Recipe::Latch);
+        let s = Recipe::Latch.script(&spec(&latch), Some(Path::new("icg.v")));
+        // Both sides: latches by async2sync, flops by clk2fflogic, in that order.
+        assert_eq!(
+            s.matches("async2sync\ndffunmap\nclk2fflogic\n").count(),
+            2,
+            "{s}"
+        );
+        // Gold keeps ports and register outputs; gate keeps the netlist's own names.
+        assert!(s.contains("rename -hide w:* x:* %d t:* %co1:+[Q] w:* %i %d\n"));
+        assert!(s.contains("setattr -set tofprobe_net 1 pix/w:*\nprep -top pix -flatten\n"));
+        assert!(s.contains("read_verilog -overwrite icg.v\nread_verilog n.v\n"));
+        assert!(s.ends_with("equiv_induct -seq 2\nequiv_status -assert\n"));
+        assert_ne!(Recipe::Latch.cache_tag(), Recipe::Flops.cache_tag());
+        let missing = spec(&dir.join("absent.v"));
+        assert!(
+            Recipe::of(&missing)
+                .unwrap_err()
+                .to_string()
+                .contains("absent.v")
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -6,8 +6,9 @@
 //! register-to-register logic delay of the pixel in isolation: an optimistic f_max. With a
 //! clock-gated register file the clock propagates through the gates (ideal: no insertion
 //! delay), the integrated gate's enable is checked like a flop's D, and a latch-and-AND
-//! gate adds OpenSTA's clock-gating checks on the AND, launched half a cycle later (see
-//! [`parse_report`]).
+//! gate adds OpenSTA's clock-gating checks on the AND, launched half a cycle later — or,
+//! for a gate on the inverted clock (a latch register file's), captured half a cycle
+//! earlier (see [`parse_report`]).
 
 use crate::error::{EdaError, Result};
 use crate::fsutil::write_atomic;
@@ -118,9 +119,10 @@ pub fn parse_report(text: &str) -> Result<Timing> {
 }
 
 /// One path of `report_checks`. Its minimum clock period scales with where in the cycle it
-/// is launched: a path launched at time L of the probe period P (a clock gate's latch opens
-/// on the falling edge, L = P/2) and closing at P with slack s needs (P − L − s)·P/(P − L);
-/// for a flop-to-flop path (L = 0) that is P − s = arrival + setup.
+/// is launched and captured: a path launched at time L of the probe period P (a clock
+/// gate's latch opens on the falling edge, L = P/2) and captured at C (P, or P/2 for the
+/// gating check of a gate on the inverted clock) with slack s needs (C − L − s)·P/(C − L);
+/// for a flop-to-flop path (L = 0, C = P) that is P − s = arrival + setup.
 fn parse_path(text: &str) -> Result<Timing> {
     let err = |what| EdaError::Parse {
         tool: "sta",
@@ -162,6 +164,18 @@ fn parse_path(text: &str) -> Result<Timing> {
         })
         .count()
         .saturating_sub(2) as u32;
+    // The capturing edge: the first clock edge line after the arrival. A check is usually
+    // required at the period's end (P), but a latch-and-AND gate on the inverted clock
+    // (a latch register file's gates) has its gating check launched at the rising edge,
+    // when its enable latch opens, and required at the falling edge (P/2), when the AND's
+    // clock input rises: that path has half a period, not P.
+    let capture = text[arrival_idx..]
+        .lines()
+        .find(|l| l.contains(" clock ") && l.trim_end().ends_with("edge)"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|c| *c > launch && *c <= PROBE_PERIOD_NS)
+        .unwrap_or(PROBE_PERIOD_NS);
     let open = PROBE_PERIOD_NS - launch;
     // A latch endpoint (a latch-and-AND clock gate's enable latch, open while clk is low):
     // OpenSTA requires the data at the opening edge and lets it borrow up to the closing
@@ -173,9 +187,10 @@ fn parse_path(text: &str) -> Result<Timing> {
         .last()
         .and_then(|l| l.split_whitespace().next())
         .and_then(|v| v.parse::<f64>().ok());
+    let window = capture - launch;
     let critical = match (latch_endpoint, arrival) {
         (true, Some(a)) => (a - launch) * PROBE_PERIOD_NS / open,
-        _ => (open - slack) * PROBE_PERIOD_NS / open,
+        _ => (window - slack) * PROBE_PERIOD_NS / window,
     };
     // The report prints 4 digits; round away the binary noise of 1000 − slack.
     let critical = (critical * 1e4).round() / 1e4;
@@ -272,6 +287,38 @@ Path Group: **clock_gating_default**
             "{}",
             t.critical_path_ns
         );
+    }
+
+    /// The gating check of a latch register file's gate on osu018 (OpenSTA 2.0.17): the gate
+    /// is on the inverted clock, so its enable latch opens at the rising edge and the AND's
+    /// clock input rises at the falling edge: required at P/2 (it read as a 500 ns path).
+    #[test]
+    fn inverted_clock_gating_check_is_captured_half_a_period_later() {
+        let inverted =
+            "Startpoint: cg_0.enable_latch (positive level-sensitive latch clocked by clk)
+Endpoint: cg_0.clk_and (rising clock gating-check end-point clocked by clk')
+Path Group: **clock_gating_default**
+    Delay      Time   Description
+   0.0000    0.0000   clock clk (rise edge)
+   0.0000    0.0000   clock network delay (ideal)
+   0.1590    0.1590   time given to startpoint
+   0.0000    0.1590 v cg_0.enable_latch/D (LATCH)
+   0.1712    0.3302 v cg_0.enable_latch/Q (LATCH)
+   0.0000    0.3302 v cg_0.clk_and/B (AND2X1)
+             0.3302   data arrival time
+ 500.0000  500.0000   clock clk' (rise edge)
+   0.0000  500.0000   clock gating setup time
+           500.0000   data required time
+           499.6698   slack (MET)
+";
+        // 0.3302 ns in half a period needs 0.6604 ns (= 2 × (500 − 499.6698)), not 500.33.
+        let t = parse_report(inverted).unwrap();
+        assert!(
+            (t.critical_path_ns - 0.6604).abs() < 1e-9,
+            "{}",
+            t.critical_path_ns
+        );
+        assert_eq!(t.endpoint, "cg_0.clk_and");
     }
 
     #[test]

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use tofprobe_eda::EdaError;
 use tofprobe_eda::analysis::RtlProvider;
-use tofprobe_eda::equiv::{EquivSpec, check_equivalence_cached};
+use tofprobe_eda::equiv::{EquivSpec, Recipe, check_equivalence_cached};
 use tofprobe_eda::generated::GeneratedPixel;
 use tofprobe_eda::pdk::Sky130Pdk;
 use tofprobe_eda::signoff::{
@@ -223,4 +223,116 @@ fn sky130_netlist_signs_off_and_a_broken_one_does_not() {
         .expect("sky130_fd_sc_hd PDK (../shared/pdk/sky130_fd_sc_hd or $TOFPROBE_SKY130_PDK)");
     let lib = SignoffLibrary::sky130(&pdk, &cache("sky130")).unwrap();
     signs_off_and_catches_a_broken_gate(&lib, "sky130_fd_sc_hd__inv_1", "sky130");
+}
+
+/// `netlist` with the pin `pin` of the cell driving `.Q(q)` connected to what that pin of
+/// the cell driving `.Q(donor)` is connected to: one latch wired to another latch's enable
+/// (or data).
+fn rewire_latch(netlist: &Path, q: &str, donor: &str, pin: &str, out: &Path) {
+    let text = std::fs::read_to_string(netlist).unwrap();
+    // The instance whose port list ends at `.Q(q)`: from the `(` after its name to there.
+    let span = |q: &str| {
+        let end = text
+            .find(&format!(".Q({q})"))
+            .unwrap_or_else(|| panic!("{q}"));
+        (text[..end].rfind(" (\n").unwrap(), end)
+    };
+    let net_of = |(start, end): (usize, usize)| {
+        let at = start + text[start..end].find(&format!(".{pin}(")).expect(pin) + pin.len() + 2;
+        // A net name has no `)` (escaped identifiers end at a blank).
+        (at, at + text[at..].find(')').unwrap())
+    };
+    let (at, to) = net_of(span(q));
+    let (d_at, d_to) = net_of(span(donor));
+    assert_ne!(
+        text[at..to],
+        text[d_at..d_to],
+        "{q} and {donor} share {pin}"
+    );
+    let broken = format!("{}{}{}", &text[..at], &text[d_at..d_to], &text[to..]);
+    std::fs::create_dir_all(out.parent().unwrap()).unwrap();
+    std::fs::write(out, broken).unwrap();
+}
+
+/// A latch register file (issue 30 point 4) on a small generated pixel (B = 2: 4 registers
+/// of W = 10 latches, A = 2 adders): the netlist is proven equivalent (every point), and
+/// the same netlist with one latch (`y[1]` bit 5) on register 2's gated clock, or on bit
+/// 6's data, is not — the first unproven point is that bit, and it is the only one.
+fn latch_pixel_is_proven_and_a_miswired_latch_is_not(liberty: &Path, enable: &str, name: &str) {
+    let px = GeneratedPixel {
+        base: PixelParams {
+            bins: 2,
+            tdc_bits: 4,
+            frac_bits: 2,
+            width: 10,
+            frame_pulses: 1024,
+            rom_depth: 16,
+            register_file: tofprobe_pixel::RegisterFile::Latch,
+            ..PixelParams::default()
+        },
+    };
+    let v = px.rtl(2, 10, &cache(name).join("latch-rtl")).unwrap();
+    let syn = synthesise(
+        &SynthSpec {
+            sources: v.sources.clone(),
+            top: v.top.clone(),
+            params: v.params.clone(),
+            liberty: liberty.to_path_buf(),
+            delay_target_ps: Some(6250.0),
+            keep: vec!["we".into()],
+        },
+        &cache(name).join("latch-syn"),
+    )
+    .unwrap();
+    let work = cache(name).join("latch-equiv");
+    // No cache: each run is a proof of its own (the broken netlists must be proven too).
+    let prove = |netlist: PathBuf| {
+        let spec = EquivSpec {
+            rtl: v.sources.clone(),
+            top: v.top.clone(),
+            params: v.params.clone(),
+            netlist,
+            liberty: liberty.to_path_buf(),
+        };
+        assert_eq!(Recipe::of(&spec).unwrap(), Recipe::Latch);
+        check_equivalence_cached(&spec, &work, None)
+    };
+    let ok = prove(syn.netlist_verilog.clone()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    // Paired points: at least the 4 × 10 register latches, all proven.
+    assert!(ok.points >= 40 && ok.proven == ok.points, "{name}: {ok:?}");
+    for (what, donor, pin) in [
+        ("enable", "\\y[2] [5]", enable),
+        ("data", "\\y[1] [6]", "D"),
+    ] {
+        let broken = cache(name).join(format!("latch-broken-{what}/netlist.v"));
+        rewire_latch(&syn.netlist_verilog, "\\y[1] [5]", donor, pin, &broken);
+        match prove(broken) {
+            Err(EdaError::NotEquivalent(f)) => {
+                assert_eq!(
+                    (f.first.as_str(), f.unproven),
+                    ("\\y[1]_gold [5] \\y[1]_gate [5]", 1),
+                    "{name}, {what}: {f:?}"
+                );
+                assert_eq!(f.total, ok.points, "{name}, {what}");
+            }
+            other => panic!("{name}: the latch on the wrong {what} must fail: {other:?}"),
+        }
+    }
+}
+
+/// osu018: `LATCH` (enable `CLK`) behind each register's latch-and-AND clock gate.
+#[test]
+fn osu018_latch_netlist_is_proven_and_a_miswired_latch_is_not() {
+    latch_pixel_is_proven_and_a_miswired_latch_is_not(Path::new(OSU018_LIBERTY), "CLK", "osu018");
+}
+
+/// sky130: `dlxtp_1` (enable `GATE`) behind the integrated `dlclkp_1`, read as its
+/// `icg_models` (the liberty's `statetable` is no function `read_liberty` can read).
+#[test]
+fn sky130_latch_netlist_is_proven_and_a_miswired_latch_is_not() {
+    let pdk = Sky130Pdk::discover(None)
+        .unwrap()
+        .expect("sky130_fd_sc_hd PDK");
+    let lib = SignoffLibrary::sky130(&pdk, &cache("sky130-latch")).unwrap();
+    latch_pixel_is_proven_and_a_miswired_latch_is_not(&lib.liberty, "GATE", "sky130");
 }
