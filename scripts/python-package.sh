@@ -16,6 +16,8 @@ if ! command -v python3 >/dev/null 2>&1; then
   exit 0
 fi
 venv="$("$root/scripts/py-venv.sh")"
+# maturin must reuse the library crates `cargo test --release` built, not recompile them.
+"$root/scripts/python-features.sh" >&2
 target="${CARGO_TARGET_DIR:-$root/target}"
 wheels="$target/python-wheels"
 start=$(date +%s)
