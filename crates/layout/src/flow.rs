@@ -27,7 +27,8 @@ pub const AUTO_CLEANUP_MAX_CELLS: u64 = 5_000;
 /// Whether qrouter runs its stage 3, the cleanup that rips up and re-routes every routed
 /// net. Stages 1 and 2 (route, then rip up and re-route the failures) leave every net
 /// routed; stage 3 shortens the wires and removes defects stage 2 can leave (the default
-/// pixel's stage-2 route had 3 DRC errors and one open net, docs/layout.md).
+/// pixel's stage-2 route had 3 DRC errors and one open net, which the ECO re-route,
+/// `crate::repair`, clears by re-routing two nets; docs/layout.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RouteCleanup {
     /// On up to [`AUTO_CLEANUP_MAX_CELLS`] cells, off above.
