@@ -3,10 +3,11 @@
 //! on large pixels). The nets to repair are read from the checks' own output — the nets
 //! whose wires come near a DRC error box (`drc listall why`), and the nets netgen's
 //! `comp.out` lists as unmatched (a layout net named after a cell pin is mapped back to
-//! the DEF net on that pin) — and only those are ripped up (`remove net`) and routed
-//! again (`stage2 route NET`, which rips up and re-queues what blocks it, then `stage2`
-//! for those) on the routed DEF, which qrouter reads with its routes. DRC and LVS then
-//! run again, at most [`MAX_ROUNDS`] times.
+//! the DEF net on that pin) — and only those are re-routed: qrouter reads the routed DEF
+//! and, one net at a time, removes it (`remove net`) and routes it with stage 1, the other
+//! nets' wires nearby also declared as obstructions (stage 2 would route across read-in
+//! routes it cannot rip up: shorts). Only the re-routed nets are spliced into the DEF and
+//! RC files; DRC and LVS then run again, at most [`MAX_ROUNDS`] times.
 
 use crate::error::{LayoutError, Result};
 use crate::qflow::Checks;
@@ -111,11 +112,7 @@ pub fn eco_round(
     let (def, rc) = (project.layout_file("def"), project.layout_file("rc"));
     let script = layout.join(format!("{top}_eco.cfg"));
     let cfg = read(&project.layout_file("cfg"))?;
-    let fenced = if std::env::var_os("TOFPROBE_ECO_NO_FENCE").is_some() {
-        vec![]
-    } else {
-        fence(&def_nets(&read(&def)?), targets)
-    };
+    let fenced = fence(&def_nets(&read(&def)?), targets);
     std::fs::write(&script, eco_script(&cfg, top, targets, &fenced))
         .map_err(|e| LayoutError::io("writing", &script, e))?;
     let out = std::process::Command::new(&qrouter)

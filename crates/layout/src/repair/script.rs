@@ -95,7 +95,8 @@ pub fn fence(nets: &DefNets, targets: &BTreeSet<String>) -> Vec<String> {
 /// The qrouter script of one ECO round: the flow's router configuration `cfg` (LEF,
 /// layers, obstructions) without its `read_def` and routing commands, the `fence`
 /// obstructions, then the routed DEF read with its routes, the `nets` removed and routed
-/// again one by one, the ripped-up blockers routed, the DEF and RC files written as
+/// again one by one by stage 1 (a net that fails is tried again without the search mask),
+/// the count of nets left unrouted printed (`ECO failing: N`), the DEF and RC files written as
 /// `TOP_eco.def` and `TOP_eco.rc`.
 pub fn eco_script(cfg: &str, top: &str, nets: &BTreeSet<String>, fence: &[String]) -> String {
     let mut s: String = cfg
