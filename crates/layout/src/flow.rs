@@ -27,7 +27,8 @@ pub const AUTO_CLEANUP_MAX_CELLS: u64 = 5_000;
 /// Whether qrouter runs its stage 3, the cleanup that rips up and re-routes every routed
 /// net. Stages 1 and 2 (route, then rip up and re-route the failures) leave every net
 /// routed; stage 3 shortens the wires and removes defects stage 2 can leave (the default
-/// pixel's stage-2 route had 3 DRC errors and one open net, docs/layout.md).
+/// pixel's stage-2 route had 3 DRC errors and one open net, which the ECO re-route,
+/// `crate::repair`, clears by re-routing two nets; docs/layout.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RouteCleanup {
     /// On up to [`AUTO_CLEANUP_MAX_CELLS`] cells, off above.
@@ -256,39 +257,31 @@ pub fn run(
         }
     }
 
-    // 3. Checks and views.
-    progress("DRC, extraction, LEF");
-    let t = Instant::now();
-    project.stage("layout database", "migrate", "migrate.log")?;
-    let (drc_log, _) = project.stage("DRC", "drc", "drc.log")?;
-    timed(&mut steps, "DRC and extraction (magic)", t);
-    let drc_errors = drc_log
-        .lines()
-        .rev()
-        .find_map(|l| l.trim().strip_prefix("drc = "))
-        .and_then(|v| v.trim().parse::<u64>().ok())
-        .ok_or_else(|| LayoutError::Parse {
-            tool: "magic",
-            what: "`drc = N`".into(),
-            path: dir.join("log/drc.log"),
-        })?;
-    let drc_rules = if drc_errors > 0 {
-        project.continue_after_drc()?;
-        project.drc_reasons()?
+    // 3. Checks and views; a dirty route is repaired by re-routing the nets at its errors.
+    progress("DRC, extraction, LEF, LVS");
+    let first = project.checks()?;
+    steps.push(Step {
+        step: "DRC and extraction (magic)".into(),
+        seconds: first.drc_seconds,
+    });
+    steps.push(Step {
+        step: "LVS (netgen)".into(),
+        seconds: first.lvs_seconds,
+    });
+    let (repair, checks) = if first.clean() {
+        (None, first)
     } else {
-        vec![]
+        let (r, c) = crate::repair::repair(&project, first, &mut steps, progress)?;
+        (Some(r), c)
     };
-    progress("LVS");
-    let t = Instant::now();
-    let (lvs_log, _) = project.stage("LVS", "lvs", "lvs.log")?;
-    timed(&mut steps, "LVS (netgen)", t);
-    let lvs_result = lvs_log
-        .lines()
-        .find(|l| l.starts_with("Result:"))
-        .map(|l| l.trim_start_matches("Result:").trim().to_string())
-        .unwrap_or_else(|| "no result line".into());
-    let lvs_match = lvs_log.contains("Total errors = 0") && lvs_result.contains("match uniquely");
-    let lvs_errors = crate::qflow::lvs_counts(&lvs_log);
+    let crate::qflow::Checks {
+        drc_errors,
+        drc_rules,
+        lvs_match,
+        lvs_result,
+        lvs_errors,
+        ..
+    } = checks;
     progress("GDS");
     let t = Instant::now();
     project.stage("GDS", "gdsii", "gdsii.log")?;
@@ -408,6 +401,7 @@ pub fn run(
         lvs_match,
         lvs_result,
         lvs_errors,
+        repair,
         post_route,
         bins_per_pitch,
         steps,
@@ -441,7 +435,7 @@ fn notes(tech: &TechFiles, other_b: u64, route_cleanup: bool) -> Vec<String> {
     n.push(if route_cleanup {
         "Routing: qrouter's stages 1 and 2 (route every net, rip up and re-route the failures) and stage 3 (every net re-routed shorter), qflow's own `qrouter::standard_route`.".into()
     } else {
-        format!("Routing: qrouter's stages 1 and 2 only (every net routed); stage 3, the cleanup that re-routes each net, was skipped (`--route-cleanup`, auto above {AUTO_CLEANUP_MAX_CELLS} cells): the wirelength and the post-route wires are those of stage 2, a little longer than a cleaned-up route, and defects stage 3 would remove show in the DRC and LVS verdicts.")
+        format!("Routing: qrouter's stages 1 and 2 only (every net routed); stage 3, the cleanup that re-routes each net, was skipped (`--route-cleanup`, auto above {AUTO_CLEANUP_MAX_CELLS} cells): the wirelength and the post-route wires are those of stage 2, a little longer than a cleaned-up route; defects stage 3 would remove are repaired by the ECO re-route (the nets at the DRC boxes and netgen's unmatched nets re-routed, DRC and LVS run again) or show in the verdicts.")
     });
     if tech.tech == Tech::Osu018 {
         n.push("osu018: Debian's qflow-tech-osu018 has no cell GDS, so the GDS and the picture hold the cells' LEF abstracts (pins and obstructions) with the routing, and magic's DRC checks the routing and the abstracts, not the cells' transistors.".into());

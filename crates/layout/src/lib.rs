@@ -12,6 +12,7 @@ pub mod error;
 pub mod flow;
 pub mod picture;
 pub mod qflow;
+pub mod repair;
 pub mod report;
 pub mod spef;
 pub mod sta;

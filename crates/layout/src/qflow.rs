@@ -127,9 +127,9 @@ impl Project {
     }
 
     /// magic's reasons for the DRC errors of the routed macro: each rule broken and how
-    /// many boxes break it (`drc listall why` on the layout database the DRC stage
-    /// checked).
-    pub fn drc_reasons(&self) -> Result<Vec<DrcRule>> {
+    /// many boxes break it, and every error box (`drc listall why` on the layout database
+    /// the DRC stage checked; the boxes are what the ECO re-route maps to nets).
+    pub fn drc_reasons(&self) -> Result<(Vec<DrcRule>, Vec<crate::repair::DrcBox>)> {
         let magic = Tool::Magic.locate()?;
         let script = self
             .dir
@@ -139,7 +139,9 @@ impl Project {
             &script,
             &format!(
                 "lef read {lef}\nload {top}\ndrc on\nselect top cell\nexpand\ndrc check\ndrc catchup\n\
-                 foreach {{rule boxes}} [drc listall why] {{ puts stdout \"TOFPROBE-DRC [llength $boxes] $rule\" }}\nquit\n",
+                 puts stdout \"TOFPROBE-SCALE [cif scale out]\"\n\
+                 foreach {{rule boxes}} [drc listall why] {{\n  puts stdout \"TOFPROBE-DRC [llength $boxes] $rule\"\n  \
+                 foreach b $boxes {{ puts stdout \"TOFPROBE-BOX [join $b] $rule\" }}\n}}\nquit\n",
                 lef = self.tech.cell_lef.display(),
                 top = self.top
             ),
@@ -150,7 +152,58 @@ impl Project {
             .current_dir(self.dir.join("layout"))
             .output()
             .map_err(|e| LayoutError::io("running", &magic, e))?;
-        Ok(parse_drc_reasons(&String::from_utf8_lossy(&out.stdout)))
+        let text = String::from_utf8_lossy(&out.stdout);
+        // Kept beside qflow's DRC log: the boxes the ECO re-route worked from.
+        write(&self.dir.join("log").join("drc_why.log"), &text)?;
+        Ok((
+            parse_drc_reasons(&text),
+            crate::repair::parse_drc_boxes(&text),
+        ))
+    }
+
+    /// The checks of the routed DEF (`layout/TOP.def`): magic reads it (qflow's `migrate`:
+    /// layout database, extraction, LEF), counts the DRC errors (with their rules and
+    /// boxes when there are any), and netgen compares the extraction with the netlist.
+    pub fn checks(&self) -> Result<Checks> {
+        let start = std::time::Instant::now();
+        self.stage("layout database", "migrate", "migrate.log")?;
+        let (drc_log, _) = self.stage("DRC", "drc", "drc.log")?;
+        let drc_errors = drc_log
+            .lines()
+            .rev()
+            .find_map(|l| l.trim().strip_prefix("drc = "))
+            .and_then(|v| v.trim().parse::<u64>().ok())
+            .ok_or_else(|| LayoutError::Parse {
+                tool: "magic",
+                what: "`drc = N`".into(),
+                path: self.dir.join("log/drc.log"),
+            })?;
+        let (drc_rules, drc_boxes) = if drc_errors > 0 {
+            self.continue_after_drc()?;
+            self.drc_reasons()?
+        } else {
+            (vec![], vec![])
+        };
+        let drc_seconds = start.elapsed().as_secs_f64();
+        let (lvs_log, lvs_seconds) = self.stage("LVS", "lvs", "lvs.log")?;
+        let lvs_result = lvs_log
+            .lines()
+            .find(|l| l.starts_with("Result:"))
+            .map(|l| l.trim_start_matches("Result:").trim().to_string())
+            .unwrap_or_else(|| "no result line".into());
+        let lvs_match =
+            lvs_log.contains("Total errors = 0") && lvs_result.contains("match uniquely");
+        Ok(Checks {
+            drc_errors,
+            drc_rules,
+            drc_boxes,
+            lvs_match,
+            lvs_result,
+            lvs_errors: lvs_counts(&lvs_log),
+            lvs_total: crate::repair::lvs_total(&lvs_log).unwrap_or(u64::from(!lvs_match)),
+            drc_seconds,
+            lvs_seconds,
+        })
     }
 
     /// Lets qflow's later stages run after a DRC failure: its GDS stage refuses to run
@@ -226,6 +279,36 @@ impl Project {
             });
         }
         Ok((text, seconds))
+    }
+}
+
+/// The verdicts of [`Project::checks`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Checks {
+    /// magic's DRC error count.
+    pub drc_errors: u64,
+    /// The rules broken (empty when clean).
+    pub drc_rules: Vec<DrcRule>,
+    /// The error boxes (empty when clean).
+    pub drc_boxes: Vec<crate::repair::DrcBox>,
+    /// netgen's verdict.
+    pub lvs_match: bool,
+    /// netgen's result line.
+    pub lvs_result: String,
+    /// The nonzero counts of the LVS summary.
+    pub lvs_errors: Vec<String>,
+    /// netgen's total error count.
+    pub lvs_total: u64,
+    /// Wall time of the layout database, extraction and DRC (s).
+    pub drc_seconds: f64,
+    /// Wall time of LVS (s).
+    pub lvs_seconds: f64,
+}
+
+impl Checks {
+    /// DRC 0 and LVS match.
+    pub fn clean(&self) -> bool {
+        self.drc_errors == 0 && self.lvs_match
     }
 }
 

@@ -103,6 +103,10 @@ pub struct LayoutReport {
     /// The nonzero counts of the LVS summary (empty when it matches).
     #[serde(default)]
     pub lvs_errors: Vec<String>,
+    /// The ECO re-route of a route the checks found dirty (None: clean at once, or a
+    /// report written before the repair existed).
+    #[serde(default)]
+    pub repair: Option<crate::repair::Repair>,
     /// Post-route timing.
     pub post_route: PostRoute,
     /// Bins per pitch (None when the B sweep's model could not be fitted).
@@ -244,6 +248,38 @@ impl LayoutReport {
             s += "DRC errors by rule (magic's `drc listall why`):\n\n| rule | error boxes |\n|---|---:|\n";
             for r in &self.drc_rules {
                 let _ = writeln!(s, "| {} | {} |", r.rule, r.boxes);
+            }
+            s += "\n";
+        }
+        if let Some(r) = &self.repair {
+            let _ = writeln!(
+                s,
+                "ECO re-route of the dirty stage-2 route (the nets at the DRC error boxes and \
+                 netgen's unmatched nets ripped up and routed again, at most {} rounds): DRC {} → {}, \
+                 LVS errors {} → {}; {}.\n\n| round | nets re-routed | unrouted | DRC after | LVS errors after | re-route (s) | checks (s) |\n|---:|---|---:|---:|---:|---:|---:|",
+                crate::repair::MAX_ROUNDS,
+                r.drc_before,
+                self.drc_errors,
+                r.lvs_before,
+                r.rounds.last().map_or(r.lvs_before, |x| x.lvs_errors),
+                r.stopped,
+            );
+            for (i, x) in r.rounds.iter().enumerate() {
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {} | {} | {} | {:.1} | {:.1} |",
+                    i + 1,
+                    x.nets
+                        .iter()
+                        .map(|n| format!("`{n}`"))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    x.unrouted,
+                    x.drc_errors,
+                    x.lvs_errors,
+                    x.route_seconds,
+                    x.check_seconds
+                );
             }
             s += "\n";
         }

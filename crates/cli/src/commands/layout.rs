@@ -28,8 +28,9 @@ pub struct LayoutArgs {
     #[arg(long, default_value_t = 0.6)]
     pub density: f64,
     /// qrouter's stage 3, the cleanup that re-routes every net: auto (on up to 5,000
-    /// cells, off above: hours on the default pixel, whose stage-2 route then is not
-    /// DRC/LVS clean — docs/layout.md), on or off.
+    /// cells, off above: hours on the default pixel; a stage-2 route that DRC or LVS
+    /// finds dirty gets the ECO re-route of the nets at its errors — docs/layout.md), on
+    /// or off.
     #[arg(long, default_value = "auto", value_name = "auto|on|off")]
     pub route_cleanup: String,
     /// Node (nm) the bins-per-pitch answer is scaled to.

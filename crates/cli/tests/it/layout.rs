@@ -73,6 +73,8 @@ fn a_two_bin_pixel_routes_drc_and_lvs_clean_on_osu018() {
     );
     assert_eq!(r["drc_errors"], 0, "{r}");
     assert_eq!(r["lvs_match"], true, "{r}");
+    // Clean at once: the ECO re-route (for a dirty stage-2 route) did not run.
+    assert!(r["repair"].is_null(), "{r}");
     assert!(
         r["lvs_result"].as_str().unwrap().contains("match uniquely"),
         "{r}"
