@@ -125,8 +125,11 @@ impl Depths {
             scene.fill_depths_mm(first_pulse, period_s, out);
             return;
         };
-        out.fill(scene.static_depth_mm());
-        for t in sines {
+        let base = scene.static_depth_mm();
+        if sines.is_empty() {
+            out.fill(base);
+        }
+        for (n, t) in sines.iter().enumerate() {
             // The anchor's phase reduced modulo one period first (as the reference does).
             let cycles =
                 (t.frequency_hz * period_s * first_pulse as f64).fract() + t.phase_deg / 360.0;
@@ -134,8 +137,16 @@ impl Depths {
             let (ds, dc) = t.step;
             for sub in out.chunks_mut(SUB) {
                 let (a_s, a_c) = (t.amplitude_mm * s, t.amplitude_mm * c);
-                for ((d, &ck), &sk) in sub.iter_mut().zip(&t.cos_k).zip(&t.sin_k) {
-                    *d += a_s * ck + a_c * sk;
+                // The first motion's term is added to the static depth as it is written
+                // (the same sum as filling first: one pass over the block, not two).
+                if n == 0 {
+                    for ((d, &ck), &sk) in sub.iter_mut().zip(&t.cos_k).zip(&t.sin_k) {
+                        *d = base + (a_s * ck + a_c * sk);
+                    }
+                } else {
+                    for ((d, &ck), &sk) in sub.iter_mut().zip(&t.cos_k).zip(&t.sin_k) {
+                        *d += a_s * ck + a_c * sk;
+                    }
                 }
                 let s1 = s * dc + c * ds;
                 c = c * dc - s * ds;
