@@ -85,17 +85,7 @@ pub fn equiv_script(spec: &EquivSpec) -> String {
 /// describes those cells by a `statetable`, which `read_liberty` cannot turn into logic.
 pub fn equiv_script_with(spec: &EquivSpec, icg_models: Option<&Path>) -> String {
     let top = &spec.top;
-    let mut s = String::new();
-    for src in &spec.rtl {
-        s += &format!("read_verilog -sv {}\n", src.display());
-    }
-    if !spec.params.is_empty() {
-        s += "chparam";
-        for (k, v) in &spec.params {
-            s += &format!(" -set {k} {v}");
-        }
-        s += &format!(" {top}\n");
-    }
+    let mut s = read_rtl(spec);
     s += &format!(
         "synth -top {top} -flatten -run begin:fine\n\
          async2sync\n\
@@ -110,22 +100,46 @@ pub fn equiv_script_with(spec: &EquivSpec, icg_models: Option<&Path>) -> String 
          async2sync\n\
          dffunmap\n\
          rename {top} gate\n\
-         design -stash gate\n\
-         design -copy-from gold -as gold gold\n\
-         design -copy-from gate -as gate gate\n\
-         equiv_make gold gate equiv\n\
-         hierarchy -top equiv\n\
-         equiv_simple -seq 2\n\
-         equiv_induct -seq 1\n\
-         equiv_status -assert\n",
+         design -stash gate\n{tail}",
         lib = spec.liberty.display(),
         net = spec.netlist.display(),
         icg = icg_models.map_or(String::new(), |m| format!(
             "read_verilog -overwrite {}\n",
             m.display()
         )),
+        tail = prove_pairs(1),
     );
     s
+}
+
+/// Reading the RTL sources with the netlist's parameter overrides (both scripts' gold side).
+fn read_rtl(spec: &EquivSpec) -> String {
+    let mut s = String::new();
+    for src in &spec.rtl {
+        s += &format!("read_verilog -sv {}\n", src.display());
+    }
+    if !spec.params.is_empty() {
+        s += "chparam";
+        for (k, v) in &spec.params {
+            s += &format!(" -set {k} {v}");
+        }
+        s += &format!(" {}\n", spec.top);
+    }
+    s
+}
+
+/// Both scripts' end: the stashed gold and gate designs paired by name, each pair proven
+/// by `equiv_simple -seq 2` and then induction over `induct_seq` steps, every pair asserted.
+fn prove_pairs(induct_seq: u32) -> String {
+    format!(
+        "design -copy-from gold -as gold gold\n\
+         design -copy-from gate -as gate gate\n\
+         equiv_make gold gate equiv\n\
+         hierarchy -top equiv\n\
+         equiv_simple -seq 2\n\
+         equiv_induct -seq {induct_seq}\n\
+         equiv_status -assert\n"
+    )
 }
 
 /// Which script proves a netlist: it follows the RTL's register file.
@@ -179,17 +193,7 @@ impl Recipe {
 /// `wd_0`) is the one pairs are made on. Then `async2sync; dffunmap; clk2fflogic` on both.
 pub fn latch_equiv_script(spec: &EquivSpec, icg_models: Option<&Path>) -> String {
     let top = &spec.top;
-    let mut s = String::new();
-    for src in &spec.rtl {
-        s += &format!("read_verilog -sv {}\n", src.display());
-    }
-    if !spec.params.is_empty() {
-        s += "chparam";
-        for (k, v) in &spec.params {
-            s += &format!(" -set {k} {v}");
-        }
-        s += &format!(" {top}\n");
-    }
+    let mut s = read_rtl(spec);
     s += &format!(
         "synth -top {top} -flatten -run begin:fine\n\
          rename -hide w:* x:* %d t:* %co1:+[Q] w:* %i %d\n\
@@ -211,20 +215,14 @@ pub fn latch_equiv_script(spec: &EquivSpec, icg_models: Option<&Path>) -> String
          clk2fflogic\n\
          opt_clean\n\
          rename {top} gate\n\
-         design -stash gate\n\
-         design -copy-from gold -as gold gold\n\
-         design -copy-from gate -as gate gate\n\
-         equiv_make gold gate equiv\n\
-         hierarchy -top equiv\n\
-         equiv_simple -seq 2\n\
-         equiv_induct -seq 2\n\
-         equiv_status -assert\n",
+         design -stash gate\n{tail}",
         lib = spec.liberty.display(),
         net = spec.netlist.display(),
         icg = icg_models.map_or(String::new(), |m| format!(
             "read_verilog -overwrite {}\n",
             m.display()
         )),
+        tail = prove_pairs(2),
     );
     s
 }
