@@ -64,13 +64,57 @@ impl RouteCleanup {
     }
 }
 
+/// The density `Density::Auto` asks for up to [`AUTO_CLEANUP_MAX_CELLS`] cells (the 2-bin
+/// pixel routes clean there, stage 3 included) and above ([`AUTO_DENSITY_LARGE`]).
+pub const AUTO_DENSITY_SMALL: f64 = 0.6;
+/// The density `Density::Auto` asks for above [`AUTO_CLEANUP_MAX_CELLS`] cells: the default
+/// pixel (9,248 cells) routes every net at 0.5 with stages 1 and 2 and is clean after the
+/// ECO re-route (docs/layout.md); at 0.6 stage 2 had not finished after 34 min.
+pub const AUTO_DENSITY_LARGE: f64 = 0.5;
+
+/// The target placement density asked for: a number, or `auto` (by the netlist's size).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Density {
+    /// [`AUTO_DENSITY_SMALL`] up to [`AUTO_CLEANUP_MAX_CELLS`] cells, [`AUTO_DENSITY_LARGE`] above.
+    Auto,
+    /// This density (cells / core), [`MIN_DENSITY`] ..= 0.95.
+    Fixed(f64),
+}
+
+impl Density {
+    /// Parses `auto` or a number (the CLI's `--density`); the range is checked by
+    /// [`check_options`].
+    pub fn parse(s: &str) -> Result<Density> {
+        if s == "auto" {
+            return Ok(Density::Auto);
+        }
+        s.trim()
+            .parse::<f64>()
+            .map(Density::Fixed)
+            .map_err(|_| LayoutError::Option {
+                option: "density",
+                value: s.into(),
+                allowed: format!("auto or a number {MIN_DENSITY} ..= 0.95, e.g. 0.5"),
+            })
+    }
+
+    /// The density to place a netlist of `cells` cells at.
+    pub fn target(self, cells: u64) -> f64 {
+        match self {
+            Density::Auto if cells <= AUTO_CLEANUP_MAX_CELLS => AUTO_DENSITY_SMALL,
+            Density::Auto => AUTO_DENSITY_LARGE,
+            Density::Fixed(d) => d,
+        }
+    }
+}
+
 /// What to lay out and how.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LayoutRequest {
     /// The technology.
     pub tech: Tech,
-    /// Target placement density (cells / core), 0.2 ..= 0.95.
-    pub density: f64,
+    /// Target placement density (cells / core), 0.2 ..= 0.95, or auto.
+    pub density: Density,
     /// The synthesis cache (`tofprobe_eda::fsutil::synth_cache_dir`), shared with `size`.
     pub cache: PathBuf,
     /// The sky130 PDK directory (default: `tofprobe_eda::pdk` discovery).
@@ -95,12 +139,16 @@ pub struct LayoutRun {
 }
 
 /// Checks the request's numbers before anything runs.
-pub fn check_options(density: f64, node_nm: f64) -> Result<()> {
-    if !(density.is_finite() && (MIN_DENSITY..=0.95).contains(&density)) {
+pub fn check_options(density: Density, node_nm: f64) -> Result<()> {
+    if let Density::Fixed(density) = density
+        && !(density.is_finite() && (MIN_DENSITY..=0.95).contains(&density))
+    {
         return Err(LayoutError::Option {
             option: "density",
             value: density.to_string(),
-            allowed: format!("{MIN_DENSITY} ..= 0.95 (0.6 routes the default pixel on osu018)"),
+            allowed: format!(
+                "auto or {MIN_DENSITY} ..= 0.95 (0.5 routes the default pixel on osu018)"
+            ),
         });
     }
     if !(node_nm.is_finite() && node_nm > 0.0 && node_nm <= 1000.0) {
@@ -214,7 +262,7 @@ pub fn run(
     let route_cleanup = req.route_cleanup.runs(syn.cell_count);
     project.set_route_cleanup(route_cleanup)?;
     let mut attempts = Vec::new();
-    let tries = densities(req.density);
+    let tries = densities(req.density.target(syn.cell_count));
     for (i, &d) in tries.iter().enumerate() {
         project.set_density(d)?;
         progress(&format!("placement at density {d}"));
@@ -468,5 +516,27 @@ mod tests {
             e.contains("route-cleanup") && e.contains("auto, on or off"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn density_auto_follows_the_netlist_size() {
+        // The 2-bin pixel (2,627 cells) at 0.6, where it routes clean with stage 3; the
+        // default (9,248 cells) at 0.5, where it routes clean after the ECO re-route.
+        assert_eq!(Density::Auto.target(2_627), 0.6);
+        assert_eq!(Density::Auto.target(AUTO_CLEANUP_MAX_CELLS), 0.6);
+        assert_eq!(Density::Auto.target(9_248), 0.5);
+        assert_eq!(Density::Fixed(0.45).target(9_248), 0.45);
+        assert_eq!(Density::parse("auto").unwrap(), Density::Auto);
+        assert_eq!(Density::parse("0.55").unwrap(), Density::Fixed(0.55));
+        let e = Density::parse("dense").unwrap_err().to_string();
+        assert!(
+            e.contains("--density = dense") && e.contains("auto or a number"),
+            "{e}"
+        );
+        assert!(check_options(Density::Auto, 40.0).is_ok());
+        let e = check_options(Density::Fixed(0.99), 40.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("0.5 routes the default pixel"), "{e}");
     }
 }

@@ -23,10 +23,11 @@ pub struct LayoutArgs {
     /// Technology: osu018 (qflow's own; always routes) or sky130 (the shared PDK).
     #[arg(long, default_value = "osu018")]
     pub tech: String,
-    /// Target placement density (cells / core); lower densities are retried when routing
+    /// Target placement density (cells / core), or auto: 0.6 up to 5,000 cells, 0.5 above
+    /// (the default pixel routes clean there); lower densities are retried when routing
     /// fails.
-    #[arg(long, default_value_t = 0.6)]
-    pub density: f64,
+    #[arg(long, default_value = "auto", value_name = "auto|D")]
+    pub density: String,
     /// qrouter's stage 3, the cleanup that re-routes every net: auto (on up to 5,000
     /// cells, off above: hours on the default pixel; a stage-2 route that DRC or LVS
     /// finds dirty gets the ECO re-route of the nets at its errors — docs/layout.md), on
@@ -53,12 +54,13 @@ pub struct LayoutArgs {
 pub fn run(a: &LayoutArgs) -> Result<crate::commands::Verdict, CliError> {
     let tech = Tech::parse(&a.tech)?;
     let route_cleanup = tofprobe_layout::flow::RouteCleanup::parse(&a.route_cleanup)?;
-    tofprobe_layout::flow::check_options(a.density, a.node_nm)?;
+    let density = tofprobe_layout::flow::Density::parse(&a.density)?;
+    tofprobe_layout::flow::check_options(density, a.node_nm)?;
     let design = crate::commands::load_for_hardware(a.config.as_deref())?;
     design.single_pixel("layout")?;
     let req = LayoutRequest {
         tech,
-        density: a.density,
+        density,
         cache: tofprobe_eda::fsutil::synth_cache_dir(a.cache.as_deref()),
         sky130_pdk: a.sky130_pdk.clone(),
         node_nm: a.node_nm,

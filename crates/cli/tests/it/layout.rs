@@ -186,7 +186,8 @@ fn bad_layout_options_are_refused_naming_a_value_that_works() {
     let out = dir.path().join("o");
     for (args, want) in [
         (vec!["--density", "1.5"], "--density = 1.5"),
-        (vec!["--density", "NaN"], "0.6 routes"),
+        (vec!["--density", "NaN"], "0.5 routes"),
+        (vec!["--density", "dense"], "auto or a number"),
         (vec!["--tech", "gf180"], "osu018 or sky130"),
         (vec!["--node-nm", "0"], "--node-nm = 0"),
         (vec!["--route-cleanup", "sometimes"], "auto, on or off"),
