@@ -124,10 +124,17 @@ fn signs_off_and_catches_a_broken_gate(lib: &SignoffLibrary, inv: &str, name: &s
     }
 }
 
-/// The broken netlist failing equivalence, on a small generated pixel (B = 2, W = 10): on
-/// the full pixel a failed induction falls back to one proof per point (over a thousand
-/// SAT problems of 700k clauses), too slow for CI; the proof itself is the same.
-fn broken_small_pixel_is_not_equivalent(liberty: &Path, inv: &str, name: &str) {
+/// A small generated pixel (B = 2, W = 10, A = 2) with `register_file`, rendered into and
+/// synthesised for `liberty` at 160 MHz under `dirs` (RTL, synthesis) of the test's cache.
+fn small_pixel_netlist(
+    liberty: &Path,
+    name: &str,
+    register_file: tofprobe_pixel::RegisterFile,
+    dirs: (&str, &str),
+) -> (
+    tofprobe_eda::analysis::RtlVariant,
+    tofprobe_eda::synth::Synthesis,
+) {
     let px = GeneratedPixel {
         base: PixelParams {
             bins: 2,
@@ -136,10 +143,11 @@ fn broken_small_pixel_is_not_equivalent(liberty: &Path, inv: &str, name: &str) {
             width: 10,
             frame_pulses: 1024,
             rom_depth: 16,
+            register_file,
             ..PixelParams::default()
         },
     };
-    let v = px.rtl(2, 10, &cache(name).join("small-rtl")).unwrap();
+    let v = px.rtl(2, 10, &cache(name).join(dirs.0)).unwrap();
     let syn = synthesise(
         &SynthSpec {
             sources: v.sources.clone(),
@@ -149,9 +157,22 @@ fn broken_small_pixel_is_not_equivalent(liberty: &Path, inv: &str, name: &str) {
             delay_target_ps: Some(6250.0),
             keep: vec!["we".into()],
         },
-        &cache(name).join("small"),
+        &cache(name).join(dirs.1),
     )
     .unwrap();
+    (v, syn)
+}
+
+/// The broken netlist failing equivalence, on a small generated pixel (B = 2, W = 10): on
+/// the full pixel a failed induction falls back to one proof per point (over a thousand
+/// SAT problems of 700k clauses), too slow for CI; the proof itself is the same.
+fn broken_small_pixel_is_not_equivalent(liberty: &Path, inv: &str, name: &str) {
+    let (v, syn) = small_pixel_netlist(
+        liberty,
+        name,
+        tofprobe_pixel::RegisterFile::Flops,
+        ("small-rtl", "small"),
+    );
     let spec = |netlist: PathBuf| EquivSpec {
         rtl: v.sources.clone(),
         top: v.top.clone(),
@@ -259,31 +280,12 @@ fn rewire_latch(netlist: &Path, q: &str, donor: &str, pin: &str, out: &Path) {
 /// the same netlist with one latch (`y[1]` bit 5) on register 2's gated clock, or on bit
 /// 6's data, is not — the first unproven point is that bit, and it is the only one.
 fn latch_pixel_is_proven_and_a_miswired_latch_is_not(liberty: &Path, enable: &str, name: &str) {
-    let px = GeneratedPixel {
-        base: PixelParams {
-            bins: 2,
-            tdc_bits: 4,
-            frac_bits: 2,
-            width: 10,
-            frame_pulses: 1024,
-            rom_depth: 16,
-            register_file: tofprobe_pixel::RegisterFile::Latch,
-            ..PixelParams::default()
-        },
-    };
-    let v = px.rtl(2, 10, &cache(name).join("latch-rtl")).unwrap();
-    let syn = synthesise(
-        &SynthSpec {
-            sources: v.sources.clone(),
-            top: v.top.clone(),
-            params: v.params.clone(),
-            liberty: liberty.to_path_buf(),
-            delay_target_ps: Some(6250.0),
-            keep: vec!["we".into()],
-        },
-        &cache(name).join("latch-syn"),
-    )
-    .unwrap();
+    let (v, syn) = small_pixel_netlist(
+        liberty,
+        name,
+        tofprobe_pixel::RegisterFile::Latch,
+        ("latch-rtl", "latch-syn"),
+    );
     let work = cache(name).join("latch-equiv");
     // No cache: each run is a proof of its own (the broken netlists must be proven too).
     let prove = |netlist: PathBuf| {
