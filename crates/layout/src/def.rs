@@ -135,10 +135,21 @@ pub fn parse_def(
     })
 }
 
-/// The Manhattan length (DEF units) of one routed segment's points `( x y ) ( x * ) …`.
-fn segment_length(t: &[&str]) -> f64 {
+/// One item of a routed segment, in order: a point `( x y )` (DEF units, a `*` coordinate
+/// taken from the previous point) or any other word (a via name, a width, `;`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum RouteItem<'a> {
+    /// A point.
+    Point(f64, f64),
+    /// Another word.
+    Word(&'a str),
+}
+
+/// The items of one routed segment's words `( x y ) ( x * ) VIA …` (a point whose
+/// coordinates cannot be read is skipped).
+pub(crate) fn route_items<'a>(t: &[&'a str]) -> Vec<RouteItem<'a>> {
+    let mut out = Vec::new();
     let mut last: Option<(f64, f64)> = None;
-    let mut len = 0.0;
     let mut i = 0;
     while i < t.len() {
         if t[i] == "(" && i + 3 < t.len() && t[i + 3] == ")" {
@@ -152,14 +163,28 @@ fn segment_length(t: &[&str]) -> f64 {
             let x = coord(t[i + 1], last.map(|p| p.0));
             let y = coord(t[i + 2], last.map(|p| p.1));
             if let (Some(x), Some(y)) = (x, y) {
-                if let Some((px, py)) = last {
-                    len += (x - px).abs() + (y - py).abs();
-                }
+                out.push(RouteItem::Point(x, y));
                 last = Some((x, y));
             }
             i += 4;
         } else {
+            out.push(RouteItem::Word(t[i]));
             i += 1;
+        }
+    }
+    out
+}
+
+/// The Manhattan length (DEF units) of one routed segment's points `( x y ) ( x * ) …`.
+fn segment_length(t: &[&str]) -> f64 {
+    let mut last: Option<(f64, f64)> = None;
+    let mut len = 0.0;
+    for item in route_items(t) {
+        if let RouteItem::Point(x, y) = item {
+            if let Some((px, py)) = last {
+                len += (x - px).abs() + (y - py).abs();
+            }
+            last = Some((x, y));
         }
     }
     len

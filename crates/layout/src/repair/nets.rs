@@ -1,6 +1,7 @@
 //! What the checks and the routed DEF say about the nets: magic's DRC error boxes,
 //! the DEF's wires, vias and pins, the nets at each box and netgen's unmatched nets.
 
+use crate::def::{RouteItem, route_items};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -141,19 +142,10 @@ pub fn def_nets(def: &str) -> DefNets {
         let Some(r) = route_at else { continue };
         let Some(layer) = t.get(r + 1) else { continue };
         let mut last: Option<(f64, f64)> = None;
-        let mut j = r + 2;
-        while j < t.len() {
-            if t[j] == "(" && j + 3 < t.len() && t[j + 3] == ")" {
-                let coord = |s: &str, prev: Option<f64>| {
-                    if s == "*" {
-                        prev
-                    } else {
-                        s.parse::<f64>().ok().map(|v| v / units)
-                    }
-                };
-                let x = coord(t[j + 1], last.map(|p| p.0));
-                let y = coord(t[j + 2], last.map(|p| p.1));
-                if let (Some(x), Some(y)) = (x, y) {
+        for item in route_items(&t[r + 2..]) {
+            match item {
+                RouteItem::Point(x, y) => {
+                    let (x, y) = (x / units, y / units);
                     let (px, py) = last.unwrap_or((x, y));
                     out.wires.push(Wire {
                         net: net.clone(),
@@ -166,23 +158,24 @@ pub fn def_nets(def: &str) -> DefNets {
                     });
                     last = Some((x, y));
                 }
-                j += 4;
-            } else if let (Some((x, y)), w) = (last, t[j]) {
                 // A via name after a point (a width or `;` is not a via).
-                if w != ";" && w.parse::<f64>().is_err() && w != "+" {
-                    out.wires.push(Wire {
-                        net: net.clone(),
-                        layer: w.to_string(),
-                        via: true,
-                        x0: x,
-                        y0: y,
-                        x1: x,
-                        y1: y,
-                    });
+                RouteItem::Word(w) => {
+                    if let Some((x, y)) = last
+                        && w != ";"
+                        && w.parse::<f64>().is_err()
+                        && w != "+"
+                    {
+                        out.wires.push(Wire {
+                            net: net.clone(),
+                            layer: w.to_string(),
+                            via: true,
+                            x0: x,
+                            y0: y,
+                            x1: x,
+                            y1: y,
+                        });
+                    }
                 }
-                j += 1;
-            } else {
-                j += 1;
             }
         }
     }
