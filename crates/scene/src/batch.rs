@@ -22,7 +22,7 @@ use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
 use crate::MotionConfig;
-use crate::lanes::{FILL_BASELINE, Fill, LANES, Lanes, Streams};
+use crate::lanes::{FILL_BASELINE, Fill, LANES, Lanes, PASS, Streams, Words};
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::{all_avx2, all_avx512, one_avx2, one_avx512};
 use crate::scene::Scene;
@@ -184,30 +184,46 @@ pub(crate) struct Block {
     pub n: usize,
 }
 
-/// Pulses per pass of the kernel: the pass's buffers (≈ 13 bytes a pulse) stay in L1.
-const PASS: usize = 512;
-
 /// Per-thread scratch of one block: the block's depths and one pass's buffers.
 #[derive(Debug, Default)]
 pub(crate) struct Scratch {
     depth: Vec<f64>,
-    pass: PassBuffers,
+    pass: Box<PassBuffers>,
 }
 
-/// The buffers of one pass of [`PASS`] pulses.
-#[derive(Debug, Default)]
+/// The buffers of one pass of [`PASS`] pulses (the pass's buffers, ≈ 37 bytes a pulse,
+/// stay in L1).
+#[derive(Debug)]
 struct PassBuffers {
     z: Vec<f64>,
     /// The jitter, signal and background streams' words.
-    words: Vec<u64>,
-    signal_words: Vec<u64>,
-    background_words: Vec<u64>,
+    words: Words,
+    signal_words: Words,
+    background_words: Words,
     flags: Vec<u8>,
+    /// Each pulse's ziggurat layer edges.
+    edges: Vec<[f64; 2]>,
     rejects: Vec<u32>,
     /// The earliest in-window arrival of each pulse, code units (∞ when none).
     best: Vec<f64>,
     /// Whether a background photon won the pulse.
     from_bg: Vec<bool>,
+}
+
+impl Default for PassBuffers {
+    fn default() -> Self {
+        PassBuffers {
+            z: Vec::new(),
+            words: [0; PASS],
+            signal_words: [0; PASS],
+            background_words: [0; PASS],
+            flags: Vec::new(),
+            edges: Vec::new(),
+            rejects: Vec::new(),
+            best: Vec::new(),
+            from_bg: Vec::new(),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -430,7 +446,6 @@ fn generate_body<O: Slot>(
     let b = &mut sc.pass;
     b.z.resize(PASS, 0.0);
     b.best.resize(PASS, 0.0);
-    b.words.resize(PASS, 0);
     b.from_bg.resize(PASS, false);
 
     let mut seeder = SplitMix64::new(block_seed);
@@ -480,21 +495,21 @@ fn pass<O: Slot>(
     let t: &Tables = tables();
     let bern = p.signal_rate < 1.0;
     let bg = p.background_rate > 0.0;
-    let (words, z) = (&mut b.words[..m], &mut b.z[..m]);
-    for v in [&mut b.signal_words, &mut b.background_words] {
-        v.resize(PASS, 0);
-    }
-    let (sw, bw) = (&mut b.signal_words[..m], &mut b.background_words[..m]);
-    // The unused streams are filled too when any is used: they are independent of the
-    // used ones, and stepping them beside the others costs little (see Streams::fill).
-    // Through `black_box`: a direct call would be inlined into the pass (despite
-    // `inline(never)`), where the lanes' step is left scalar.
+    // Whole passes of words are drawn (the fills' fixed length), also for a block's last,
+    // shorter pass: its generators are not used after it.
     if bern || bg {
-        std::hint::black_box(fill.all)(g, words, sw, bw);
+        std::hint::black_box(fill.all)(
+            g,
+            &mut b.words,
+            &mut b.signal_words,
+            &mut b.background_words,
+        );
     } else {
-        std::hint::black_box(fill.one)(&mut g.jitter, words);
+        std::hint::black_box(fill.one)(&mut g.jitter, &mut b.words);
     }
-    fast_pass(t, words, z, &mut b.flags, &mut b.rejects);
+    let (words, z) = (&b.words[..m], &mut b.z[..m]);
+    let (sw, bw) = (&b.signal_words[..m], &b.background_words[..m]);
+    fast_pass(t, words, z, &mut b.flags, &mut b.edges, &mut b.rejects);
     for &k in &b.rejects {
         z[k as usize] = finish(t, words[k as usize], slow);
     }

@@ -4,8 +4,18 @@
 
 use crate::splitmix::SplitMix64;
 
-/// Interleaved generators per stream.
-pub(crate) const LANES: usize = 4;
+/// Interleaved generators per stream: eight, one 512-bit vector per state word (with four,
+/// LLVM packed two state words into one 512-bit register and the shuffles between them
+/// lengthened every step's dependency chain: 3.2× slower a word on AVX-512).
+pub(crate) const LANES: usize = 8;
+
+/// Words per fill: one pass of the kernel (crates/scene/src/batch.rs). A fixed length, so
+/// the fills' loops have a known trip count: with a slice of unknown length LLVM left the
+/// eight lanes' step scalar (8.5× slower a word).
+pub(crate) const PASS: usize = 512;
+
+/// One fill's words of one stream.
+pub(crate) type Words = [u64; PASS];
 
 /// `LANES` xoshiro256++ generators side by side (state word j of lane l is `s[j][l]`).
 #[derive(Debug, Clone)]
@@ -24,9 +34,9 @@ impl Lanes {
         Lanes { s }
     }
 
-    /// Fills `out` (a multiple of `LANES` long) with the streams' next words.
+    /// Fills `out` with the stream's next words.
     #[inline(always)]
-    fn fill(&mut self, out: &mut [u64]) {
+    fn fill(&mut self, out: &mut Words) {
         let mut s = self.s;
         for chunk in out.chunks_exact_mut(LANES) {
             chunk.copy_from_slice(&step(&mut s));
@@ -67,12 +77,12 @@ pub(crate) struct Streams {
 }
 
 impl Streams {
-    /// Fills `j`, `s` and `b` with the jitter, signal and background streams' next words
-    /// (the same length, a multiple of [`LANES`]). The three lane sets step in one loop:
+    /// Fills `j`, `s` and `b` with the jitter, signal and background streams' next words.
+    /// The three lane sets step in one loop:
     /// each set's step depends on its last, so one set alone waits on that chain's
     /// latency, three interleaved overlap it.
     #[inline(always)]
-    fn fill_all(&mut self, j: &mut [u64], s: &mut [u64], b: &mut [u64]) {
+    fn fill_all(&mut self, j: &mut Words, s: &mut Words, b: &mut Words) {
         let (mut sj, mut ss, mut sb) = (self.jitter.s, self.signal.s, self.background.s);
         for ((x, y), z) in j
             .chunks_exact_mut(LANES)
@@ -93,9 +103,9 @@ impl Streams {
 #[derive(Clone, Copy)]
 pub(crate) struct Fill {
     /// The jitter stream alone ([`Lanes::fill`]).
-    pub one: fn(&mut Lanes, &mut [u64]),
+    pub one: fn(&mut Lanes, &mut Words),
     /// The three streams ([`Streams::fill_all`]).
-    pub all: fn(&mut Streams, &mut [u64], &mut [u64], &mut [u64]),
+    pub all: fn(&mut Streams, &mut Words, &mut Words, &mut Words),
 }
 
 /// The AVX-512 copy's fills: built in that copy (a target-feature function is a
@@ -103,14 +113,14 @@ pub(crate) struct Fill {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512dq")]
 #[inline(never)]
-pub(crate) fn one_avx512(l: &mut Lanes, j: &mut [u64]) {
+pub(crate) fn one_avx512(l: &mut Lanes, j: &mut Words) {
     l.fill(j);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512dq")]
 #[inline(never)]
-pub(crate) fn all_avx512(g: &mut Streams, j: &mut [u64], s: &mut [u64], b: &mut [u64]) {
+pub(crate) fn all_avx512(g: &mut Streams, j: &mut Words, s: &mut Words, b: &mut Words) {
     g.fill_all(j, s, b);
 }
 
@@ -119,14 +129,14 @@ pub(crate) fn all_avx512(g: &mut Streams, j: &mut [u64], s: &mut [u64], b: &mut 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
-pub(crate) fn one_avx2(l: &mut Lanes, j: &mut [u64]) {
+pub(crate) fn one_avx2(l: &mut Lanes, j: &mut Words) {
     l.fill(j);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
-pub(crate) fn all_avx2(g: &mut Streams, j: &mut [u64], s: &mut [u64], b: &mut [u64]) {
+pub(crate) fn all_avx2(g: &mut Streams, j: &mut Words, s: &mut Words, b: &mut Words) {
     g.fill_all(j, s, b);
 }
 
@@ -137,11 +147,11 @@ pub(crate) const FILL_BASELINE: Fill = Fill {
 };
 
 #[inline(never)]
-pub(crate) fn one_baseline(l: &mut Lanes, j: &mut [u64]) {
+pub(crate) fn one_baseline(l: &mut Lanes, j: &mut Words) {
     l.fill(j);
 }
 
 #[inline(never)]
-pub(crate) fn all_baseline(g: &mut Streams, j: &mut [u64], s: &mut [u64], b: &mut [u64]) {
+pub(crate) fn all_baseline(g: &mut Streams, j: &mut Words, s: &mut Words, b: &mut Words) {
     g.fill_all(j, s, b);
 }
