@@ -9,22 +9,21 @@
 //!   finished exactly by the scalar slow path from a fourth, scalar stream
 //!   ([`crate::ziggurat`]).
 //! - **Depth**: a sine motion is evaluated as sin(θ_j + kΔ) = s_j cos kΔ + c_j sin kΔ over
-//!   sub-blocks of [`SUB`] pulses from a table of (cos kΔ, sin kΔ) (no serial recurrence
+//!   sub-blocks of [`crate::depths::SUB`] pulses from a table of (cos kΔ, sin kΔ) (no serial recurrence
 //!   per pulse); other motions use the scene's own evaluation.
 //! - **Laws**: signal with probability ρ_s at δ/c·2 + σ_I·z; background first arrival
 //!   −ln(u)·W/ρ_b with u ∈ (0, 1] (52 bits), inside the window iff u > e^(−ρ_b); earliest in-window
 //!   arrival wins; code = ⌊t / lsb⌋ (computed in code units, ≤ 1 ulp from the division).
 //!   Every pulse draws its words whether or not it uses them: no per-pulse branches.
 
-use std::f64::consts::TAU;
-
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
-use crate::MotionConfig;
+use crate::depths::Depths;
 use crate::lanes::{FILL_BASELINE, Fill, LANES, Lanes, PASS, Streams, Words};
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::{all_avx2, all_avx512, one_avx2, one_avx512};
+use crate::ln::ln;
 use crate::scene::Scene;
 use crate::splitmix::SplitMix64;
 use crate::ziggurat::{Tables, fast_pass, finish, tables};
@@ -64,97 +63,6 @@ impl Slot for u32 {
 /// The compact form's code of a pulse without a detection (TDC codes have at most 16
 /// bits); the pixel's drivers read the same sentinel (`tofprobe_pixel::NO_DETECTION`).
 pub const NO_DETECTION: u32 = u32::MAX;
-
-/// Pulses per sine sub-block (one table of cos kΔ, sin kΔ).
-pub(crate) const SUB: usize = 64;
-
-/// A sine motion's per-sub-block tables.
-#[derive(Debug, Clone)]
-pub(crate) struct SineTable {
-    amplitude_mm: f64,
-    frequency_hz: f64,
-    phase_deg: f64,
-    cos_k: [f64; SUB],
-    sin_k: [f64; SUB],
-    /// (sin, cos) of SUB·Δ: the step from one sub-block's anchor to the next.
-    step: (f64, f64),
-}
-
-/// How the batched kernel evaluates δ(t): the sine tables when every motion is a sine.
-#[derive(Debug, Clone)]
-pub(crate) struct Depths {
-    sines: Option<Vec<SineTable>>,
-}
-
-impl Depths {
-    pub(crate) fn new(scene: &Scene, period_s: f64) -> Depths {
-        let sines = scene
-            .motions()
-            .iter()
-            .map(|m| match *m {
-                MotionConfig::Sine {
-                    amplitude_mm,
-                    frequency_hz,
-                    phase_deg,
-                } => {
-                    let d = TAU * frequency_hz * period_s;
-                    let mut cos_k = [0.0; SUB];
-                    let mut sin_k = [0.0; SUB];
-                    for k in 0..SUB {
-                        (sin_k[k], cos_k[k]) = (d * k as f64).sin_cos();
-                    }
-                    Some(SineTable {
-                        amplitude_mm,
-                        frequency_hz,
-                        phase_deg,
-                        cos_k,
-                        sin_k,
-                        step: (d * SUB as f64).sin_cos(),
-                    })
-                }
-                _ => None,
-            })
-            .collect();
-        Depths { sines }
-    }
-
-    /// δ (mm) of pulses `first_pulse ..` into `out`.
-    #[inline(always)]
-    fn fill(&self, scene: &Scene, first_pulse: u64, period_s: f64, out: &mut [f64]) {
-        let Some(sines) = &self.sines else {
-            scene.fill_depths_mm(first_pulse, period_s, out);
-            return;
-        };
-        let base = scene.static_depth_mm();
-        if sines.is_empty() {
-            out.fill(base);
-        }
-        for (n, t) in sines.iter().enumerate() {
-            // The anchor's phase reduced modulo one period first (as the reference does).
-            let cycles =
-                (t.frequency_hz * period_s * first_pulse as f64).fract() + t.phase_deg / 360.0;
-            let (mut s, mut c) = (TAU * cycles).sin_cos();
-            let (ds, dc) = t.step;
-            for sub in out.chunks_mut(SUB) {
-                let (a_s, a_c) = (t.amplitude_mm * s, t.amplitude_mm * c);
-                // The first motion's term is added to the static depth as it is written
-                // (the same sum as filling first: one pass over the block, not two).
-                if n == 0 {
-                    for ((d, &ck), &sk) in sub.iter_mut().zip(&t.cos_k).zip(&t.sin_k) {
-                        *d = base + (a_s * ck + a_c * sk);
-                    }
-                } else {
-                    for ((d, &ck), &sk) in sub.iter_mut().zip(&t.cos_k).zip(&t.sin_k) {
-                        *d += a_s * ck + a_c * sk;
-                    }
-                }
-                let s1 = s * dc + c * ds;
-                c = c * dc - s * ds;
-                s = s1;
-            }
-        }
-    }
-}
 
 /// The parameters of the kernel, in TDC code units (time / lsb).
 #[derive(Debug, Clone, Copy)]
@@ -229,7 +137,7 @@ impl Default for PassBuffers {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{SceneConfig, SensorConfig};
+    use crate::{MotionConfig, SceneConfig, SensorConfig};
 
     /// The dispatched copy (AVX-512 or AVX2 where the CPU has them) and the baseline copy
     /// give the same codes, detections and background wins, bit for bit, on a moving
@@ -302,37 +210,12 @@ mod tests {
             assert!(ca.0 > 3000 && ca.1 > 500, "block {block}: {ca:?}");
         }
     }
-
-    /// The branch-free ln against the platform's over (0, 1]: within 2 ulps everywhere
-    /// tried (a wrong fdlibm coefficient shows at ~1e-10).
-    #[test]
-    fn ln_matches_std() {
-        let mut g = crate::SplitMix64::new(7);
-        let mut worst = 0.0f64;
-        for i in 0..200_000 {
-            let u = if i < 64 {
-                0.5f64.powi(i) * 0.999
-            } else {
-                ((g.next_u64() >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64)
-            };
-            let (a, b) = (super::ln(u), u.ln());
-            if b != 0.0 {
-                worst = worst.max(((a - b) / b).abs());
-            } else {
-                assert_eq!(a, 0.0);
-            }
-        }
-        assert!(
-            worst <= 2.0 * f64::EPSILON,
-            "worst relative error {worst:e}"
-        );
-    }
 }
 
 /// Generates pulses 0 .. n of a block (n ≤ the block length), in passes of [`PASS`] pulses,
 /// and writes pulses `offset .. offset + out.len()` of them as codes into `out` (returns
 /// its detections and background wins):
-/// the AVX2 copy of the kernel where the CPU has it (the same IEEE operations, no fused
+/// the AVX-512 or AVX2 copy of the kernel where the CPU has it (the same IEEE operations, no fused
 /// multiply-adds: bit-identical to the baseline copy), the baseline copy elsewhere.
 pub(crate) fn generate<O: Slot>(
     p: &Params,
@@ -374,7 +257,7 @@ pub(crate) fn generate<O: Slot>(
     )
 }
 
-/// [`generate_body`] compiled for AVX-512 (64-bit rotates, gathers and integer-to-float
+/// [`generate_body`] compiled for AVX-512 (64-bit rotates and integer-to-float
 /// conversions in vectors).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512dq")]
@@ -556,38 +439,6 @@ fn pass<O: Slot>(
     } else {
         codes::<O, false>(&best[lo..hi], &from_bg[lo..hi], last, out)
     }
-}
-
-/// ln(u) for u ∈ [2^−53, 1] (normal, positive), branch-free so a batch vectorises: the
-/// fdlibm algorithm (e_log.c: u = 2^k·m with m ∈ [√½, √2), s = (m − 1)/(m + 1), a degree-14
-/// polynomial in s), error < 1 ulp as fdlibm's. The constants as fdlibm publishes them.
-#[allow(clippy::excessive_precision)]
-#[inline(always)]
-pub(crate) fn ln(u: f64) -> f64 {
-    const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
-    const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
-    const LG1: f64 = 6.666_666_666_666_735_130e-1;
-    const LG2: f64 = 3.999_999_999_940_941_908e-1;
-    const LG3: f64 = 2.857_142_874_366_239_149e-1;
-    const LG4: f64 = 2.222_219_843_214_978_396e-1;
-    const LG5: f64 = 1.818_357_216_161_805_012e-1;
-    const LG6: f64 = 1.531_383_769_920_937_332e-1;
-    const LG7: f64 = 1.479_819_860_511_658_591e-1;
-    let bits = u.to_bits();
-    let e = ((bits >> 52) as i64 - 1023) as f64;
-    let m = f64::from_bits((bits & 0x000F_FFFF_FFFF_FFFF) | 0x3FF0_0000_0000_0000);
-    let big = m > std::f64::consts::SQRT_2;
-    let m = if big { 0.5 * m } else { m };
-    let k = if big { e + 1.0 } else { e };
-    let f = m - 1.0;
-    let s = f / (2.0 + f);
-    let z = s * s;
-    let w = z * z;
-    let t1 = w * (LG2 + w * (LG4 + w * LG6));
-    let t2 = z * (LG1 + w * (LG3 + w * (LG5 + w * LG7)));
-    let r = t2 + t1;
-    let hfsq = 0.5 * f * f;
-    k * LN2_HI - ((hfsq - (s * (hfsq + r) + k * LN2_LO)) - f)
 }
 
 /// Writes `best` as TDC codes into `out` (no detection outside the window); returns the

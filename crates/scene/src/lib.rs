@@ -7,8 +7,10 @@
 
 mod acquisition;
 mod batch;
+mod depths;
 mod error;
 mod lanes;
+mod ln;
 mod motion;
 mod scene;
 mod sensor;

@@ -34,7 +34,8 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
 use crate::MM_PER_PS;
-use crate::batch::{self, Block, Depths, Params, Scratch, Slot};
+use crate::batch::{self, Block, Params, Scratch, Slot};
+use crate::depths::Depths;
 use crate::error::SceneError;
 use crate::scene::Scene;
 use crate::sensor::SensorConfig;
