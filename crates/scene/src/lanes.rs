@@ -4,6 +4,9 @@
 
 use crate::splitmix::SplitMix64;
 
+#[cfg(target_arch = "x86_64")]
+mod avx2;
+
 /// Interleaved generators per stream: eight, one 512-bit vector per state word (with four,
 /// LLVM packed two state words into one 512-bit register and the shuffles between them
 /// lengthened every step's dependency chain: 3.2× slower a word on AVX-512).
@@ -125,19 +128,20 @@ pub(crate) fn all_avx512(g: &mut Streams, j: &mut Words, s: &mut Words, b: &mut 
 }
 
 /// The AVX2 copy's fills: built in that copy (a target-feature function is a
-/// safe function pointer only where its features are enabled).
+/// safe function pointer only where its features are enabled), by the explicit vector
+/// step of [`avx2`] (LLVM leaves [`step`] scalar without a 64-bit vector rotate).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
 pub(crate) fn one_avx2(l: &mut Lanes, j: &mut Words) {
-    l.fill(j);
+    avx2::one(l, j);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
 pub(crate) fn all_avx2(g: &mut Streams, j: &mut Words, s: &mut Words, b: &mut Words) {
-    g.fill_all(j, s, b);
+    avx2::all(g, j, s, b);
 }
 
 /// The baseline copy's fills.
