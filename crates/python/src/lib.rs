@@ -181,7 +181,8 @@ impl Design {
     /// ``shift`` (S), ``frac_bits`` (F), ``register_frac_bits`` (G: the registers count
     /// 2^−G codes), ``adders`` (A), ``cycles_per_pulse`` (C),
     /// ``pulses`` (the acquisition), ``seed``, ``laser_rate_hz``, ``tdc_lsb_mm``, ``notes``
-    /// and ``array`` (``(rows, cols)`` or ``None``).
+    /// ``array`` (``(rows, cols)`` of pixels, or ``None``) and ``superpixel`` (G: SPADs per
+    /// pixel side, so the written SPAD grid is G·rows × G·cols; ``None`` without an array).
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = &self.inner;
         let p = &d.pixel;
@@ -213,6 +214,7 @@ impl Design {
         out.set_item("tdc_lsb_mm", d.sensor().tdc_lsb_mm())?;
         out.set_item("notes", d.notes.clone())?;
         out.set_item("array", d.array.as_ref().map(|a| (a.rows, a.cols)))?;
+        out.set_item("superpixel", d.array.as_ref().map(|a| a.superpixel))?;
         Ok(out)
     }
 

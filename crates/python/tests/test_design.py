@@ -25,7 +25,15 @@ def test_default_summary_holds_the_resolved_values():
     # width_bits: test_pixel.py), at most T + 1 + F + ⌈log2 N⌉ = 16 + 24 = 40.
     assert s["width"] == 39
     assert s["tdc_lsb_mm"] == pytest.approx(0.75, rel=1e-12)
-    assert s["array"] is None and s["seed"] == 1
+    assert s["array"] is None and s["superpixel"] is None and s["seed"] == 1
+
+
+def test_a_superpixel_array_summary_counts_pixels_and_names_g(array_text):
+    # The 4 × 3 SPAD test array as 4 × 4 SPADs in 2 × 2 superpixels: 2 × 2 pixels, G = 2.
+    text = array_text.replace("cols = 3", "cols = 4\nsuperpixel = 2")
+    s = tofprobe.Design.from_toml(text).summary()
+    assert s["array"] == (2, 2) and s["superpixel"] == 2
+    assert tofprobe.Design.from_toml(array_text).summary()["superpixel"] == 1
 
 
 def test_the_cli_prints_the_same_resolution(cli):

@@ -30,6 +30,7 @@ class Summary(TypedDict):
     tdc_lsb_mm: float
     notes: list[str]
     array: tuple[int, int] | None
+    superpixel: int | None
 
 class Design:
     """A tofprobe design resolved once; see ``help(tofprobe.Design)``."""
