@@ -1,0 +1,76 @@
+//! Table 2's closed-form predictions of a row: the noise floor over the band's bins (eq. 12
+//! with the background mixture and the hold's noise factor) and the tone's expected
+//! amplitude, from `tofprobe_dsp::closed_form`.
+
+use tofprobe_dsp::closed_form::{
+    MixtureParams, first_arrival, hold_noise_factor, hold_response_sq, mixture_gain, noise_floor_mm,
+};
+use tofprobe_dsp::stats::NoiseBand;
+
+use super::super::setup::{FS_HZ, LSB_MM};
+use super::{BAND, F0_HZ, Spec, WINDOW, tone_bin};
+use crate::ExperimentError;
+
+/// Number of DFT bins the noise floor of a row averages (the band minus DC and tone).
+pub fn band_bins(spec: &Spec, n: usize) -> Result<usize, ExperimentError> {
+    let tones: Vec<f64> = if spec.amp_um.is_some() {
+        vec![tone_bin(n) as f64]
+    } else {
+        vec![]
+    };
+    Ok(NoiseBand::new(BAND.0, BAND.1)
+        .bins(n / 2 + 1, n, FS_HZ, &tones)?
+        .len())
+}
+
+/// The closed-form noise floor of a row over the same band bins (µm): eq. 12 with the
+/// mixture variance (plus a²/12) and the held-noise factor F(ρ_v, ω) averaged as
+/// sqrt(F) over the band's bins, like the measured mean magnitude.
+pub fn closed_form_noise_um(spec: &Spec, n: usize) -> Result<f64, ExperimentError> {
+    let setup = spec.setup();
+    let fa = first_arrival(&MixtureParams {
+        signal_rate: spec.rho_s,
+        background_rate: spec.rho_b,
+        signal_depth_mm: setup.depth_mm(),
+        jitter_mm: setup.jitter_mm()?,
+        window_mm: setup.window_mm,
+    })?;
+    let sigma = (fa.variance_mm2 + LSB_MM * LSB_MM / 12.0).sqrt();
+    let band = NoiseBand::new(BAND.0, BAND.1);
+    let tones: Vec<f64> = if spec.amp_um.is_some() {
+        vec![tone_bin(n) as f64]
+    } else {
+        vec![]
+    };
+    let bins = band.bins(n / 2 + 1, n, FS_HZ, &tones)?;
+    let mean_sqrt_f = bins
+        .iter()
+        .map(|&k| {
+            let w = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
+            hold_noise_factor(fa.valid_rate.min(1.0), w).sqrt()
+        })
+        .sum::<f64>()
+        / bins.len() as f64;
+    let n_eff = n as f64 * WINDOW.effective_length_factor();
+    Ok(noise_floor_mm(sigma, n_eff) * mean_sqrt_f * 1e3)
+}
+
+/// The expected tone amplitude (µm): the mixture's mean follows the signal with gain
+/// g = ∂μ/∂t_s, and the hold's mean response at f0 is |H(ρ_v, ω0)|.
+pub fn closed_form_amp_um(spec: &Spec) -> Result<Option<f64>, ExperimentError> {
+    let Some(a) = spec.amp_um else {
+        return Ok(None);
+    };
+    let setup = spec.setup();
+    let p = MixtureParams {
+        signal_rate: spec.rho_s,
+        background_rate: spec.rho_b,
+        signal_depth_mm: setup.depth_mm(),
+        jitter_mm: setup.jitter_mm()?,
+        window_mm: setup.window_mm,
+    };
+    let g = mixture_gain(&p)?;
+    let rho_v = first_arrival(&p)?.valid_rate.min(1.0);
+    let w0 = 2.0 * std::f64::consts::PI * F0_HZ / FS_HZ;
+    Ok(Some(a * g * hold_response_sq(rho_v, w0).sqrt()))
+}
