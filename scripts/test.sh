@@ -67,9 +67,7 @@ phase clippy cargo clippy --workspace --all-targets --release -- -D warnings
 phase build-tests cargo test --workspace --release --no-run
 await install-tools
 [ -f "$prep/python-venv.pid" ] && await python-venv
-# The tests: scripts/run-tests.sh runs what `cargo test --workspace --release` runs, the
-# CLI's long integration binary beside the others (see there why).
-phase tests scripts/run-tests.sh
+phase tests cargo test --workspace --release
 # The Python package (crates/python): maturin builds it into the scripts' venv, reusing the
 # library crates just built, and pytest runs its suite against the CLI binary built above.
 phase python scripts/python-package.sh
