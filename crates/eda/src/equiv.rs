@@ -118,14 +118,7 @@ fn read_rtl(spec: &EquivSpec) -> String {
     for src in &spec.rtl {
         s += &format!("read_verilog -sv {}\n", src.display());
     }
-    if !spec.params.is_empty() {
-        s += "chparam";
-        for (k, v) in &spec.params {
-            s += &format!(" -set {k} {v}");
-        }
-        s += &format!(" {}\n", spec.top);
-    }
-    s
+    s + &crate::synth::chparam(&spec.params, &spec.top)
 }
 
 /// Both scripts' end: the stashed gold and gate designs paired by name, each pair proven

@@ -119,13 +119,7 @@ pub fn yosys_script(
     if let Some(map) = clock_gate_map {
         s += &format!("read_verilog -overwrite {}\n", map.display());
     }
-    if !spec.params.is_empty() {
-        s += "chparam";
-        for (k, v) in &spec.params {
-            s += &format!(" -set {k} {v}");
-        }
-        s += &format!(" {}\n", spec.top);
-    }
+    s += &chparam(&spec.params, &spec.top);
     for w in &spec.keep {
         s += &format!("setattr -set keep 1 {}/w:{w}\n", spec.top);
     }
@@ -394,6 +388,19 @@ pub fn parse_stat(log: &str) -> Result<(BTreeMap<String, u64>, u64, f64)> {
         }
     }
     Ok((by_type, count, area))
+}
+
+/// The parameter overrides of `top` as one yosys `chparam` line (empty without any): the
+/// synthesis script's and the equivalence script's gold side (crates/eda/src/equiv.rs).
+pub(crate) fn chparam(params: &[(String, i64)], top: &str) -> String {
+    if params.is_empty() {
+        return String::new();
+    }
+    let sets: String = params
+        .iter()
+        .map(|(k, v)| format!(" -set {k} {v}"))
+        .collect();
+    format!("chparam{sets} {top}\n")
 }
 
 #[cfg(test)]

@@ -99,37 +99,37 @@ pub(crate) struct Scratch {
     pass: Box<PassBuffers>,
 }
 
-/// The buffers of one pass of [`PASS`] pulses (the pass's buffers, ≈ 37 bytes a pulse,
-/// stay in L1).
+/// The buffers of one pass of [`PASS`] pulses (≈ 58 bytes a pulse, 29 kB: within L1), each
+/// a whole pass long; a block's last, shorter pass uses their first pulses.
 #[derive(Debug)]
 struct PassBuffers {
-    z: Vec<f64>,
+    z: [f64; PASS],
     /// The jitter, signal and background streams' words.
     words: Words,
     signal_words: Words,
     background_words: Words,
-    flags: Vec<u8>,
+    flags: [u8; PASS],
     /// Each pulse's ziggurat layer edges.
-    edges: Vec<[f64; 2]>,
+    edges: [[f64; 2]; PASS],
     rejects: Vec<u32>,
     /// The earliest in-window arrival of each pulse, code units (∞ when none).
-    best: Vec<f64>,
+    best: [f64; PASS],
     /// Whether a background photon won the pulse.
-    from_bg: Vec<bool>,
+    from_bg: [bool; PASS],
 }
 
 impl Default for PassBuffers {
     fn default() -> Self {
         PassBuffers {
-            z: Vec::new(),
+            z: [0.0; PASS],
             words: [0; PASS],
             signal_words: [0; PASS],
             background_words: [0; PASS],
-            flags: Vec::new(),
-            edges: Vec::new(),
+            flags: [0; PASS],
+            edges: [[0.0; 2]; PASS],
             rejects: Vec::new(),
-            best: Vec::new(),
-            from_bg: Vec::new(),
+            best: [0.0; PASS],
+            from_bg: [false; PASS],
         }
     }
 }
@@ -327,10 +327,6 @@ fn generate_body<O: Slot>(
     sc.depth.resize(padded, 0.0);
     depths.fill(scene, first_pulse, p.period_s, &mut sc.depth[..n]);
     let b = &mut sc.pass;
-    b.z.resize(PASS, 0.0);
-    b.best.resize(PASS, 0.0);
-    b.from_bg.resize(PASS, false);
-
     let mut seeder = SplitMix64::new(block_seed);
     let mut g = Streams {
         jitter: Lanes::new(&mut seeder),
@@ -392,7 +388,13 @@ fn pass<O: Slot>(
     }
     let (words, z) = (&b.words[..m], &mut b.z[..m]);
     let (sw, bw) = (&b.signal_words[..m], &b.background_words[..m]);
-    fast_pass(t, words, z, &mut b.flags, &mut b.edges, &mut b.rejects);
+    fast_pass(
+        t,
+        words,
+        z,
+        (&mut b.flags[..m], &mut b.edges[..m]),
+        &mut b.rejects,
+    );
     for &k in &b.rejects {
         z[k as usize] = finish(t, words[k as usize], slow);
     }

@@ -71,13 +71,10 @@ pub(crate) fn fast_pass(
     t: &Tables,
     bits: &[u64],
     z: &mut [f64],
-    flags: &mut Vec<u8>,
-    edges: &mut Vec<[f64; 2]>,
+    (flags, edges): (&mut [u8], &mut [[f64; 2]]),
     rejects: &mut Vec<u32>,
 ) {
-    debug_assert_eq!(bits.len(), z.len());
-    flags.resize(bits.len(), 0);
-    edges.resize(bits.len(), [0.0; 2]);
+    debug_assert!(bits.len() == z.len() && z.len() == flags.len() && z.len() == edges.len());
     // The layer's two edges copied per sample by scalar 16-byte loads: on AMD Zen 4 a
     // vector gather of eight is slower than eight plain loads (the two gathers were
     // ≈ 40 % of the kernel at (ρ_s, ρ_b) = (1, 0)).

@@ -163,6 +163,21 @@ fn small_pixel_netlist(
     (v, syn)
 }
 
+/// The equivalence of `netlist` against the generated RTL `v` on `liberty`.
+fn equiv_spec(
+    v: &tofprobe_eda::analysis::RtlVariant,
+    netlist: PathBuf,
+    liberty: &Path,
+) -> EquivSpec {
+    EquivSpec {
+        rtl: v.sources.clone(),
+        top: v.top.clone(),
+        params: v.params.clone(),
+        netlist,
+        liberty: liberty.to_path_buf(),
+    }
+}
+
 /// The broken netlist failing equivalence, on a small generated pixel (B = 2, W = 10): on
 /// the full pixel a failed induction falls back to one proof per point (over a thousand
 /// SAT problems of 700k clauses), too slow for CI; the proof itself is the same.
@@ -173,13 +188,7 @@ fn broken_small_pixel_is_not_equivalent(liberty: &Path, inv: &str, name: &str) {
         tofprobe_pixel::RegisterFile::Flops,
         ("small-rtl", "small"),
     );
-    let spec = |netlist: PathBuf| EquivSpec {
-        rtl: v.sources.clone(),
-        top: v.top.clone(),
-        params: v.params.clone(),
-        netlist,
-        liberty: liberty.to_path_buf(),
-    };
+    let spec = |netlist: PathBuf| equiv_spec(&v, netlist, liberty);
     let work = cache(name).join("small-equiv");
     // A cache of this test's own (the default one is shared by every run on the machine).
     let proofs = cache(name).join("equiv-cache");
@@ -289,13 +298,7 @@ fn latch_pixel_is_proven_and_a_miswired_latch_is_not(liberty: &Path, enable: &st
     let work = cache(name).join("latch-equiv");
     // No cache: each run is a proof of its own (the broken netlists must be proven too).
     let prove = |netlist: PathBuf| {
-        let spec = EquivSpec {
-            rtl: v.sources.clone(),
-            top: v.top.clone(),
-            params: v.params.clone(),
-            netlist,
-            liberty: liberty.to_path_buf(),
-        };
+        let spec = equiv_spec(&v, netlist, liberty);
         assert_eq!(Recipe::of(&spec).unwrap(), Recipe::Latch);
         check_equivalence_cached(&spec, &work, None)
     };
