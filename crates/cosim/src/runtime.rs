@@ -122,9 +122,9 @@ fn entry_key(
     }
     let compiler = commands.split_whitespace().next()?.to_string();
     let compiler_version = Command::new(&compiler).arg("--version").output().ok()?;
-    let verilator_version = Command::new(verilator).arg("--version").output().ok()?;
+    let verilator_version = crate::verilator::version(verilator).ok()?;
     let mut key = b"tofprobe-verilator-runtime-v1\n".to_vec();
-    key.extend_from_slice(&verilator_version.stdout);
+    key.extend_from_slice(&verilator_version);
     key.extend_from_slice(&compiler_version.stdout);
     key.extend_from_slice(commands.as_bytes());
     Some((format!("runtime-{:016x}", fnv1a64(&key)), objects))

@@ -180,6 +180,29 @@ pub fn build_with(
     })
 }
 
+/// `verilator --version`'s output, run once per executable path in a process (every
+/// build's key and its run-time library's key hold it).
+pub(crate) fn version(verilator: &Path) -> Result<Vec<u8>, CosimError> {
+    type Seen = std::sync::Mutex<Vec<(PathBuf, Vec<u8>)>>;
+    static SEEN: std::sync::OnceLock<Seen> = std::sync::OnceLock::new();
+    let seen = SEEN.get_or_init(Default::default);
+    if let Some((_, v)) = seen
+        .lock()
+        .ok()
+        .and_then(|s| s.iter().find(|(p, _)| p == verilator).cloned())
+    {
+        return Ok(v);
+    }
+    let out = Command::new(verilator)
+        .arg("--version")
+        .output()
+        .map_err(|e| CosimError::io(verilator, e))?;
+    if let Ok(mut s) = seen.lock() {
+        s.push((verilator.to_path_buf(), out.stdout.clone()));
+    }
+    Ok(out.stdout)
+}
+
 /// The cache key of a harness build: the Verilator version, a `tag`, the harness source,
 /// the build's `options` (top, profile, flags) and every RTL source's name and bytes.
 pub(crate) fn build_key(
@@ -189,12 +212,8 @@ pub(crate) fn build_key(
     options: &str,
     sources: &[PathBuf],
 ) -> Result<Vec<u8>, CosimError> {
-    let version = Command::new(verilator)
-        .arg("--version")
-        .output()
-        .map_err(|e| CosimError::io(verilator, e))?;
     let mut key = tag.as_bytes().to_vec();
-    key.extend_from_slice(&version.stdout);
+    key.extend_from_slice(&version(verilator)?);
     key.extend_from_slice(harness.as_bytes());
     key.extend_from_slice(options.as_bytes());
     for s in sources {
