@@ -2,8 +2,8 @@
 // DO NOT EDIT: regenerate with `tofprobe rtl --out rtl`.
 // Configuration hash: baefdf00f23c13f4 (Fourier, B=16, U=4, A=2, C=16, T=7, Z=0, S=5, F=8, W=39, N=10000000, L=20000).
 // Probe ROM: ΣΔ probe ROM (periodic rectangular, order 3, OSR 32, A_p 0.5, window gain 1), L = 20000, bins k = [9, 23, 43, 63, 83, 103, 123, 143, 163, 183, 203, 223, 243, 263, 283, 303] (f_k = k·f_s/L), wrap clean (in-band wrap error 1.8e-2 of the quantisation error, 1 period(s) searched), content hash 617e400db4d12d37
-// Top: the pixel, the probe ROM and the pulse/clock sequencer of the
-// contract ("The reference sequencer"): after rst, 10000000 pulses one every 16 cycles, then a
+// Top: the pixel, the probe ROM and the chip's one sequencer (`tofprobe_sequencer`, the
+// contract's "The reference sequencer" walking one pixel): after rst, 10000000 pulses one every 16 cycles, then a
 // readout cycle and 33 idle cycles, frame after frame. `pulse_o` tells the TDC
 // (and a testbench) that this cycle samples `valid`/`tdc`.
 module tofprobe_top (
@@ -17,47 +17,36 @@ module tofprobe_top (
     output wire [5:0] rd_index,
     output wire [38:0] rd_data
 );
-    reg ro_phase;
-    reg [3:0] ph;
-    reg [23:0] pidx;
-    reg [5:0] rc;
-    wire pulse = !rst && !ro_phase && (ph == 4'd0);
-    wire readout = !rst && ro_phase && (rc == 6'd0);
+    // The chip's one sequencer, walking one pixel: its readout slot is the strobe and the
+    // 33 cycles its words take.
+    wire pulse;
+    wire readout;
     assign pulse_o = pulse;
-    reg [14:0] addr;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire s_swap;
+    wire s_q;
+    wire s_row;
+    wire s_col;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [14:0] addr;
     wire [31:0] rom_word;
     tofprobe_probe_rom u_rom (.addr(addr), .word(rom_word));
-
-    always @(posedge clk) begin
-        if (rst) begin
-            ro_phase <= 1'b0;
-            ph <= 4'd0;
-            pidx <= 24'd0;
-            rc <= 6'd0;
-            addr <= 15'd0;
-        end else if (!ro_phase) begin
-            if (ph == 4'd15) begin
-                ph <= 4'd0;
-                addr <= (addr == 15'd19999) ? 15'd0 : addr + 15'd1;
-                if (pidx == 24'd9999999) begin
-                    pidx <= 24'd0;
-                    ro_phase <= 1'b1;
-                    rc <= 6'd0;
-                    addr <= 15'd0;
-                end else begin
-                    pidx <= pidx + 24'd1;
-                end
-            end else begin
-                ph <= ph + 4'd1;
-            end
-        end else begin
-            if (rc == 6'd33) begin
-                ro_phase <= 1'b0;
-            end else begin
-                rc <= rc + 6'd1;
-            end
-        end
-    end
+    tofprobe_sequencer #(
+        .PIXELS(1),
+        .COLS(1),
+        .SLOT(33),
+        .DOUBLE_BUFFER(0)
+    ) u_sequencer (
+        .clk(clk),
+        .rst(rst),
+        .pulse(pulse),
+        .readout(readout),
+        .swap(s_swap),
+        .q(s_q),
+        .row(s_row),
+        .col(s_col),
+        .addr(addr)
+    );
 
     tofprobe_pixel u_pixel (
         .clk(clk),

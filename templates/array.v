@@ -1,182 +1,115 @@
 {{ header }}
-// The array of docs/pixel-contract.md "Array": {{ rows }} x {{ cols }} instances of the one pixel,
-// one probe ROM{% if !fourier %} (none: Haar){% endif %} and one sequencer at the root. The sequencer's
-// `pulse`{% if fourier %}, `rom_word`{% endif %} and readout strobes reach every pixel through two registered
-// fan-out stages (the root, then one per row). After {{ n }} pulses one every {{ c }} cycles,
-// the readout phase reads the pixels one at a time, row-major, one every {{ s }} cycles
-// ({{ rows * cols }} x {{ s }} + 1 cycles, no pulse presented): a row select puts the pixel on
-// its column bus, the selected column's words are captured into a readout buffer, and
-// the buffer drains onto the {{ b }}-bit port, {{ k }} beat(s) per word (least significant
-// first; registers sign-extended, the status word zero-extended), one beat every {{ g }}
-// cycle(s). `pulse_o` tells the TDCs (and a testbench) that the pixels sample `valid` and
-// `tdc` this cycle; {% if sp > 1 %}each pixel is a superpixel of
-// {{ sp }} x {{ sp }} SPADs: `valid` and `tdc` are per SPAD, SPAD (sr, sc) of the {{ trows * sp }} x {{ scols }} SPAD grid{% if let Some(t) = tile %}
-// of the TILE of rows {{ t.0 }}..{{ t.0 + trows - 1 }}, columns {{ t.1 }}..{{ t.1 + tcols - 1 }} (the sequencer, broadcast and readout of the whole array,
-// the other pixels absent: their slots carry no beat){% endif %} is bit sr*{{ scols }}+sc of `valid` and that field of
-// `tdc`, and pixel (r, c) averages SPADs (r*{{ sp }}+i, c*{{ sp }}+j) through one `{{ sp_name }}` (combinational: it
-// samples the average as it would one SPAD's).{% else %}{% if let Some(t) = tile %}this is the TILE of rows {{ t.0 }}..{{ t.0 + trows - 1 }}, columns {{ t.1 }}..{{ t.1 + tcols - 1 }}
-// only (the sequencer, broadcast and readout of the whole array, the other pixels absent:
-// their slots carry no beat); its pixel (r, c) is bit (r-{{ t.0 }})*{{ tcols }}+(c-{{ t.1 }}) of `valid` and that field of `tdc`.{% else %}pixel (r, c) is bit r*{{ cols }}+c of `valid` and field r*{{ cols }}+c of `tdc`.{% endif %}{% endif %}
-module {{ name }} (
+// The array of docs/pixel-contract.md "Array": ROWS x COLS instances of the one pixel
+// `{{ pixel_name }}`, one probe ROM{% if !fourier %} (none: Haar){% endif %} and the chip's one sequencer
+// `{{ seq_name }}` at the root, written with generate loops over the parameters below: the
+// file's size does not grow with the array. The sequencer's `pulse`{% if fourier %}, `rom_word`{% endif %} and
+// readout strobes reach every pixel through two registered fan-out stages (the root, then
+// one per row). After {{ n }} pulses one every {{ c }} cycles, the readout phase reads the pixels
+// one at a time, row-major, one every SLOT = (R+1) x K x BEAT_CYCLES cycles ({{ r }} registers and
+// the status word; ROWS x COLS x SLOT + 1 cycles{% if dbuf %}, beside the next frame's pulses: double-buffered{% else %}, no pulse presented{% endif %}): a row select puts the
+// pixel on its column bus, the selected column's words are captured into a readout buffer,
+// and the buffer drains onto the READOUT_BITS-bit port, K = ceil({{ w }} / READOUT_BITS) beat(s)
+// per word (least significant first; registers sign-extended, the status word
+// zero-extended), one beat every BEAT_CYCLES cycle(s). `pulse_o` tells the TDCs (and a
+// testbench) that the pixels sample `valid` and `tdc` this cycle.
+//
+// Only the pixels of the TILE (rows TILE_ROW0 .. TILE_ROW0+TILE_ROWS-1, columns TILE_COL0 ..
+// TILE_COL0+TILE_COLS-1; the whole array by default) are instantiated: the sequencer,
+// broadcast and readout still walk the whole array, the absent pixels' slots carry no beat.
+// The ports are per pixel of the tile{% if sp > 1 %} and per SPAD: each pixel is a superpixel of
+// G x G = {{ sp }} x {{ sp }} SPADs, SPAD (sr, sc) of the tile's (TILE_ROWS*G) x (TILE_COLS*G) SPAD grid is
+// bit sr*TILE_COLS*G+sc of `valid` and that field of `tdc`, and pixel (r, c) averages SPADs
+// (r*G+i, c*G+j) through one `{{ sp_name }}` (combinational: it samples the average as it would
+// one SPAD's){% else %}: the tile's pixel (r, c) is bit r*TILE_COLS+c of `valid` and that field of `tdc`{% endif %}.
+// G and the double buffer are fixed by the files of this set (the superpixel's reciprocal
+// table and the pixel's `swap` port are rendered for them); ROWS, COLS, the tile and the
+// readout port may be overridden, and `tofprobe cosim --rtl` re-verifies an edited set.
+module {{ name }} #(
+    parameter integer ROWS = {{ rows }},
+    parameter integer COLS = {{ cols }},
+    parameter integer TILE_ROW0 = {{ tile_row0 }},
+    parameter integer TILE_COL0 = {{ tile_col0 }},
+    parameter integer TILE_ROWS = {{ trows }},
+    parameter integer TILE_COLS = {{ tcols }},
+    parameter integer READOUT_BITS = {{ b }},
+    parameter integer BEAT_CYCLES = {{ g }},
+    // Derived (not to be overridden): SPADs per pixel, inputs on the ports.
+    parameter integer SPADS = {{ sp * sp }},
+    parameter integer INPUTS = TILE_ROWS * TILE_COLS * SPADS
+) (
     input  wire clk,
     input  wire rst,
-    input  wire [{{ nin - 1 }}:0] valid,
-    input  wire [{{ nin * t - 1 }}:0] tdc,
+    input  wire [INPUTS - 1:0] valid,
+    input  wire [INPUTS * {{ t }} - 1:0] tdc,
     output wire pulse_o,
     output wire ready,
     output reg  ro_valid,
-    output reg  [{{ b - 1 }}:0] ro_data
+    output reg  [READOUT_BITS - 1:0] ro_data
 );
-    // ---- the sequencer (root) ----
-    reg ro_phase;
-    reg [{{ pw - 1 }}:0] ph;
-    reg [{{ nw - 1 }}:0] pidx;
-    reg [{{ qw - 1 }}:0] q;
-    reg [{{ scw - 1 }}:0] sc;
-    reg [{{ rw - 1 }}:0] qr;
-    reg [{{ cw - 1 }}:0] qc;
-{%- if dbuf %}
-    // Double-buffered (docs/pixel-contract.md "Double buffer"): after the frame's
-    // {{ n }} pulses the sequencer holds {{ idle + 1 }} cycle(s) (the swap cycle, then the wait until
-    // the last frame's readout is done), while the readout walks the pixels beside the
-    // next frame's pulses; the swap is its first cycle.
-    reg hold;
-    reg [{{ hw - 1 }}:0] wt;
-    wire s_pulse = !rst && !hold && (ph == {{ pw }}'d0);
-    wire s_swap = !rst && ro_phase && (q == {{ qw }}'d0) && (sc == {{ scw }}'d0);
-{%- else %}
-    wire s_pulse = !rst && !ro_phase && (ph == {{ pw }}'d0);
+{%- if sp > 1 %}
+    localparam integer G = {{ sp }};
 {%- endif %}
-    wire s_ro = !rst && ro_phase && (sc == {{ scw }}'d0) && (q != {{ qw }}'d{{ np }});
-{%- if mutation == "order_swap" %}
-    // DELIBERATELY BROKEN: the readout order swaps its first two pixels.
-    wire [{{ rw - 1 }}:0] s_row = (q == {{ qw }}'d0) ? {{ rw }}'d{{ swap_r1 }} : (q == {{ qw }}'d1) ? {{ rw }}'d{{ swap_r0 }} : qr;
-    wire [{{ cw - 1 }}:0] s_col = (q == {{ qw }}'d0) ? {{ cw }}'d{{ swap_c1 }} : (q == {{ qw }}'d1) ? {{ cw }}'d{{ swap_c0 }} : qc;
-{%- else %}
-    wire [{{ rw - 1 }}:0] s_row = qr;
-    wire [{{ cw - 1 }}:0] s_col = qc;
-{%- endif %}
+    localparam integer T = {{ t }};
+    localparam integer W = {{ w }};
+    localparam integer R = {{ r }};
+    localparam integer IB = {{ ib }};
+    localparam integer PIXELS = ROWS * COLS;
+    localparam integer TILE_PIXELS = TILE_ROWS * TILE_COLS;
+    localparam integer K = (W + READOUT_BITS - 1) / READOUT_BITS;
+    localparam integer KB = K * READOUT_BITS;
+    localparam integer SLOT = (R + 1) * K * BEAT_CYCLES;
+    localparam integer RW = (ROWS > 2) ? $clog2(ROWS) : 1;
+    localparam integer CW = (COLS > 2) ? $clog2(COLS) : 1;
+    localparam integer QW = (PIXELS + 1 > 2) ? $clog2(PIXELS + 1) : 1;
+    localparam integer KW = (K > 2) ? $clog2(K) : 1;
+    localparam integer GW = (BEAT_CYCLES > 2) ? $clog2(BEAT_CYCLES) : 1;
+    localparam integer K_LAST = K - 1;
+    localparam integer G_LAST = BEAT_CYCLES - 1;
+    localparam [IB - 1:0] LAST_WORD = R[IB - 1:0];
+    localparam [KW - 1:0] DM_END = K_LAST[KW - 1:0];
+    localparam [GW - 1:0] DG_END = G_LAST[GW - 1:0];
+
+    // ---- the sequencer (root) and the probe ROM ----
+    wire s_pulse;
+    wire s_ro;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire s_swap;
+    wire [QW - 1:0] s_q;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [RW - 1:0] q_row;
+    wire [CW - 1:0] q_col;
 {%- if fourier %}
-    reg [{{ aw - 1 }}:0] addr;
-    wire [{{ r - 1 }}:0] rom_word;
+    wire [{{ aw - 1 }}:0] addr;
+    wire [R - 1:0] rom_word;
     {{ rom_name }} u_rom (.addr(addr), .word(rom_word));
 {%- endif %}
-
-{%- if dbuf %}
-
-    always @(posedge clk) begin
-        if (rst) begin
-            ro_phase <= 1'b0;
-            ph <= {{ pw }}'d0;
-            pidx <= {{ nw }}'d0;
-            q <= {{ qw }}'d0;
-            sc <= {{ scw }}'d0;
-            qr <= {{ rw }}'d0;
-            qc <= {{ cw }}'d0;
-            hold <= 1'b0;
-            wt <= {{ hw }}'d0;
-{%- if fourier %}
-            addr <= {{ aw }}'d0;
-{%- endif %}
-        end else begin
-            // The readout walker.
-            if (ro_phase) begin
-                if (q == {{ qw }}'d{{ np }}) begin
-                    ro_phase <= 1'b0;
-                end else if (sc == {{ scw }}'d{{ s - 1 }}) begin
-                    sc <= {{ scw }}'d0;
-                    q <= q + {{ qw }}'d1;
-                    if (qc == {{ cw }}'d{{ cols - 1 }}) begin
-                        qc <= {{ cw }}'d0;
-                        qr <= qr + {{ rw }}'d1;
-                    end else begin
-                        qc <= qc + {{ cw }}'d1;
-                    end
-                end else begin
-                    sc <= sc + {{ scw }}'d1;
-                end
-            end
-            // The pulses; the frame's end starts the walker (it has finished: D <= the
-            // frame period), after it in the block so the restart wins.
-            if (hold) begin
-                if (wt == {{ hw }}'d0) hold <= 1'b0;
-                else wt <= wt - {{ hw }}'d1;
-            end else if (ph == {{ pw }}'d{{ c - 1 }}) begin
-                ph <= {{ pw }}'d0;
-{%- if fourier %}
-                addr <= (addr == {{ aw }}'d{{ l - 1 }}) ? {{ aw }}'d0 : addr + {{ aw }}'d1;
-{%- endif %}
-                if (pidx == {{ nw }}'d{{ n - 1 }}) begin
-                    pidx <= {{ nw }}'d0;
-                    hold <= 1'b1;
-                    wt <= {{ hw }}'d{{ idle }};
-                    ro_phase <= 1'b1;
-                    q <= {{ qw }}'d0;
-                    sc <= {{ scw }}'d0;
-                    qr <= {{ rw }}'d0;
-                    qc <= {{ cw }}'d0;
-{%- if fourier %}
-                    addr <= {{ aw }}'d0;
-{%- endif %}
-                end else begin
-                    pidx <= pidx + {{ nw }}'d1;
-                end
-            end else begin
-                ph <= ph + {{ pw }}'d1;
-            end
-        end
-    end
+    {{ seq_name }} #(
+        .PIXELS(PIXELS),
+        .COLS(COLS),
+        .SLOT(SLOT),
+        .DOUBLE_BUFFER({% if dbuf %}1{% else %}0{% endif %})
+    ) u_sequencer (
+        .clk(clk),
+        .rst(rst),
+        .pulse(s_pulse),
+        .readout(s_ro),
+        .swap(s_swap),
+        .q(s_q),
+        .row(q_row),
+        .col(q_col){% if fourier %},
+        .addr(addr){% endif %}
+    );
+{%- if mutation == "order_swap" %}
+    // DELIBERATELY BROKEN: the readout order swaps its first two pixels.
+    localparam [RW - 1:0] SWAP_R0 = 0;
+    localparam [CW - 1:0] SWAP_C0 = 0;
+    localparam [RW - 1:0] SWAP_R1 = (COLS > 1) ? 0 : 1;
+    localparam [CW - 1:0] SWAP_C1 = (COLS > 1) ? 1 : 0;
+    wire [RW - 1:0] s_row = (s_q == {QW{1'b0}}) ? SWAP_R1 : (s_q == { {(QW - 1){1'b0}}, 1'b1 }) ? SWAP_R0 : q_row;
+    wire [CW - 1:0] s_col = (s_q == {QW{1'b0}}) ? SWAP_C1 : (s_q == { {(QW - 1){1'b0}}, 1'b1 }) ? SWAP_C0 : q_col;
 {%- else %}
-
-    always @(posedge clk) begin
-        if (rst) begin
-            ro_phase <= 1'b0;
-            ph <= {{ pw }}'d0;
-            pidx <= {{ nw }}'d0;
-            q <= {{ qw }}'d0;
-            sc <= {{ scw }}'d0;
-            qr <= {{ rw }}'d0;
-            qc <= {{ cw }}'d0;
-{%- if fourier %}
-            addr <= {{ aw }}'d0;
-{%- endif %}
-        end else if (!ro_phase) begin
-            if (ph == {{ pw }}'d{{ c - 1 }}) begin
-                ph <= {{ pw }}'d0;
-{%- if fourier %}
-                addr <= (addr == {{ aw }}'d{{ l - 1 }}) ? {{ aw }}'d0 : addr + {{ aw }}'d1;
-{%- endif %}
-                if (pidx == {{ nw }}'d{{ n - 1 }}) begin
-                    pidx <= {{ nw }}'d0;
-                    ro_phase <= 1'b1;
-                    q <= {{ qw }}'d0;
-                    sc <= {{ scw }}'d0;
-                    qr <= {{ rw }}'d0;
-                    qc <= {{ cw }}'d0;
-{%- if fourier %}
-                    addr <= {{ aw }}'d0;
-{%- endif %}
-                end else begin
-                    pidx <= pidx + {{ nw }}'d1;
-                end
-            end else begin
-                ph <= ph + {{ pw }}'d1;
-            end
-        end else if (q == {{ qw }}'d{{ np }}) begin
-            ro_phase <= 1'b0;
-        end else if (sc == {{ scw }}'d{{ s - 1 }}) begin
-            sc <= {{ scw }}'d0;
-            q <= q + {{ qw }}'d1;
-            if (qc == {{ cw }}'d{{ cols - 1 }}) begin
-                qc <= {{ cw }}'d0;
-                qr <= qr + {{ rw }}'d1;
-            end else begin
-                qc <= qc + {{ cw }}'d1;
-            end
-        end else begin
-            sc <= sc + {{ scw }}'d1;
-        end
-    end
+    wire [RW - 1:0] s_row = q_row;
+    wire [CW - 1:0] s_col = q_col;
 {%- endif %}
 
     // ---- broadcast stage 1: the root's registers ----
@@ -185,10 +118,10 @@ module {{ name }} (
 {%- if dbuf %}
     reg b_swap;
 {%- endif %}
-    reg [{{ rw - 1 }}:0] b_row;
-    reg [{{ cw - 1 }}:0] b_col;
+    reg [RW - 1:0] b_row;
+    reg [CW - 1:0] b_col;
 {%- if fourier %}
-    reg [{{ r - 1 }}:0] b_word;
+    reg [R - 1:0] b_word;
 {%- endif %}
     always @(posedge clk) begin
         if (rst) begin
@@ -197,10 +130,10 @@ module {{ name }} (
 {%- if dbuf %}
             b_swap <= 1'b0;
 {%- endif %}
-            b_row <= {{ rw }}'d0;
-            b_col <= {{ cw }}'d0;
+            b_row <= {RW{1'b0}};
+            b_col <= {CW{1'b0}};
 {%- if fourier %}
-            b_word <= {{ r }}'d0;
+            b_word <= {R{1'b0}};
 {%- endif %}
         end else begin
             b_pulse <= s_pulse;
@@ -215,15 +148,6 @@ module {{ name }} (
 {%- endif %}
         end
     end
-
-    // ---- broadcast stage 2: one register per row (and the TDCs' strobe) ----
-    reg o_pulse;
-    assign pulse_o = o_pulse;
-    reg [{{ trows - 1 }}:0] r_pulse;
-    reg [{{ trows - 1 }}:0] r_ro;
-{%- if dbuf %}
-    reg [{{ trows - 1 }}:0] r_swap;
-{%- endif %}
 {%- if mutation == "swap_late" %}
     // DELIBERATELY BROKEN: the swap passes one extra register (the shadow a cycle late).
     reg late_swap;
@@ -232,129 +156,199 @@ module {{ name }} (
         else late_swap <= b_swap;
     end
 {%- endif %}
-    reg [{{ trows * cw - 1 }}:0] r_col;
-{%- if fourier %}
-    reg [{{ trows * r - 1 }}:0] r_word;
-{%- endif %}
-{%- if mutation == "row_late" %}
-    // DELIBERATELY BROKEN: one row's broadcast passes one extra register.
-    reg late_pulse;
-{%- if fourier %}
-    reg [{{ r - 1 }}:0] late_word;
-{%- endif %}
-{%- endif %}
+
+    // ---- broadcast stage 2: one register per row (and the TDCs' strobe) ----
     // Each row's stage is its own register (`keep`): the rows' stages take the same value,
     // and a synthesis tool merges equal registers unless told not to — into one register
     // driving every pixel, the fan-out the stages are there to split.
-    (* keep *) always @(posedge clk) begin
+    (* keep *) reg o_pulse;
+    assign pulse_o = o_pulse;
+    always @(posedge clk) begin
         if (rst) o_pulse <= 1'b0;
         else o_pulse <= b_pulse;
     end
-{%- for row in rows_t %}
-    (* keep *) always @(posedge clk) begin
-        if (rst) begin
-            r_pulse[{{ row.lr }}] <= 1'b0;
-            r_ro[{{ row.lr }}] <= 1'b0;
+    wire [TILE_ROWS - 1:0] r_pulse;
+    wire [TILE_ROWS - 1:0] r_ro;
 {%- if dbuf %}
-            r_swap[{{ row.lr }}] <= 1'b0;
+    wire [TILE_ROWS - 1:0] r_swap;
 {%- endif %}
-            r_col[{{ row.lr * cw }} +: {{ cw }}] <= {{ cw }}'d0;
+    wire [TILE_ROWS * CW - 1:0] r_col;
 {%- if fourier %}
-            r_word[{{ row.lr * r }} +: {{ r }}] <= {{ r }}'d0;
+    wire [TILE_ROWS * R - 1:0] r_word;
 {%- endif %}
-{%- if row.late %}
-            late_pulse <= 1'b0;
+    genvar lr;
+    genvar lc;
+    generate
+        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_row
+            localparam integer ROW_I = TILE_ROW0 + lr;
+            localparam [RW - 1:0] ROW = ROW_I[RW - 1:0];
+            (* keep *) reg pulse_q;
+            (* keep *) reg ro_q;
+{%- if dbuf %}
+            (* keep *) reg swap_q;
+            assign r_swap[lr] = swap_q;
+{%- endif %}
+            (* keep *) reg [CW - 1:0] col_q;
+            assign r_pulse[lr] = pulse_q;
+            assign r_ro[lr] = ro_q;
+            assign r_col[lr * CW +: CW] = col_q;
 {%- if fourier %}
-            late_word <= {{ r }}'d0;
+            (* keep *) reg [R - 1:0] word_q;
+            assign r_word[lr * R +: R] = word_q;
 {%- endif %}
+{%- if mutation == "row_late" %}
+            // DELIBERATELY BROKEN: row {{ fault_row }}'s broadcast passes one extra register.
+            reg late_pulse;
+{%- if fourier %}
+            reg [R - 1:0] late_word;
 {%- endif %}
-        end else begin
-{%- if row.late %}
-            late_pulse <= b_pulse;
-            r_pulse[{{ row.lr }}] <= late_pulse;
+            always @(posedge clk) begin
+                if (rst) begin
+                    late_pulse <= 1'b0;
+{%- if fourier %}
+                    late_word <= {R{1'b0}};
+{%- endif %}
+                end else begin
+                    late_pulse <= b_pulse;
+{%- if fourier %}
+                    late_word <= b_word;
+{%- endif %}
+                end
+            end
+            wire late = (TILE_ROW0 + lr == {{ fault_row }});
+            wire next_pulse = late ? late_pulse : b_pulse;
+{%- if fourier %}
+            wire [R - 1:0] next_word = late ? late_word : b_word;
+{%- endif %}
 {%- else %}
-            r_pulse[{{ row.lr }}] <= b_pulse;
+            wire next_pulse = b_pulse;
+{%- if fourier %}
+            wire [R - 1:0] next_word = b_word;
 {%- endif %}
-            r_ro[{{ row.lr }}] <= b_ro && (b_row == {{ rw }}'d{{ row.row }});
+{%- endif %}
+            always @(posedge clk) begin
+                if (rst) begin
+                    pulse_q <= 1'b0;
+                    ro_q <= 1'b0;
+{%- if dbuf %}
+                    swap_q <= 1'b0;
+{%- endif %}
+                    col_q <= {CW{1'b0}};
+{%- if fourier %}
+                    word_q <= {R{1'b0}};
+{%- endif %}
+                end else begin
+                    pulse_q <= next_pulse;
+                    ro_q <= b_ro && (b_row == ROW);
 {%- if mutation == "swap_late" %}
-            r_swap[{{ row.lr }}] <= late_swap;
+                    swap_q <= late_swap;
 {%- else if dbuf %}
-            r_swap[{{ row.lr }}] <= b_swap;
+                    swap_q <= b_swap;
 {%- endif %}
-            r_col[{{ row.lr * cw }} +: {{ cw }}] <= b_col;
+                    col_q <= b_col;
 {%- if fourier %}
-{%- if row.late %}
-            late_word <= b_word;
-            r_word[{{ row.lr * r }} +: {{ r }}] <= late_word;
-{%- else %}
-            r_word[{{ row.lr * r }} +: {{ r }}] <= b_word;
+                    word_q <= next_word;
 {%- endif %}
-{%- endif %}
+                end
+            end
         end
-    end
-{%- endfor %}
+    endgenerate
+
+    // ---- the pixels' inputs{% if sp > 1 %}: each pixel's G x G SPADs averaged into its (valid, tdc){% endif %} ----
+    wire [TILE_PIXELS - 1:0] in_valid;
+    wire [TILE_PIXELS * T - 1:0] in_tdc;
+    generate
+        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_in_row
+            for (lc = 0; lc < TILE_COLS; lc = lc + 1) begin : g_in
+                localparam integer I = lr * TILE_COLS + lc;
+{%- if sp > 1 %}
+                wire [SPADS - 1:0] spad_valid;
+                wire [SPADS * T - 1:0] spad_tdc;
+                genvar s;
+                for (s = 0; s < SPADS; s = s + 1) begin : g_spad
+                    // SPAD s of the superpixel (row-major): (lr*G + s/G, lc*G + s%G) of the grid.
+                    localparam integer BIT = (lr * G + s / G) * (TILE_COLS * G) + lc * G + s % G;
+                    assign spad_valid[s] = valid[BIT];
+                    assign spad_tdc[s * T +: T] = tdc[BIT * T +: T];
+                end
+                {{ sp_name }} u_superpixel (
+                    .spad_valid(spad_valid),
+                    .spad_tdc(spad_tdc),
+                    .valid(in_valid[I]),
+                    .tdc(in_tdc[I * T +: T])
+                );
+{%- else %}
+                assign in_valid[I] = valid[I];
+                assign in_tdc[I * T +: T] = tdc[I * T +: T];
+{%- endif %}
+            end
+        end
+    endgenerate
 
     // ---- the pixels ----
-    wire [{{ npt - 1 }}:0] p_ready;
-    wire [{{ npt - 1 }}:0] p_valid;
-    wire [{{ npt * ib - 1 }}:0] p_index;
-    wire [{{ npt * w - 1 }}:0] p_data;
+    wire [TILE_PIXELS - 1:0] p_ready;
+    wire [TILE_PIXELS - 1:0] p_valid;
+    wire [TILE_PIXELS * IB - 1:0] p_index;
+    wire [TILE_PIXELS * W - 1:0] p_data;
     assign ready = &p_ready;
-{%- if sp > 1 %}
-    // Each pixel's {{ sp }} x {{ sp }} SPADs averaged into its (valid, tdc).
-    wire [{{ npt - 1 }}:0] s_valid;
-    wire [{{ npt * t - 1 }}:0] s_tdc;
-{%- for px in pixels %}
-    {{ sp_name }} u_superpixel_{{ px.row }}_{{ px.col }} (
-        .spad_valid({ {% for s in px.spads.iter().rev() %}valid[{{ s }}]{% if !loop.last %}, {% endif %}{% endfor %} }),
-        .spad_tdc({ {% for s in px.spads.iter().rev() %}tdc[{{ s * t }} +: {{ t }}]{% if !loop.last %}, {% endif %}{% endfor %} }),
-        .valid(s_valid[{{ px.i }}]),
-        .tdc(s_tdc[{{ px.i * t }} +: {{ t }}])
-    );
-{%- endfor %}
+{%- if let Some(nb) = neighbour %}
+    // DELIBERATELY BROKEN: the tile's pixel {{ nb }} reads the next pixel's TDC and that one its.
+    localparam integer NB = {{ nb }};
 {%- endif %}
-{%- for px in pixels %}
-    {{ pixel_name }} u_pixel_{{ px.row }}_{{ px.col }} (
-        .clk(clk),
-        .rst(rst),
-        .pulse(r_pulse[{{ px.lr }}]),
-        .valid({{ px.valid }}),
-        .tdc({{ px.tdc }}),
+    generate
+        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_px_row
+            for (lc = 0; lc < TILE_COLS; lc = lc + 1) begin : g_px
+                localparam integer I = lr * TILE_COLS + lc;
+{%- if neighbour.is_some() %}
+                localparam integer SRC = (I == NB) ? (I + 1) % TILE_PIXELS
+                    : ((NB + 1) % TILE_PIXELS == I) ? NB : I;
+{%- else %}
+                localparam integer SRC = I;
+{%- endif %}
+                localparam integer COL_I = TILE_COL0 + lc;
+                localparam [CW - 1:0] COL = COL_I[CW - 1:0];
+                {{ pixel_name }} u_pixel (
+                    .clk(clk),
+                    .rst(rst),
+                    .pulse(r_pulse[lr]),
+                    .valid(in_valid[I]),
+                    .tdc(in_tdc[SRC * T +: T]),
 {%- if fourier %}
-        .rom_word(r_word[{{ px.lr * r }} +: {{ r }}]),
+                    .rom_word(r_word[lr * R +: R]),
 {%- endif %}
-        .readout(r_ro[{{ px.lr }}] && (r_col[{{ px.lr * cw }} +: {{ cw }}] == {{ cw }}'d{{ px.col }})),
+                    .readout(r_ro[lr] && (r_col[lr * CW +: CW] == COL)),
 {%- if dbuf %}
-        .swap(r_swap[{{ px.lr }}]),
+                    .swap(r_swap[lr]),
 {%- endif %}
-        .ready(p_ready[{{ px.i }}]),
-        .rd_valid(p_valid[{{ px.i }}]),
-        .rd_index(p_index[{{ px.i * ib }} +: {{ ib }}]),
-        .rd_data(p_data[{{ px.i * w }} +: {{ w }}])
-    );
-{%- endfor %}
+                    .ready(p_ready[I]),
+                    .rd_valid(p_valid[I]),
+                    .rd_index(p_index[I * IB +: IB]),
+                    .rd_data(p_data[I * W +: W])
+                );
+            end
+        end
+    endgenerate
 
     // ---- the read select: a row onto the column buses, a column onto the capture ----
     // The strobe's root registers, two more stages on: the select changes the cycle after
     // the pixel takes its strobe, when its first word is still a cycle away.
     reg d_ro;
-    reg [{{ rw - 1 }}:0] d_row;
-    reg [{{ cw - 1 }}:0] d_col;
+    reg [RW - 1:0] d_row;
+    reg [CW - 1:0] d_col;
     reg e_ro;
-    reg [{{ rw - 1 }}:0] e_row;
-    reg [{{ cw - 1 }}:0] e_col;
-    reg [{{ trows - 1 }}:0] m_row;
-    reg [{{ cw - 1 }}:0] m_col;
+    reg [RW - 1:0] e_row;
+    reg [CW - 1:0] e_col;
+    reg [TILE_ROWS - 1:0] m_row;
+    reg [CW - 1:0] m_col;
     always @(posedge clk) begin
         if (rst) begin
             d_ro <= 1'b0;
-            d_row <= {{ rw }}'d0;
-            d_col <= {{ cw }}'d0;
+            d_row <= {RW{1'b0}};
+            d_col <= {CW{1'b0}};
             e_ro <= 1'b0;
-            e_row <= {{ rw }}'d0;
-            e_col <= {{ cw }}'d0;
-            m_row <= {{ trows }}'d0;
-            m_col <= {{ cw }}'d0;
+            e_row <= {RW{1'b0}};
+            e_col <= {CW{1'b0}};
+            m_col <= {CW{1'b0}};
         end else begin
             d_ro <= b_ro;
             d_row <= b_row;
@@ -362,86 +356,106 @@ module {{ name }} (
             e_ro <= d_ro;
             e_row <= d_row;
             e_col <= d_col;
-            if (e_ro) begin
-                m_col <= e_col;
-{%- for row in rows_t %}
-{%- if row.stuck %}
-                // DELIBERATELY BROKEN: row {{ row.row }} never leaves readout once selected.
-                m_row[{{ row.lr }}] <= m_row[{{ row.lr }}] || (e_row == {{ rw }}'d{{ row.row }});
-{%- else %}
-                m_row[{{ row.lr }}] <= (e_row == {{ rw }}'d{{ row.row }});
-{%- endif %}
-{%- endfor %}
-            end
+            if (e_ro) m_col <= e_col;
         end
     end
-    // Column buses: the OR of the selected row's pixels.
-    wire [{{ tcols - 1 }}:0] bus_valid;
-    wire [{{ tcols * ib - 1 }}:0] bus_index;
-    wire [{{ tcols * w - 1 }}:0] bus_data;
-{%- for col in columns %}
-    assign bus_valid[{{ col.lc }}] = {{ col.valid }};
-    assign bus_index[{{ col.lc * ib }} +: {{ ib }}] = {{ col.index }};
-    assign bus_data[{{ col.lc * w }} +: {{ w }}] = {{ col.data }};
-{%- endfor %}
+    generate
+        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_sel
+            localparam integer ROW_I = TILE_ROW0 + lr;
+            localparam [RW - 1:0] ROW = ROW_I[RW - 1:0];
+            always @(posedge clk) begin
+                if (rst) m_row[lr] <= 1'b0;
+{%- if mutation == "row_stuck" %}
+                // DELIBERATELY BROKEN: row {{ fault_row }} never leaves readout once selected.
+                else if (e_ro) m_row[lr] <= (e_row == ROW) || ((TILE_ROW0 + lr == {{ fault_row }}) && m_row[lr]);
+{%- else %}
+                else if (e_ro) m_row[lr] <= (e_row == ROW);
+{%- endif %}
+            end
+        end
+    endgenerate
+    // Column buses: the OR of the selected rows' pixels.
+    wire [TILE_COLS - 1:0] bus_valid;
+    wire [TILE_COLS * IB - 1:0] bus_index;
+    wire [TILE_COLS * W - 1:0] bus_data;
+    generate
+        for (lc = 0; lc < TILE_COLS; lc = lc + 1) begin : g_bus
+            reg v;
+            reg [IB - 1:0] x;
+            reg [W - 1:0] d;
+            integer i;
+            always @* begin
+                v = 1'b0;
+                x = {IB{1'b0}};
+                d = {W{1'b0}};
+                for (i = 0; i < TILE_ROWS; i = i + 1) begin
+                    v = v | (m_row[i] & p_valid[i * TILE_COLS + lc]);
+                    x = x | ({IB{m_row[i]}} & p_index[(i * TILE_COLS + lc) * IB +: IB]);
+                    d = d | ({W{m_row[i]}} & p_data[(i * TILE_COLS + lc) * W +: W]);
+                end
+            end
+            assign bus_valid[lc] = v;
+            assign bus_index[lc * IB +: IB] = x;
+            assign bus_data[lc * W +: W] = d;
+        end
+    endgenerate
+    // The selected column of the tile (none: an absent pixel's slot carries no beat): its
+    // offset from the tile's first column, wrapped past the tile's width when left of it.
+    localparam [CW:0] TC0 = TILE_COL0[CW:0];
+    localparam [CW:0] TCOLS = TILE_COLS[CW:0];
+    wire [CW:0] m_off = {1'b0, m_col} - TC0;
+    wire m_in_tile = m_off < TCOLS;
+    wire [CW - 1:0] m_lc = m_off[CW - 1:0];
     reg m_valid;
-    reg [{{ ib - 1 }}:0] m_index;
-    reg [{{ w - 1 }}:0] m_data;
+    reg [IB - 1:0] m_index;
+    reg [W - 1:0] m_data;
+    integer j;
     always @* begin
-        case (m_col)
-{%- for col in columns %}
-            {{ cw }}'d{{ col.col }}: begin
-                m_valid = bus_valid[{{ col.lc }}];
-                m_index = bus_index[{{ col.lc * ib }} +: {{ ib }}];
-                m_data = bus_data[{{ col.lc * w }} +: {{ w }}];
+        m_valid = 1'b0;
+        m_index = {IB{1'b0}};
+        m_data = {W{1'b0}};
+        for (j = 0; j < TILE_COLS; j = j + 1) begin
+            if (m_in_tile && m_lc == j[CW - 1:0]) begin
+                m_valid = bus_valid[j];
+                m_index = bus_index[j * IB +: IB];
+                m_data = bus_data[j * W +: W];
             end
-{%- endfor %}
-            default: begin
-                m_valid = 1'b0;
-                m_index = {{ ib }}'d0;
-                m_data = {{ w }}'d0;
-            end
-        endcase
+        end
     end
 
     // ---- the readout buffer and the port ----
 {%- for j in words %}
-    reg [{{ w - 1 }}:0] rbuf_{{ j }};
+    reg [W - 1:0] rbuf_{{ j }};
 {%- endfor %}
     reg dr_act;
-    reg [{{ ib - 1 }}:0] dj;
-{%- if k > 1 %}
-    reg [{{ kw - 1 }}:0] dm;
-{%- endif %}
-{%- if g > 1 %}
-    reg [{{ gw - 1 }}:0] dg;
-    wire beat = dr_act && (dg == {{ gw }}'d0);
-    wire step = dr_act && (dg == {{ gw }}'d{{ g - 1 }});
-{%- else %}
-    wire beat = dr_act;
-    wire step = dr_act;
-{%- endif %}
-{%- if k > 1 %}
-    wire last = (dj == {{ ib }}'d{{ r }}) && (dm == {{ kw }}'d{{ k - 1 }});
-{%- else %}
-    wire last = (dj == {{ ib }}'d{{ r }});
-{%- endif %}
-    reg [{{ w - 1 }}:0] dw;
+    reg [IB - 1:0] dj;
+    reg [KW - 1:0] dm;
+    reg [GW - 1:0] dg;
+    wire beat = dr_act && (BEAT_CYCLES == 1 || dg == {GW{1'b0}});
+    wire step = dr_act && (BEAT_CYCLES == 1 || dg == DG_END);
+    wire last = (dj == LAST_WORD) && (K == 1 || dm == DM_END);
+    reg [W - 1:0] dw;
     always @* begin
         case (dj)
 {%- for j in words %}
             {{ ib }}'d{{ j }}: dw = rbuf_{{ j }};
 {%- endfor %}
-            default: dw = {{ w }}'d0;
+            default: dw = {W{1'b0}};
         endcase
     end
-{%- if kb > w %}
-    // Registers sign-extended, the status word (index {{ r }}) zero-extended, to {{ kb }} bits.
-    wire dsx = dw[{{ w - 1 }}] && (dj != {{ ib }}'d{{ r }});
-    wire [{{ kb - 1 }}:0] dx = {{ dx_ext }};
-{%- else %}
-    wire [{{ kb - 1 }}:0] dx = dw;
-{%- endif %}
+    // Registers sign-extended, the status word (index R) zero-extended, to K x READOUT_BITS bits.
+    wire dsx = dw[W - 1] && (dj != LAST_WORD);
+    wire [KB - 1:0] dx;
+    generate
+        if (KB > W) begin : g_ext
+            assign dx = { {(KB - W){dsx}}, dw };
+        end else begin : g_noext
+            assign dx = dw;
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire unused_dsx = dsx;
+            /* verilator lint_on UNUSEDSIGNAL */
+        end
+    endgenerate
     always @(posedge clk) begin
 {%- for j in words %}
         if (m_valid && (m_index == {{ ib }}'d{{ j }})) begin
@@ -452,56 +466,30 @@ module {{ name }} (
     always @(posedge clk) begin
         if (rst) begin
             dr_act <= 1'b0;
-            dj <= {{ ib }}'d0;
-{%- if k > 1 %}
-            dm <= {{ kw }}'d0;
-{%- endif %}
-{%- if g > 1 %}
-            dg <= {{ gw }}'d0;
-{%- endif %}
+            dj <= {IB{1'b0}};
+            dm <= {KW{1'b0}};
+            dg <= {GW{1'b0}};
             ro_valid <= 1'b0;
-            ro_data <= {{ b }}'d0;
+            ro_data <= {READOUT_BITS{1'b0}};
         end else begin
             ro_valid <= beat;
-            if (beat) begin
-{%- if k > 1 %}
-                case (dm)
-{%- for m in parts %}
-                    {{ kw }}'d{{ m }}: ro_data <= dx[{{ m * b }} +: {{ b }}];
-{%- endfor %}
-                    default: ro_data <= {{ b }}'d0;
-                endcase
-{%- else %}
-                ro_data <= dx;
-{%- endif %}
-            end
-            if (m_valid && (m_index == {{ ib }}'d0)) begin
+            if (beat) ro_data <= dx[dm * READOUT_BITS +: READOUT_BITS];
+            if (m_valid && (m_index == {IB{1'b0}})) begin
                 // A pixel's word 0 is in the buffer: its drain starts at the next edge.
                 dr_act <= 1'b1;
-                dj <= {{ ib }}'d0;
-{%- if k > 1 %}
-                dm <= {{ kw }}'d0;
-{%- endif %}
-{%- if g > 1 %}
-                dg <= {{ gw }}'d0;
-{%- endif %}
+                dj <= {IB{1'b0}};
+                dm <= {KW{1'b0}};
+                dg <= {GW{1'b0}};
             end else if (dr_act) begin
-{%- if g > 1 %}
-                dg <= step ? {{ gw }}'d0 : dg + {{ gw }}'d1;
-{%- endif %}
+                if (BEAT_CYCLES > 1) dg <= step ? {GW{1'b0}} : dg + 1'b1;
                 if (step) begin
                     if (last) begin
                         dr_act <= 1'b0;
-{%- if k > 1 %}
-                    end else if (dm == {{ kw }}'d{{ k - 1 }}) begin
-                        dm <= {{ kw }}'d0;
-                        dj <= dj + {{ ib }}'d1;
+                    end else if (K == 1 || dm == DM_END) begin
+                        dm <= {KW{1'b0}};
+                        dj <= dj + 1'b1;
                     end else begin
-                        dm <= dm + {{ kw }}'d1;
-{%- else %}
-                    end else begin
-                        dj <= dj + {{ ib }}'d1;
-{%- endif %}
+                        dm <= dm + 1'b1;
                     end
                 end
             end

@@ -4,8 +4,8 @@
 // table below in a loop; a step presents its strobe (pulse and/or readout) at the first of
 // every `every` cycles, `count` times. It drives the refusal paths the reference sequencer
 // never takes. `pulse_o` tells the TDC (and a testbench) that this cycle samples `valid`/`tdc`.{% else %}
-// Top: the pixel{% if fourier %}, the probe ROM{% endif %} and the pulse/clock sequencer of the
-// contract ("The reference sequencer"): after rst, {{ n }} pulses one every {{ c }} cycles, then a
+// Top: the pixel{% if fourier %}, the probe ROM{% endif %} and the chip's one sequencer (`{{ seq_name }}`, the
+// contract's "The reference sequencer" walking one pixel): after rst, {{ n }} pulses one every {{ c }} cycles, then a
 // readout cycle and {{ r + 1 }} idle cycles, frame after frame. `pulse_o` tells the TDC
 // (and a testbench) that this cycle samples `valid`/`tdc`.{% endif %}
 module {{ name }} (
@@ -87,55 +87,38 @@ module {{ name }} (
         end
     end
 {% else %}
-    reg ro_phase;
-    reg [{{ pw - 1 }}:0] ph;
-    reg [{{ nw - 1 }}:0] pidx;
-    reg [{{ ib - 1 }}:0] rc;
-    wire pulse = !rst && !ro_phase && (ph == {{ pw }}'d0);
-    wire readout = !rst && ro_phase && (rc == {{ ib }}'d0);
+    // The chip's one sequencer, walking one pixel: its readout slot is the strobe and the
+    // {{ r + 1 }} cycles its words take.
+    wire pulse;
+    wire readout;
     assign pulse_o = pulse;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire s_swap;
+    wire s_q;
+    wire s_row;
+    wire s_col;
+    /* verilator lint_on UNUSEDSIGNAL */
 {%- if fourier %}
-    reg [{{ aw - 1 }}:0] addr;
+    wire [{{ aw - 1 }}:0] addr;
     wire [{{ r - 1 }}:0] rom_word;
     {{ rom_name }} u_rom (.addr(addr), .word(rom_word));
 {%- endif %}
-
-    always @(posedge clk) begin
-        if (rst) begin
-            ro_phase <= 1'b0;
-            ph <= {{ pw }}'d0;
-            pidx <= {{ nw }}'d0;
-            rc <= {{ ib }}'d0;
-{%- if fourier %}
-            addr <= {{ aw }}'d0;
-{%- endif %}
-        end else if (!ro_phase) begin
-            if (ph == {{ pw }}'d{{ c - 1 }}) begin
-                ph <= {{ pw }}'d0;
-{%- if fourier %}
-                addr <= (addr == {{ aw }}'d{{ l - 1 }}) ? {{ aw }}'d0 : addr + {{ aw }}'d1;
-{%- endif %}
-                if (pidx == {{ nw }}'d{{ n - 1 }}) begin
-                    pidx <= {{ nw }}'d0;
-                    ro_phase <= 1'b1;
-                    rc <= {{ ib }}'d0;
-{%- if fourier %}
-                    addr <= {{ aw }}'d0;
-{%- endif %}
-                end else begin
-                    pidx <= pidx + {{ nw }}'d1;
-                end
-            end else begin
-                ph <= ph + {{ pw }}'d1;
-            end
-        end else begin
-            if (rc == {{ ib }}'d{{ r + 1 }}) begin
-                ro_phase <= 1'b0;
-            end else begin
-                rc <= rc + {{ ib }}'d1;
-            end
-        end
-    end
+    {{ seq_name }} #(
+        .PIXELS(1),
+        .COLS(1),
+        .SLOT({{ r + 1 }}),
+        .DOUBLE_BUFFER(0)
+    ) u_sequencer (
+        .clk(clk),
+        .rst(rst),
+        .pulse(pulse),
+        .readout(readout),
+        .swap(s_swap),
+        .q(s_q),
+        .row(s_row),
+        .col(s_col){% if fourier %},
+        .addr(addr){% endif %}
+    );
 {% endif %}
     {{ pixel_name }} u_pixel (
         .clk(clk),

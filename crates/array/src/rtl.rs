@@ -11,7 +11,9 @@
 
 use tofprobe_design::readout::ArrayTile;
 use tofprobe_design::readout::{ArrayFault, Readout};
-use tofprobe_pixel::{CycleModel, Mode, NO_DETECTION, PinsIn, PixelParams, Superpixel};
+use tofprobe_pixel::{
+    ChipSequencer, CycleModel, Mode, NO_DETECTION, PinsIn, PixelParams, Superpixel, Walk,
+};
 
 use crate::error::ArrayError;
 use crate::shadow::{Shadow, sample};
@@ -40,7 +42,6 @@ pub struct ArrayModel {
     fourier: bool,
     words: usize,
     rom: Vec<u64>,
-    rom_depth: usize,
     fault: Option<ArrayFault>,
     /// The pixels that exist (the whole array unless a tile of it is co-simulated).
     tile: ArrayTile,
@@ -51,17 +52,8 @@ pub struct ArrayModel {
     /// `[array] double_buffer`: per pixel present, its shadow and the shadow's readout
     /// (empty when single-buffered).
     shadows: Vec<Shadow>,
-    // Root sequencer (`hold`, `wt`: double-buffered, the hold after a frame's pulses).
-    ro_phase: bool,
-    hold: bool,
-    wt: u64,
-    ph: u64,
-    pidx: u64,
-    q: usize,
-    sc: u64,
-    qr: usize,
-    qc: usize,
-    addr: usize,
+    /// The root: the chip's one sequencer walking the array (`templates/sequencer.v`).
+    seq: ChipSequencer,
     // Broadcast stage 1.
     b_pulse: bool,
     b_ro: bool,
@@ -162,7 +154,6 @@ impl ArrayModel {
             fourier,
             words,
             rom: rom.to_vec(),
-            rom_depth: p.rom_depth.max(1),
             fault,
             tile,
             superpixel: None,
@@ -172,16 +163,17 @@ impl ArrayModel {
             } else {
                 Vec::new()
             },
-            ro_phase: false,
-            hold: false,
-            wt: 0,
-            ph: 0,
-            pidx: 0,
-            q: 0,
-            sc: 0,
-            qr: 0,
-            qc: 0,
-            addr: 0,
+            seq: ChipSequencer::new(
+                readout.frame_pulses,
+                readout.cycles_per_pulse,
+                p.rom_depth as u64,
+                Walk {
+                    pixels: readout.pixels() as u64,
+                    cols: readout.cols as u64,
+                    slot: readout.slot_cycles(),
+                    double_buffer: readout.double_buffer,
+                },
+            ),
             b_pulse: false,
             b_ro: false,
             b_swap: false,
@@ -327,21 +319,20 @@ impl ArrayModel {
         let out = self.outputs();
         let ro = self.ro;
         let t = self.tile;
-        let np = ro.pixels();
         let npt = t.pixels();
         let (reg, k, g) = (ro.registers, ro.beats_per_word, ro.beat_cycles);
         // Root, combinational.
         let dbuf = ro.double_buffer;
-        let s_pulse = !rst && !(if dbuf { self.hold } else { self.ro_phase }) && self.ph == 0;
-        let s_swap = dbuf && !rst && self.ro_phase && self.q == 0 && self.sc == 0;
-        let s_ro = !rst && self.ro_phase && self.sc == 0 && self.q != np;
-        let (s_row, s_col) = match (self.fault, self.q) {
+        let root = self.seq.strobes(rst);
+        let (s_pulse, s_swap, s_ro) = (root.pulse, root.swap, root.readout);
+        let (s_row, s_col) = match (self.fault, root.q) {
             (Some(ArrayFault::OrderSwap), 0) => ro.order(1),
             (Some(ArrayFault::OrderSwap), 1) => ro.order(0),
-            _ => (self.qr, self.qc),
+            _ => (root.row as usize, root.col as usize),
         };
+        let addr = root.addr as usize;
         let rom_word: Vec<u64> = if self.fourier {
-            self.rom[self.addr * self.words..(self.addr + 1) * self.words].to_vec()
+            self.rom[addr * self.words..(addr + 1) * self.words].to_vec()
         } else {
             Vec::new()
         };
@@ -455,92 +446,16 @@ impl ArrayModel {
         (self.b_pulse, self.b_ro, self.b_row, self.b_col) = (s_pulse, s_ro, s_row, s_col);
         self.b_swap = s_swap;
         self.b_word = rom_word;
-        self.sequencer_edge();
+        self.seq.edge(false);
         out
-    }
-
-    /// The root sequencer's edge (not in reset).
-    fn sequencer_edge(&mut self) {
-        if self.ro.double_buffer {
-            return self.sequencer_edge_double();
-        }
-        let ro = self.ro;
-        if !self.ro_phase {
-            if self.ph == ro.cycles_per_pulse - 1 {
-                self.ph = 0;
-                self.addr = (self.addr + 1) % self.rom_depth;
-                if self.pidx == ro.frame_pulses - 1 {
-                    self.pidx = 0;
-                    self.ro_phase = true;
-                    (self.q, self.sc, self.qr, self.qc, self.addr) = (0, 0, 0, 0, 0);
-                } else {
-                    self.pidx += 1;
-                }
-            } else {
-                self.ph += 1;
-            }
-        } else {
-            self.walker_edge();
-        }
-    }
-
-    /// The double-buffered sequencer's edge: the readout walker beside the pulses; the
-    /// frame's end (after its N pulses) starts the walker — which has finished, D being at
-    /// most the frame period — and holds the pulses for max(N·C + 1, D) − N·C cycles.
-    fn sequencer_edge_double(&mut self) {
-        let ro = self.ro;
-        if self.ro_phase {
-            self.walker_edge();
-        }
-        if self.hold {
-            if self.wt == 0 {
-                self.hold = false;
-            } else {
-                self.wt -= 1;
-            }
-        } else if self.ph == ro.cycles_per_pulse - 1 {
-            self.ph = 0;
-            self.addr = (self.addr + 1) % self.rom_depth;
-            if self.pidx == ro.frame_pulses - 1 {
-                self.pidx = 0;
-                self.hold = true;
-                self.wt = ro.frame_cycles() - ro.accumulate_cycles() - 1;
-                self.ro_phase = true;
-                (self.q, self.sc, self.qr, self.qc, self.addr) = (0, 0, 0, 0, 0);
-            } else {
-                self.pidx += 1;
-            }
-        } else {
-            self.ph += 1;
-        }
-    }
-
-    /// The readout walker's edge during the readout phase: a slot of S cycles per pixel,
-    /// row-major, then the phase's last cycle.
-    fn walker_edge(&mut self) {
-        let ro = self.ro;
-        if self.q == ro.pixels() {
-            self.ro_phase = false;
-        } else if self.sc == ro.slot_cycles() - 1 {
-            self.sc = 0;
-            self.q += 1;
-            if self.qc == ro.cols - 1 {
-                (self.qc, self.qr) = (0, self.qr + 1);
-            } else {
-                self.qc += 1;
-            }
-        } else {
-            self.sc += 1;
-        }
     }
 
     /// Every register with a reset (all but the readout buffer) to zero.
     fn reset_registers(&mut self) {
         let words = self.words;
-        (self.ro_phase, self.ph, self.pidx, self.q, self.sc) = (false, 0, 0, 0, 0);
-        (self.hold, self.wt, self.b_swap, self.late_swap) = (false, 0, false, false);
+        self.seq.reset();
+        (self.b_swap, self.late_swap) = (false, false);
         self.r_swap.fill(false);
-        (self.qr, self.qc, self.addr) = (0, 0, 0);
         (self.b_pulse, self.b_ro, self.b_row, self.b_col) = (false, false, 0, 0);
         self.b_word = vec![0; words];
         self.o_pulse = false;

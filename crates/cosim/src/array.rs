@@ -61,14 +61,21 @@ pub fn build(rtl_dir: &Path, top: &str, profile: BuildProfile) -> Result<Harness
 }
 
 /// Runs a built array harness on the vectors in `vec_dir`, from `rtl_dir` (where a deep
-/// probe ROM's hex file is read).
-pub fn run_verilator(exe: &Path, rtl_dir: &Path, vec_dir: &Path) -> Result<RunOutcome, CosimError> {
+/// probe ROM's hex file is read), its registers powered up from Verilator's random values
+/// of `x_seed` (≥ 1).
+pub fn run_verilator(
+    exe: &Path,
+    rtl_dir: &Path,
+    vec_dir: &Path,
+    x_seed: u64,
+) -> Result<RunOutcome, CosimError> {
     let vec_dir = std::path::absolute(vec_dir).map_err(|e| CosimError::io(vec_dir, e))?;
     let out = Command::new(exe)
         .current_dir(rtl_dir)
         .arg(&vec_dir)
         // Randomised initial values (recorded seed): a register the reset forgets shows.
-        .args(["+verilator+rand+reset+2", "+verilator+seed+1"])
+        .arg("+verilator+rand+reset+2")
+        .arg(format!("+verilator+seed+{}", x_seed.max(1)))
         .output()
         .map_err(|e| CosimError::io(exe, e))?;
     parse_output(

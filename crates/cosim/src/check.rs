@@ -69,10 +69,18 @@ fn meaning(key: &str) -> &'static str {
     }
 }
 
-/// Reads the header of the top module in `dir`.
+/// Reads the header of the top module in `dir`: the single pixel's top, or the array's
+/// module in an array set.
 pub fn read_header(dir: &Path) -> Result<RtlHeader, CosimError> {
     let (_, _, top) = module_names(DEFAULT_MODULE_PREFIX);
-    let path = dir.join(format!("{top}.v"));
+    let mut path = dir.join(format!("{top}.v"));
+    let array = dir.join(format!(
+        "{}.v",
+        tofprobe_rtlgen::array::array_module_name(DEFAULT_MODULE_PREFIX)
+    ));
+    if !path.exists() && array.exists() {
+        path = array;
+    }
     let text = std::fs::read_to_string(&path).map_err(|e| CosimError::io(&path, e))?;
     let bad = |why: &str| CosimError::RtlHeader {
         path: path.clone(),

@@ -127,15 +127,30 @@ pub fn suite(name: &str, hash: &str, r: &CosimReport) -> Suite {
             (Some(k), message.clone(), message)
         }
     };
-    let cases = (0..r.frames)
+    let failure = failing.map(|k| (k, message, detail));
+    frames_suite(name, hash, seconds, r.frames, failure)
+}
+
+/// A configuration's `frames` as test cases, `failure` = (frame, message, detail) the one
+/// holding the first mismatch: the frames before it pass, the ones after are skipped (the
+/// simulators report only their first mismatch). The pixel's [`suite`] and the array's
+/// co-simulation both build theirs here.
+pub fn frames_suite(
+    name: &str,
+    hash: &str,
+    seconds: f64,
+    frames: u64,
+    failure: Option<(u64, String, String)>,
+) -> Suite {
+    let cases = (0..frames)
         .map(|k| Case {
             frame: k,
-            verdict: match failing {
-                Some(f) if k == f => Verdict::Fail {
+            verdict: match &failure {
+                Some((f, message, detail)) if k == *f => Verdict::Fail {
                     message: message.clone(),
                     detail: detail.clone(),
                 },
-                Some(f) if k > f => Verdict::Skipped {
+                Some((f, ..)) if k > *f => Verdict::Skipped {
                     message: format!(
                         "not judged: the run diverged in frame {f} and the simulator reports only its first mismatch"
                     ),

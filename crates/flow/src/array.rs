@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 use tofprobe_array::rtl::{ArrayModel, ArrayRun, run};
 use tofprobe_array::rtl_vectors::{scene_detections, vector_files};
+use tofprobe_cosim::RunOutcome;
 use tofprobe_design::readout::{ArrayFault, ArrayTile, Readout};
 use tofprobe_design::rom_policy::RtlOverrides;
 use tofprobe_design::{Chip, ResolvedDesign, RomPurpose};
@@ -50,6 +51,17 @@ pub struct ArrayCosimOptions {
     pub tile: Option<ArrayTile>,
     /// The regeneration command recorded in the headers.
     pub command: String,
+    /// Co-simulate this array set (written by `tofprobe rtl`, perhaps edited since)
+    /// instead of rendering one: its header must name this configuration's pixel, its
+    /// array module the ports the testbenches drive.
+    pub rtl: Option<PathBuf>,
+    /// Seeds of Verilator's randomised power-up state, one run each (every one ≥ 1; three
+    /// by default, so a register the reset forgets shows under some seed);
+    /// Icarus starts from X instead.
+    pub x_seeds: Vec<u64>,
+    /// The first K pulses of every pixel (or SPAD) present no detection (the priming
+    /// rule, array-wide).
+    pub lead_misses: u64,
 }
 
 impl ArrayCosimOptions {
@@ -66,8 +78,57 @@ impl ArrayCosimOptions {
             detections: None,
             tile: None,
             command: "tofprobe cosim".into(),
+            rtl: None,
+            x_seeds: vec![1, 2, 3],
+            lead_misses: 0,
         }
     }
+}
+
+/// The ports `testbench/array_harness.cpp` and `array_tb.v` drive and read, in order.
+pub const ARRAY_PORTS: [&str; 8] = [
+    "clk", "rst", "valid", "tdc", "pulse_o", "ready", "ro_valid", "ro_data",
+];
+
+/// Checks that the array module in `dir` still has the ports the testbenches connect (an
+/// edited set may rename or drop one): the first missing or foreign port is named.
+fn check_array_ports(dir: &Path, top: &str) -> Result<(), FlowError> {
+    let path = dir.join(format!("{top}.v"));
+    let text = tofprobe_io::read_bounded_text(&path, 64 << 20)
+        .map_err(|e| FlowError::output(path.clone(), e.to_string()))?;
+    let bad = |what: String| {
+        FlowError::option(
+            "rtl",
+            path.display(),
+            &format!(
+                "{what}: the array module `{top}` must keep the ports {ARRAY_PORTS:?} that the testbenches drive"
+            ),
+        )
+    };
+    let start = text
+        .find(&format!("module {top}"))
+        .ok_or_else(|| bad(format!("no `module {top}`")))?;
+    // The port list: after the parameter list's `) (`, or the module name's `(`.
+    let rest = &text[start..];
+    let end = rest
+        .find(");")
+        .ok_or_else(|| bad("no end of the port list".into()))?;
+    let header = &rest[..end];
+    let list = match header.find(") (") {
+        Some(i) => &header[i + 3..],
+        None => header.split_once('(').map_or("", |(_, l)| l),
+    };
+    let ports: Vec<&str> = list
+        .split(',')
+        .filter_map(|d| d.split_whitespace().last())
+        .collect();
+    if let Some(p) = ARRAY_PORTS.iter().find(|p| !ports.contains(p)) {
+        return Err(bad(format!("port `{p}` is missing")));
+    }
+    if let Some(p) = ports.iter().find(|p| !ARRAY_PORTS.contains(p)) {
+        return Err(bad(format!("port `{p}` is not one of them")));
+    }
+    Ok(())
 }
 
 /// What an array co-simulation found.
@@ -76,6 +137,8 @@ pub struct ArrayCosimReport {
     pub pass: bool,
     /// The readout the RTL and the model follow (N as simulated).
     pub readout: Readout,
+    /// The pixel's parameters as simulated (N, L overridden).
+    pub pixel: tofprobe_pixel::PixelParams,
     pub cycles: u64,
     pub mismatches: u64,
     /// The first mismatch: signal, expected, actual and what the array was doing then
@@ -83,6 +146,12 @@ pub struct ArrayCosimReport {
     pub first: Option<String>,
     /// The first mismatch's cycle.
     pub first_cycle: Option<u64>,
+    /// The frame whose readout holds the first mismatch (the first frame whose last beat
+    /// is at or after it; the last frame past every readout).
+    pub first_frame: Option<u64>,
+    /// The Verilator power-up seed of the reported run (the first that failed, else the
+    /// last), `None` under Icarus (X).
+    pub x_seed: Option<u64>,
     /// The model's run (its stream and per-pixel words).
     pub run: ArrayRun,
     /// Harness build seconds (0 for Icarus) and whether the cached build was reused.
@@ -167,18 +236,57 @@ pub fn write_array_vectors(
     vec_dir: &Path,
     command: &str,
 ) -> Result<ArrayVectors, FlowError> {
+    let stimulus = ArrayStimulus {
+        frames,
+        detections,
+        tile,
+        lead_misses: 0,
+        purpose: RomPurpose::Replayed,
+    };
+    write_vectors(design, o, stimulus, vec_dir, command)
+}
+
+/// What the array's golden vectors replay: frames, detections (`None`: the scene's), the
+/// tile present, the lead misses and the ROM the chip carries.
+struct ArrayStimulus {
+    frames: u64,
+    detections: Option<Vec<Vec<Option<u32>>>>,
+    tile: Option<ArrayTile>,
+    lead_misses: u64,
+    purpose: RomPurpose,
+}
+
+fn write_vectors(
+    design: &ResolvedDesign,
+    o: &RtlOverrides,
+    stimulus: ArrayStimulus,
+    vec_dir: &Path,
+    command: &str,
+) -> Result<ArrayVectors, FlowError> {
+    let ArrayStimulus {
+        frames,
+        detections,
+        tile,
+        lead_misses: v_lead,
+        purpose,
+    } = stimulus;
     if frames == 0 || frames > 100 {
         return Err(FlowError::option("frames", frames, "1..=100"));
     }
-    let chip = chip(design, o, RomPurpose::Replayed)?;
+    let chip = chip(design, o, purpose)?;
     let ro = chip
         .readout
         .ok_or_else(|| FlowError::option("array", "none", "an [array] design"))?;
     let p = &chip.pixel;
-    let detections = match detections {
+    let mut detections = match detections {
         Some(d) => d,
         None => scene_detections(design, p.frame_pulses, frames, tile)?,
     };
+    for d in &mut detections {
+        d.iter_mut()
+            .take(usize::try_from(v_lead).unwrap_or(usize::MAX))
+            .for_each(|x| *x = None);
+    }
     let t0 = std::time::Instant::now();
     let mut model = ArrayModel::tile(&ro, p, &chip.rom.words, None, tile)?
         .with_superpixel(chip.superpixel, p)?;
@@ -215,39 +323,46 @@ pub fn cosim_array(
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
     };
-    let rtl_dir = a.out.join("rtl");
     let vec_dir = a.out.join("vectors");
-    let v = write_array_vectors(
-        design,
-        &o,
-        a.frames,
-        a.detections.clone(),
-        a.tile,
-        &vec_dir,
-        &a.command,
-    )?;
-    render_array_to(&v.chip, &rtl_dir, a.command.clone(), a.fault, a.tile)?;
-    let (ro, r, detections, model_seconds) = (v.readout, v.run, v.detections, v.model_seconds);
-    let p = &v.chip.pixel;
+    // An existing set carries the ROM `tofprobe rtl` renders; fresh RTL the replayed one.
+    let purpose = if a.rtl.is_some() {
+        RomPurpose::Rendered
+    } else {
+        RomPurpose::Replayed
+    };
+    if a.x_seeds.is_empty() || a.x_seeds.contains(&0) {
+        return Err(FlowError::option(
+            "x-seed",
+            format!("{:?}", a.x_seeds),
+            "one or more seeds, each ≥ 1",
+        ));
+    }
+    let stimulus = ArrayStimulus {
+        frames: a.frames,
+        detections: a.detections.clone(),
+        tile: a.tile,
+        lead_misses: a.lead_misses,
+        purpose,
+    };
+    let v = write_vectors(design, &o, stimulus, &vec_dir, &a.command)?;
     let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
-    let rtl_abs = std::fs::canonicalize(&rtl_dir)
-        .map_err(|e| FlowError::output(rtl_dir.clone(), e.to_string()))?;
-    let (outcome, build_seconds, reused) = match a.simulator {
-        ArraySimulator::Verilator => {
-            let b = tofprobe_cosim::array::build(&rtl_abs, &top, a.profile)?;
-            (
-                tofprobe_cosim::array::run_verilator(&b.exe, &rtl_abs, &vec_dir)?,
-                b.seconds,
-                b.reused,
-            )
+    let rtl_dir = match &a.rtl {
+        Some(dir) => {
+            tofprobe_cosim::check::check_header(&v.chip.pixel, dir)?;
+            check_array_ports(dir, &top)?;
+            dir.clone()
         }
-        ArraySimulator::Icarus => {
-            let work = a.out.join("icarus");
-            let o = tofprobe_cosim::array::run_icarus(&rtl_abs, &vec_dir, &work)?;
-            let _ = std::fs::remove_dir_all(&work);
-            (o, 0.0, false)
+        None => {
+            let dir = a.out.join("rtl");
+            render_array_to(&v.chip, &dir, a.command.clone(), a.fault, a.tile)?;
+            dir
         }
     };
+    let (ro, r, detections, model_seconds) = (v.readout, v.run, v.detections, v.model_seconds);
+    let p = &v.chip.pixel;
+    let rtl_abs = std::fs::canonicalize(&rtl_dir)
+        .map_err(|e| FlowError::output(rtl_dir.clone(), e.to_string()))?;
+    let (outcome, build_seconds, reused, x_seed) = simulate(a, &rtl_abs, &vec_dir, &top)?;
     let first = outcome.first.as_ref().map(|m| {
         format!(
             "{} expected {} actual {} at {}",
@@ -269,10 +384,19 @@ pub fn cosim_array(
     Ok(ArrayCosimReport {
         pass: outcome.mismatches == 0 && outcome.cycles == r.cycles(),
         readout: ro,
+        pixel: p.clone(),
         cycles: outcome.cycles,
         mismatches: outcome.mismatches,
         first,
         first_cycle: outcome.first.as_ref().map(|m| m.cycle),
+        first_frame: outcome.first.as_ref().map(|m| {
+            let last =
+                |k: u64| r.beat_cycle(k, ro.pixels() - 1, ro.registers, ro.beats_per_word - 1);
+            (0..a.frames)
+                .find(|&k| m.cycle <= last(k))
+                .unwrap_or(a.frames - 1)
+        }),
+        x_seed,
         run: r,
         build_seconds,
         reused,
@@ -280,6 +404,39 @@ pub fn cosim_array(
         model_seconds,
         detections: count,
     })
+}
+
+/// Replays the vectors under the simulator: Verilator once per power-up seed (the first
+/// run that fails is the one reported), Icarus once (from X). Returns the outcome, the build
+/// seconds and whether the build was reused.
+fn simulate(
+    a: &ArrayCosimOptions,
+    rtl: &Path,
+    vec_dir: &Path,
+    top: &str,
+) -> Result<(RunOutcome, f64, bool, Option<u64>), FlowError> {
+    match a.simulator {
+        ArraySimulator::Verilator => {
+            let b = tofprobe_cosim::array::build(rtl, top, a.profile)?;
+            let mut last = None;
+            for &seed in &a.x_seeds {
+                let o = tofprobe_cosim::array::run_verilator(&b.exe, rtl, vec_dir, seed)?;
+                let failed = o.mismatches > 0;
+                last = Some((o, seed));
+                if failed {
+                    break;
+                }
+            }
+            let (o, seed) = last.ok_or_else(|| FlowError::option("x-seed", "none", "≥ 1 seed"))?;
+            Ok((o, b.seconds, b.reused, Some(seed)))
+        }
+        ArraySimulator::Icarus => {
+            let work = a.out.join("icarus");
+            let o = tofprobe_cosim::array::run_icarus(rtl, vec_dir, &work)?;
+            let _ = std::fs::remove_dir_all(&work);
+            Ok((o, 0.0, false, None))
+        }
+    }
 }
 
 /// The report's readout section: the configured frame's figures and the comparison with

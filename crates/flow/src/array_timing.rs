@@ -188,16 +188,6 @@ pub fn array_timing_with(
     Ok(out)
 }
 
-/// The ports of a rendered module (its header up to `);`) as a black box.
-fn black_box(text: &str, module: &str) -> Option<String> {
-    let start = text.find(&format!("module {module} ("))?;
-    let end = start + text[start..].find(");")? + 2;
-    Some(format!(
-        "(* blackbox *)\n{}\nendmodule\n",
-        text[start..end].replace("output reg ", "output wire ")
-    ))
-}
-
 /// Times one `rows` × `cols` netlist of the chip's array: mapped on `map_lib`, timed on
 /// `time_lib` (default `map_lib`; another corner of the same cells).
 #[allow(clippy::too_many_arguments)]
@@ -253,9 +243,10 @@ fn time_on(
     let mut text = String::new();
     for f in files.iter().filter(|f| f.name.ends_with(".v")) {
         if f.template == "pixel.v" {
-            text += &black_box(&f.contents, &pixel_name).unwrap_or_default();
+            text +=
+                &tofprobe_rtlgen::array::black_box(&f.contents, &pixel_name).unwrap_or_default();
         } else if f.template == "probe_rom.v" {
-            text += &black_box(&f.contents, &rom_name).unwrap_or_default();
+            text += &tofprobe_rtlgen::array::black_box(&f.contents, &rom_name).unwrap_or_default();
         } else {
             text += &f.contents;
         }
@@ -285,9 +276,9 @@ fn time_on(
          set_input_delay 0 -clock clk [delete_from_list [all_inputs] [get_ports clk]]\n\
          set_output_delay 0 -clock clk [all_outputs]\n\
          puts \"== broadcast\"\n\
-         report_checks -path_delay max -digits 4 -through [get_pins {{u_pixel_*/pulse u_pixel_*/rom_word* u_pixel_*/readout}}]\n\
+         report_checks -path_delay max -digits 4 -through [get_pins {{*u_pixel/pulse *u_pixel/rom_word* *u_pixel/readout}}]\n\
          puts \"== readout\"\n\
-         report_checks -path_delay max -digits 4 -through [get_pins {{u_pixel_*/rd_valid u_pixel_*/rd_index* u_pixel_*/rd_data*}}]\n\
+         report_checks -path_delay max -digits 4 -through [get_pins {{*u_pixel/rd_valid *u_pixel/rd_index* *u_pixel/rd_data*}}]\n\
          exit\n",
         lib = time_lib.display(),
         pixel = pixel.synthesis.netlist_verilog.display(),
@@ -444,17 +435,5 @@ mod tests {
         assert!(!got[0].meets_margin);
         // An option that found no A judges nothing.
         assert!(corner_option_paths(&timing, &[option("ss", None)]).is_empty());
-    }
-
-    #[test]
-    fn a_black_box_keeps_the_ports_only() {
-        let v = "// x\nmodule m (\n    input wire a,\n    output reg [3:0] y\n);\n    reg z;\nendmodule\n";
-        let b = black_box(v, "m").unwrap();
-        assert!(b.starts_with("(* blackbox *)\nmodule m ("), "{b}");
-        assert!(
-            b.contains("output wire [3:0] y") && !b.contains("reg z"),
-            "{b}"
-        );
-        assert!(black_box(v, "n").is_none());
     }
 }

@@ -25,6 +25,7 @@
 
 pub mod autobins;
 pub mod bench;
+pub mod chip;
 pub mod config;
 pub mod cycle;
 pub mod datapath;
@@ -54,6 +55,7 @@ pub mod valid_codes;
 #[allow(rustdoc::broken_intra_doc_links)]
 pub mod contract {}
 
+pub use chip::{ChipSequencer, Strobes, Walk};
 pub use config::{PixelConfig, PixelContext};
 pub use cycle::{CycleModel, PinsIn, PinsOut, RegWrite};
 pub use datapath::Datapath;

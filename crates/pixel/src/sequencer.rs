@@ -11,6 +11,7 @@
 
 use tofprobe_dsp::RomImage;
 
+use crate::chip::{ChipSequencer, Walk};
 use crate::cycle::PinsIn;
 use crate::directed::Program;
 use crate::error::PixelError;
@@ -56,24 +57,12 @@ pub struct Sequencer<'a> {
     rom_depth: u64,
     /// The directed schedule, when this is not the reference sequencer.
     program: Option<Program>,
-    /// Where [`Iterator::next`] is in the reference sequence, kept by counting instead of
-    /// dividing the cycle index (what [`Sequencer::phase`] does for any cycle).
-    at: Position,
-}
-
-/// The reference sequence's counters at the iterator's cycle (after the reset cycles).
-#[derive(Debug, Clone, Copy, Default)]
-struct Position {
-    /// Cycle within the frame.
-    within: u64,
-    /// Cycle within the pulse (`within` mod C, while pulses are presented).
-    sub: u64,
-    /// Pulse within the frame (`within` / C).
-    pulse: u64,
-    /// ROM address of that pulse (`pulse` mod L).
-    address: u64,
-    /// Global index of the frame's first pulse (frame · N).
-    first: u64,
+    /// The chip's one sequencer walking this one pixel: what [`Iterator::next`] steps (the
+    /// same registers as the RTL's `<prefix>_sequencer`; [`Sequencer::phase`] divides the
+    /// cycle index instead, for any cycle, and the two are tested equal).
+    chip: ChipSequencer,
+    /// Pulses presented so far: the next one's detection index.
+    presented: u64,
 }
 
 /// Presents no detection for pulses beyond the stimuli (the status cycle's pulse).
@@ -102,6 +91,7 @@ impl<'a> Sequencer<'a> {
         let c = params.cycles_per_pulse as u64;
         let frame_cycles = n * c + params.registers() as u64 + 2;
         let frames = stimuli.len() as u64 / n;
+        let rom_depth = params.rom_depth.max(1) as u64;
         Ok(Sequencer {
             stimuli,
             rom,
@@ -110,9 +100,10 @@ impl<'a> Sequencer<'a> {
             frame_cycles,
             total: RESET_CYCLES + frames * frame_cycles,
             cycle: 0,
-            rom_depth: params.rom_depth.max(1) as u64,
+            rom_depth,
             program: None,
-            at: Position::default(),
+            chip: ChipSequencer::new(n, c, rom_depth, Walk::single(params.registers())),
+            presented: 0,
         })
     }
 
@@ -133,17 +124,20 @@ impl<'a> Sequencer<'a> {
             Mode::Haar => None,
         };
         let loop_cycles = program.loop_cycles();
+        let (n, c) = (params.frame_pulses, params.cycles_per_pulse as u64);
+        let rom_depth = params.rom_depth.max(1) as u64;
         Ok(Sequencer {
             stimuli,
             rom,
-            n: params.frame_pulses,
-            c: params.cycles_per_pulse as u64,
+            n,
+            c,
             frame_cycles: loop_cycles,
             total: RESET_CYCLES + loops * loop_cycles,
             cycle: 0,
-            rom_depth: params.rom_depth.max(1) as u64,
+            rom_depth,
             program: Some(program),
-            at: Position::default(),
+            chip: ChipSequencer::new(n, c, rom_depth, Walk::single(params.registers())),
+            presented: 0,
         })
     }
 
@@ -292,48 +286,30 @@ impl<'a> Iterator for Sequencer<'a> {
             self.cycle += 1;
             return Some(pins);
         }
-        // The reference sequence by counting: the same pins as `pins(cycle)` (tested).
-        let at = &mut self.at;
-        let pulses = self.n * self.c;
-        let pins = if at.within < pulses {
-            if at.sub == 0 {
-                let det = detection(self.stimuli, at.first + at.pulse);
-                PinsIn {
-                    pulse: true,
-                    valid: det.is_some(),
-                    tdc: det.unwrap_or(0),
-                    rom_word: self
-                        .rom
-                        .map(|rom| rom.entry(at.address as usize))
-                        .unwrap_or(&[]),
-                    ..PinsIn::default()
-                }
-            } else {
-                PinsIn::default()
+        // The reference sequence by stepping the chip's sequencer: the same pins as
+        // `pins(cycle)` (tested).
+        let o = self.chip.strobes(false);
+        let pins = if o.pulse {
+            let det = detection(self.stimuli, self.presented);
+            self.presented += 1;
+            PinsIn {
+                pulse: true,
+                valid: det.is_some(),
+                tdc: det.unwrap_or(0),
+                rom_word: self
+                    .rom
+                    .map(|rom| rom.entry(o.addr as usize))
+                    .unwrap_or(&[]),
+                ..PinsIn::default()
             }
         } else {
             PinsIn {
-                readout: at.within == pulses,
+                readout: o.readout,
                 ..PinsIn::default()
             }
         };
+        self.chip.edge(false);
         self.cycle += 1;
-        at.within += 1;
-        at.sub += 1;
-        if at.sub == self.c {
-            at.sub = 0;
-            at.pulse += 1;
-            at.address += 1;
-            if at.address == self.rom_depth {
-                at.address = 0;
-            }
-        }
-        if at.within == self.frame_cycles {
-            *at = Position {
-                first: at.first + self.n,
-                ..Position::default()
-            };
-        }
         Some(pins)
     }
 

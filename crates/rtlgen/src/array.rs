@@ -126,43 +126,6 @@ impl ArrayTile {
     }
 }
 
-/// Largest rows × cols the generator renders (the template writes one instance and one
-/// bus term per pixel: 64 × 64 is 4096 instances).
-pub const MAX_RENDERED_PIXELS: usize = 64 * 64;
-
-struct RowT {
-    row: usize,
-    /// Its index in the tile.
-    lr: usize,
-    late: bool,
-    stuck: bool,
-}
-
-struct PixelT {
-    /// Index in the tile (the ports' and the pixel vectors').
-    i: usize,
-    row: usize,
-    col: usize,
-    /// Row index in the tile.
-    lr: usize,
-    /// The pixel's `valid` input: its port bit (G = 1) or its superpixel's output.
-    valid: String,
-    /// The pixel's `tdc` input: its port field, or its superpixel's output (the pixel's
-    /// own unless NeighbourTdc crosses it).
-    tdc: String,
-    /// G > 1: the port bits of its G² SPADs, row-major within the superpixel.
-    spads: Vec<usize>,
-}
-
-struct ColT {
-    col: usize,
-    /// Its index in the tile.
-    lc: usize,
-    valid: String,
-    index: String,
-    data: String,
-}
-
 #[derive(Template)]
 #[template(path = "array.v", escape = "none")]
 struct ArrayT<'a> {
@@ -170,6 +133,7 @@ struct ArrayT<'a> {
     name: &'a str,
     pixel_name: &'a str,
     rom_name: &'a str,
+    seq_name: &'a str,
     fourier: bool,
     mutation: &'a str,
     t: usize,
@@ -177,51 +141,41 @@ struct ArrayT<'a> {
     r: usize,
     c: usize,
     n: u64,
-    l: usize,
     ib: usize,
     aw: usize,
-    pw: usize,
-    nw: usize,
     rows: usize,
     cols: usize,
-    np: usize,
+    tile_row0: usize,
+    tile_col0: usize,
     trows: usize,
     tcols: usize,
-    npt: usize,
-    tile: Option<(usize, usize)>,
-    qw: usize,
-    scw: usize,
-    rw: usize,
-    cw: usize,
-    s: u64,
     b: usize,
-    k: usize,
     g: u64,
-    kw: usize,
-    gw: usize,
-    kb: usize,
-    dx_ext: String,
-    parts: Vec<usize>,
+    /// The readout buffer's words: the registers and the status word.
     words: Vec<usize>,
-    swap_r0: usize,
-    swap_c0: usize,
-    swap_r1: usize,
-    swap_c1: usize,
-    rows_t: Vec<RowT>,
-    pixels: Vec<PixelT>,
-    columns: Vec<ColT>,
+    /// The row of a row fault (`row_late`, `row_stuck`).
+    fault_row: usize,
+    /// `neighbour_tdc`: the tile's index of the pixel whose TDC is crossed with the next's.
+    neighbour: Option<usize>,
     /// G (1: no superpixel) and its module.
     sp: usize,
     sp_name: String,
-    /// Inputs on the ports: the pixels rendered × G².
-    nin: usize,
-    /// SPAD columns of the rendered grid (tcols · G).
-    scols: usize,
     dbuf: bool,
-    /// Double-buffered: the hold after the frame's pulses beyond its swap cycle,
-    /// max(D − N·C − 1, 0) cycles, and its counter's width.
-    idle: u64,
-    hw: usize,
+}
+
+/// `module`'s declaration in `text` as a black box: its ports, no body (yosys keeps it as a
+/// `blackbox` cell, Verilator and Icarus see an empty module with the same pins). How the
+/// array's own logic is timed, and linted at sizes where elaborating every pixel would cost
+/// minutes (the pixel is linted alone by its own gates).
+pub fn black_box(text: &str, module: &str) -> Option<String> {
+    let start = text.find(&format!("module {module} ("))?;
+    let end = start + text[start..].find(");")? + 2;
+    Some(format!(
+        "/* verilator lint_off UNDRIVEN */\n/* verilator lint_off UNUSEDSIGNAL */\n\
+         (* blackbox *)\n{}\nendmodule\n/* verilator lint_on UNUSEDSIGNAL */\n\
+         /* verilator lint_on UNDRIVEN */\n",
+        text[start..end].replace("output reg ", "output wire ")
+    ))
 }
 
 /// The array module's name for a module prefix.
@@ -279,7 +233,6 @@ pub fn render_array(
             ),
         ));
     }
-    let order = |q: usize| (q / a.cols, q % a.cols);
     let tile = a.tile.unwrap_or(ArrayTile::whole(a.rows, a.cols));
     let npt = tile.pixels();
     if npt == 0 || tile.row0 + tile.rows > a.rows || tile.col0 + tile.cols > a.cols {
@@ -292,16 +245,6 @@ pub fn render_array(
             format!(
                 "a non-empty rectangle inside the {} × {} array",
                 a.rows, a.cols
-            ),
-        ));
-    }
-    if npt > MAX_RENDERED_PIXELS {
-        return Err(bad(
-            "array.rows × array.cols",
-            format!("{} × {}", tile.rows, tile.cols),
-            format!(
-                "1..={MAX_RENDERED_PIXELS} pixels rendered (64 × 64); a larger array is \
-                 co-simulated as a tile of it (`tofprobe cosim --tile ROW,COL,ROWS,COLS`)"
             ),
         ));
     }
@@ -377,77 +320,19 @@ pub fn render_array(
         .filter(|f| f.template != "top.v")
         .collect();
     let (pixel_name, rom_name, _) = crate::naming::module_names(&o.module_prefix);
+    let seq_name = crate::naming::sequencer_module_name(&o.module_prefix);
     let name = array_module_name(&o.module_prefix);
     let r = p.registers();
     let ib = p.rd_index_bits();
-    let cw = clog2(a.cols as u64);
     let k = a.beats_per_word;
-    let kb = k as u32 * a.bits;
     let neighbour = match a.fault {
         Some(ArrayFault::NeighbourTdc { row, col }) => tile.local(row, col),
         _ => None,
     };
-    let tb = p.tdc_bits as usize;
-    let scols = tile.cols * g;
-    let pixels: Vec<PixelT> = (0..npt)
-        .map(|i| {
-            let src = match neighbour {
-                Some(n) if n == i => (i + 1) % npt,
-                Some(n) if (n + 1) % npt == i => n,
-                _ => i,
-            };
-            let (lr, lc) = (i / tile.cols, i % tile.cols);
-            PixelT {
-                i,
-                row: tile.row0 + lr,
-                col: tile.col0 + lc,
-                lr,
-                valid: if g > 1 {
-                    format!("s_valid[{i}]")
-                } else {
-                    format!("valid[{i}]")
-                },
-                tdc: if g > 1 {
-                    format!("s_tdc[{} +: {tb}]", src * tb)
-                } else {
-                    format!("tdc[{} +: {tb}]", src * tb)
-                },
-                spads: (0..g * g)
-                    .filter(|_| g > 1)
-                    .map(|s| (lr * g + s / g) * scols + lc * g + s % g)
-                    .collect(),
-            }
-        })
-        .collect();
-    let columns = (0..tile.cols)
-        .map(|lc| {
-            let terms =
-                |f: &dyn Fn(usize) -> String| (0..tile.rows).map(f).collect::<Vec<_>>().join(" | ");
-            ColT {
-                col: tile.col0 + lc,
-                lc,
-                valid: terms(&|lr| format!("(m_row[{lr}] & p_valid[{}])", lr * tile.cols + lc)),
-                index: terms(&|lr| {
-                    format!(
-                        "({{{ib}{{m_row[{lr}]}}}} & p_index[{} +: {ib}])",
-                        (lr * tile.cols + lc) * ib as usize
-                    )
-                }),
-                data: terms(&|lr| {
-                    format!(
-                        "({{{w}{{m_row[{lr}]}}}} & p_data[{} +: {w}])",
-                        (lr * tile.cols + lc) * w as usize
-                    )
-                }),
-            }
-        })
-        .collect();
-    let (late, stuck) = match a.fault {
-        Some(ArrayFault::RowLate { row }) => (Some(row), None),
-        Some(ArrayFault::RowStuck { row }) => (None, Some(row)),
-        _ => (None, None),
+    let fault_row = match a.fault {
+        Some(ArrayFault::RowLate { row } | ArrayFault::RowStuck { row }) => row,
+        _ => 0,
     };
-    let (s0, s1) = (order(0), order(1.min(np - 1)));
     let mut h = header(p, "array.v", o);
     h.push_str(&format!(
         "\n// Array: {} x {} pixels, readout {} bits x {} beat(s) per word, one beat every {} \
@@ -472,7 +357,6 @@ pub fn render_array(
     // D = P·S + 1; double-buffered, the frame is max(N·C + 1, D) cycles.
     let d = (np as u64).saturating_mul(a.slot_cycles).saturating_add(1);
     let acc = p.frame_pulses.saturating_mul(p.cycles_per_pulse as u64);
-    let idle = d.saturating_sub(acc + 1);
     if a.double_buffer {
         h.push_str(&format!(
             "\n// Double-buffered: the readout streams each pixel's shadow while the next frame \
@@ -491,6 +375,7 @@ pub fn render_array(
         name: &name,
         pixel_name: &pixel_name,
         rom_name: &rom_name,
+        seq_name: &seq_name,
         fourier: p.mode == Mode::Fourier,
         mutation: a.fault.map(ArrayFault::name).unwrap_or(""),
         t: p.tdc_bits as usize,
@@ -498,57 +383,22 @@ pub fn render_array(
         r,
         c: p.cycles_per_pulse,
         n: p.frame_pulses,
-        l: p.rom_depth,
         ib: ib as usize,
         aw: clog2(p.rom_depth as u64) as usize,
-        pw: clog2(p.cycles_per_pulse as u64) as usize,
-        nw: clog2(p.frame_pulses) as usize,
         rows: a.rows,
         cols: a.cols,
-        np,
+        tile_row0: tile.row0,
+        tile_col0: tile.col0,
         trows: tile.rows,
         tcols: tile.cols,
-        npt,
-        tile: a.tile.map(|t| (t.row0, t.col0)),
-        qw: clog2(np as u64 + 1) as usize,
-        scw: clog2(a.slot_cycles) as usize,
-        rw: clog2(a.rows as u64) as usize,
-        cw: cw as usize,
-        s: a.slot_cycles,
         b: a.bits as usize,
-        k,
         g: a.beat_cycles,
-        kw: clog2(k as u64) as usize,
-        gw: clog2(a.beat_cycles) as usize,
-        kb: kb as usize,
-        dx_ext: if kb > w {
-            format!("{{{{{}{{dsx}}}}, dw}}", kb - w)
-        } else {
-            "dw".into()
-        },
-        parts: (0..k).collect(),
         words: (0..=r).collect(),
-        swap_r0: s0.0,
-        swap_c0: s0.1,
-        swap_r1: s1.0,
-        swap_c1: s1.1,
-        rows_t: (0..tile.rows)
-            .map(|lr| RowT {
-                row: tile.row0 + lr,
-                lr,
-                late: late == Some(tile.row0 + lr),
-                stuck: stuck == Some(tile.row0 + lr),
-            })
-            .collect(),
-        pixels,
-        columns,
+        fault_row,
+        neighbour,
         sp: g,
         sp_name: crate::superpixel::module_name(&o.module_prefix),
-        nin: npt * g * g,
-        scols,
         dbuf: a.double_buffer,
-        idle,
-        hw: clog2(idle + 1) as usize,
     };
     if let Some(sp) = &sp {
         files.push(crate::superpixel::render_superpixel(p, sp, o)?);
@@ -562,4 +412,21 @@ pub fn render_array(
         })? + "\n",
     });
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::black_box;
+
+    #[test]
+    fn a_black_box_keeps_the_ports_only() {
+        let v = "// x\nmodule m (\n    input wire a,\n    output reg [3:0] y\n);\n    reg z;\nendmodule\n";
+        let b = black_box(v, "m").unwrap();
+        assert!(b.contains("(* blackbox *)\nmodule m ("), "{b}");
+        assert!(
+            b.contains("output wire [3:0] y") && !b.contains("reg z"),
+            "{b}"
+        );
+        assert!(black_box(v, "n").is_none());
+    }
 }

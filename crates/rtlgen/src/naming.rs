@@ -103,6 +103,12 @@ pub fn module_names(prefix: &str) -> (String, String, String) {
     )
 }
 
+/// The chip's one sequencer module (`templates/sequencer.v`) for a module prefix: the
+/// single pixel's top and the array instantiate it.
+pub fn sequencer_module_name(prefix: &str) -> String {
+    format!("{prefix}_sequencer")
+}
+
 /// ceil(log2(n)) with a minimum of 1 bit (a Verilog vector needs at least one bit).
 pub fn clog2(n: u64) -> u32 {
     if n <= 2 {

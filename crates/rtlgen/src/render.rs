@@ -5,7 +5,8 @@
 
 use crate::error::RtlError;
 use crate::naming::{
-    DEFAULT_MODULE_PREFIX, clog2, config_hash_with_prefix, module_names, validate_identifier,
+    DEFAULT_MODULE_PREFIX, clog2, config_hash_with_prefix, module_names, sequencer_module_name,
+    validate_identifier,
 };
 use askama::Template;
 use tofprobe_pixel::{
@@ -216,6 +217,48 @@ struct RomT<'a> {
     entries: Vec<(usize, String)>,
 }
 
+/// The chip's one sequencer (`templates/sequencer.v`): the frame's constants are rendered,
+/// the walk's shape (pixels, row length, slot, double buffer) are Verilog parameters its
+/// instantiating top sets.
+#[derive(Template)]
+#[template(path = "sequencer.v", escape = "none")]
+struct SequencerT<'a> {
+    header: String,
+    name: &'a str,
+    fourier: bool,
+    r: usize,
+    c: usize,
+    n: u64,
+    acc: u64,
+    l: usize,
+    aw: u32,
+    pw: u32,
+    nw: u32,
+}
+
+/// Renders `<prefix>_sequencer.v`, the sequencer of the single pixel's top and the array's.
+pub(crate) fn render_sequencer(p: &PixelParams, o: &RenderOptions) -> Result<RtlFile, RtlError> {
+    let name = sequencer_module_name(&o.module_prefix);
+    let t = SequencerT {
+        header: header(p, "sequencer.v", o),
+        name: &name,
+        fourier: p.mode == Mode::Fourier,
+        r: p.registers(),
+        c: p.cycles_per_pulse,
+        n: p.frame_pulses,
+        acc: p.frame_pulses.saturating_mul(p.cycles_per_pulse as u64),
+        l: p.rom_depth,
+        aw: clog2(p.rom_depth as u64),
+        pw: clog2(p.cycles_per_pulse as u64),
+        nw: clog2(p.frame_pulses),
+    };
+    Ok(RtlFile {
+        name: format!("{name}.v"),
+        template: "sequencer.v",
+        contents: t.render().map_err(render_err("sequencer.v"))? + "\n",
+    })
+}
+
 #[derive(Template)]
 #[template(path = "top.v", escape = "none")]
 struct TopT<'a> {
@@ -223,6 +266,7 @@ struct TopT<'a> {
     name: &'a str,
     pixel_name: &'a str,
     rom_name: &'a str,
+    seq_name: &'a str,
     fourier: bool,
     t: u32,
     w: u32,
@@ -231,8 +275,6 @@ struct TopT<'a> {
     n: u64,
     l: usize,
     ib: u32,
-    pw: u32,
-    nw: u32,
     aw: u32,
     directed: bool,
     steps: Vec<StepRow>,
@@ -491,11 +533,18 @@ pub(crate) fn render_set(
         })
         .collect();
     let widest = |f: fn(&StepRow) -> u64| clog2(steps.iter().map(f).max().unwrap_or(0) + 1);
+    // The reference top steps the chip's one sequencer (its own file); the directed top is
+    // the contract's test sequencer and needs none.
+    if program.is_none() {
+        files.push(render_sequencer(p, o)?);
+    }
+    let seq_name = sequencer_module_name(&o.module_prefix);
     let top = TopT {
         header: header(p, "top.v", o),
         name: &top_name,
         pixel_name: &pixel_name,
         rom_name: &rom_name,
+        seq_name: &seq_name,
         fourier,
         t: p.tdc_bits,
         w: p.width,
@@ -504,8 +553,6 @@ pub(crate) fn render_set(
         n: p.frame_pulses,
         l: p.rom_depth,
         ib,
-        pw: clog2(p.cycles_per_pulse as u64),
-        nw: clog2(p.frame_pulses),
         aw,
         directed: program.is_some(),
         stw: clog2(steps.len() as u64),

@@ -3,100 +3,113 @@
 // Configuration hash: 80e6cadc8a373432 (Fourier, B=2, U=4, A=2, C=4, T=7, Z=0, S=5, F=8, W=30, N=16, L=16).
 // Probe ROM: sign-of-cosine probe ROM (L = 16): --rom-depth given
 // Array: 2 x 2 pixels, readout 16 bits x 2 beat(s) per word, one beat every 1 cycle(s), slot 10 cycles (docs/pixel-contract.md "Array").
-// The array of docs/pixel-contract.md "Array": 2 x 2 instances of the one pixel,
-// one probe ROM and one sequencer at the root. The sequencer's
-// `pulse`, `rom_word` and readout strobes reach every pixel through two registered
-// fan-out stages (the root, then one per row). After 16 pulses one every 4 cycles,
-// the readout phase reads the pixels one at a time, row-major, one every 10 cycles
-// (4 x 10 + 1 cycles, no pulse presented): a row select puts the pixel on
-// its column bus, the selected column's words are captured into a readout buffer, and
-// the buffer drains onto the 16-bit port, 2 beat(s) per word (least significant
-// first; registers sign-extended, the status word zero-extended), one beat every 1
-// cycle(s). `pulse_o` tells the TDCs (and a testbench) that the pixels sample `valid` and
-// `tdc` this cycle; pixel (r, c) is bit r*2+c of `valid` and field r*2+c of `tdc`.
-module tofprobe_array (
+// The array of docs/pixel-contract.md "Array": ROWS x COLS instances of the one pixel
+// `tofprobe_pixel`, one probe ROM and the chip's one sequencer
+// `tofprobe_sequencer` at the root, written with generate loops over the parameters below: the
+// file's size does not grow with the array. The sequencer's `pulse`, `rom_word` and
+// readout strobes reach every pixel through two registered fan-out stages (the root, then
+// one per row). After 16 pulses one every 4 cycles, the readout phase reads the pixels
+// one at a time, row-major, one every SLOT = (R+1) x K x BEAT_CYCLES cycles (4 registers and
+// the status word; ROWS x COLS x SLOT + 1 cycles, no pulse presented): a row select puts the
+// pixel on its column bus, the selected column's words are captured into a readout buffer,
+// and the buffer drains onto the READOUT_BITS-bit port, K = ceil(30 / READOUT_BITS) beat(s)
+// per word (least significant first; registers sign-extended, the status word
+// zero-extended), one beat every BEAT_CYCLES cycle(s). `pulse_o` tells the TDCs (and a
+// testbench) that the pixels sample `valid` and `tdc` this cycle.
+//
+// Only the pixels of the TILE (rows TILE_ROW0 .. TILE_ROW0+TILE_ROWS-1, columns TILE_COL0 ..
+// TILE_COL0+TILE_COLS-1; the whole array by default) are instantiated: the sequencer,
+// broadcast and readout still walk the whole array, the absent pixels' slots carry no beat.
+// The ports are per pixel of the tile: the tile's pixel (r, c) is bit r*TILE_COLS+c of `valid` and that field of `tdc`.
+// G and the double buffer are fixed by the files of this set (the superpixel's reciprocal
+// table and the pixel's `swap` port are rendered for them); ROWS, COLS, the tile and the
+// readout port may be overridden, and `tofprobe cosim --rtl` re-verifies an edited set.
+module tofprobe_array #(
+    parameter integer ROWS = 2,
+    parameter integer COLS = 2,
+    parameter integer TILE_ROW0 = 0,
+    parameter integer TILE_COL0 = 0,
+    parameter integer TILE_ROWS = 2,
+    parameter integer TILE_COLS = 2,
+    parameter integer READOUT_BITS = 16,
+    parameter integer BEAT_CYCLES = 1,
+    // Derived (not to be overridden): SPADs per pixel, inputs on the ports.
+    parameter integer SPADS = 1,
+    parameter integer INPUTS = TILE_ROWS * TILE_COLS * SPADS
+) (
     input  wire clk,
     input  wire rst,
-    input  wire [3:0] valid,
-    input  wire [27:0] tdc,
+    input  wire [INPUTS - 1:0] valid,
+    input  wire [INPUTS * 7 - 1:0] tdc,
     output wire pulse_o,
     output wire ready,
     output reg  ro_valid,
-    output reg  [15:0] ro_data
+    output reg  [READOUT_BITS - 1:0] ro_data
 );
-    // ---- the sequencer (root) ----
-    reg ro_phase;
-    reg [1:0] ph;
-    reg [3:0] pidx;
-    reg [2:0] q;
-    reg [3:0] sc;
-    reg [0:0] qr;
-    reg [0:0] qc;
-    wire s_pulse = !rst && !ro_phase && (ph == 2'd0);
-    wire s_ro = !rst && ro_phase && (sc == 4'd0) && (q != 3'd4);
-    wire [0:0] s_row = qr;
-    wire [0:0] s_col = qc;
-    reg [3:0] addr;
-    wire [3:0] rom_word;
-    tofprobe_probe_rom u_rom (.addr(addr), .word(rom_word));
+    localparam integer T = 7;
+    localparam integer W = 30;
+    localparam integer R = 4;
+    localparam integer IB = 3;
+    localparam integer PIXELS = ROWS * COLS;
+    localparam integer TILE_PIXELS = TILE_ROWS * TILE_COLS;
+    localparam integer K = (W + READOUT_BITS - 1) / READOUT_BITS;
+    localparam integer KB = K * READOUT_BITS;
+    localparam integer SLOT = (R + 1) * K * BEAT_CYCLES;
+    localparam integer RW = (ROWS > 2) ? $clog2(ROWS) : 1;
+    localparam integer CW = (COLS > 2) ? $clog2(COLS) : 1;
+    localparam integer QW = (PIXELS + 1 > 2) ? $clog2(PIXELS + 1) : 1;
+    localparam integer KW = (K > 2) ? $clog2(K) : 1;
+    localparam integer GW = (BEAT_CYCLES > 2) ? $clog2(BEAT_CYCLES) : 1;
+    localparam integer K_LAST = K - 1;
+    localparam integer G_LAST = BEAT_CYCLES - 1;
+    localparam [IB - 1:0] LAST_WORD = R[IB - 1:0];
+    localparam [KW - 1:0] DM_END = K_LAST[KW - 1:0];
+    localparam [GW - 1:0] DG_END = G_LAST[GW - 1:0];
 
-    always @(posedge clk) begin
-        if (rst) begin
-            ro_phase <= 1'b0;
-            ph <= 2'd0;
-            pidx <= 4'd0;
-            q <= 3'd0;
-            sc <= 4'd0;
-            qr <= 1'd0;
-            qc <= 1'd0;
-            addr <= 4'd0;
-        end else if (!ro_phase) begin
-            if (ph == 2'd3) begin
-                ph <= 2'd0;
-                addr <= (addr == 4'd15) ? 4'd0 : addr + 4'd1;
-                if (pidx == 4'd15) begin
-                    pidx <= 4'd0;
-                    ro_phase <= 1'b1;
-                    q <= 3'd0;
-                    sc <= 4'd0;
-                    qr <= 1'd0;
-                    qc <= 1'd0;
-                    addr <= 4'd0;
-                end else begin
-                    pidx <= pidx + 4'd1;
-                end
-            end else begin
-                ph <= ph + 2'd1;
-            end
-        end else if (q == 3'd4) begin
-            ro_phase <= 1'b0;
-        end else if (sc == 4'd9) begin
-            sc <= 4'd0;
-            q <= q + 3'd1;
-            if (qc == 1'd1) begin
-                qc <= 1'd0;
-                qr <= qr + 1'd1;
-            end else begin
-                qc <= qc + 1'd1;
-            end
-        end else begin
-            sc <= sc + 4'd1;
-        end
-    end
+    // ---- the sequencer (root) and the probe ROM ----
+    wire s_pulse;
+    wire s_ro;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire s_swap;
+    wire [QW - 1:0] s_q;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [RW - 1:0] q_row;
+    wire [CW - 1:0] q_col;
+    wire [3:0] addr;
+    wire [R - 1:0] rom_word;
+    tofprobe_probe_rom u_rom (.addr(addr), .word(rom_word));
+    tofprobe_sequencer #(
+        .PIXELS(PIXELS),
+        .COLS(COLS),
+        .SLOT(SLOT),
+        .DOUBLE_BUFFER(0)
+    ) u_sequencer (
+        .clk(clk),
+        .rst(rst),
+        .pulse(s_pulse),
+        .readout(s_ro),
+        .swap(s_swap),
+        .q(s_q),
+        .row(q_row),
+        .col(q_col),
+        .addr(addr)
+    );
+    wire [RW - 1:0] s_row = q_row;
+    wire [CW - 1:0] s_col = q_col;
 
     // ---- broadcast stage 1: the root's registers ----
     reg b_pulse;
     reg b_ro;
-    reg [0:0] b_row;
-    reg [0:0] b_col;
-    reg [3:0] b_word;
+    reg [RW - 1:0] b_row;
+    reg [CW - 1:0] b_col;
+    reg [R - 1:0] b_word;
     always @(posedge clk) begin
         if (rst) begin
             b_pulse <= 1'b0;
             b_ro <= 1'b0;
-            b_row <= 1'd0;
-            b_col <= 1'd0;
-            b_word <= 4'd0;
+            b_row <= {RW{1'b0}};
+            b_col <= {CW{1'b0}};
+            b_word <= {R{1'b0}};
         end else begin
             b_pulse <= s_pulse;
             b_ro <= s_ro;
@@ -107,126 +120,114 @@ module tofprobe_array (
     end
 
     // ---- broadcast stage 2: one register per row (and the TDCs' strobe) ----
-    reg o_pulse;
-    assign pulse_o = o_pulse;
-    reg [1:0] r_pulse;
-    reg [1:0] r_ro;
-    reg [1:0] r_col;
-    reg [7:0] r_word;
     // Each row's stage is its own register (`keep`): the rows' stages take the same value,
     // and a synthesis tool merges equal registers unless told not to — into one register
     // driving every pixel, the fan-out the stages are there to split.
-    (* keep *) always @(posedge clk) begin
+    (* keep *) reg o_pulse;
+    assign pulse_o = o_pulse;
+    always @(posedge clk) begin
         if (rst) o_pulse <= 1'b0;
         else o_pulse <= b_pulse;
     end
-    (* keep *) always @(posedge clk) begin
-        if (rst) begin
-            r_pulse[0] <= 1'b0;
-            r_ro[0] <= 1'b0;
-            r_col[0 +: 1] <= 1'd0;
-            r_word[0 +: 4] <= 4'd0;
-        end else begin
-            r_pulse[0] <= b_pulse;
-            r_ro[0] <= b_ro && (b_row == 1'd0);
-            r_col[0 +: 1] <= b_col;
-            r_word[0 +: 4] <= b_word;
+    wire [TILE_ROWS - 1:0] r_pulse;
+    wire [TILE_ROWS - 1:0] r_ro;
+    wire [TILE_ROWS * CW - 1:0] r_col;
+    wire [TILE_ROWS * R - 1:0] r_word;
+    genvar lr;
+    genvar lc;
+    generate
+        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_row
+            localparam integer ROW_I = TILE_ROW0 + lr;
+            localparam [RW - 1:0] ROW = ROW_I[RW - 1:0];
+            (* keep *) reg pulse_q;
+            (* keep *) reg ro_q;
+            (* keep *) reg [CW - 1:0] col_q;
+            assign r_pulse[lr] = pulse_q;
+            assign r_ro[lr] = ro_q;
+            assign r_col[lr * CW +: CW] = col_q;
+            (* keep *) reg [R - 1:0] word_q;
+            assign r_word[lr * R +: R] = word_q;
+            wire next_pulse = b_pulse;
+            wire [R - 1:0] next_word = b_word;
+            always @(posedge clk) begin
+                if (rst) begin
+                    pulse_q <= 1'b0;
+                    ro_q <= 1'b0;
+                    col_q <= {CW{1'b0}};
+                    word_q <= {R{1'b0}};
+                end else begin
+                    pulse_q <= next_pulse;
+                    ro_q <= b_ro && (b_row == ROW);
+                    col_q <= b_col;
+                    word_q <= next_word;
+                end
+            end
         end
-    end
-    (* keep *) always @(posedge clk) begin
-        if (rst) begin
-            r_pulse[1] <= 1'b0;
-            r_ro[1] <= 1'b0;
-            r_col[1 +: 1] <= 1'd0;
-            r_word[4 +: 4] <= 4'd0;
-        end else begin
-            r_pulse[1] <= b_pulse;
-            r_ro[1] <= b_ro && (b_row == 1'd1);
-            r_col[1 +: 1] <= b_col;
-            r_word[4 +: 4] <= b_word;
+    endgenerate
+
+    // ---- the pixels' inputs ----
+    wire [TILE_PIXELS - 1:0] in_valid;
+    wire [TILE_PIXELS * T - 1:0] in_tdc;
+    generate
+        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_in_row
+            for (lc = 0; lc < TILE_COLS; lc = lc + 1) begin : g_in
+                localparam integer I = lr * TILE_COLS + lc;
+                assign in_valid[I] = valid[I];
+                assign in_tdc[I * T +: T] = tdc[I * T +: T];
+            end
         end
-    end
+    endgenerate
 
     // ---- the pixels ----
-    wire [3:0] p_ready;
-    wire [3:0] p_valid;
-    wire [11:0] p_index;
-    wire [119:0] p_data;
+    wire [TILE_PIXELS - 1:0] p_ready;
+    wire [TILE_PIXELS - 1:0] p_valid;
+    wire [TILE_PIXELS * IB - 1:0] p_index;
+    wire [TILE_PIXELS * W - 1:0] p_data;
     assign ready = &p_ready;
-    tofprobe_pixel u_pixel_0_0 (
-        .clk(clk),
-        .rst(rst),
-        .pulse(r_pulse[0]),
-        .valid(valid[0]),
-        .tdc(tdc[0 +: 7]),
-        .rom_word(r_word[0 +: 4]),
-        .readout(r_ro[0] && (r_col[0 +: 1] == 1'd0)),
-        .ready(p_ready[0]),
-        .rd_valid(p_valid[0]),
-        .rd_index(p_index[0 +: 3]),
-        .rd_data(p_data[0 +: 30])
-    );
-    tofprobe_pixel u_pixel_0_1 (
-        .clk(clk),
-        .rst(rst),
-        .pulse(r_pulse[0]),
-        .valid(valid[1]),
-        .tdc(tdc[7 +: 7]),
-        .rom_word(r_word[0 +: 4]),
-        .readout(r_ro[0] && (r_col[0 +: 1] == 1'd1)),
-        .ready(p_ready[1]),
-        .rd_valid(p_valid[1]),
-        .rd_index(p_index[3 +: 3]),
-        .rd_data(p_data[30 +: 30])
-    );
-    tofprobe_pixel u_pixel_1_0 (
-        .clk(clk),
-        .rst(rst),
-        .pulse(r_pulse[1]),
-        .valid(valid[2]),
-        .tdc(tdc[14 +: 7]),
-        .rom_word(r_word[4 +: 4]),
-        .readout(r_ro[1] && (r_col[1 +: 1] == 1'd0)),
-        .ready(p_ready[2]),
-        .rd_valid(p_valid[2]),
-        .rd_index(p_index[6 +: 3]),
-        .rd_data(p_data[60 +: 30])
-    );
-    tofprobe_pixel u_pixel_1_1 (
-        .clk(clk),
-        .rst(rst),
-        .pulse(r_pulse[1]),
-        .valid(valid[3]),
-        .tdc(tdc[21 +: 7]),
-        .rom_word(r_word[4 +: 4]),
-        .readout(r_ro[1] && (r_col[1 +: 1] == 1'd1)),
-        .ready(p_ready[3]),
-        .rd_valid(p_valid[3]),
-        .rd_index(p_index[9 +: 3]),
-        .rd_data(p_data[90 +: 30])
-    );
+    generate
+        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_px_row
+            for (lc = 0; lc < TILE_COLS; lc = lc + 1) begin : g_px
+                localparam integer I = lr * TILE_COLS + lc;
+                localparam integer SRC = I;
+                localparam integer COL_I = TILE_COL0 + lc;
+                localparam [CW - 1:0] COL = COL_I[CW - 1:0];
+                tofprobe_pixel u_pixel (
+                    .clk(clk),
+                    .rst(rst),
+                    .pulse(r_pulse[lr]),
+                    .valid(in_valid[I]),
+                    .tdc(in_tdc[SRC * T +: T]),
+                    .rom_word(r_word[lr * R +: R]),
+                    .readout(r_ro[lr] && (r_col[lr * CW +: CW] == COL)),
+                    .ready(p_ready[I]),
+                    .rd_valid(p_valid[I]),
+                    .rd_index(p_index[I * IB +: IB]),
+                    .rd_data(p_data[I * W +: W])
+                );
+            end
+        end
+    endgenerate
 
     // ---- the read select: a row onto the column buses, a column onto the capture ----
     // The strobe's root registers, two more stages on: the select changes the cycle after
     // the pixel takes its strobe, when its first word is still a cycle away.
     reg d_ro;
-    reg [0:0] d_row;
-    reg [0:0] d_col;
+    reg [RW - 1:0] d_row;
+    reg [CW - 1:0] d_col;
     reg e_ro;
-    reg [0:0] e_row;
-    reg [0:0] e_col;
-    reg [1:0] m_row;
-    reg [0:0] m_col;
+    reg [RW - 1:0] e_row;
+    reg [CW - 1:0] e_col;
+    reg [TILE_ROWS - 1:0] m_row;
+    reg [CW - 1:0] m_col;
     always @(posedge clk) begin
         if (rst) begin
             d_ro <= 1'b0;
-            d_row <= 1'd0;
-            d_col <= 1'd0;
+            d_row <= {RW{1'b0}};
+            d_col <= {CW{1'b0}};
             e_ro <= 1'b0;
-            e_row <= 1'd0;
-            e_col <= 1'd0;
-            m_row <= 2'd0;
-            m_col <= 1'd0;
+            e_row <= {RW{1'b0}};
+            e_col <= {CW{1'b0}};
+            m_col <= {CW{1'b0}};
         end else begin
             d_ro <= b_ro;
             d_row <= b_row;
@@ -234,59 +235,82 @@ module tofprobe_array (
             e_ro <= d_ro;
             e_row <= d_row;
             e_col <= d_col;
-            if (e_ro) begin
-                m_col <= e_col;
-                m_row[0] <= (e_row == 1'd0);
-                m_row[1] <= (e_row == 1'd1);
+            if (e_ro) m_col <= e_col;
+        end
+    end
+    generate
+        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_sel
+            localparam integer ROW_I = TILE_ROW0 + lr;
+            localparam [RW - 1:0] ROW = ROW_I[RW - 1:0];
+            always @(posedge clk) begin
+                if (rst) m_row[lr] <= 1'b0;
+                else if (e_ro) m_row[lr] <= (e_row == ROW);
+            end
+        end
+    endgenerate
+    // Column buses: the OR of the selected rows' pixels.
+    wire [TILE_COLS - 1:0] bus_valid;
+    wire [TILE_COLS * IB - 1:0] bus_index;
+    wire [TILE_COLS * W - 1:0] bus_data;
+    generate
+        for (lc = 0; lc < TILE_COLS; lc = lc + 1) begin : g_bus
+            reg v;
+            reg [IB - 1:0] x;
+            reg [W - 1:0] d;
+            integer i;
+            always @* begin
+                v = 1'b0;
+                x = {IB{1'b0}};
+                d = {W{1'b0}};
+                for (i = 0; i < TILE_ROWS; i = i + 1) begin
+                    v = v | (m_row[i] & p_valid[i * TILE_COLS + lc]);
+                    x = x | ({IB{m_row[i]}} & p_index[(i * TILE_COLS + lc) * IB +: IB]);
+                    d = d | ({W{m_row[i]}} & p_data[(i * TILE_COLS + lc) * W +: W]);
+                end
+            end
+            assign bus_valid[lc] = v;
+            assign bus_index[lc * IB +: IB] = x;
+            assign bus_data[lc * W +: W] = d;
+        end
+    endgenerate
+    // The selected column of the tile (none: an absent pixel's slot carries no beat): its
+    // offset from the tile's first column, wrapped past the tile's width when left of it.
+    localparam [CW:0] TC0 = TILE_COL0[CW:0];
+    localparam [CW:0] TCOLS = TILE_COLS[CW:0];
+    wire [CW:0] m_off = {1'b0, m_col} - TC0;
+    wire m_in_tile = m_off < TCOLS;
+    wire [CW - 1:0] m_lc = m_off[CW - 1:0];
+    reg m_valid;
+    reg [IB - 1:0] m_index;
+    reg [W - 1:0] m_data;
+    integer j;
+    always @* begin
+        m_valid = 1'b0;
+        m_index = {IB{1'b0}};
+        m_data = {W{1'b0}};
+        for (j = 0; j < TILE_COLS; j = j + 1) begin
+            if (m_in_tile && m_lc == j[CW - 1:0]) begin
+                m_valid = bus_valid[j];
+                m_index = bus_index[j * IB +: IB];
+                m_data = bus_data[j * W +: W];
             end
         end
     end
-    // Column buses: the OR of the selected row's pixels.
-    wire [1:0] bus_valid;
-    wire [5:0] bus_index;
-    wire [59:0] bus_data;
-    assign bus_valid[0] = (m_row[0] & p_valid[0]) | (m_row[1] & p_valid[2]);
-    assign bus_index[0 +: 3] = ({3{m_row[0]}} & p_index[0 +: 3]) | ({3{m_row[1]}} & p_index[6 +: 3]);
-    assign bus_data[0 +: 30] = ({30{m_row[0]}} & p_data[0 +: 30]) | ({30{m_row[1]}} & p_data[60 +: 30]);
-    assign bus_valid[1] = (m_row[0] & p_valid[1]) | (m_row[1] & p_valid[3]);
-    assign bus_index[3 +: 3] = ({3{m_row[0]}} & p_index[3 +: 3]) | ({3{m_row[1]}} & p_index[9 +: 3]);
-    assign bus_data[30 +: 30] = ({30{m_row[0]}} & p_data[30 +: 30]) | ({30{m_row[1]}} & p_data[90 +: 30]);
-    reg m_valid;
-    reg [2:0] m_index;
-    reg [29:0] m_data;
-    always @* begin
-        case (m_col)
-            1'd0: begin
-                m_valid = bus_valid[0];
-                m_index = bus_index[0 +: 3];
-                m_data = bus_data[0 +: 30];
-            end
-            1'd1: begin
-                m_valid = bus_valid[1];
-                m_index = bus_index[3 +: 3];
-                m_data = bus_data[30 +: 30];
-            end
-            default: begin
-                m_valid = 1'b0;
-                m_index = 3'd0;
-                m_data = 30'd0;
-            end
-        endcase
-    end
 
     // ---- the readout buffer and the port ----
-    reg [29:0] rbuf_0;
-    reg [29:0] rbuf_1;
-    reg [29:0] rbuf_2;
-    reg [29:0] rbuf_3;
-    reg [29:0] rbuf_4;
+    reg [W - 1:0] rbuf_0;
+    reg [W - 1:0] rbuf_1;
+    reg [W - 1:0] rbuf_2;
+    reg [W - 1:0] rbuf_3;
+    reg [W - 1:0] rbuf_4;
     reg dr_act;
-    reg [2:0] dj;
-    reg [0:0] dm;
-    wire beat = dr_act;
-    wire step = dr_act;
-    wire last = (dj == 3'd4) && (dm == 1'd1);
-    reg [29:0] dw;
+    reg [IB - 1:0] dj;
+    reg [KW - 1:0] dm;
+    reg [GW - 1:0] dg;
+    wire beat = dr_act && (BEAT_CYCLES == 1 || dg == {GW{1'b0}});
+    wire step = dr_act && (BEAT_CYCLES == 1 || dg == DG_END);
+    wire last = (dj == LAST_WORD) && (K == 1 || dm == DM_END);
+    reg [W - 1:0] dw;
     always @* begin
         case (dj)
             3'd0: dw = rbuf_0;
@@ -294,12 +318,22 @@ module tofprobe_array (
             3'd2: dw = rbuf_2;
             3'd3: dw = rbuf_3;
             3'd4: dw = rbuf_4;
-            default: dw = 30'd0;
+            default: dw = {W{1'b0}};
         endcase
     end
-    // Registers sign-extended, the status word (index 4) zero-extended, to 32 bits.
-    wire dsx = dw[29] && (dj != 3'd4);
-    wire [31:0] dx = {{2{dsx}}, dw};
+    // Registers sign-extended, the status word (index R) zero-extended, to K x READOUT_BITS bits.
+    wire dsx = dw[W - 1] && (dj != LAST_WORD);
+    wire [KB - 1:0] dx;
+    generate
+        if (KB > W) begin : g_ext
+            assign dx = { {(KB - W){dsx}}, dw };
+        end else begin : g_noext
+            assign dx = dw;
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire unused_dsx = dsx;
+            /* verilator lint_on UNUSEDSIGNAL */
+        end
+    endgenerate
     always @(posedge clk) begin
         if (m_valid && (m_index == 3'd0)) begin
             rbuf_0 <= m_data;
@@ -320,33 +354,30 @@ module tofprobe_array (
     always @(posedge clk) begin
         if (rst) begin
             dr_act <= 1'b0;
-            dj <= 3'd0;
-            dm <= 1'd0;
+            dj <= {IB{1'b0}};
+            dm <= {KW{1'b0}};
+            dg <= {GW{1'b0}};
             ro_valid <= 1'b0;
-            ro_data <= 16'd0;
+            ro_data <= {READOUT_BITS{1'b0}};
         end else begin
             ro_valid <= beat;
-            if (beat) begin
-                case (dm)
-                    1'd0: ro_data <= dx[0 +: 16];
-                    1'd1: ro_data <= dx[16 +: 16];
-                    default: ro_data <= 16'd0;
-                endcase
-            end
-            if (m_valid && (m_index == 3'd0)) begin
+            if (beat) ro_data <= dx[dm * READOUT_BITS +: READOUT_BITS];
+            if (m_valid && (m_index == {IB{1'b0}})) begin
                 // A pixel's word 0 is in the buffer: its drain starts at the next edge.
                 dr_act <= 1'b1;
-                dj <= 3'd0;
-                dm <= 1'd0;
+                dj <= {IB{1'b0}};
+                dm <= {KW{1'b0}};
+                dg <= {GW{1'b0}};
             end else if (dr_act) begin
+                if (BEAT_CYCLES > 1) dg <= step ? {GW{1'b0}} : dg + 1'b1;
                 if (step) begin
                     if (last) begin
                         dr_act <= 1'b0;
-                    end else if (dm == 1'd1) begin
-                        dm <= 1'd0;
-                        dj <= dj + 3'd1;
+                    end else if (K == 1 || dm == DM_END) begin
+                        dm <= {KW{1'b0}};
+                        dj <= dj + 1'b1;
                     end else begin
-                        dm <= dm + 1'd1;
+                        dm <= dm + 1'b1;
                     end
                 end
             end

@@ -48,17 +48,31 @@ pub fn rtl(a: &RtlArgs, design: &ResolvedDesign) -> Result<(), CliError> {
 
 /// `tofprobe cosim` on an array design.
 pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<super::Verdict, CliError> {
-    if a.rtl.is_some() || a.directed || a.coverage || a.trace || a.bare {
-        return Err(CliError::option(
-            "rtl/directed/coverage/trace/bare",
-            "given",
-            "the pixel's co-simulation (an array runs its reference sequencer on fresh RTL)",
-        ));
+    // Every option either works on an array or is refused by name: none is ignored.
+    let pixel_only = [
+        ("directed", a.directed, "the pixel's directed sequencer"),
+        ("coverage", a.coverage, "the pixel module's line coverage"),
+        ("trace", a.trace, "the pixel's VCD"),
+        ("bare", a.bare, "the pixel's bare-model timing"),
+        (
+            "seed",
+            a.seed.is_some(),
+            "the pixel's random stimulus (an array's detections come from its scene: set \
+             `[acquisition] seed` in the configuration)",
+        ),
+    ];
+    if let Some((name, _, what)) = pixel_only.iter().find(|(_, given, _)| *given) {
+        return Err(CliError::option(name, "given", format!("{what} only")));
     }
     let mut o = ArrayCosimOptions::new(&a.out);
     o.frame_pulses = a.frame_pulses;
     o.rom_depth = a.rom_depth;
     o.frames = a.frames;
+    o.rtl = a.rtl.clone();
+    o.lead_misses = a.lead_misses;
+    if let Some(x) = a.x_seed {
+        o.x_seeds = vec![x];
+    }
     o.simulator = match a.simulator {
         SimulatorArg::Verilator => ArraySimulator::Verilator,
         SimulatorArg::Icarus => ArraySimulator::Icarus,
@@ -94,6 +108,9 @@ pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<super::Verdict, C
             "first_mismatch": r.first,
             "readout_cycles": ro.readout_cycles(),
             "beats_per_frame": ro.beats_per_frame(),
+            "first_frame": r.first_frame,
+            "x_seed": r.x_seed,
+            "edited_rtl": a.rtl.is_some(),
             "build_seconds": r.build_seconds,
             "build_reused": r.reused,
             "simulator_seconds": r.sim_seconds,
@@ -123,5 +140,37 @@ pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<super::Verdict, C
                 .unwrap_or_default()
         );
     }
+    let failure = r.first_frame.map(|k| {
+        let m = r.first.clone().unwrap_or_default();
+        (
+            k,
+            format!("first mismatch: {m}"),
+            format!(
+                "first mismatch: {m}\n{} mismatch(es) in the run",
+                r.mismatches
+            ),
+        )
+    });
+    let failure = match (failure, r.pass) {
+        (Some(f), _) => Some(f),
+        (None, true) => None,
+        (None, false) => {
+            let m = format!(
+                "{} mismatch(es), {} of {} cycles run",
+                r.mismatches,
+                r.cycles,
+                r.run.cycles()
+            );
+            Some((a.frames - 1, m.clone(), m))
+        }
+    };
+    let suite = tofprobe_cosim::junit::frames_suite(
+        &super::cosim::junit_name(a),
+        &tofprobe_rtlgen::config_hash(&r.pixel),
+        r.build_seconds + r.sim_seconds + r.model_seconds,
+        a.frames,
+        failure,
+    );
+    super::cosim::write_junit(a, &[suite])?;
     Ok(super::Verdict::of(r.pass))
 }

@@ -30,9 +30,10 @@ pub struct CosimArgs {
     /// Frames to run.
     #[arg(long, default_value_t = 1)]
     pub frames: u64,
-    /// Stimulus seed.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
+    /// Stimulus seed (default 1). An array's detections come from its scene's own seed
+    /// (`[acquisition] seed`): refused there.
+    #[arg(long)]
+    pub seed: Option<u64>,
     /// Write a VCD (around the first mismatch, else of the first 10^5 cycles).
     #[arg(long)]
     pub trace: bool,
@@ -59,9 +60,10 @@ pub struct CosimArgs {
     /// Simulator replaying the vectors (same stimuli, same report, same JSON).
     #[arg(long, value_enum, default_value_t = SimulatorArg::Verilator)]
     pub simulator: SimulatorArg,
-    /// Seed of Verilator's randomised initial register values (≥ 1; recorded in the report).
-    #[arg(long, default_value_t = 1)]
-    pub x_seed: u64,
+    /// Seed of Verilator's randomised initial register values (≥ 1; recorded in the
+    /// report). Default: 1 for the pixel; an array runs seeds 1, 2 and 3 unless one is given.
+    #[arg(long)]
+    pub x_seed: Option<u64>,
     /// Directed stimulus: the first K pulses are misses (the priming rule).
     #[arg(long, default_value_t = 0)]
     pub lead_misses: u64,
@@ -99,7 +101,7 @@ pub struct CosimArgs {
 
 /// The configuration's name in the JUnit report: the configuration file's stem, `default`
 /// for the embedded default.
-fn junit_name(a: &CosimArgs) -> String {
+pub(crate) fn junit_name(a: &CosimArgs) -> String {
     a.config
         .as_deref()
         .and_then(|c| c.file_stem())
@@ -108,7 +110,10 @@ fn junit_name(a: &CosimArgs) -> String {
 }
 
 /// Writes `--junit FILE` if asked (the command line, sanitised, goes into its header).
-fn write_junit(a: &CosimArgs, suites: &[tofprobe_cosim::junit::Suite]) -> Result<(), CliError> {
+pub(crate) fn write_junit(
+    a: &CosimArgs,
+    suites: &[tofprobe_cosim::junit::Suite],
+) -> Result<(), CliError> {
     if let Some(path) = &a.junit {
         let command: Vec<String> = std::iter::once("tofprobe".to_string())
             .chain(std::env::args().skip(1))
@@ -202,13 +207,13 @@ pub fn time_transaction(pp: &tofprobe_pixel::PixelParams, p: &PixelParams, r: &C
 pub fn options(p: &PixelParams, a: &CosimArgs) -> CosimOptions {
     let mut o = CosimOptions::new(&a.out);
     o.frames = a.frames;
-    o.seed = a.seed;
+    o.seed = a.seed.unwrap_or(1);
     o.rtl_dir = a.rtl.clone();
     o.trace = a.trace;
     o.vcd_on_mismatch = !a.no_vcd;
     o.measure_bare = a.bare;
     o.simulator = a.simulator.into();
-    o.x_seed = a.x_seed;
+    o.x_seed = a.x_seed.unwrap_or(1);
     o.lead_misses = a.lead_misses;
     o.coverage = a.coverage;
     o.directed = a.directed.then(|| DirectedOptions {
@@ -411,10 +416,10 @@ fn run_random(a: &CosimArgs, n: u64) -> Result<super::Verdict, CliError> {
     }
     let t0 = Instant::now();
     let o = tofprobe_cosim::soak::SoakOptions {
-        seed: a.seed,
+        seed: a.seed.unwrap_or(1),
         frames: a.frames,
         simulator: a.simulator.into(),
-        x_seed: a.x_seed,
+        x_seed: a.x_seed.unwrap_or(1),
         out: &a.out,
     };
     let mut printed: Result<(), CliError> = Ok(());
@@ -470,7 +475,7 @@ fn run_random(a: &CosimArgs, n: u64) -> Result<super::Verdict, CliError> {
             .to_possible_value()
             .map(|v| v.get_name().to_string())
             .unwrap_or_default(),
-        a.seed,
+        a.seed.unwrap_or(1),
         a.frames,
         t0.elapsed().as_secs_f64()
     );

@@ -361,8 +361,17 @@ fn a_superpixel_array_is_bit_exact_and_a_crossed_average_is_caught() {
             "{j}"
         );
         let rtl = std::fs::read_to_string(out.join("rtl/tofprobe_array.v")).unwrap();
-        assert_eq!(rtl.matches("tofprobe_superpixel u_superpixel_").count(), 4);
-        assert!(rtl.contains("input  wire [15:0] valid,"), "16 SPAD inputs");
+        // One averaging instance in the generate loop over the 2 × 2 pixels; the ports
+        // are per SPAD: 2 × 2 pixels × 4 SPADs.
+        assert_eq!(rtl.matches("tofprobe_superpixel u_superpixel (").count(), 1);
+        assert!(
+            rtl.contains("parameter integer SPADS = 4,"),
+            "2 × 2 SPADs a pixel"
+        );
+        assert!(
+            rtl.contains("input  wire [INPUTS - 1:0] valid,"),
+            "SPAD inputs"
+        );
     }
     if !have_tools(&["iverilog", "vvp"]) {
         return;

@@ -4,6 +4,7 @@
 
 mod adders_auto;
 mod array;
+mod array_edited;
 mod array_rtl;
 mod array_size;
 mod bench_fullband;

@@ -1,7 +1,7 @@
 //! Quality gates on the array RTL (`templates/array.v`): `verilator --lint-only -Wall` with
 //! zero warnings, `iverilog -g2005 -Wall` compiles, yosys `synth` with no latch and no
 //! warning beyond the pixel's register-file note, for a 2 × 2 Fourier array on a one-word
-//! port, a 3 × 5 Haar array on a 5-bit port (3 beats per word), a 2 × 3 array with beats
+//! port, a 1 × 1, a 1 × 7 and a 7 × 1 array, a 3 × 5 Haar array on a 5-bit port (3 beats per word), a 2 × 3 array with beats
 //! 3 cycles apart, superpixel arrays (G = 2, and a tile at G = 3), double-buffered arrays
 //! (Fourier, Haar: the synthesised shadow is (R+1)·W flops per pixel) and each array
 //! mutant; and the renderer's refusals.
@@ -57,6 +57,11 @@ fn configs() -> Vec<(String, PixelParams, ArraySpec)> {
     let h = small(Mode::Haar);
     let mut v = vec![
         ("2x2".to_string(), f.clone(), spec(&f, 2, 2, 24, 1)),
+        // The degenerate shapes: one pixel, one row, one column (the counters' widths
+        // bottom out at one bit).
+        ("1x1".to_string(), f.clone(), spec(&f, 1, 1, 24, 1)),
+        ("1x7".to_string(), f.clone(), spec(&f, 1, 7, 8, 2)),
+        ("7x1-haar".to_string(), h.clone(), spec(&h, 7, 1, 13, 1)),
         ("3x5-haar-k3".to_string(), h.clone(), spec(&h, 3, 5, 5, 1)),
         ("2x3-g3".to_string(), f.clone(), spec(&f, 2, 3, 10, 3)),
         // A 64 × 64 array's far-corner tile: the whole array's sequencer and readout.
@@ -258,31 +263,46 @@ fn array_lint_iverilog_and_yosys_are_clean() {
     }
 }
 
-/// The array file instantiates the one pixel module R × C times and nothing else of its
-/// own; the set holds no single-pixel top.
+/// The array file instantiates the one pixel module (in a generate loop over the rows and
+/// columns), the one sequencer and the ROM, and nothing else of its own; the set holds no
+/// single-pixel top. Its size does not grow with the array: a 256 × 256 array's file is a
+/// 2 × 2's but for the digits of its parameters' defaults and its header.
 #[test]
 fn the_array_is_instances_of_the_one_pixel() {
     let p = small(Mode::Fourier);
-    let files = render_array(
-        &p,
-        &sign_probe_rom(&p),
-        &RenderOptions::default(),
-        &spec(&p, 3, 5, 24, 1),
-    )
-    .unwrap();
+    let render = |rows, cols| {
+        render_array(
+            &p,
+            &sign_probe_rom(&p),
+            &RenderOptions::default(),
+            &spec(&p, rows, cols, 24, 1),
+        )
+        .unwrap()
+    };
+    let files = render(3, 5);
     let names: Vec<&str> = files.iter().map(|f| f.name.as_str()).collect();
     assert_eq!(
         names,
         [
             "tofprobe_pixel.v",
             "tofprobe_probe_rom.v",
+            "tofprobe_sequencer.v",
             "tofprobe_array.v"
         ]
     );
-    let a = &files[2].contents;
-    assert_eq!(a.matches("tofprobe_pixel u_pixel_").count(), 15);
+    let a = &files[3].contents;
+    assert_eq!(a.matches("tofprobe_pixel u_pixel (").count(), 1);
+    assert_eq!(a.matches("tofprobe_sequencer #(").count(), 1);
     assert_eq!(a.matches("tofprobe_probe_rom u_rom").count(), 1);
     assert_eq!(a.matches("\nmodule ").count(), 1);
+    assert!(a.contains("parameter integer ROWS = 3,") && a.contains("parameter integer COLS = 5,"));
+    let small_len = render(2, 2)[3].contents.len();
+    let large_len = render(256, 256)[3].contents.len();
+    // The defaults' digits (4 × 2 more) and the header's line naming the shape.
+    assert!(
+        large_len.abs_diff(small_len) < 64,
+        "256 × 256: {large_len} bytes against 2 × 2: {small_len}"
+    );
 }
 
 /// Refusals name the field: a slot that is not (R+1)·k·g, a width beyond W, a mutant
@@ -314,7 +334,10 @@ fn bad_array_specs_are_refused() {
             },
             "mutation row = 2",
         ),
-        (spec(&p, 65, 64, 24, 1), "array.rows × array.cols = 65 × 64"),
+        (
+            spec(&p, 4097, 64, 24, 1),
+            "array.rows × array.cols = 4097 × 64",
+        ),
         (
             ArraySpec {
                 superpixel: 5,
@@ -373,9 +396,21 @@ fn the_double_buffer_is_rendered_only_when_on() {
         },
     )
     .unwrap();
+    // Only the array wires the sequencer's swap strobe: its pixels and broadcast do not.
     for f in &off {
-        assert!(!f.contents.contains("swap"), "{}", f.name);
+        let text = f.contents.replace(".swap(s_swap)", "");
+        let own = if f.name.ends_with("_sequencer.v") {
+            ""
+        } else {
+            &text
+        };
+        assert!(
+            !own.contains("swap_q") && !own.contains("input  wire swap"),
+            "{}",
+            f.name
+        );
     }
+    assert_eq!(on[2].contents, off[2].contents, "one sequencer for both");
     let (pix_off, pix_on) = (&off[0].contents, &on[0].contents);
     assert!(pix_on.contains("input  wire swap,") && pix_on.contains("sh_0 <= y[0];"));
     assert!(
@@ -384,5 +419,9 @@ fn the_double_buffer_is_rendered_only_when_on() {
     );
     assert!(pix_off.contains("!rd_active && (!active"));
     assert_eq!(on[1].contents, off[1].contents, "the ROM is the same");
-    assert_eq!(on[2].contents.matches(".swap(r_swap[").count(), 4);
+    assert_eq!(on[3].contents.matches(".swap(r_swap[lr])").count(), 1);
+    assert!(
+        on[3].contents.contains(".DOUBLE_BUFFER(1)")
+            && off[3].contents.contains(".DOUBLE_BUFFER(0)")
+    );
 }

@@ -100,7 +100,7 @@ fn headers_name_generator_template_command_hash() {
         ..RenderOptions::default()
     };
     let files = render(&p, &sign_probe_rom(&p), &o).expect("renders");
-    assert_eq!(files.len(), 3, "case-table ROM: pixel, rom, top");
+    assert_eq!(files.len(), 4, "case-table ROM: pixel, rom, sequencer, top");
     for f in &files {
         assert!(f.contents.starts_with(HEADER_MARK), "{}", f.name);
         let head: String = f.contents.lines().take(4).collect::<Vec<_>>().join("\n");

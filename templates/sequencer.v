@@ -1,0 +1,131 @@
+{{ header }}
+// The chip's one sequencer (docs/pixel-contract.md "The reference sequencer" and "Array"):
+// after rst, {{ n }} pulse strobes one every {{ c }} cycles{% if fourier %} (each with its probe ROM address, pulse
+// index mod {{ l }}){% endif %}, then the readout phase walks PIXELS pixels row-major (COLS a row), one
+// readout strobe every SLOT cycles, and ends one cycle after the last slot. The single pixel's
+// top is PIXELS = COLS = 1, SLOT = {{ r + 1 }} (the readout strobe, then {{ r + 1 }} idle cycles while
+// its words come out); the array's top walks its R x C pixels. With DOUBLE_BUFFER = 1 the
+// walk runs beside the next frame's pulses, which wait after the frame's last pulse for
+// max(PIXELS*SLOT + 1, {{ n }}*{{ c }} + 1) - {{ n }}*{{ c }} cycles (the `swap` strobe is the walk's first cycle).
+// The Rust twin is `tofprobe_pixel::chip::ChipSequencer`; both step the same registers.
+module {{ name }} #(
+    parameter integer PIXELS = 1,
+    parameter integer COLS = 1,
+    parameter integer SLOT = {{ r + 1 }},
+    parameter integer DOUBLE_BUFFER = 0,
+    // Derived widths (not to be overridden).
+    parameter integer QW = (PIXELS + 1 > 2) ? $clog2(PIXELS + 1) : 1,
+    parameter integer RW = (PIXELS / COLS > 2) ? $clog2(PIXELS / COLS) : 1,
+    parameter integer CW = (COLS > 2) ? $clog2(COLS) : 1
+) (
+    input  wire clk,
+    input  wire rst,
+    output wire pulse,
+    output wire readout,
+    output wire swap,
+    output wire [QW - 1:0] q,
+    output wire [RW - 1:0] row,
+    output wire [CW - 1:0] col{% if fourier %},
+    output wire [{{ aw - 1 }}:0] addr{% endif %}
+);
+    // Sized in 64 bits: a large array's readout outlasts 2^32 cycles.
+    localparam [63:0] WALK = 64'd0 + PIXELS * 64'd1 * SLOT + 64'd1;
+    localparam [63:0] ACC = 64'd{{ acc }};
+    localparam [63:0] WAIT = (DOUBLE_BUFFER != 0 && WALK > ACC + 64'd1) ? WALK - ACC - 64'd1 : 64'd0;
+    localparam integer SW = (SLOT > 2) ? $clog2(SLOT) : 1;
+    localparam integer HW = (WAIT + 64'd1 > 64'd2) ? $clog2(WAIT + 64'd1) : 1;
+    localparam [QW - 1:0] Q_END = PIXELS[QW - 1:0];
+    localparam integer SLOT_LAST = SLOT - 1;
+    localparam integer COL_LAST = COLS - 1;
+    localparam [SW - 1:0] SC_END = SLOT_LAST[SW - 1:0];
+    localparam [CW - 1:0] C_END = COL_LAST[CW - 1:0];
+    localparam [HW - 1:0] WT_START = WAIT[HW - 1:0];
+
+    reg ro_phase;
+    reg hold;
+    reg [{{ pw - 1 }}:0] ph;
+    reg [{{ nw - 1 }}:0] pidx;
+    reg [QW - 1:0] qi;
+    reg [SW - 1:0] sc;
+    reg [RW - 1:0] qr;
+    reg [CW - 1:0] qc;
+    reg [HW - 1:0] wt;
+{%- if fourier %}
+    reg [{{ aw - 1 }}:0] ai;
+    assign addr = ai;
+{%- endif %}
+    // Single-buffered the pulses wait for the walk; double-buffered for the hold only.
+    wire waiting = (DOUBLE_BUFFER != 0) ? hold : ro_phase;
+    assign pulse = !rst && !waiting && (ph == {{ pw }}'d0);
+    assign readout = !rst && ro_phase && (sc == {SW{1'b0}}) && (qi != Q_END);
+    assign swap = (DOUBLE_BUFFER != 0) && !rst && ro_phase && (qi == {QW{1'b0}}) && (sc == {SW{1'b0}});
+    assign q = qi;
+    assign row = qr;
+    assign col = qc;
+    wire frame_end = !waiting && (ph == {{ pw }}'d{{ c - 1 }}) && (pidx == {{ nw }}'d{{ n - 1 }});
+
+    always @(posedge clk) begin
+        if (rst) begin
+            ro_phase <= 1'b0;
+            hold <= 1'b0;
+            ph <= {{ pw }}'d0;
+            pidx <= {{ nw }}'d0;
+            qi <= {QW{1'b0}};
+            sc <= {SW{1'b0}};
+            qr <= {RW{1'b0}};
+            qc <= {CW{1'b0}};
+            wt <= {HW{1'b0}};
+{%- if fourier %}
+            ai <= {{ aw }}'d0;
+{%- endif %}
+        end else begin
+            // The readout walk: a slot of SLOT cycles per pixel, row-major, then the
+            // phase's last cycle.
+            if (ro_phase) begin
+                if (qi == Q_END) begin
+                    ro_phase <= 1'b0;
+                end else if (sc == SC_END) begin
+                    sc <= {SW{1'b0}};
+                    qi <= qi + 1'b1;
+                    if (qc == C_END) begin
+                        qc <= {CW{1'b0}};
+                        qr <= qr + 1'b1;
+                    end else begin
+                        qc <= qc + 1'b1;
+                    end
+                end else begin
+                    sc <= sc + 1'b1;
+                end
+            end
+            // The pulses (double-buffered: the hold after a frame's last pulse).
+            if (DOUBLE_BUFFER != 0 && hold) begin
+                if (wt == {HW{1'b0}}) hold <= 1'b0;
+                else wt <= wt - 1'b1;
+            end else if (!waiting) begin
+                if (ph == {{ pw }}'d{{ c - 1 }}) begin
+                    ph <= {{ pw }}'d0;
+                    pidx <= (pidx == {{ nw }}'d{{ n - 1 }}) ? {{ nw }}'d0 : pidx + 1'b1;
+{%- if fourier %}
+                    ai <= (ai == {{ aw }}'d{{ l - 1 }}) ? {{ aw }}'d0 : ai + 1'b1;
+{%- endif %}
+                end else begin
+                    ph <= ph + 1'b1;
+                end
+            end
+            // The frame's end starts the walk (double-buffered it has finished: the walk
+            // is no longer than the frame), after the blocks above so the restart wins.
+            if (frame_end) begin
+                ro_phase <= 1'b1;
+                hold <= (DOUBLE_BUFFER != 0);
+                wt <= WT_START;
+                qi <= {QW{1'b0}};
+                sc <= {SW{1'b0}};
+                qr <= {RW{1'b0}};
+                qc <= {CW{1'b0}};
+{%- if fourier %}
+                ai <= {{ aw }}'d0;
+{%- endif %}
+            end
+        end
+    end
+endmodule
