@@ -37,6 +37,7 @@ mod register_frac_bits;
 mod reliability;
 mod replay;
 mod reproduce;
+mod self_contained;
 mod resolution;
 mod shard;
 mod signals;
