@@ -96,7 +96,10 @@ fn every_data_lookup_resolves_inside_the_repository() {
     }
     for dir in [data::TTTR_DIR, pdk::VENDORED] {
         check(format!("{dir}/LICENSE"), &root.join(dir).join("LICENSE"));
-        check(format!("{dir}/README.md"), &root.join(dir).join("README.md"));
+        check(
+            format!("{dir}/README.md"),
+            &root.join(dir).join("README.md"),
+        );
     }
     assert!(bad.is_empty(), "{}", bad.join("\n"));
 }
@@ -154,7 +157,14 @@ fn no_source_names_a_path_outside_the_repository() {
     let machine = ["/wo", "rk/"].concat();
     let mut files = Vec::new();
     for top in [
-        "crates", "scripts", "testbench", "examples", "templates", "scenes", "docs", ".ci",
+        "crates",
+        "scripts",
+        "testbench",
+        "examples",
+        "templates",
+        "scenes",
+        "docs",
+        ".ci",
     ] {
         walk(&root.join(top), &mut files);
     }
@@ -210,7 +220,11 @@ fn no_source_names_a_path_outside_the_repository() {
         }
     }
     assert!(scanned > 300, "scanned only {scanned} files");
-    assert!(bad.is_empty(), "paths outside the repository:\n{}", bad.join("\n"));
+    assert!(
+        bad.is_empty(),
+        "paths outside the repository:\n{}",
+        bad.join("\n")
+    );
 }
 
 /// The scan can fail: a crate-relative path three levels up (the old
