@@ -3,6 +3,10 @@
 the float DFT of the same photons and the closed-form noise floor, and plot the spectrum
 and an array's vibration map with matplotlib (Agg: no display needed).
 
+Needs the package's [plot] extra (matplotlib): pip install "tofprobe[plot]" (from the
+wheel, or "./crates/python[plot]"); without it, importing tofprobe.plot raises an
+ImportError naming the extra.
+
     python examples/python_pixel.py [--out DIR] [--pulses N] [--quick]
 
 Writes DIR/spectrum.png and DIR/vibration_map.png (default DIR: examples-out) and prints
@@ -12,20 +16,20 @@ the comparison. --quick shortens the frame and the array (what CI runs).
 import argparse
 import pathlib
 
-import matplotlib
+import os
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+os.environ.setdefault("MPLBACKEND", "Agg")
 import numpy as np  # noqa: E402
 
 import tofprobe  # noqa: E402
+from tofprobe import plot  # noqa: E402  (the [plot] extra: matplotlib)
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 
 def pixel(out: pathlib.Path, pulses: int) -> None:
     text = (ROOT / "scenes" / "default.toml").read_text()
-    d = tofprobe.Design.from_toml(text.replace("duration_s = 1.0", f"pulses = {pulses}"))
+    d = tofprobe.Design.from_toml_text(text.replace("duration_s = 1.0", f"pulses = {pulses}"))
     valid, tdc = d.simulate_scene(seed=1)
     f, amp, phase = d.spectrum(d.run_pixel(valid, tdc))
     _, amp_dft, phase_dft = d.dft(valid, tdc)
@@ -37,17 +41,9 @@ def pixel(out: pathlib.Path, pulses: int) -> None:
     tone = int(np.argmax(amp))
     print(f"tone at {f[tone]:.1f} Hz: pixel {amp[tone]:.2f} um at {phase[tone]:.1f} deg, "
           f"DFT {amp_dft[tone]:.2f} um at {phase_dft[tone]:.1f} deg")
-    fig, ax = plt.subplots(figsize=(7, 4))
-    ax.semilogy(f, amp, "o-", label="bit-true pixel (ΣΔ probe)")
-    ax.semilogy(f, amp_dft, "x--", label="float DFT of the same photons")
-    ax.semilogy(f, floor, ":", label="closed-form noise floor (eq. 12)")
-    ax.set_xlabel("frequency (Hz)")
-    ax.set_ylabel("amplitude (µm)")
-    ax.set_title(f"{d.summary()['frame_pulses']} pulses, seed 1")
-    ax.legend()
-    fig.tight_layout()
+    fig = plot.spectrum(f, amp, dft_um=amp_dft, floor_um=floor,
+                        title=f"{d.summary()['frame_pulses']} pulses, seed 1")
     fig.savefig(out / "spectrum.png", dpi=100)
-    plt.close(fig)
 
 
 def array(out: pathlib.Path, quick: bool) -> None:
@@ -56,23 +52,14 @@ def array(out: pathlib.Path, quick: bool) -> None:
         for old, new in [("pulses = 1000000", "pulses = 40000"), ("rows = 32", "rows = 8"),
                          ("cols = 32", "cols = 8"), ("mm_per_pixel = 10.0", "mm_per_pixel = 40.0")]:
             text = text.replace(old, new)
-    d = tofprobe.Design.from_toml(text)
+    d = tofprobe.Design.from_toml_text(text)
     maps = d.simulate_array(tiles=4)
     k = int(np.argmax(maps["amplitude_um"].mean(axis=(1, 2))))
     amp, phase = maps["amplitude_um"][k], maps["phase_deg"][k]
     print(f"array {amp.shape[0]} x {amp.shape[1]}: dominant bin {maps['frequencies_hz'][k]:.1f} Hz, "
           f"max {amp.max():.1f} um")
-    fig, axes = plt.subplots(1, 2, figsize=(9, 4))
-    for ax, data, label, cmap in [(axes[0], amp, "amplitude (µm)", "viridis"),
-                                  (axes[1], phase, "phase (deg)", "twilight")]:
-        im = ax.imshow(data, cmap=cmap, origin="upper")
-        ax.set_title(f"{label} at {maps['frequencies_hz'][k]:.0f} Hz")
-        ax.set_xlabel("column")
-        ax.set_ylabel("row")
-        fig.colorbar(im, ax=ax, shrink=0.8)
-    fig.tight_layout()
+    fig = plot.vibration_map(maps, k)
     fig.savefig(out / "vibration_map.png", dpi=100)
-    plt.close(fig)
 
 
 def main() -> None:

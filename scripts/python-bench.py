@@ -5,7 +5,7 @@ frame of the default design (docs/performance.md records the figures).
 Both sides run the same frame through the same library call: `run_pixel(valid, tdc)` is
 the whole Python call (numpy.asarray, dtype and shape checks, borrowing the arrays in
 place, the GIL released, the library's `FrameDriver` run on `tofprobe_pixel::ValidCodes`,
-the readout, the int64 array back); `time_library_run_pixel(valid, tdc)` times, inside
+the readout, the int64 array back); `_time_library_run_pixel(valid, tdc)` (private: a benchmark helper, not the API) times, inside
 Rust, what a Rust program holding the same two arrays pays for that call (FrameDriver::new,
 run on ValidCodes, range check, readout). Best of --repeat for each, interleaved, so a
 busy machine affects both alike. Prints both, the overhead in % and whether it is within
@@ -40,8 +40,8 @@ def main() -> None:
         t0 = time.perf_counter()
         regs = d.run_pixel(valid, tdc)
         python.append(time.perf_counter() - t0)
-        library.append(d.time_library_run_pixel(valid, tdc))
-        codes.append(d.time_library_run_pixel(valid, tdc, codes=True))
+        library.append(d._time_library_run_pixel(valid, tdc))
+        codes.append(d._time_library_run_pixel(valid, tdc, codes=True))
     assert regs.shape == (d.summary()["registers"],)
     p, lib, lib_codes = min(python), min(library), min(codes)
     overhead = (p - lib) / lib * 100

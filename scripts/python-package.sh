@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# Builds the Python package `tofprobe` (crates/python: pyo3 + maturin, an abi3 wheel) in
-# release mode in the workspace's target dir (reusing the library crates `cargo test
-# --release` compiled), installs it into the scripts' venv (scripts/py-venv.sh) and runs
-# its pytest suite (crates/python/tests), then runs examples/python_pixel.py headless.
+# Builds the Python package `tofprobe` (crates/python: pyo3 + maturin, an abi3 wheel,
+# scripts/wheel.sh) in release mode in the workspace's target dir (reusing the library
+# crates `cargo test --release` compiled), installs it into the scripts' venv
+# (scripts/py-venv.sh) and runs its pytest suite (crates/python/tests: among them the
+# wheel installed into a fresh venv without Rust running the README's example, and every
+# Python snippet of README.md and docs/ run as a script), then runs
+# examples/python_pixel.py headless.
 # Prints the build, test and example times.
 # A missing python3 fails under CI (TOFPROBE_REQUIRE_TOOLS=1 or CI set) and skips otherwise.
 set -euo pipefail
@@ -16,17 +19,13 @@ if ! command -v python3 >/dev/null 2>&1; then
   exit 0
 fi
 venv="$("$root/scripts/py-venv.sh")"
-# maturin must reuse the library crates `cargo test --release` built, not recompile them.
-"$root/scripts/python-features.sh" >&2
 target="${CARGO_TARGET_DIR:-$root/target}"
-wheels="$target/python-wheels"
 start=$(date +%s)
-rm -rf "$wheels"
-# --release: the profile `cargo test --release` built the library crates in.
-"$venv/bin/maturin" build --release --quiet -m "$root/crates/python/Cargo.toml" \
-  --interpreter "$venv/bin/python" --out "$wheels" >&2
+# The one build: the abi3 wheel of scripts/wheel.sh (target/wheels/), installed here and,
+# by tests/test_wheel.py, into a fresh venv without Rust.
+wheel="$("$root/scripts/wheel.sh")"
 "$venv/bin/python" -m pip install -q --disable-pip-version-check --no-deps --force-reinstall \
-  "$wheels"/tofprobe-*.whl >&2
+  "$wheel" >&2
 built=$(date +%s)
 # The CLI binary the bit-identity test compares with (built by `cargo test --release`).
 export TOFPROBE_CLI="${TOFPROBE_CLI:-$target/release/tofprobe}"

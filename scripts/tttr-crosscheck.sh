@@ -6,7 +6,7 @@
 # resolutions; exits non-zero on any difference. Also proves the comparison can fail (a
 # perturbed copy of our result must be rejected).
 #
-# Usage: scripts/tttr-crosscheck.sh [FILE...]   (default: ../shared/data/tttr/*.ptu and
+# Usage: scripts/tttr-crosscheck.sh [FILE...]   (default: third_party/picoquant-tttr/*.ptu and
 # crates/scene/tests/data/*); the real files' licences are beside them.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -16,7 +16,7 @@ venv="$(scripts/py-venv.sh)"
 files=("$@")
 if [ ${#files[@]} -eq 0 ]; then
   shopt -s nullglob
-  files=(../shared/data/tttr/*.ptu crates/scene/tests/data/*.ptu crates/scene/tests/data/*.spc)
+  files=(third_party/picoquant-tttr/*.ptu crates/scene/tests/data/*.ptu crates/scene/tests/data/*.spc)
 fi
 if [ ${#files[@]} -eq 0 ]; then
   echo "tttr-crosscheck: no files found" >&2

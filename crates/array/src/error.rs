@@ -24,6 +24,9 @@ pub enum ArrayError {
     /// A tile set that cannot be merged (not one, or not of the same run as the others).
     #[error("tile set {}: {message}", path.display())]
     TileSet { path: PathBuf, message: String },
+    /// The host stopped the run (`tofprobe_io::watch::Watch::stop`: Ctrl-C in Python).
+    #[error("stopped before the end (interrupted)")]
+    Stopped,
     /// An output file that cannot be written.
     #[error("cannot write {}: {message}", path.display())]
     Output { path: PathBuf, message: String },

@@ -23,4 +23,4 @@ pub mod shard;
 pub mod uff;
 
 pub use error::ArrayError;
-pub use model::{ArrayFrame, Tile, run_array, run_tile};
+pub use model::{ArrayFrame, Tile, run_array, run_tile, run_tile_watched};

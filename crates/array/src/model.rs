@@ -17,6 +17,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use tofprobe_design::ResolvedDesign;
 use tofprobe_dsp::rom::RomImage;
+use tofprobe_io::watch::Watch;
 use tofprobe_pixel::{FoldLanes, FrameDriver, LANES, Superpixel, fold_pays};
 use tofprobe_scene::PhotonSource;
 
@@ -125,6 +126,17 @@ pub fn run_pixel(
     r: usize,
     c: usize,
 ) -> Result<(Vec<i64>, u64), ArrayError> {
+    pixel_watched(design, rom, r, c, &Watch::default())
+}
+
+/// [`run_pixel`], counting its pulses on `watch` and stopping when told, chunk by chunk.
+fn pixel_watched(
+    design: &ResolvedDesign,
+    rom: Option<&RomImage>,
+    r: usize,
+    c: usize,
+    watch: &Watch,
+) -> Result<(Vec<i64>, u64), ArrayError> {
     let n = design.pixel.frame_pulses;
     let mut source = PixelStream::new(design, r, c, CHUNK.min(n as usize))?;
     let err = |source| ArrayError::Pixel {
@@ -144,6 +156,9 @@ pub fn run_pixel(
         detections += source.fill(first, &mut buf[..k]);
         tm.run(&buf[..k], first).map_err(err)?;
         first += k as u64;
+        if !watch.advance(k as u64) {
+            return Err(ArrayError::Stopped);
+        }
     }
     Ok((tm.readout().words, detections))
 }
@@ -156,6 +171,16 @@ pub fn run_group(
     design: &ResolvedDesign,
     rom: &RomImage,
     group: &[(usize, usize)],
+) -> Result<Vec<(Vec<i64>, u64)>, ArrayError> {
+    group_watched(design, rom, group, &Watch::default())
+}
+
+/// [`run_group`], counting its pixel-pulses on `watch` and stopping when told.
+fn group_watched(
+    design: &ResolvedDesign,
+    rom: &RomImage,
+    group: &[(usize, usize)],
+    watch: &Watch,
 ) -> Result<Vec<(Vec<i64>, u64)>, ArrayError> {
     let err = |(row, col): (usize, usize)| move |source| ArrayError::Pixel { row, col, source };
     let first = *group
@@ -179,6 +204,9 @@ pub fn run_group(
         let chunk: Vec<&[u32]> = bufs.iter().map(|b| &b[..k]).collect();
         lanes.run(&chunk, start).map_err(err(first))?;
         start += k as u64;
+        if !watch.advance((k * group.len()) as u64) {
+            return Err(ArrayError::Stopped);
+        }
     }
     Ok(lanes
         .readout()
@@ -205,6 +233,20 @@ pub fn run_tile(
     rows: Range<usize>,
     cols: Range<usize>,
 ) -> Result<Tile, ArrayError> {
+    run_tile_watched(design, rom, rows, cols, &Watch::default())
+}
+
+/// [`run_tile`] watched: every pixel counts its pulses on `watch` chunk by chunk (a tile
+/// of P pixels counts P·N pixel-pulses), and the tile stops with [`ArrayError::Stopped`]
+/// within a chunk of [`Watch::stop`] (a few milliseconds). The registers of a run that
+/// was not stopped are [`run_tile`]'s.
+pub fn run_tile_watched(
+    design: &ResolvedDesign,
+    rom: Option<&RomImage>,
+    rows: Range<usize>,
+    cols: Range<usize>,
+    watch: &Watch,
+) -> Result<Tile, ArrayError> {
     let (nr, nc) = shape(design)?;
     if rows.start >= rows.end || cols.start >= cols.end || rows.end > nr || cols.end > nc {
         return Err(ArrayError::Shape(format!(
@@ -220,7 +262,7 @@ pub fn run_tile(
             .into_par_iter()
             .map(|g| {
                 let group: Vec<_> = (g * LANES..((g + 1) * LANES).min(count)).map(at).collect();
-                run_group(design, rom, &group)
+                group_watched(design, rom, &group, watch)
             })
             .collect::<Result<Vec<_>, _>>()?
             .into_iter()
@@ -228,7 +270,7 @@ pub fn run_tile(
             .collect(),
         _ => (0..count)
             .into_par_iter()
-            .map(|i| run_pixel(design, rom, at(i).0, at(i).1))
+            .map(|i| pixel_watched(design, rom, at(i).0, at(i).1, watch))
             .collect::<Result<_, _>>()?,
     };
     let registers_per_pixel = design.pixel.registers();

@@ -12,6 +12,7 @@ pub mod bins;
 pub mod chip;
 pub mod document;
 pub mod error;
+pub mod overrides;
 pub mod probe_cache;
 mod rate_image;
 pub mod readout;

@@ -123,6 +123,11 @@ fn default_value(section: &str, key: &str, entry: Option<&Value>) -> Option<Valu
 /// from the document's serde types ([`Document`]), so a new key needs no entry here.
 pub fn wrong_type(text: &str) -> Option<String> {
     let doc: Table = toml::from_str(text).ok()?;
+    wrong_type_in(&doc)
+}
+
+/// [`wrong_type`] of a document already parsed (or built from values: a Python dict).
+pub fn wrong_type_in(doc: &Table) -> Option<String> {
     // A wrong type (or an integer out of its type's range, or no alternative of a choice)
     // is described by what the key takes; a value of the right type that is not one of the
     // key's names keeps serde's message, which lists them.
@@ -143,7 +148,7 @@ pub fn wrong_type(text: &str) -> Option<String> {
             )
         }
     };
-    for (section, body) in &doc {
+    for (section, body) in doc {
         let Some(t) = body.as_table() else {
             continue;
         };
@@ -181,6 +186,83 @@ pub fn wrong_type(text: &str) -> Option<String> {
             }
             if let Some(e) = misfit(section, key, v, None) {
                 return Some(report(format!("{section}.{key}"), v, e, section, key, None));
+            }
+        }
+    }
+    None
+}
+
+/// serde's refusal of the one key `key` of `section` (a motion entry: `entry` its kind)
+/// when it is not a key there: "unknown field `x`, expected one of …"; `None` when the
+/// schema knows the key (whatever its value).
+fn unknown(section: &str, key: Option<&str>, entry: Option<&Value>) -> Option<String> {
+    let mut body = Table::new();
+    if let Some(k) = key {
+        // A value that fits no key's type: the key's own name is what serde judges first.
+        body.insert(k.to_string(), Value::Table(Table::new()));
+    }
+    let body = match entry {
+        None => body,
+        Some(kind) => {
+            let mut m = Table::new();
+            m.insert("kind".into(), kind.clone());
+            m.extend(body);
+            let mut scene = Table::new();
+            scene.insert("motion".into(), Value::Array(vec![Value::Table(m)]));
+            scene
+        }
+    };
+    let mut doc = Table::new();
+    doc.insert(section.to_string(), Value::Table(body));
+    let e = Document::deserialize(Value::Table(doc)).err()?;
+    let m = e.message().trim();
+    m.starts_with("unknown field").then(|| m.to_string())
+}
+
+/// The first section or key of `doc` the document does not have, named by its dotted path
+/// with the keys that are there ("`pixel.binz` is not a key of [pixel]: expected one of
+/// `bins`, …"): a document built from values (a dict, overrides) has no line to cite, so
+/// the path is the whole address. `None` when every name is known.
+pub fn unknown_key(doc: &Table) -> Option<String> {
+    let expected = |m: String| {
+        m.split_once(", expected ")
+            .map_or(m.clone(), |(_, e)| format!("expected {e}"))
+    };
+    for (section, body) in doc {
+        if let Some(m) = unknown(section, None, None) {
+            return Some(format!(
+                "`{section}` is not a section of the document: {}",
+                expected(m)
+            ));
+        }
+        let Some(t) = body.as_table() else {
+            continue;
+        };
+        for (key, v) in t {
+            if let Some(m) = unknown(section, Some(key), None) {
+                return Some(format!(
+                    "`{section}.{key}` is not a key of [{section}]: {}",
+                    expected(m)
+                ));
+            }
+            if section == "scene" && key == "motion" {
+                for (i, entry) in v.as_array().into_iter().flatten().enumerate() {
+                    let Some(e) = entry.as_table() else {
+                        continue;
+                    };
+                    let kind = e
+                        .get("kind")
+                        .cloned()
+                        .unwrap_or(Value::String(String::new()));
+                    for mk in e.keys().filter(|k| *k != "kind") {
+                        if let Some(m) = unknown(section, Some(mk), Some(&kind)) {
+                            return Some(format!(
+                                "`scene.motion[{i}].{mk}` is not a key of a {kind} motion: {}",
+                                expected(m)
+                            ));
+                        }
+                    }
+                }
             }
         }
     }

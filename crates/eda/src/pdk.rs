@@ -4,8 +4,11 @@
 //! Search order, first hit wins (documented in docs/size-report-schema.md):
 //! 1. an explicit directory (the CLI's `--sky130-pdk DIR`);
 //! 2. `$TOFPROBE_SKY130_PDK`;
-//! 3. `../shared/pdk/sky130_fd_sc_hd` relative to the project root (what tests and CI use);
-//! 4. `/usr/share/pdk/sky130A/libs.ref/sky130_fd_sc_hd/lib` (an open_pdks install).
+//! 3. [`VENDORED`], `third_party/sky130_fd_sc_hd` in this checkout (the liberties, cell
+//!    models and layout files the code uses, gzipped, Apache-2.0: its README.md says where
+//!    they come from), so a fresh clone times, signs off and lays out on sky130;
+//! 4. `/usr/share/pdk/sky130A/libs.ref/sky130_fd_sc_hd/lib` (an open_pdks install: what a
+//!    build whose checkout has moved away, e.g. an installed wheel, can still find).
 //!
 //! A directory qualifies when it holds `sky130_fd_sc_hd__tt_025C_1v80.lib` (or `.lib.gz`).
 //! When none does, the area-only liberty of [`crate::sky130`] is the fallback.
@@ -43,15 +46,23 @@ pub struct Sky130Pdk {
     pub primitives: Option<PathBuf>,
 }
 
+/// The vendored PDK's directory, relative to the project root.
+pub const VENDORED: &str = "third_party/sky130_fd_sc_hd";
+
 /// The project root (the workspace directory of this checkout).
 pub fn project_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
+/// The PDK vendored in this checkout ([`VENDORED`] under [`project_root`]).
+pub fn vendored() -> PathBuf {
+    project_root().join(VENDORED)
+}
+
 /// The directories searched after an explicit one and the environment variable.
 pub fn search_path() -> Vec<PathBuf> {
     vec![
-        project_root().join("../shared/pdk/sky130_fd_sc_hd"),
+        vendored(),
         PathBuf::from("/usr/share/pdk/sky130A/libs.ref/sky130_fd_sc_hd/lib"),
     ]
 }
@@ -98,8 +109,9 @@ impl Sky130Pdk {
                 field: "sky130 PDK directory",
                 value: format!("{} (from {origin})", dir.display()),
                 allowed: format!(
-                    "a directory holding sky130_fd_sc_hd__{}.lib or .lib.gz (e.g. ../shared/pdk/sky130_fd_sc_hd)",
-                    CORNERS[0]
+                    "a directory holding sky130_fd_sc_hd__{}.lib or .lib.gz (e.g. the vendored {})",
+                    CORNERS[0],
+                    vendored().display()
                 ),
             });
         }

@@ -84,7 +84,14 @@ fn sky130_corner(name: &str, corner: &str, cache: &std::path::Path) -> Result<Pa
         .ok_or_else(|| {
             key_error(
                 name,
-                "no timed sky130_fd_sc_hd PDK found ($TOFPROBE_SKY130_PDK, ../shared/pdk/sky130_fd_sc_hd)",
+                format!(
+                    "no timed sky130_fd_sc_hd PDK found ($TOFPROBE_SKY130_PDK, then {})",
+                    tofprobe_eda::pdk::search_path()
+                        .iter()
+                        .map(|d| d.display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
             )
         })?;
     pdk.corner(corner, cache)

@@ -24,7 +24,7 @@ pub struct SizeOptions {
     /// Skip sky130 (the timed PDK and the area-only fallback).
     pub no_sky130: bool,
     /// The timed sky130_fd_sc_hd PDK directory; default `$TOFPROBE_SKY130_PDK`, then the
-    /// search path (`tofprobe_eda::pdk::search_path`: ../shared/pdk/sky130_fd_sc_hd).
+    /// search path (`tofprobe_eda::pdk::search_path`: the vendored third_party/sky130_fd_sc_hd).
     pub sky130_pdk: Option<PathBuf>,
     /// Node (nm) for the bins-per-pixel answer, scaled from sky130 by (node/130)².
     pub node_nm: f64,

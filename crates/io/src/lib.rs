@@ -5,7 +5,8 @@
 //! ([`bounded`]: regular files only, so `/dev/zero` cannot exhaust memory), the sanitising of user text
 //! before it reaches a generated file ([`text`]) and the FNV-1a content hash ([`fnv1a64`],
 //! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries, and the one
-//! root of the caches ([`cache::root`]).
+//! root of the caches ([`cache::root`]), and the [`watch::Watch`] a host stops a long
+//! computation with.
 //!
 //! Errors are plain [`std::io::Error`]s: each crate maps them into its own error enum with
 //! the path it was writing.
@@ -19,6 +20,7 @@ pub mod npy;
 mod set;
 pub mod stale;
 pub mod text;
+pub mod watch;
 
 pub use atomic::{write_atomic, write_svg_atomic};
 pub use bounded::{read_bounded, read_bounded_text};

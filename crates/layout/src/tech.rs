@@ -2,8 +2,9 @@
 //!
 //! osu018 is qflow's own (Debian's `qflow-tech-osu018`: liberty, cell LEF, SPICE, magic
 //! technology, graywolf parameters, netgen setup; no cell GDS, so magic's GDS holds the
-//! cells' LEF abstracts). sky130 is assembled from the shared PDK directory (the same
-//! public source as the liberties, `tofprobe_eda::pdk`): its technology LEF, merged cell
+//! cells' LEF abstracts). sky130 is assembled from the PDK directory (the vendored
+//! third_party/sky130_fd_sc_hd by default, the same public source as the liberties,
+//! `tofprobe_eda::pdk`): its technology LEF, merged cell
 //! LEF, cell GDS, CDL, magic technology file and netgen setup, decompressed into the cache,
 //! with a qflow setup script, graywolf parameters and a magic startup file written here.
 
@@ -102,8 +103,9 @@ impl TechFiles {
         Ok(t)
     }
 
-    /// sky130 from the shared PDK directory `pdk` (see [`tofprobe_eda::pdk`]), assembled
-    /// under `cache/layout-tech/sky130`.
+    /// sky130 from the PDK directory `pdk` (by default the vendored
+    /// third_party/sky130_fd_sc_hd, see [`tofprobe_eda::pdk`]), assembled under
+    /// `cache/layout-tech/sky130`.
     pub fn sky130(pdk: &Path, cache: &Path) -> Result<TechFiles> {
         let plain = |stem: &str| -> Result<PathBuf> {
             let found = [pdk.join(stem), pdk.join(format!("{stem}.gz"))]
@@ -113,7 +115,7 @@ impl TechFiles {
                     tech: "sky130",
                     what: "a PDK file",
                     path: pdk.join(stem),
-                    hint: "../shared/pdk/sky130_fd_sc_hd (see its README)",
+                    hint: "the vendored third_party/sky130_fd_sc_hd (see its README.md), --sky130-pdk DIR or $TOFPROBE_SKY130_PDK",
                 })?;
             Ok(tofprobe_eda::pdk::plain_copy(&found, cache)?)
         };

@@ -8,7 +8,6 @@
 
 use numpy::Complex64;
 use numpy::IntoPyArray;
-use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use tofprobe_dsp::sd::ProbeRom;
@@ -45,7 +44,7 @@ pub fn reference<'py>(
     let rom = d.fourier_rom(py, which)?;
     let detections = d.frame(py, valid, tdc)?;
     if detections.is_empty() {
-        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+        return Err(crate::errors::input(format!(
             "{which} of an empty frame: pass at least one pulse in `valid` and `tdc`"
         )));
     }
@@ -68,7 +67,7 @@ pub fn noise_floor<'py>(
     let rom = d.fourier_rom(py, "noise_floor")?;
     let n = pulses.unwrap_or(d.inner.pixel.frame_pulses);
     if n == 0 {
-        return Err(pyo3::exceptions::PyValueError::new_err(
+        return Err(crate::errors::input(
             "`pulses` = 0: a frame has at least one pulse",
         ));
     }
@@ -82,7 +81,7 @@ pub fn noise_floor<'py>(
 /// The NTF: zeros, poles, and |NTF| on `points` frequencies 0 ..= f_s/2.
 pub fn ntf<'py>(d: &Design, py: Python<'py>, points: usize) -> PyResult<Bound<'py, PyDict>> {
     if !(2..=1 << 20).contains(&points) {
-        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+        return Err(crate::errors::input(format!(
             "`points` = {points} is out of range: use 2 ..= 1048576 (e.g. 512)"
         )));
     }
@@ -159,7 +158,7 @@ pub fn size<'py>(
     use tofprobe_eda::tools::Tool;
     for tool in [Tool::Yosys, Tool::Sta] {
         tool.locate().map_err(|e| {
-            PyRuntimeError::new_err(format!("Design.size needs the EDA tools: {e}"))
+            crate::errors::tool_missing(format!("Design.size needs the EDA tools: {e}"))
         })?;
     }
     let options = tofprobe_flow::sizing::SizeOptions {
@@ -172,9 +171,12 @@ pub fn size<'py>(
         cache: None,
         corner_trials: tofprobe_flow::sizing::DEFAULT_CORNER_TRIALS,
     };
-    let design = &d.inner;
-    let report = py
-        .detach(|| tofprobe_flow::sizing::size_report(design, &options))
-        .map_err(value_error)?;
+    // Minutes of syntheses with no chunk to stop between: Ctrl-C returns at once and the
+    // abandoned run finishes in the background (its cache entries are written atomically).
+    let design = d.inner.clone();
+    let report = crate::long_call::detached(py, move || {
+        tofprobe_flow::sizing::size_report(&design, &options)
+    })?
+    .map_err(value_error)?;
     to_python(py, &report)
 }

@@ -2,18 +2,18 @@
 //! through `numpy.asarray`, checked for its dimension and dtype (a `TypeError` naming the
 //! argument otherwise) and borrowed without a copy when it is aligned and contiguous (an
 //! array rebuilt from a pickle or a Dask frame may be neither: it is copied once, then
-//! borrowed). Library errors become `ValueError` with the library's message, which names
-//! the field, the value and the allowed range.
+//! borrowed). Library errors become `tofprobe.InputError` (a `ValueError`) with the
+//! library's message, which names the field, the value and the allowed range.
 
 use numpy::{Element, PyReadonlyArray1};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 use tofprobe_pixel::{FrameDriver, PixelError, TdcCode, ValidCodes};
 
-/// A library error as a Python `ValueError` carrying its message.
+/// A library error (an argument's value refused) as a `tofprobe.InputError` (a
+/// `ValueError`) carrying its message.
 pub fn value_error(e: impl std::fmt::Display) -> PyErr {
-    PyValueError::new_err(e.to_string())
+    crate::errors::input_error(e)
 }
 
 /// `numpy.asarray(obj)`, refused unless it is one-dimensional; `name` is the argument.
@@ -23,7 +23,7 @@ pub fn as_1d<'py>(name: &str, obj: &Bound<'py, PyAny>) -> PyResult<Bound<'py, Py
     let ndim: usize = array.getattr("ndim")?.extract()?;
     if ndim != 1 {
         let shape = array.getattr("shape")?.str()?.to_string();
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::input(format!(
             "`{name}` must be a one-dimensional array, got shape {shape}"
         )));
     }
@@ -58,7 +58,7 @@ pub fn try_borrow<'py, T: Element>(
 /// The slice of a borrowed array ([`try_borrow`] made it contiguous).
 pub fn slice<'a, T: Element>(a: &'a PyReadonlyArray1<'_, T>, name: &str) -> PyResult<&'a [T]> {
     a.as_slice()
-        .map_err(|e| PyValueError::new_err(format!("`{name}`: {e}")))
+        .map_err(|e| crate::errors::input(format!("`{name}`: {e}")))
 }
 
 /// A bool array argument (`valid`): refused with a `TypeError` for any other dtype.
@@ -192,6 +192,17 @@ impl CodeSlice<'_> {
     }
 }
 
+macro_rules! code_slice_from {
+    ($($v:ident: $t:ty),*) => {$(
+        impl<'a> From<&'a [$t]> for CodeSlice<'a> {
+            fn from(s: &'a [$t]) -> Self {
+                CodeSlice::$v(s)
+            }
+        }
+    )*};
+}
+code_slice_from!(U8: u8, U16: u16, U32: u32, U64: u64, I8: i8, I16: i16, I32: i32, I64: i64);
+
 /// Calls `$f::<T>($slice, args...)` for the integer type the codes arrived in (the one
 /// dtype dispatch; the decoding itself is the library's, `tofprobe_pixel::ValidCodes`).
 macro_rules! with_codes {
@@ -210,27 +221,39 @@ macro_rules! with_codes {
 }
 
 impl CodeSlice<'_> {
-    /// Runs the frame (`valid`, these codes) through `driver`, read in place by the
-    /// library ([`ValidCodes`]: decoded a block at a time, the range check riding along);
-    /// a valid code outside 0 ..= `max_code` is refused afterwards, naming the pulse (the
-    /// driver's registers are then not to be read).
+    /// Runs the frame (`valid`, these codes: pulses `first ..` of the frame) through
+    /// `driver`, read in place by the library ([`ValidCodes`]: decoded a block at a time,
+    /// the range check riding along); a valid code outside 0 ..= `max_code` is refused
+    /// afterwards, naming the pulse (the driver's registers are then not to be read).
     pub fn run_pixel(
         &self,
         valid: &[bool],
+        first: u64,
         max_code: u32,
         driver: &mut FrameDriver<'_>,
     ) -> Result<(), PixelError> {
         fn go<T: TdcCode>(
             valid: &[bool],
             tdc: &[T],
+            first: u64,
             max_code: u32,
             driver: &mut FrameDriver<'_>,
         ) -> Result<(), PixelError> {
             let frame = ValidCodes::new(valid, tdc, max_code)?;
-            driver.run(&frame, 0)?;
+            driver.run(&frame, first)?;
             frame.check()
         }
-        with_codes!(*self, |s| go(valid, s, max_code, driver))
+        with_codes!(*self, |s| go(valid, s, first, max_code, driver))
+    }
+
+    /// The codes of pulses `r` (a chunk of the frame).
+    pub fn range(&self, r: std::ops::Range<usize>) -> CodeSlice<'_> {
+        with_codes!(*self, |s| CodeSlice::from(&s[r]))
+    }
+
+    /// The range check of the whole frame alone (the library's `ValidCodes::scan`).
+    pub fn scan(&self, valid: &[bool], max_code: u32) -> Result<(), PixelError> {
+        with_codes!(*self, |s| ValidCodes::new(valid, s, max_code)?.scan())
     }
 
     /// The frame (`valid`, these codes) in the drivers' compact form (the library's
@@ -246,31 +269,6 @@ impl CodeSlice<'_> {
     }
 }
 
-/// A dict shaped like the configuration document as TOML text (through `json.dumps`: a
-/// value JSON cannot hold is a `TypeError` naming `d`; a `None` a `ValueError`).
-pub fn dict_to_toml(d: &Bound<'_, PyAny>) -> PyResult<String> {
-    if d.cast::<PyDict>().is_err() {
-        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
-            "`d` must be a dict of the configuration's tables, got {}",
-            d.get_type().name()?
-        )));
-    }
-    let json: String = d
-        .py()
-        .import("json")?
-        .call_method1("dumps", (d,))
-        .map_err(|e| {
-            pyo3::exceptions::PyTypeError::new_err(format!(
-                "`d` holds a value a configuration cannot: {e}"
-            ))
-        })?
-        .extract()?;
-    let value: toml::Value = serde_json::from_str(&json).map_err(|e| {
-        PyValueError::new_err(format!("`d` is not a TOML document (no None values): {e}"))
-    })?;
-    toml::to_string(&value).map_err(value_error)
-}
-
 impl crate::Design {
     /// The borrowed frame `(valid, tdc)`, checked: equal lengths, at most one frame.
     pub(crate) fn checked_frame<'a>(
@@ -281,7 +279,7 @@ impl crate::Design {
         let valid_s = slice(valid_a, "valid")?;
         let tdc_s: CodeSlice<'_> = tdc_a.slice("tdc")?;
         if valid_s.len() != tdc_s.len() {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::input(format!(
                 "`valid` has {} pulses and `tdc` {}: one code per pulse",
                 valid_s.len(),
                 tdc_s.len()
@@ -289,7 +287,7 @@ impl crate::Design {
         }
         let n = self.inner.pixel.frame_pulses;
         if valid_s.len() as u64 > n {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::input(format!(
                 "{} pulses exceed one frame of pixel.frame_pulses = {n}: pass at most {n} \
                  (one frame; call once per frame)",
                 valid_s.len()

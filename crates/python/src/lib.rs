@@ -3,12 +3,18 @@
 //! library entry — the one resolution (`tofprobe_design`), the photon source
 //! (`tofprobe_scene::PhotonSource`), the pixel's `FrameDriver`, the one readout → phasor
 //! function (`tofprobe_pixel::spectrum::phasors`) and the array model
-//! (`tofprobe_array::output::simulate`) — run with the GIL released (`Python::detach`).
-//! Errors are `ValueError`s carrying the library's message (it names the field, the value
-//! and what would work) or `TypeError`s naming the argument of a wrong dtype.
+//! (`tofprobe_array::output::simulate`) — run with the GIL released, off the calling
+//! thread so that Ctrl-C stops a long call (`long_call`). Errors are the package's
+//! exceptions (`errors`: `tofprobe.Error` and its subclasses, each also the builtin a user
+//! would catch) carrying the library's message (it names the field, the value and what
+//! would work), or `TypeError`s naming the argument of a wrong type.
 
 mod analysis;
 mod convert;
+mod design_io;
+mod errors;
+mod frames;
+mod long_call;
 mod tiles;
 
 use std::path::PathBuf;
@@ -16,35 +22,47 @@ use std::sync::OnceLock;
 
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString, PyTuple};
-use tofprobe_design::{DEFAULT_ORIGIN, DEFAULT_TOML, Document, ResolvedDesign};
+use pyo3::types::{PyDict, PyTuple};
+use tofprobe_design::{DEFAULT_ORIGIN, DEFAULT_TOML, ResolvedDesign};
 use tofprobe_dsp::sd::ProbeRom;
 use tofprobe_pixel::{FrameDriver, PixelError};
 
 use convert::value_error;
+use long_call::Progress;
 
-/// Origin of a design given as TOML text.
-const TEXT_ORIGIN: &str = "<TOML text>";
 /// What a pickled Design carries: its resolved JSON and, once generated, its ROM's JSON.
 type PickleState = (String, Option<String>);
 
 /// A tile's rectangle for Python: `((row_start, row_end), (col_start, col_end))`.
 type PyRect = ((usize, usize), (usize, usize));
 
-/// Origin of a design given as a dict.
-const DICT_ORIGIN: &str = "<dict>";
-
 /// A tofprobe design resolved once (``tofprobe config``'s resolution): sensor, scene,
 /// acquisition, the pixel's parameters and widths, the Fourier bins and the ΣΔ probe.
 ///
 /// Build one with ``Design.default()`` (the embedded paper Fig. 8 case),
-/// ``Design.from_toml(path_or_text)`` or ``Design.from_json(text)``; then
-/// ``simulate_scene`` → ``run_pixel`` → ``spectrum`` is ``tofprobe simulate``'s bit-true
-/// frame with numpy arrays at each step, and ``simulate_array`` runs an ``[array]`` design.
-/// Computations release the GIL; do not mutate an input array from another thread during a
-/// call. A Design is immutable and picklable.
+/// ``Design.from_toml(path)``, ``Design.from_toml_text(text)``, ``Design.from_dict(d)`` or
+/// ``Design.from_json(text)``, and change keys with ``design.with_overrides({"pixel.bins":
+/// 4})``; then ``simulate_scene`` → ``run_pixel`` → ``spectrum`` is ``tofprobe
+/// simulate``'s bit-true frame with numpy arrays at each step, and ``simulate_array`` runs
+/// an ``[array]`` design.
+///
+/// The letters of the shapes and the summary: B is the number of Fourier bins (frequencies
+/// the pixel measures; 2B registers, an I and a Q per bin); W the width in bits of each
+/// register; N the pulses of one frame (``frame_pulses``: one TDC code or none per laser
+/// pulse); L the depth of the probe ROM (its period in pulses; bin k sits at k·f_s/L,
+/// f_s the laser rate); G the register's fractional bits (the registers count 2^−G TDC
+/// codes; ``register_frac_bits``) — and, for an ``[array]``, R × C the pixels and
+/// ``superpixel`` the SPADs per pixel side.
+///
+/// The first call that needs the probe ROM (``run_pixel``, ``spectrum``, ``probe_rom``,
+/// ``simulate_array``, ...) generates it — about 1.4 s for the default L = 20 000 on two
+/// cores — and keeps it: later calls and pickled copies do not pay again.
+///
+/// Computations release the GIL and run off the calling thread: Ctrl-C stops a long call
+/// within a fraction of a second (``KeyboardInterrupt``). Do not mutate an input array from
+/// another thread during a call. Errors are ``tofprobe.Error`` subclasses
+/// (``tofprobe.errors``). A Design is immutable and picklable.
 #[pyclass(module = "tofprobe._native", name = "Design", frozen)]
 #[derive(Debug)]
 struct Design {
@@ -61,17 +79,6 @@ impl Design {
         }
     }
 
-    /// The one resolution of TOML text, without the GIL (it designs the ΣΔ modulator).
-    fn resolve(py: Python<'_>, text: &str, origin: &str) -> PyResult<Self> {
-        let inner = py
-            .detach(|| {
-                let doc = Document::from_toml_str(text, origin)?;
-                tofprobe_design::resolve(doc, origin)
-            })
-            .map_err(value_error)?;
-        Design::loaded(py, inner)
-    }
-
     /// A resolved design, with what it ignores (`ignored_warning`: a `[probe]` in Haar
     /// mode) shown as a Python `UserWarning`, as the CLI shows it on stderr.
     fn loaded(py: Python<'_>, inner: ResolvedDesign) -> PyResult<Self> {
@@ -83,19 +90,21 @@ impl Design {
         Ok(Design::new(inner))
     }
 
-    /// The probe ROM (`None` in Haar mode), generated once without the GIL.
+    /// The probe ROM (`None` in Haar mode), generated once off the calling thread (about
+    /// 1.4 s for L = 20 000: Ctrl-C returns at once, the generation finishing unseen).
     pub(crate) fn rom(&self, py: Python<'_>) -> PyResult<Option<&ProbeRom>> {
         if let Some(r) = self.rom.get() {
             return Ok(r.as_ref());
         }
-        let r = py.detach(|| self.inner.probe_rom()).map_err(value_error)?;
+        let inner = self.inner.clone();
+        let r = long_call::detached(py, move || inner.probe_rom())?.map_err(value_error)?;
         Ok(self.rom.get_or_init(|| r).as_ref())
     }
 
     /// The probe ROM, refused in Haar mode (`what` names the call).
     pub(crate) fn fourier_rom(&self, py: Python<'_>, what: &str) -> PyResult<&ProbeRom> {
         self.rom(py)?.ok_or_else(|| {
-            PyValueError::new_err(format!(
+            errors::input(format!(
                 "{what} needs a Fourier pixel, and pixel.mode of `{}` resolved to \"{}\" \
                  (set pixel.mode = \"fourier\")",
                 self.inner.origin, self.inner.pixel.mode
@@ -104,7 +113,7 @@ impl Design {
     }
 
     /// The largest TDC code the pixel takes: 2^T − 1.
-    fn max_code(&self) -> u32 {
+    pub(crate) fn max_code(&self) -> u32 {
         ((1u64 << self.inner.pixel.tdc_bits.min(32)) - 1) as u32
     }
 }
@@ -115,39 +124,55 @@ impl Design {
     /// pulses; 16 bins), as ``tofprobe`` commands use without a configuration.
     #[staticmethod]
     fn default(py: Python<'_>) -> PyResult<Self> {
-        Design::resolve(py, DEFAULT_TOML, DEFAULT_ORIGIN)
+        let inner = design_io::from_text(py, DEFAULT_TOML.to_string(), DEFAULT_ORIGIN)?;
+        Design::loaded(py, inner)
     }
 
-    /// A design from a TOML file or TOML text, resolved (validated and completed).
+    /// The design in the TOML file at ``path`` (a ``str`` or an ``os.PathLike``), resolved
+    /// (validated and completed). A string is always a path, never TOML text: text goes
+    /// to ``from_toml_text``.
     ///
-    /// ``source`` is a path (``str`` or ``os.PathLike``) or the TOML text itself: a
-    /// ``str`` holding a newline or ``=`` is text, any other ``str`` a path. Raises
-    /// ``ValueError`` naming the key and the allowed values for a document that does not
-    /// resolve, and for a file that cannot be read.
+    /// Raises ``tofprobe.FileNotFoundError`` (also the builtin ``FileNotFoundError``) for a
+    /// path that does not exist, ``tofprobe.FileError`` (an ``OSError``) for a directory,
+    /// a file that is not a regular file or cannot be read — each naming the path — and
+    /// ``tofprobe.ConfigError`` (a ``ValueError``) naming the key, the value and the allowed
+    /// values for a document that does not resolve; ``TypeError`` for a path of another
+    /// type.
     #[staticmethod]
-    fn from_toml(source: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let py = source.py();
-        if let Ok(s) = source.cast::<PyString>() {
-            let s = s.to_cow()?;
-            if s.contains('\n') || s.contains('=') {
-                return Design::resolve(py, &s, TEXT_ORIGIN);
-            }
-        }
-        let path: PathBuf = source.extract()?;
-        let inner = py
-            .detach(|| tofprobe_design::load(Some(&path)))
-            .map_err(value_error)?;
+    fn from_toml(path: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let py = path.py();
+        let inner = design_io::load(py, design_io::path_of(path)?)?;
+        Design::loaded(py, inner)
+    }
+
+    /// The design a TOML document given as text holds, resolved like ``from_toml``'s file
+    /// (``origin`` is ``<TOML text>``). ``tofprobe.ConfigError`` names the key (and the
+    /// line and column of ``text``) when it does not resolve.
+    #[staticmethod]
+    fn from_toml_text(py: Python<'_>, text: String) -> PyResult<Self> {
+        let inner = design_io::from_text(py, text, design_io::TEXT_ORIGIN)?;
         Design::loaded(py, inner)
     }
 
     /// A design from a dict shaped like the TOML document (``{"sensor": {...}, "scene":
     /// {...}, "pixel": {...}, ...}``, e.g. ``tomllib.load`` of a configuration), resolved
-    /// by the same one resolution as ``from_toml``. ``ValueError`` naming the key for an
-    /// unknown key or a bad value; ``TypeError`` for a value JSON/TOML cannot hold.
+    /// by the same one resolution as ``from_toml``. ``tofprobe.ConfigError`` naming the
+    /// key's dotted path (``pixel.binz``, with the keys its section takes) for an unknown
+    /// key or a bad value, or a ``None``; ``TypeError`` for a value TOML cannot hold.
     #[staticmethod]
     fn from_dict(d: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let text = convert::dict_to_toml(d)?;
-        Design::resolve(d.py(), &text, DICT_ORIGIN)
+        let inner = design_io::from_dict(d)?;
+        Design::loaded(d.py(), inner)
+    }
+
+    /// This design with some keys changed, resolved again by the one resolution: a dict of
+    /// dotted keys ``"section.key"`` to values, e.g. ``{"pixel.bins": 4,
+    /// "acquisition.seed": 7}``; ``None`` removes a key (back to its default: ``{"pixel.
+    /// frame_pulses": None}``). Every other key keeps its value. ``tofprobe.ConfigError``
+    /// names an unknown key or a refused value by its dotted path.
+    fn with_overrides(&self, py: Python<'_>, overrides: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let inner = design_io::with_overrides(&self.inner, overrides)?;
+        Design::loaded(py, inner)
     }
 
     /// A design serialised by ``to_json`` (no resolution runs again).
@@ -169,13 +194,15 @@ impl Design {
         toml::to_string(&self.inner.document).map_err(value_error)
     }
 
-    /// Where the design came from: the file path, ``<embedded default>`` or ``<TOML text>``.
+    /// Where the design came from: the file path, ``<embedded default>``, ``<TOML text>``
+    /// or ``<dict>`` (``... with overrides of KEYS`` after ``with_overrides``).
     #[getter]
     fn origin(&self) -> &str {
         &self.inner.origin
     }
 
-    /// The resolved values as a dict: ``mode``, ``bins`` (ROM bin indices k),
+    /// The resolved values as a dict (the letters as in ``help(tofprobe.Design)``):
+    /// ``mode``, ``bins`` (ROM bin indices k: B of them),
     /// ``frequencies_hz`` (f_k = k·f_s/L), ``tdc_bits`` (T), ``width`` (W),
     /// ``frame_pulses`` (N), ``rom_depth`` (L), ``registers`` (2B, or 2^(U+1) − 1 Haar),
     /// ``shift`` (S), ``frac_bits`` (F), ``register_frac_bits`` (G: the registers count
@@ -225,12 +252,20 @@ impl Design {
     /// ``tofprobe simulate``'s bit-true frame; ``seed`` replaces ``[acquisition] seed``.
     /// For an ``[array]`` design, ``pixel=(row, col)`` gives that pixel's own stream (its
     /// rates, the scene at its centre, its own seed), the one ``simulate_array`` runs.
-    #[pyo3(signature = (seed=None, pixel=None))]
+    ///
+    /// ``threads``: the cores to draw on (a rayon pool of that size; default all);
+    /// ``progress``: a callable ``progress(done, total)`` in pulses (called about every
+    /// 50 ms and at the end), or ``True`` for a tqdm bar (``tofprobe[progress]``). The
+    /// photons do not depend on ``threads``. Ctrl-C stops the call between chunks of 2^20
+    /// pulses.
+    #[pyo3(signature = (seed=None, pixel=None, *, progress=None, threads=None))]
     fn simulate_scene<'py>(
         &self,
         py: Python<'py>,
         seed: Option<u64>,
         pixel: Option<(usize, usize)>,
+        progress: Option<&Bound<'py, PyAny>>,
+        threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyTuple>> {
         let mut design = self.inner.clone();
         if let Some(s) = seed {
@@ -242,13 +277,9 @@ impl Design {
         }
         .map_err(value_error)?;
         let n = design.pixel.frame_pulses;
-        let (valid, tdc) = py.detach(|| {
-            let record = source.record(n);
-            let valid: Vec<bool> = record.iter().map(Option::is_some).collect();
-            // Codes have at most MAX_TDC_BITS = 16 bits: u16 holds every one.
-            let tdc: Vec<u16> = record.iter().map(|d| d.map_or(0, |c| c as u16)).collect();
-            (valid, tdc)
-        });
+        let pool = long_call::pool(threads)?;
+        let progress = Progress::new(py, progress, "simulate_scene", "pulses", n)?;
+        let (valid, tdc) = frames::scene(py, &source, n, &progress, pool.as_ref())?;
         PyTuple::new(
             py,
             [
@@ -260,11 +291,15 @@ impl Design {
 
     /// The registers after one frame of ``(valid, tdc)`` through the bit-true pixel (the
     /// transaction level, ``tofprobe_pixel::FrameDriver``): an int64 array of the
-    /// sign-extended register words (2B: I and Q of each bin; Haar 2^(U+1) − 1).
+    /// sign-extended register words (2B: the I and the Q register of each of the B bins;
+    /// Haar 2^(U+1) − 1), each W bits wide, counting 2^−G TDC codes.
     ///
     /// ``valid`` is a 1-D bool array, ``tdc`` a 1-D integer array of the same length, at
-    /// most ``frame_pulses`` pulses; pulse i reads ROM address i mod L. A valid pulse's
+    /// most N = ``frame_pulses`` pulses; pulse i reads ROM address i mod L. A valid pulse's
     /// code must be in 0 .. 2^T − 1 (``tdc_bits``); an invalid pulse's code is ignored.
+    ///
+    /// The first call on a Fourier design generates the probe ROM (about 1.4 s for the
+    /// default L = 20 000; kept for later calls); a 10^7-pulse frame then takes ≈ 15–30 ms.
     fn run_pixel<'py>(
         &self,
         py: Python<'py>,
@@ -274,18 +309,10 @@ impl Design {
         let valid_a = convert::bool_array("valid", valid)?;
         let tdc_a = convert::codes("tdc", tdc)?;
         let (valid_s, tdc_s) = self.checked_frame(&valid_a, &tdc_a)?;
-        let rom = self.rom(py)?.map(|r| &r.image);
-        let params = &self.inner.pixel;
-        let max_code = self.max_code();
         // The library reads (valid, tdc) in place (`tofprobe_pixel::ValidCodes`: a block of
         // pulses decoded at a time into the compact codes the driver steps, the range check
         // riding along): no conversion pass here (scripts/python-bench.py).
-        let words = py.detach(|| -> Result<Vec<i64>, PixelError> {
-            let mut driver = FrameDriver::new(params, rom)?;
-            tdc_s.run_pixel(valid_s, max_code, &mut driver)?;
-            Ok(driver.readout().words)
-        });
-        Ok(words.map_err(value_error)?.into_pyarray(py))
+        Ok(frames::pixel(self, py, valid_s, tdc_s)?.into_pyarray(py))
     }
 
     /// The spectrum of a Fourier frame's registers (``tofprobe_pixel::spectrum::phasors``,
@@ -340,19 +367,28 @@ impl Design {
     /// Runs an ``[array]`` design (``tofprobe simulate CONFIG --out DIR``'s model, nothing
     /// written): a dict of numpy arrays ``registers`` (int64 [R, C, K]), ``detections``
     /// (uint64 [R, C]) and, for a Fourier pixel, ``frequencies_hz`` ([B]),
-    /// ``amplitude_um`` and ``phase_deg`` (float64 [B, R, C]). Pixel (r, c)'s registers
-    /// are ``run_pixel(*simulate_scene(pixel=(r, c)))``.
+    /// ``amplitude_um`` and ``phase_deg`` (float64 [B, R, C]) — R × C the array's pixels,
+    /// K = 2B registers a pixel. Pixel (r, c)'s registers are
+    /// ``run_pixel(*simulate_scene(pixel=(r, c)))``.
     ///
     /// ``tiles`` (1 ..= R·C) splits the array into that many tiles (``tile_rects``); with
     /// ``client``, a ``dask.distributed.Client``, each tile is a task run in the workers
     /// (``tofprobe.dask.simulate_array``; default tiles: twice the cluster's threads).
     /// Any tiling, local or distributed, gives the same registers bit for bit.
-    #[pyo3(signature = (tiles=None, client=None))]
+    ///
+    /// ``threads``: the cores to run on locally (a rayon pool of that size; default all);
+    /// ``progress``: a callable ``progress(done, total)`` in pixel-pulses (R·C·N in all),
+    /// or ``True`` for a tqdm bar (``tofprobe[progress]``). Ctrl-C stops a local run
+    /// between chunks of each pixel's pulses. Both apply to the local run; with
+    /// ``client`` the cluster sizes its workers and ``progress`` is not called.
+    #[pyo3(signature = (tiles=None, client=None, *, progress=None, threads=None))]
     fn simulate_array<'py>(
         slf: &Bound<'py, Self>,
         py: Python<'py>,
         tiles: Option<usize>,
         client: Option<&Bound<'py, PyAny>>,
+        progress: Option<&Bound<'py, PyAny>>,
+        threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let d = slf.get();
         if let Some(client) = client.filter(|c| !c.is_none()) {
@@ -363,7 +399,9 @@ impl Design {
                 .call_method1("simulate_array", (slf, tiles, client))?;
             return Ok(out.cast_into::<PyDict>()?);
         }
-        let (frame, seconds) = tiles::run_local(d, py, tiles.unwrap_or(1))?;
+        let pool = long_call::pool(threads)?;
+        let (frame, seconds) =
+            tiles::run_local(d, py, tiles.unwrap_or(1), progress, pool.as_ref())?;
         tiles::array_dict(d, py, frame, seconds)
     }
 
@@ -472,14 +510,15 @@ impl Design {
         analysis::size(self, py, liberty, sky130, sweep_bins, sweep_widths, node_nm)
     }
 
-    /// Seconds the library's own pixel call takes on the frame, best of ``repeat``: the
-    /// baseline of ``run_pixel``'s overhead (scripts/python-bench.py). By default the call
+    /// Private (scripts/python-bench.py's, not the API): seconds the library's own pixel
+    /// call takes on the frame, best of ``repeat``: the baseline of ``run_pixel``'s
+    /// overhead. By default the call
     /// a Rust program holding the same (``valid``, ``tdc``) arrays makes — ``FrameDriver``
     /// run on ``tofprobe_pixel::ValidCodes`` (decoded in place), range check, readout —
     /// the very call ``run_pixel`` wraps. With ``codes=True`` the frame is first converted
     /// (untimed) to the drivers' compact codes, what the Monte Carlo hands the array: the
     /// difference is the decoding's cost, which the input's form, not Python, sets.
-    #[pyo3(signature = (valid, tdc, repeat=1, codes=false))]
+    #[pyo3(name = "_time_library_run_pixel", signature = (valid, tdc, repeat=1, codes=false))]
     fn time_library_run_pixel(
         &self,
         py: Python<'_>,
@@ -509,7 +548,7 @@ impl Design {
                 let mut driver = FrameDriver::new(params, rom)?;
                 match &compact {
                     Some(c) => driver.run(c.as_slice(), 0)?,
-                    None => tdc_s.run_pixel(valid_s, max_code, &mut driver)?,
+                    None => tdc_s.run_pixel(valid_s, 0, max_code, &mut driver)?,
                 }
                 std::hint::black_box(driver.readout());
                 best = best.min(t0.elapsed().as_secs_f64());
@@ -544,7 +583,7 @@ impl Design {
                     .map_err(|e| format!("the pickled probe ROM: {e}"))?;
                 Ok((inner, rom))
             })
-            .map_err(PyValueError::new_err)?;
+            .map_err(errors::input)?;
         let d = Design::new(inner);
         if let Some(r) = rom {
             let _ = d.rom.set(r);

@@ -1,6 +1,7 @@
 //! The array in tiles, conversion only: the partition (`tofprobe_array::shard::tiles`),
-//! one tile run on a rayon pool of the caller's size (`tofprobe_array::run_tile`: a Dask
-//! task sizes it to its worker's threads), tiles merged back (`tofprobe_array::model::merge`)
+//! one tile run on a rayon pool of the caller's size (`tofprobe_array::run_tile_watched`,
+//! through `long_call::run`, so Ctrl-C stops it between chunks: a Dask task sizes the pool
+//! to its worker's threads), tiles merged back (`tofprobe_array::model::merge`)
 //! and the maps of the merged frame (`tofprobe_array::output::finish`). Tiles arriving
 //! through pickle or a Dask frame may be misaligned: they are copied once (`convert`).
 
@@ -9,13 +10,13 @@ use std::time::Instant;
 
 use numpy::IntoPyArray;
 use numpy::ndarray::{Array2, Array3};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use tofprobe_array::model::{ArrayFrame, Tile};
 
 use crate::Design;
 use crate::convert::{self, value_error};
+use crate::long_call::{self, Progress};
 
 /// The array shape, or a ValueError naming the missing `[array]`.
 fn shape(d: &Design) -> PyResult<(usize, usize)> {
@@ -24,7 +25,7 @@ fn shape(d: &Design) -> PyResult<(usize, usize)> {
         .as_ref()
         .map(|a| (a.rows, a.cols))
         .ok_or_else(|| {
-            PyValueError::new_err(format!(
+            crate::errors::input(format!(
                 "`{}` has no [array] section: simulate_array and tiles run an [array] design",
                 d.inner.origin
             ))
@@ -35,10 +36,11 @@ fn shape(d: &Design) -> PyResult<(usize, usize)> {
 pub fn rects(d: &Design, tiles: usize) -> PyResult<Vec<tofprobe_array::shard::Rect>> {
     let (r, c) = shape(d)?;
     tofprobe_array::shard::tiles(r, c, tiles)
-        .map_err(|e| PyValueError::new_err(format!("`tiles`: {e}")))
+        .map_err(|e| crate::errors::input(format!("`tiles`: {e}")))
 }
 
-/// Runs one tile on a pool of `threads` threads (`None`: the global pool).
+/// Runs one tile on a pool of `threads` threads (`None`: the current pool), stopped by
+/// Ctrl-C between chunks.
 pub fn run_tile(
     d: &Design,
     py: Python<'_>,
@@ -46,27 +48,14 @@ pub fn run_tile(
     cols: Range<usize>,
     threads: Option<usize>,
 ) -> PyResult<Tile> {
-    if let Some(t) = threads
-        && !(1..=1024).contains(&t)
-    {
-        return Err(PyValueError::new_err(format!(
-            "`threads` = {t} is out of range: use 1 ..= 1024 (the worker's threads), or None"
-        )));
-    }
+    let pool = long_call::pool(threads)?;
     let rom = d.rom(py)?.map(|r| &r.image);
     let design = &d.inner;
-    py.detach(|| {
-        let run = || tofprobe_array::run_tile(design, rom, rows, cols);
-        match threads {
-            Some(t) => rayon::ThreadPoolBuilder::new()
-                .num_threads(t)
-                .build()
-                .map_err(value_error)?
-                .install(run)
-                .map_err(value_error),
-            None => run().map_err(value_error),
-        }
-    })
+    let progress = Progress::none(0);
+    long_call::run(py, &progress, pool.as_ref(), |w| {
+        tofprobe_array::run_tile_watched(design, rom, rows, cols, w)
+    })?
+    .map_err(value_error)
 }
 
 /// A tile as a dict: `rows`, `cols` (`(start, end)`), `registers` (int64 [h, w, K]),
@@ -94,7 +83,7 @@ fn tile_from(py: Python<'_>, i: usize, obj: &Bound<'_, PyAny>, k: usize) -> PyRe
     })?;
     let get = |key: &str| -> PyResult<Bound<'_, PyAny>> {
         d.get_item(key)?
-            .ok_or_else(|| PyValueError::new_err(format!("`{name}` has no `{key}`")))
+            .ok_or_else(|| crate::errors::input(format!("`{name}` has no `{key}`")))
     };
     let (r0, r1): (usize, usize) = get("rows")?.extract()?;
     let (c0, c1): (usize, usize) = get("cols")?.extract()?;
@@ -108,7 +97,7 @@ fn tile_from(py: Python<'_>, i: usize, obj: &Bound<'_, PyAny>, k: usize) -> PyRe
     let regs = convert::slice(&regs, "registers")?;
     let dets = convert::slice(&dets, "detections")?;
     if regs.len() != pixels * k || dets.len() != pixels {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::input(format!(
             "`{name}`: rows {r0}..{r1} × cols {c0}..{c1} needs {} registers and {pixels} \
              detections, got {} and {}",
             pixels * k,
@@ -121,7 +110,7 @@ fn tile_from(py: Python<'_>, i: usize, obj: &Bound<'_, PyAny>, k: usize) -> PyRe
         .map(|&x| u64::try_from(x))
         .collect::<Result<_, _>>()
         .map_err(|_| {
-            PyValueError::new_err(format!("`{name}['detections']` holds a negative count"))
+            crate::errors::input(format!("`{name}['detections']` holds a negative count"))
         })?;
     Ok(Tile {
         rows: r0..r1,
@@ -144,24 +133,33 @@ pub fn merge(d: &Design, py: Python<'_>, tiles: &Bound<'_, PyAny>) -> PyResult<A
         parts.push(tile_from(py, i, &t, k)?);
     }
     py.detach(|| tofprobe_array::model::merge(r, c, &parts))
-        .map_err(|e| PyValueError::new_err(format!("`tiles`: {e}")))
+        .map_err(|e| crate::errors::input(format!("`tiles`: {e}")))
 }
 
-/// Runs the array in `tiles` tiles one after the other (each on the global pool).
-pub fn run_local(d: &Design, py: Python<'_>, tiles: usize) -> PyResult<(ArrayFrame, f64)> {
+/// Runs the array in `tiles` tiles one after the other (each on `pool`, or the current
+/// pool), reporting pixel-pulses to `progress` and stopped by Ctrl-C between chunks.
+pub fn run_local(
+    d: &Design,
+    py: Python<'_>,
+    tiles: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+    pool: Option<&rayon::ThreadPool>,
+) -> PyResult<(ArrayFrame, f64)> {
     let (r, c) = shape(d)?;
     let parts = rects(d, tiles)?;
     let rom = d.rom(py)?.map(|r| &r.image);
     let design = &d.inner;
-    py.detach(|| {
+    let total = (r * c) as u64 * design.pixel.frame_pulses;
+    let progress = Progress::new(py, progress, "simulate_array", "pixel-pulses", total)?;
+    long_call::run(py, &progress, pool, |w| {
         let t0 = Instant::now();
         let done = parts
             .into_iter()
-            .map(|(rs, cs)| tofprobe_array::run_tile(design, rom, rs, cs))
+            .map(|(rs, cs)| tofprobe_array::run_tile_watched(design, rom, rs, cs, w))
             .collect::<Result<Vec<_>, _>>()?;
         let frame = tofprobe_array::model::merge(r, c, &done)?;
         Ok((frame, t0.elapsed().as_secs_f64()))
-    })
+    })?
     .map_err(|e: tofprobe_array::ArrayError| value_error(e))
 }
 

@@ -29,7 +29,7 @@ def small_text() -> str:
 
 @pytest.fixture(scope="session")
 def small(small_text) -> tofprobe.Design:
-    return tofprobe.Design.from_toml(small_text)
+    return tofprobe.Design.from_toml_text(small_text)
 
 
 @pytest.fixture(scope="session")

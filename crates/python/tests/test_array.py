@@ -14,7 +14,7 @@ import tofprobe
 
 @pytest.fixture(scope="module")
 def arr(array_text):
-    return tofprobe.Design.from_toml(array_text)
+    return tofprobe.Design.from_toml_text(array_text)
 
 
 @pytest.fixture(scope="module")

@@ -75,7 +75,7 @@ def test_a_real_slurm_cluster_runs_the_array_exactly(array_text):
     jq = pytest.importorskip("dask_jobqueue")
     from distributed import Client
 
-    d = tofprobe.Design.from_toml(array_text)
+    d = tofprobe.Design.from_toml_text(array_text)
     cluster = jq.SLURMCluster(queue=os.environ.get("TOFPROBE_SLURM_QUEUE", "debug"), cores=1,
                               processes=1, memory="1GB",
                               interface=os.environ.get("TOFPROBE_SLURM_INTERFACE", "lo"))

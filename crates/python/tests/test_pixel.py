@@ -28,7 +28,7 @@ def test_registers_give_the_cli_spectrum_bit_for_bit(cli, tmp_path, seed):
     path = tmp_path / "small.toml"
     path.write_text(default_text(200_000, seed=seed))
     sim = cli_spectrum(cli, path)
-    d = tofprobe.Design.from_toml(default_text(200_000, seed=1))
+    d = tofprobe.Design.from_toml_text(default_text(200_000, seed=1))
     valid, tdc = d.simulate_scene(seed=seed)
     assert int(valid.sum()) == sim["detections"]
     f, amp, ph = d.spectrum(d.run_pixel(valid, tdc))
@@ -94,7 +94,7 @@ def test_probe_rom_and_spectrum_of_zero(small):
 
 
 def test_array_pixels_are_run_pixel_of_their_streams(array_text, cli, tmp_path):
-    d = tofprobe.Design.from_toml(array_text)
+    d = tofprobe.Design.from_toml_text(array_text)
     out = d.simulate_array()
     rows, cols = d.summary()["array"]
     k = d.summary()["registers"]
@@ -169,7 +169,7 @@ def test_haar_design_has_no_rom():
     # The default's [probe] section is ignored in Haar mode, and said so as the CLI says it
     # on stderr: a UserWarning naming `probe` and `pixel.mode`.
     with pytest.warns(UserWarning, match=r"probe.*pixel\.mode|pixel\.mode.*probe"):
-        d = tofprobe.Design.from_toml(text)
+        d = tofprobe.Design.from_toml_text(text)
     s = d.summary()
     assert s["mode"] == "haar" and s["registers"] == 2 ** (s["haar_scales"] + 1) - 1
     valid, tdc = d.simulate_scene()

@@ -23,7 +23,7 @@ from conftest import ROOT
 def test_from_dict_is_the_same_resolution_as_the_toml(small_text):
     doc = tomllib.loads(small_text)
     a = tofprobe.Design.from_dict(doc)
-    b = tofprobe.Design.from_toml(small_text)
+    b = tofprobe.Design.from_toml_text(small_text)
     assert a.origin == "<dict>"
     sa, sb = a.summary(), b.summary()
     sa.pop("origin"), sb.pop("origin")
@@ -185,8 +185,8 @@ def test_size_with_the_tools_reports_area(small):
 
 def test_the_library_timing_runs_the_frame(small):
     valid, tdc = small.simulate_scene()
-    seconds = small.time_library_run_pixel(valid, tdc, repeat=2)
-    in_codes = small.time_library_run_pixel(valid, tdc, repeat=2, codes=True)
+    seconds = small._time_library_run_pixel(valid, tdc, repeat=2)
+    in_codes = small._time_library_run_pixel(valid, tdc, repeat=2, codes=True)
     # 2·10^5 pulses at 1 ns – 1 µs each (the folded driver: ≈ 3 ns; a loaded machine),
     # read in place or from the compact codes alike.
     assert 2e-4 < seconds < 0.2 and 2e-4 < in_codes < 0.2
@@ -194,12 +194,12 @@ def test_the_library_timing_runs_the_frame(small):
     bad = tdc.astype(np.int64)
     bad[np.flatnonzero(valid)[0]] = 1 << 16
     with pytest.raises(ValueError, match="outside"):
-        small.time_library_run_pixel(valid, bad)
+        small._time_library_run_pixel(valid, bad)
     with pytest.raises(ValueError, match="outside"):
-        small.time_library_run_pixel(valid, bad, codes=True)
+        small._time_library_run_pixel(valid, bad, codes=True)
 
 
-@pytest.mark.parametrize("call", ["dft", "float_sd", "time_library_run_pixel"])
+@pytest.mark.parametrize("call", ["dft", "float_sd", "_time_library_run_pixel"])
 def test_the_references_refuse_bad_frames_like_run_pixel(small, call):
     f = getattr(small, call)
     valid, tdc = small.simulate_scene()
@@ -228,7 +228,7 @@ def test_an_empty_frame_and_haar_designs_are_refused(small):
     text = text.replace("duration_s = 1.0", f"pulses = {1 << 17}")
     text = text.replace('mode = "fourier"', 'mode = "haar"').replace("rom_depth = 20000 ", "rom_depth = 16384 ")
     with pytest.warns(UserWarning, match="probe section is ignored"):
-        haar = tofprobe.Design.from_toml(text)
+        haar = tofprobe.Design.from_toml_text(text)
     v, t = haar.simulate_scene()
     for call in (lambda: haar.dft(v, t), lambda: haar.float_sd(v, t), haar.noise_floor, haar.ntf):
         with pytest.raises(ValueError, match="fourier"):

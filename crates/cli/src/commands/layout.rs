@@ -20,7 +20,7 @@ pub struct LayoutArgs {
     /// Directory of the output set.
     #[arg(long)]
     pub out: PathBuf,
-    /// Technology: osu018 (qflow's own; always routes) or sky130 (the shared PDK).
+    /// Technology: osu018 (qflow's own; always routes) or sky130 (the vendored PDK).
     #[arg(long, default_value = "osu018")]
     pub tech: String,
     /// Target placement density (cells / core), or auto: 0.6 up to 5,000 cells, 0.5 above
@@ -37,8 +37,8 @@ pub struct LayoutArgs {
     /// Node (nm) the bins-per-pitch answer is scaled to.
     #[arg(long, default_value_t = 40.0)]
     pub node_nm: f64,
-    /// The sky130_fd_sc_hd PDK directory (default: $TOFPROBE_SKY130_PDK, then
-    /// ../shared/pdk/sky130_fd_sc_hd).
+    /// The sky130_fd_sc_hd PDK directory (default: $TOFPROBE_SKY130_PDK, then the
+    /// checkout's vendored third_party/sky130_fd_sc_hd).
     #[arg(long, value_name = "DIR")]
     pub sky130_pdk: Option<PathBuf>,
     /// Synthesis cache (default: $TOFPROBE_CACHE or ~/.cache/tofprobe, then /synth); the

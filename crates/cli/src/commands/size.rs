@@ -38,7 +38,7 @@ pub struct SizeArgs {
     pub no_sky130: bool,
     /// The timed sky130_fd_sc_hd PDK: a directory holding sky130_fd_sc_hd__tt_025C_1v80.lib
     /// (or .lib.gz; ss/ff corners beside it are timed too). Default: $TOFPROBE_SKY130_PDK,
-    /// then ../shared/pdk/sky130_fd_sc_hd beside the checkout; without one, the area-only
+    /// then the checkout's vendored third_party/sky130_fd_sc_hd; without one, the area-only
     /// mapping.
     #[arg(long, value_name = "DIR", conflicts_with = "no_sky130")]
     pub sky130_pdk: Option<PathBuf>,

@@ -220,13 +220,8 @@ fn the_slowest_corner_judges_the_adders() {
     if !have_tools(&["yosys", "sta"]) {
         return;
     }
-    let pdk = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/pdk/sky130_fd_sc_hd"
-    );
-    if !Path::new(pdk).is_dir() {
-        return;
-    }
+    let pdk = tofprobe_eda::pdk::vendored();
+    let pdk = pdk.to_str().unwrap();
     let dir = scratch("corner");
     let note = |name: &str, lib: &str| -> (Output, String) {
         let cfg = config(&dir, name, 2, "25e6", &format!("timing_liberty = {lib:?}"));

@@ -224,10 +224,9 @@ fn rtl_renders_a_periodic_rom_at_its_depth() {
     assert_eq!(entries, 1 << 17);
 }
 
-/// The HydraHarp v2 T3 sample record (BSD-3-Clause, ../shared/data/tttr).
+/// The HydraHarp v2 T3 sample record (BSD-3-Clause, third_party/picoquant-tttr).
 fn hydraharp_t3() -> Vec<u8> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/tttr/hydraharp_v20_t3.ptu");
+    let p = tofprobe_testkit::data::tttr_record("hydraharp_v20_t3.ptu");
     std::fs::read(p).expect("sample record")
 }
 

@@ -84,7 +84,7 @@ fn run_json(what: &str, args: &[&str], config: Option<&Path>) -> Walk {
 }
 
 fn record() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/tttr/hydraharp_v20_t3.ptu")
+    tofprobe_testkit::data::tttr_record("hydraharp_v20_t3.ptu")
 }
 
 #[test]
@@ -119,19 +119,15 @@ fn every_command_json_is_finite_on_extreme_configurations() {
         ));
     }
     tally(run_json("scene bench", &["bench", "scene", "--json"], None));
+    // The vendored record, fitted, and quantised by a configuration whose window misses
+    // every photon (0 detections: the spectrum is absent, not 0).
     let rec = record();
-    if rec.exists() {
-        let r = rec.to_str().unwrap();
-        // Fitted to the record, and quantised by a configuration whose window misses every
-        // photon (0 detections: the spectrum is absent, not 0).
-        tally(run_json("replay, fitted", &["replay", r, "--json"], None));
-        let cfg = tmp.path().join("x0.toml");
-        let w = run_json("replay, empty window", &["replay", r, "--json"], Some(&cfg));
-        assert!(w.nulls >= 4, "an empty window's spectrum is null, not 0");
-        tally(w);
-    } else {
-        eprintln!("skipped replay: no record at {}", rec.display());
-    }
+    let r = rec.to_str().unwrap();
+    tally(run_json("replay, fitted", &["replay", r, "--json"], None));
+    let cfg = tmp.path().join("x0.toml");
+    let w = run_json("replay, empty window", &["replay", r, "--json"], Some(&cfg));
+    assert!(w.nulls >= 4, "an empty window's spectrum is null, not 0");
+    tally(w);
     if Command::new("verilator").arg("--version").output().is_ok() {
         let out = tmp.path().join("cosim");
         let o = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
@@ -235,10 +231,6 @@ fn an_empty_record_says_so_instead_of_printing_zero() {
     assert!(sim(&full, false).contains("noise estimate"));
 
     let rec = record();
-    if !rec.exists() {
-        eprintln!("skipped replay: no record at {}", rec.display());
-        return;
-    }
     // The short configuration's 0–400 ps window misses every photon of the record.
     let o = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
         .arg("replay")

@@ -1,5 +1,5 @@
 //! Mutated time-tagged records through `tofprobe replay` (issue 31, item 5): the real
-//! PicoQuant records of ../shared/data/tttr (cut to their first 4000 records, the header's
+//! PicoQuant records of third_party/picoquant-tttr (cut to their first 4000 records, the header's
 //! record count patched, so a run takes about a second) and a B&H SPC file built here (no
 //! real one is shipped), mutated in their header tags (integers, floats, strings' lengths
 //! left alone: every 8-byte value of a scalar tag), their records (all-ones overflow
@@ -21,9 +21,7 @@ const KEEP_RECORDS: usize = 4000;
 const LIMIT: Duration = Duration::from_secs(20);
 
 fn data(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/tttr")
-        .join(name)
+    tofprobe_testkit::data::tttr_record(name)
 }
 
 /// A PTU header tag: its name, type and where its 8-byte value sits.
@@ -62,14 +60,19 @@ fn tags(d: &[u8]) -> (Vec<Tag>, usize) {
 
 /// The real record `name` cut to its first [`KEEP_RECORDS`] records, its record count
 /// patched to match (so the cut file is a valid record).
-fn cut_ptu(name: &str) -> Option<Vec<u8>> {
-    let mut d = std::fs::read(data(name)).ok()?;
+fn cut_ptu(name: &str) -> Vec<u8> {
+    let path = data(name);
+    let mut d = std::fs::read(&path)
+        .unwrap_or_else(|e| panic!("the vendored record {}: {e}", path.display()));
     let (tags, start) = tags(&d);
-    let n = tags.iter().find(|t| t.name == "TTResult_NumberOfRecords")?;
+    let n = tags
+        .iter()
+        .find(|t| t.name == "TTResult_NumberOfRecords")
+        .unwrap_or_else(|| panic!("{name}: no TTResult_NumberOfRecords tag"));
     let keep = KEEP_RECORDS.min((d.len() - start) / 4);
     d[n.value_at..n.value_at + 8].copy_from_slice(&(keep as i64).to_le_bytes());
     d.truncate(start + 4 * keep);
-    Some(d)
+    d
 }
 
 /// A B&H SPC-130 file: the clock word, then `n` photons around ADC code 100 one macro tick
@@ -193,19 +196,10 @@ fn mutated_records_exit_0_or_2_within_a_time_limit() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(12);
-    let bases: Vec<(String, Vec<u8>)> = [
-        "hydraharp_v20_t3.ptu",
-        "hydraharp_v10_t3.ptu",
-        "hydraharp_v20_t2.ptu",
-        "picoharp_v30_t2.ptu",
-    ]
-    .iter()
-    .filter_map(|n| Some((n.to_string(), cut_ptu(n)?)))
-    .collect();
-    if bases.is_empty() {
-        eprintln!("skipped: no records in ../shared/data/tttr");
-        return;
-    }
+    let bases: Vec<(String, Vec<u8>)> = tofprobe_testkit::data::TTTR_RECORDS
+        .iter()
+        .map(|n| (n.to_string(), cut_ptu(n)))
+        .collect();
     let tmp = tempfile::tempdir().unwrap();
     let mut rng = Rng(0x7777_2026_1126);
     let (mut accepted, mut refused, mut slowest) = (0, 0, 0.0f64);

@@ -39,6 +39,7 @@ mod reliability;
 mod replay;
 mod reproduce;
 mod resolution;
+mod self_contained;
 mod shard;
 mod signals;
 mod size;

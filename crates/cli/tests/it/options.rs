@@ -100,7 +100,7 @@ fn front_and_recommendation(cfg: &str, cache: &Path, out_dir: &Path) -> String {
         .map(|r| r["option"]["name"].as_str().unwrap())
         .collect();
     assert_eq!(names, ["baseline", OPTIONS[0], OPTIONS[1]]);
-    // osu018, then sky130 tt (CI has the PDK at ../shared): the front is read on sky130.
+    // osu018, then sky130 tt (the vendored PDK, third_party/sky130_fd_sc_hd): the front is read on sky130.
     let libs: Vec<&str> = rows[0]["libraries"]
         .as_array()
         .unwrap()

@@ -1,4 +1,4 @@
-//! `tofprobe replay` through the binary on the real PicoQuant records of ../shared/data/tttr
+//! `tofprobe replay` through the binary on the real PicoQuant records of third_party/picoquant-tttr
 //! (BSD-3-Clause sample data): the counts the decoder must read (cross-checked against
 //! PyPI's `ptufile` by scripts/tttr-crosscheck.sh), the bit-true spectrum against its float
 //! twin, finite JSON, and the errors a user meets.
@@ -9,9 +9,7 @@ use common::tofprobe;
 use std::path::PathBuf;
 
 fn record(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/tttr")
-        .join(name)
+    tofprobe_testkit::data::tttr_record(name)
 }
 
 /// The HydraHarp v2 T3 record (5 MHz sync): 77,883 photons in 106,349 records (the

@@ -165,10 +165,8 @@ fn sky130_pdk_option_times_every_corner() {
     let dir = scratch("sky130-pdk");
     let cfg = tiny_config(&dir);
     let cfg = cfg.to_str().unwrap();
-    let pdk = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/pdk/sky130_fd_sc_hd"
-    );
+    let pdk = tofprobe_eda::pdk::vendored();
+    let pdk = pdk.to_str().unwrap();
     let out = size(
         &[cfg, "--sky130-pdk", pdk, "--json"],
         &[],
@@ -221,10 +219,8 @@ fn sky130_pdk_option_times_every_corner() {
 #[test]
 fn default_pixel_fits_its_clock_with_margin() {
     let dir = scratch("default-fits");
-    let pdk = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/pdk/sky130_fd_sc_hd"
-    );
+    let pdk = tofprobe_eda::pdk::vendored();
+    let pdk = pdk.to_str().unwrap();
     let args = [
         "--sky130-pdk",
         pdk,

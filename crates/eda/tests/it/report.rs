@@ -116,10 +116,10 @@ fn fixture_report_end_to_end() {
     assert!(!c.meets_clock && c.slack_ns < 0.0);
     assert_eq!(c.registers_per_adder, t.throughput.registers_per_adder);
 
-    // The timed PDK (CI: ../shared/pdk): sky130 mapped on tt and timed on tt/ss/ff.
+    // The timed PDK (vendored: third_party/sky130_fd_sc_hd): sky130 mapped on tt and timed on tt/ss/ff.
     let pdk = Sky130Pdk::discover(None)
         .unwrap()
-        .expect("sky130_fd_sc_hd PDK at ../shared/pdk or $TOFPROBE_SKY130_PDK");
+        .expect("sky130_fd_sc_hd PDK at third_party/sky130_fd_sc_hd or $TOFPROBE_SKY130_PDK");
     let r = build_with(&req, Some(&Sky130Source::Timed(pdk))).unwrap();
     let sky = r.sky130.as_ref().unwrap();
     assert!(sky.has_timing && sky.area.has_timing);

@@ -247,10 +247,10 @@ fn osu018_netlist_signs_off_and_a_broken_one_does_not() {
 
 #[test]
 fn sky130_netlist_signs_off_and_a_broken_one_does_not() {
-    // CI provides the PDK at ../shared/pdk (the search path): its absence is a failure.
+    // The PDK is vendored (third_party/sky130_fd_sc_hd, the search path): its absence is a failure.
     let pdk = Sky130Pdk::discover(None)
         .unwrap()
-        .expect("sky130_fd_sc_hd PDK (../shared/pdk/sky130_fd_sc_hd or $TOFPROBE_SKY130_PDK)");
+        .expect("sky130_fd_sc_hd PDK (third_party/sky130_fd_sc_hd or $TOFPROBE_SKY130_PDK)");
     let lib = SignoffLibrary::sky130(&pdk, &cache("sky130")).unwrap();
     signs_off_and_catches_a_broken_gate(&lib, "sky130_fd_sc_hd__inv_1", "sky130");
 }

@@ -1,12 +1,16 @@
 """Type stubs of tofprobe's native module (crates/python/src/lib.rs)."""
 
 import os
-from typing import Any, TypedDict
+from collections.abc import Callable
+from typing import Any, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+
+# progress=: a callable progress(done, total), True for a tqdm bar, or None.
+Progress = Union[Callable[[int, int], Any], bool, None]
 
 class Summary(TypedDict):
     origin: str
@@ -38,9 +42,12 @@ class Design:
     @staticmethod
     def default() -> Design: ...
     @staticmethod
-    def from_toml(source: str | os.PathLike[str]) -> Design: ...
+    def from_toml(path: str | os.PathLike[str]) -> Design: ...
+    @staticmethod
+    def from_toml_text(text: str) -> Design: ...
     @staticmethod
     def from_dict(d: dict[str, Any]) -> Design: ...
+    def with_overrides(self, overrides: dict[str, Any]) -> Design: ...
     @staticmethod
     def from_json(text: str) -> Design: ...
     def to_json(self) -> str: ...
@@ -49,7 +56,12 @@ class Design:
     def origin(self) -> str: ...
     def summary(self) -> Summary: ...
     def simulate_scene(
-        self, seed: int | None = None, pixel: tuple[int, int] | None = None
+        self,
+        seed: int | None = None,
+        pixel: tuple[int, int] | None = None,
+        *,
+        progress: Progress = None,
+        threads: int | None = None,
     ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.uint16]]: ...
     def run_pixel(
         self, valid: npt.ArrayLike, tdc: npt.ArrayLike
@@ -61,7 +73,12 @@ class Design:
     ]: ...
     def probe_rom(self) -> npt.NDArray[np.int8]: ...
     def simulate_array(
-        self, tiles: int | None = None, client: Any | None = None
+        self,
+        tiles: int | None = None,
+        client: Any | None = None,
+        *,
+        progress: Progress = None,
+        threads: int | None = None,
     ) -> dict[str, npt.NDArray[Any]]: ...
     def tile_rects(self, tiles: int) -> list[tuple[tuple[int, int], tuple[int, int]]]: ...
     def run_tile(
@@ -89,7 +106,7 @@ class Design:
         sweep_widths: list[int] | None = None,
         node_nm: float = 40.0,
     ) -> dict[str, Any]: ...
-    def time_library_run_pixel(
+    def _time_library_run_pixel(
         self,
         valid: npt.ArrayLike,
         tdc: npt.ArrayLike,

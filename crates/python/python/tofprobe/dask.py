@@ -16,14 +16,19 @@ from __future__ import annotations
 
 from typing import Any
 
+from tofprobe._extras import require
+
+# A missing Dask is an ImportError naming the extra to install.
+require("dask", "tofprobe.dask (simulate_array(client=...))")
+
 
 def worker_threads() -> int | None:
     """The threads of the Dask worker running the current task (``None`` outside one)."""
-    try:
-        from distributed import get_worker
+    from distributed import get_worker
 
+    try:
         worker = get_worker()
-    except (ImportError, ValueError):
+    except ValueError:
         return None
     state = getattr(worker, "state", None)
     threads = getattr(state, "nthreads", None) or getattr(worker, "nthreads", None)

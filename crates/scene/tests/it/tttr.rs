@@ -8,11 +8,9 @@ use std::path::{Path, PathBuf};
 use tofprobe_scene::SceneError;
 use tofprobe_scene::tttr::{self, Event, PulseStream, RecordFormat, ReplayOptions, TdcWindow};
 
-/// `../shared/data/tttr/` beside the workspace (PicoQuant's sample files, BSD-3-Clause).
+/// PicoQuant's sample files vendored in `third_party/picoquant-tttr` (BSD-3-Clause).
 fn shared(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/tttr")
-        .join(name)
+    tofprobe_testkit::data::tttr_record(name)
 }
 
 fn data(name: &str) -> PathBuf {
