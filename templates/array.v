@@ -254,13 +254,22 @@ module {{ name }} #(
         end
     endgenerate
 
-    // ---- the pixels' inputs{% if sp > 1 %}: each pixel's G x G SPADs averaged into its (valid, tdc){% endif %} ----
-    wire [TILE_PIXELS - 1:0] in_valid;
-    wire [TILE_PIXELS * T - 1:0] in_tdc;
+    // ---- the pixels: each in its own generate block, with its inputs ({% if sp > 1 %}its G x G SPADs
+    // averaged{% else %}its port bit and field{% endif %}) and its outputs as wires of the block (no array-wide vector) ----
+    wire [TILE_PIXELS - 1:0] p_ready;
+    assign ready = &p_ready;
+{%- if let Some(nb) = neighbour %}
+    // DELIBERATELY BROKEN: the tile's pixel {{ nb }} reads the next pixel's TDC and that one its.
+    localparam integer NB = {{ nb }};
+{%- endif %}
     generate
-        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_in_row
-            for (lc = 0; lc < TILE_COLS; lc = lc + 1) begin : g_in
+        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_r
+            for (lc = 0; lc < TILE_COLS; lc = lc + 1) begin : g_c
                 localparam integer I = lr * TILE_COLS + lc;
+                localparam integer COL_I = TILE_COL0 + lc;
+                localparam [CW - 1:0] COL = COL_I[CW - 1:0];
+                wire v_in;
+                wire [T - 1:0] t_in;
 {%- if sp > 1 %}
                 wire [SPADS - 1:0] spad_valid;
                 wire [SPADS * T - 1:0] spad_tdc;
@@ -274,45 +283,32 @@ module {{ name }} #(
                 {{ sp_name }} u_superpixel (
                     .spad_valid(spad_valid),
                     .spad_tdc(spad_tdc),
-                    .valid(in_valid[I]),
-                    .tdc(in_tdc[I * T +: T])
+                    .valid(v_in),
+                    .tdc(t_in)
                 );
 {%- else %}
-                assign in_valid[I] = valid[I];
-                assign in_tdc[I * T +: T] = tdc[I * T +: T];
+                assign v_in = valid[I];
+                assign t_in = tdc[I * T +: T];
 {%- endif %}
-            end
-        end
-    endgenerate
-
-    // ---- the pixels ----
-    wire [TILE_PIXELS - 1:0] p_ready;
-    wire [TILE_PIXELS - 1:0] p_valid;
-    wire [TILE_PIXELS * IB - 1:0] p_index;
-    wire [TILE_PIXELS * W - 1:0] p_data;
-    assign ready = &p_ready;
-{%- if let Some(nb) = neighbour %}
-    // DELIBERATELY BROKEN: the tile's pixel {{ nb }} reads the next pixel's TDC and that one its.
-    localparam integer NB = {{ nb }};
-{%- endif %}
-    generate
-        for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_px_row
-            for (lc = 0; lc < TILE_COLS; lc = lc + 1) begin : g_px
-                localparam integer I = lr * TILE_COLS + lc;
 {%- if neighbour.is_some() %}
                 localparam integer SRC = (I == NB) ? (I + 1) % TILE_PIXELS
                     : ((NB + 1) % TILE_PIXELS == I) ? NB : I;
-{%- else %}
-                localparam integer SRC = I;
+                wire [T - 1:0] t_src;
+                if (SRC == I) begin : g_own
+                    assign t_src = t_in;
+                end else begin : g_crossed
+                    assign t_src = g_r[SRC / TILE_COLS].g_c[SRC % TILE_COLS].t_in;
+                end
 {%- endif %}
-                localparam integer COL_I = TILE_COL0 + lc;
-                localparam [CW - 1:0] COL = COL_I[CW - 1:0];
+                wire rd_valid;
+                wire [IB - 1:0] rd_index;
+                wire [W - 1:0] rd_data;
                 {{ pixel_name }} u_pixel (
                     .clk(clk),
                     .rst(rst),
                     .pulse(r_pulse[lr]),
-                    .valid(in_valid[I]),
-                    .tdc(in_tdc[SRC * T +: T]),
+                    .valid(v_in),
+                    .tdc({% if neighbour.is_some() %}t_src{% else %}t_in{% endif %}),
 {%- if fourier %}
                     .rom_word(r_word[lr * R +: R]),
 {%- endif %}
@@ -321,9 +317,9 @@ module {{ name }} #(
                     .swap(r_swap[lr]),
 {%- endif %}
                     .ready(p_ready[I]),
-                    .rd_valid(p_valid[I]),
-                    .rd_index(p_index[I * IB +: IB]),
-                    .rd_data(p_data[I * W +: W])
+                    .rd_valid(rd_valid),
+                    .rd_index(rd_index),
+                    .rd_data(rd_data)
                 );
             end
         end
@@ -374,29 +370,33 @@ module {{ name }} #(
             end
         end
     endgenerate
-    // Column buses: the OR of the selected rows' pixels.
+    // Column buses: the OR of the selected rows' pixels, a chain down each column (one
+    // stage of wires per row: no signal feeds itself).
     wire [TILE_COLS - 1:0] bus_valid;
     wire [TILE_COLS * IB - 1:0] bus_index;
     wire [TILE_COLS * W - 1:0] bus_data;
     generate
         for (lc = 0; lc < TILE_COLS; lc = lc + 1) begin : g_bus
-            reg v;
-            reg [IB - 1:0] x;
-            reg [W - 1:0] d;
-            integer i;
-            always @* begin
-                v = 1'b0;
-                x = {IB{1'b0}};
-                d = {W{1'b0}};
-                for (i = 0; i < TILE_ROWS; i = i + 1) begin
-                    v = v | (m_row[i] & p_valid[i * TILE_COLS + lc]);
-                    x = x | ({IB{m_row[i]}} & p_index[(i * TILE_COLS + lc) * IB +: IB]);
-                    d = d | ({W{m_row[i]}} & p_data[(i * TILE_COLS + lc) * W +: W]);
+            for (lr = 0; lr < TILE_ROWS; lr = lr + 1) begin : g_t
+                wire v_px = m_row[lr] & g_r[lr].g_c[lc].rd_valid;
+                wire [IB - 1:0] x_px = {IB{m_row[lr]}} & g_r[lr].g_c[lc].rd_index;
+                wire [W - 1:0] d_px = {W{m_row[lr]}} & g_r[lr].g_c[lc].rd_data;
+                wire v;
+                wire [IB - 1:0] x;
+                wire [W - 1:0] d;
+                if (lr == 0) begin : g_first
+                    assign v = v_px;
+                    assign x = x_px;
+                    assign d = d_px;
+                end else begin : g_next
+                    assign v = g_t[lr - 1].v | v_px;
+                    assign x = g_t[lr - 1].x | x_px;
+                    assign d = g_t[lr - 1].d | d_px;
                 end
             end
-            assign bus_valid[lc] = v;
-            assign bus_index[lc * IB +: IB] = x;
-            assign bus_data[lc * W +: W] = d;
+            assign bus_valid[lc] = g_t[TILE_ROWS - 1].v;
+            assign bus_index[lc * IB +: IB] = g_t[TILE_ROWS - 1].x;
+            assign bus_data[lc * W +: W] = g_t[TILE_ROWS - 1].d;
         end
     endgenerate
     // The selected column of the tile (none: an absent pixel's slot carries no beat): its

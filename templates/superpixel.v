@@ -13,8 +13,8 @@ module {{ name }} (
     output wire [{{ t - 1 }}:0] tdc
 );
     // Each SPAD's code (0 when it did not detect) and its count, widened to the sum's.
-{%- for i in 0..n %}
-    wire [{{ sw - 1 }}:0] code_{{ i }} = spad_valid[{{ i }}] ? { {{ sw - t }}'d0, spad_tdc[{{ i * t + t - 1 }}:{{ i * t }}] } : {{ sw }}'d0;
+{%- for (i, c) in codes %}
+    wire [{{ sw - 1 }}:0] code_{{ i }} = spad_valid[{{ i }}] ? { {{ sw - t }}'d0, spad_tdc[{{ c * t + t - 1 }}:{{ c * t }}] } : {{ sw }}'d0;
     wire [{{ cw - 1 }}:0] one_{{ i }} = { {{ cw - 1 }}'d0, spad_valid[{{ i }}] };
 {%- endfor %}
     wire [{{ sw - 1 }}:0] sum = {{ sum_expr }};
@@ -34,6 +34,11 @@ module {{ name }} (
     /* verilator lint_off UNUSEDSIGNAL */
     wire [{{ sw + mw - 1 }}:0] product = { {{ mw }}'d0, x } * { {{ sw }}'d0, recip };
     /* verilator lint_on UNUSEDSIGNAL */
+{%- if and_valid %}
+    // DELIBERATELY BROKEN: valid only when every SPAD is.
+    assign valid = &spad_valid;
+{%- else %}
     assign valid = |spad_valid;
+{%- endif %}
     assign tdc = product[{{ k + t - 1 }}:{{ k }}];
 endmodule

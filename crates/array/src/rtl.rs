@@ -10,10 +10,11 @@
 //! each pixel's readout streams its [`crate::shadow::Shadow`], loaded by the broadcast swap.
 
 use tofprobe_design::readout::ArrayTile;
-use tofprobe_design::readout::{ArrayFault, Readout};
+use tofprobe_design::readout::Readout;
 use tofprobe_pixel::{
     ChipSequencer, CycleModel, Mode, NO_DETECTION, PinsIn, PixelParams, Superpixel, Walk,
 };
+use tofprobe_rtlgen::ArrayFault;
 
 use crate::error::ArrayError;
 use crate::shadow::{Shadow, sample};

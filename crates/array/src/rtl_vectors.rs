@@ -57,6 +57,36 @@ pub fn scene_detections(
     Ok(out)
 }
 
+/// Thins the detections of `inputs` (as [`scene_detections`] orders them: the tile's
+/// `cols` pixels a row, G × G SPADs each) so the co-simulation reaches what a bright scene
+/// never does (issue 42's mutation study: with every SPAD valid on every pulse, a
+/// superpixel whose `valid` is the AND of its SPADs, two crossed SPAD codes or a wrong
+/// reciprocal entry passed). At pulse n, pixel p keeps k = (n + p) mod (G² + 1) of its G²
+/// SPADs' detections — every count from none to all, exactly one among them — the ones at
+/// positions n, n + 1, … mod G² within the superpixel (so each SPAD is the only one in
+/// turn); with G = 1 a pixel presents its detection on one pulse in two (the hold and the
+/// priming between). Deterministic: the same inputs give the same stimulus.
+pub fn exercise(inputs: &mut [Vec<Option<u32>>], cols: usize, g: usize) {
+    let g2 = g * g;
+    if cols == 0 || g == 0 || inputs.len() % (cols * g2) != 0 {
+        return;
+    }
+    let scols = cols * g;
+    for (k, stream) in inputs.iter_mut().enumerate() {
+        let (sr, sc) = (k / scols, k % scols);
+        let pixel = (sr / g) * cols + sc / g;
+        let spad = (sr % g) * g + sc % g;
+        for (n, x) in stream.iter_mut().enumerate() {
+            let keep = (n + pixel) % (g2 + 1);
+            // SPAD `spad` is kept when it is among the `keep` positions from n mod G².
+            let offset = (spad + g2 - n % g2) % g2;
+            if offset >= keep {
+                *x = None;
+            }
+        }
+    }
+}
+
 fn hex_of_bits(bits: &[bool]) -> String {
     let digits = bits.len().div_ceil(4).max(1);
     (0..digits)

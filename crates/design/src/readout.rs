@@ -407,8 +407,5 @@ pub fn resolve_readout(
     Readout::new(keys, rows, cols, pixel, laser_rate_hz).map_err(|m| DesignError::array(origin, m))
 }
 
-/// The array's deliberate faults (mutation tests), rendered by tofprobe-rtlgen and carried
-/// by the array model.
-pub use tofprobe_rtlgen::ArrayFault;
 /// A tile of an array (the part of a large array co-simulated).
 pub use tofprobe_rtlgen::array::ArrayTile;

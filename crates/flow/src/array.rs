@@ -10,11 +10,12 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use tofprobe_array::rtl::{ArrayModel, ArrayRun, run};
-use tofprobe_array::rtl_vectors::{scene_detections, vector_files};
+use tofprobe_array::rtl_vectors::{exercise, scene_detections, vector_files};
 use tofprobe_cosim::RunOutcome;
-use tofprobe_design::readout::{ArrayFault, ArrayTile, Readout};
+use tofprobe_design::readout::{ArrayTile, Readout};
 use tofprobe_design::rom_policy::RtlOverrides;
 use tofprobe_design::{Chip, ResolvedDesign, RomPurpose};
+use tofprobe_rtlgen::ArrayFault;
 use tofprobe_rtlgen::render::{HEADER_MARK, RenderOptions};
 use tofprobe_rtlgen::write::write_generated;
 
@@ -62,6 +63,10 @@ pub struct ArrayCosimOptions {
     /// The first K pulses of every pixel (or SPAD) present no detection (the priming
     /// rule, array-wide).
     pub lead_misses: u64,
+    /// Thin the scene's detections (`tofprobe_array::rtl_vectors::exercise`) so every
+    /// count of valid SPADs, the hold and the priming are reached (default on; given
+    /// `detections` are replayed as they are).
+    pub exercise: bool,
 }
 
 impl ArrayCosimOptions {
@@ -81,6 +86,7 @@ impl ArrayCosimOptions {
             rtl: None,
             x_seeds: vec![1, 2, 3],
             lead_misses: 0,
+            exercise: true,
         }
     }
 }
@@ -241,6 +247,7 @@ pub fn write_array_vectors(
         detections,
         tile,
         lead_misses: 0,
+        exercise: false,
         purpose: RomPurpose::Replayed,
     };
     write_vectors(design, o, stimulus, vec_dir, command)
@@ -253,6 +260,8 @@ struct ArrayStimulus {
     detections: Option<Vec<Vec<Option<u32>>>>,
     tile: Option<ArrayTile>,
     lead_misses: u64,
+    /// Thin the scene's detections (`rtl_vectors::exercise`).
+    exercise: bool,
     purpose: RomPurpose,
 }
 
@@ -268,6 +277,7 @@ fn write_vectors(
         detections,
         tile,
         lead_misses: v_lead,
+        exercise: thin,
         purpose,
     } = stimulus;
     if frames == 0 || frames > 100 {
@@ -280,7 +290,14 @@ fn write_vectors(
     let p = &chip.pixel;
     let mut detections = match detections {
         Some(d) => d,
-        None => scene_detections(design, p.frame_pulses, frames, tile)?,
+        None => {
+            let mut d = scene_detections(design, p.frame_pulses, frames, tile)?;
+            if thin {
+                let cols = tile.map_or(ro.cols, |t| t.cols);
+                exercise(&mut d, cols, chip.superpixel);
+            }
+            d
+        }
     };
     for d in &mut detections {
         d.iter_mut()
@@ -342,6 +359,7 @@ pub fn cosim_array(
         detections: a.detections.clone(),
         tile: a.tile,
         lead_misses: a.lead_misses,
+        exercise: a.exercise,
         purpose,
     };
     let v = write_vectors(design, &o, stimulus, &vec_dir, &a.command)?;

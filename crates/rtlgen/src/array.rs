@@ -38,6 +38,16 @@ pub enum ArrayFault {
     /// pixel's shadow copy is taken a cycle late (after the first readout has begun and
     /// together with the next frame's first pulse).
     SwapLate,
+    /// Superpixel arrays only (G > 1): a pixel is valid only when every SPAD is (the AND
+    /// of the SPADs' `valid`, not the OR).
+    SuperpixelAnd,
+    /// Superpixel arrays only: SPADs 0 and 1 of every superpixel have their codes crossed
+    /// (each averaged with the other's `valid`).
+    SpadSwap,
+    /// Superpixel arrays only: the reciprocal table's entry for one valid SPAD is one too
+    /// small (2^k − 1: a lone SPAD's code comes out one less). With every SPAD valid on
+    /// every pulse it never shows.
+    ReciprocalEntry,
 }
 
 impl ArrayFault {
@@ -49,7 +59,18 @@ impl ArrayFault {
             ArrayFault::OrderSwap => "order_swap",
             ArrayFault::RowStuck { .. } => "row_stuck",
             ArrayFault::SwapLate => "swap_late",
+            ArrayFault::SuperpixelAnd => "superpixel_and",
+            ArrayFault::SpadSwap => "spad_swap",
+            ArrayFault::ReciprocalEntry => "reciprocal_entry",
         }
+    }
+
+    /// A fault of the superpixel front end (`templates/superpixel.v`), not of the array.
+    pub fn in_superpixel(self) -> bool {
+        matches!(
+            self,
+            ArrayFault::SuperpixelAnd | ArrayFault::SpadSwap | ArrayFault::ReciprocalEntry
+        )
     }
 }
 
@@ -283,6 +304,13 @@ pub fn render_array(
                 format!("{}..{}", tile.row0, tile.row0 + tile.rows),
             ));
         }
+        Some(f) if f.in_superpixel() && a.superpixel < 2 => {
+            return Err(bad(
+                "mutation",
+                f.name().into(),
+                "a superpixel array (array.superpixel ≥ 2)".into(),
+            ));
+        }
         Some(ArrayFault::SwapLate) if !a.double_buffer => {
             return Err(bad(
                 "mutation",
@@ -377,7 +405,11 @@ pub fn render_array(
         rom_name: &rom_name,
         seq_name: &seq_name,
         fourier: p.mode == Mode::Fourier,
-        mutation: a.fault.map(ArrayFault::name).unwrap_or(""),
+        mutation: a
+            .fault
+            .filter(|f| !f.in_superpixel())
+            .map(ArrayFault::name)
+            .unwrap_or(""),
         t: p.tdc_bits as usize,
         w: w as usize,
         r,
@@ -401,7 +433,8 @@ pub fn render_array(
         dbuf: a.double_buffer,
     };
     if let Some(sp) = &sp {
-        files.push(crate::superpixel::render_superpixel(p, sp, o)?);
+        let fault = a.fault.filter(|f| f.in_superpixel());
+        files.push(crate::superpixel::render_superpixel_with(p, sp, o, fault)?);
     }
     files.push(RtlFile {
         name: format!("{name}.v"),

@@ -9,6 +9,7 @@
 use askama::Template;
 use tofprobe_pixel::{PixelParams, Superpixel};
 
+use crate::array::ArrayFault;
 use crate::error::RtlError;
 use crate::render::{RenderOptions, RtlFile, header};
 
@@ -33,6 +34,10 @@ struct SuperpixelT {
     count_expr: String,
     /// (n, M[n]).
     table: Vec<(usize, u64)>,
+    /// Per SPAD i, (i, the SPAD whose code it sums: itself but for the `spad_swap` mutant).
+    codes: Vec<(u32, u32)>,
+    /// The `superpixel_and` mutant: valid = AND of the SPADs.
+    and_valid: bool,
 }
 
 /// The module name of the front end for a module prefix.
@@ -46,6 +51,17 @@ pub fn render_superpixel(
     sp: &Superpixel,
     o: &RenderOptions,
 ) -> Result<RtlFile, RtlError> {
+    render_superpixel_with(p, sp, o, None)
+}
+
+/// [`render_superpixel`] with a deliberate fault of the front end (the mutation tests:
+/// [`ArrayFault::in_superpixel`]; another fault renders it correct).
+pub fn render_superpixel_with(
+    p: &PixelParams,
+    sp: &Superpixel,
+    o: &RenderOptions,
+    fault: Option<ArrayFault>,
+) -> Result<RtlFile, RtlError> {
     if sp.side() < 2 || sp.tdc_bits() != p.tdc_bits {
         return Err(RtlError::Pixel(tofprobe_pixel::PixelError::mismatch(
             "superpixel front end",
@@ -57,7 +73,14 @@ pub fn render_superpixel(
     let join = |f: &dyn Fn(usize) -> String| (0..n).map(f).collect::<Vec<_>>().join(" + ");
     let name = module_name(&o.module_prefix);
     let t = SuperpixelT {
-        header: header(p, TEMPLATE, o),
+        header: match fault.filter(|f| f.in_superpixel()) {
+            Some(f) => format!(
+                "{}\n// DELIBERATELY BROKEN ({}) for the array mutation tests.",
+                header(p, TEMPLATE, o),
+                f.name()
+            ),
+            None => header(p, TEMPLATE, o),
+        },
         name: name.clone(),
         n: n as u32,
         t: sp.tdc_bits(),
@@ -71,8 +94,19 @@ pub fn render_superpixel(
             .table()
             .iter()
             .enumerate()
-            .map(|(i, &m)| (i + 1, m))
+            .map(|(i, &m)| {
+                let wrong = fault == Some(ArrayFault::ReciprocalEntry) && i == 0;
+                (i + 1, m - u64::from(wrong))
+            })
             .collect(),
+        codes: (0..n as u32)
+            .map(|i| match (fault, i) {
+                (Some(ArrayFault::SpadSwap), 0) => (0, 1),
+                (Some(ArrayFault::SpadSwap), 1) => (1, 0),
+                _ => (i, i),
+            })
+            .collect(),
+        and_valid: fault == Some(ArrayFault::SuperpixelAnd),
     };
     Ok(RtlFile {
         name: format!("{name}.v"),

@@ -6,9 +6,10 @@
 //! cycles; and the shadow taken a cycle late is caught at the first beat it spoils.
 
 use tofprobe_array::rtl::{ArrayModel, run};
-use tofprobe_design::readout::{ArrayFault, BROADCAST_LATENCY, Readout};
+use tofprobe_design::readout::{BROADCAST_LATENCY, Readout};
 use tofprobe_pixel::PixelParams;
 use tofprobe_pixel::sequencer::RESET_CYCLES;
+use tofprobe_rtlgen::ArrayFault;
 
 use crate::rtl::{detections, fourier, haar, pixel_alone, readout, rom};
 

@@ -10,10 +10,10 @@
 use std::path::Path;
 
 use tofprobe_array::rtl::{ArrayModel, run};
-use tofprobe_array::rtl_vectors::scene_detections;
-use tofprobe_design::readout::ArrayFault;
+use tofprobe_array::rtl_vectors::{exercise, scene_detections};
 use tofprobe_design::{Chip, Document, RomPurpose, RtlOverrides, resolve};
 use tofprobe_flow::array::{ArrayCosimOptions, ArraySimulator, cosim_array};
+use tofprobe_rtlgen::ArrayFault;
 
 use crate::common::{default_text, edit, have_tools, tofprobe};
 
@@ -235,7 +235,9 @@ fn icarus_is_bit_exact_and_every_array_mutant_is_caught_where_predicted() {
     };
     let chip = Chip::array_of(&design, &ov, RomPurpose::Replayed).unwrap();
     let ro = chip.readout.unwrap();
-    let det = scene_detections(&design, 16, 2, None).unwrap();
+    // The stimulus the co-simulation replays: the scene's, thinned (`exercise`).
+    let mut det = scene_detections(&design, 16, 2, None).unwrap();
+    exercise(&mut det, 2, 1);
     let model = |f| {
         run(
             &mut ArrayModel::new(&ro, &chip.pixel, &chip.rom.words, f).unwrap(),
@@ -314,9 +316,27 @@ fn a_superpixel_array_is_bit_exact_and_a_crossed_average_is_caught() {
         "sp.toml",
     )
     .unwrap();
-    let det = scene_detections(&design, 16, 2, None).unwrap();
+    // The stimulus the co-simulation replays: the scene's, thinned so that every count of
+    // valid SPADs (none, exactly one, …, all four) occurs (`exercise`).
+    let mut det = scene_detections(&design, 16, 2, None).unwrap();
+    exercise(&mut det, 2, 2);
     // 16 SPADs row-major over the 4 × 4 grid: pixel (r, c) owns (2r + i, 2c + j).
     assert_eq!(det.len(), 16);
+    for count in 0..=4 {
+        let seen = (0..32).any(|n| {
+            (0..4).any(|px| {
+                let (r, c) = (px / 2, px % 2);
+                (0..4)
+                    .filter(|s| det[(2 * r + s / 2) * 4 + 2 * c + s % 2][n].is_some())
+                    .count()
+                    == count
+            })
+        });
+        assert!(
+            seen,
+            "no pulse with exactly {count} valid SPAD(s) of a pixel"
+        );
+    }
     let mixed = (0..32)
         .filter(|&n| {
             (0..4).any(|px| {
@@ -405,6 +425,60 @@ fn a_superpixel_array_is_bit_exact_and_a_crossed_average_is_caught() {
     let r = cosim_array(&design, &o).unwrap();
     assert!(!r.pass && r.mismatches > 0, "crossed averages not caught");
     assert_eq!(r.first_cycle, Some(predicted), "{:?}", r.first);
+    // The mutation study's escapes, caught now that SPADs go missing: valid as the AND of
+    // the SPADs, two SPADs' codes crossed, a wrong reciprocal entry.
+    for fault in [
+        ArrayFault::SuperpixelAnd,
+        ArrayFault::SpadSwap,
+        ArrayFault::ReciprocalEntry,
+    ] {
+        o.out = dir.path().join(fault.name());
+        o.fault = Some(fault);
+        let r = cosim_array(&design, &o).unwrap();
+        assert!(!r.pass && r.mismatches > 0, "{fault:?} not caught");
+    }
+}
+
+/// G = 3: 6 × 6 SPADs as 2 × 2 pixels; under Icarus bit-exact on the thinned stimulus (every
+/// count of valid SPADs from none to nine, exactly one among them), and the three
+/// superpixel escapes caught.
+#[test]
+fn a_three_by_three_superpixel_reaches_every_count_and_its_escapes_are_caught() {
+    if !have_tools(&["iverilog", "vvp"]) {
+        return;
+    }
+    let text = config(6, 6, false, "superpixel = 3\n");
+    let design = resolve(
+        Document::from_toml_str(&text, "sp3.toml").unwrap(),
+        "sp3.toml",
+    )
+    .unwrap();
+    let mut det = scene_detections(&design, 16, 2, None).unwrap();
+    exercise(&mut det, 2, 3);
+    assert_eq!(det.len(), 36);
+    let one = (0..32).any(|n| {
+        (0..9)
+            .filter(|s| det[(s / 3) * 6 + s % 3][n].is_some())
+            .count()
+            == 1
+    });
+    assert!(one, "pixel (0, 0) never has exactly one valid SPAD");
+    let dir = tempfile::tempdir().unwrap();
+    let mut o = ArrayCosimOptions::new(&dir.path().join("good"));
+    (o.frame_pulses, o.rom_depth, o.frames, o.simulator) =
+        (Some(16), Some(16), 2, ArraySimulator::Icarus);
+    let good = cosim_array(&design, &o).unwrap();
+    assert!(good.pass && good.mismatches == 0, "{:?}", good.first);
+    for fault in [
+        ArrayFault::SuperpixelAnd,
+        ArrayFault::SpadSwap,
+        ArrayFault::ReciprocalEntry,
+    ] {
+        o.out = dir.path().join(fault.name());
+        o.fault = Some(fault);
+        let r = cosim_array(&design, &o).unwrap();
+        assert!(!r.pass && r.mismatches > 0, "{fault:?} not caught");
+    }
 }
 
 /// `[array] double_buffer = true` (docs/pixel-contract.md "Double buffer"): a 2 × 3 array
@@ -468,7 +542,8 @@ fn a_double_buffered_array_is_bit_exact_and_a_late_shadow_is_caught() {
     let chip = Chip::array_of(&design, &ov, RomPurpose::Replayed).unwrap();
     let ro = chip.readout.unwrap();
     assert!(ro.double_buffer);
-    let det = scene_detections(&design, 8, 3, None).unwrap();
+    let mut det = scene_detections(&design, 8, 3, None).unwrap();
+    exercise(&mut det, 3, 1);
     let model = |f| {
         let mut m = ArrayModel::new(&ro, &chip.pixel, &chip.rom.words, f).unwrap();
         run(&mut m, &det, 3).unwrap()

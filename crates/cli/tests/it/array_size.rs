@@ -224,10 +224,7 @@ fn a_superpixel_array_reports_memory_and_area_per_spad() {
     assert_eq!(out.status.code(), Some(0), "{err}");
     let rtl = std::fs::read_to_string(dir.join("rtl/tofprobe_array.v")).unwrap();
     assert!(dir.join("rtl/tofprobe_superpixel.v").exists());
-    assert!(
-        rtl.contains("tofprobe_superpixel u_superpixel_0_0"),
-        "{err}"
-    );
+    assert!(rtl.contains("tofprobe_superpixel u_superpixel ("), "{err}");
 }
 
 #[test]

@@ -149,7 +149,7 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
 /// the file's folder, any other Rust path from its crate (`CARGO_MANIFEST_DIR`), a script's
 /// from the project root it changes to, a crate's TOML from its crate — and must stay
 /// inside. Documents (Markdown): no
-/// folder beside the checkout (`../shared`) and no absolute path of this machine's.
+/// folder beside the checkout (the data folder CI lays beside it) and no absolute path of this machine's.
 #[test]
 fn no_source_names_a_path_outside_the_repository() {
     let root = root();
@@ -228,7 +228,7 @@ fn no_source_names_a_path_outside_the_repository() {
 }
 
 /// The scan can fail: a crate-relative path three levels up (the old
-/// `CARGO_MANIFEST_DIR/../../../shared/…`) leaves the repository, an `include_str!` four
+/// `CARGO_MANIFEST_DIR` followed by three `..` and a folder name) leaves the repository, an `include_str!` four
 /// levels up from a test file does not.
 #[test]
 fn the_path_scan_rejects_a_path_beside_the_checkout() {
