@@ -27,6 +27,8 @@ pub const NULLABLE: &[&str] = &[
     "paper",
     "design",
     "closed_form",
+    "same_record_dft",
+    "same_record_tolerance",
     "seed_sd",
     "z_paper",
     "z_closed_form",

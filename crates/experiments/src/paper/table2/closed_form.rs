@@ -27,6 +27,25 @@ pub fn band_bins(spec: &Spec, n: usize) -> Result<usize, ExperimentError> {
 /// mixture variance (plus a²/12) and the held-noise factor F(ρ_v, ω) averaged as
 /// sqrt(F) over the band's bins, like the measured mean magnitude.
 pub fn closed_form_noise_um(spec: &Spec, n: usize) -> Result<f64, ExperimentError> {
+    let tones: Vec<f64> = if spec.amp_um.is_some() {
+        vec![tone_bin(n) as f64]
+    } else {
+        vec![]
+    };
+    let bins = NoiseBand::new(BAND.0, BAND.1).bins(n / 2 + 1, n, FS_HZ, &tones)?;
+    let bins: Vec<u64> = bins.into_iter().map(|k| k as u64).collect();
+    closed_form_noise_on_bins_um(spec, n, &bins)
+}
+
+/// The closed-form noise floor (µm) read as the mean magnitude over the DFT bins `bins`
+/// of an N-pulse record: eq. 12 with the mixture variance (plus a²/12), N_eff of the
+/// Blackman window, and the held-noise factor F(ρ_v, ω) averaged as sqrt(F) over `bins`.
+/// The probe columns read the floor on their own bins (`sigma_delta::probe_bins`).
+pub fn closed_form_noise_on_bins_um(
+    spec: &Spec,
+    n: usize,
+    bins: &[u64],
+) -> Result<f64, ExperimentError> {
     let setup = spec.setup();
     let fa = first_arrival(&MixtureParams {
         signal_rate: spec.rho_s,
@@ -36,13 +55,6 @@ pub fn closed_form_noise_um(spec: &Spec, n: usize) -> Result<f64, ExperimentErro
         window_mm: setup.window_mm,
     })?;
     let sigma = (fa.variance_mm2 + LSB_MM * LSB_MM / 12.0).sqrt();
-    let band = NoiseBand::new(BAND.0, BAND.1);
-    let tones: Vec<f64> = if spec.amp_um.is_some() {
-        vec![tone_bin(n) as f64]
-    } else {
-        vec![]
-    };
-    let bins = band.bins(n / 2 + 1, n, FS_HZ, &tones)?;
     let mean_sqrt_f = bins
         .iter()
         .map(|&k| {
@@ -50,9 +62,22 @@ pub fn closed_form_noise_um(spec: &Spec, n: usize) -> Result<f64, ExperimentErro
             hold_noise_factor(fa.valid_rate.min(1.0), w).sqrt()
         })
         .sum::<f64>()
-        / bins.len() as f64;
+        / bins.len().max(1) as f64;
     let n_eff = n as f64 * WINDOW.effective_length_factor();
     Ok(noise_floor_mm(sigma, n_eff) * mean_sqrt_f * 1e3)
+}
+
+/// The expected SNR (dB) of `20·log10(Â/N̂)` for a tone read as the Rician mean of
+/// amplitude `a_eff` in a floor `floor` (µm), N̂ a mean over `floor_rel_sd` relative sd:
+/// the delta method's second-order terms. With Â = m + e_A (var (2/π)·floor², the noise's
+/// projection on the tone) and N̂ = floor·(1 + e_N), E[ln Â] ≈ ln m − var_A/(2m²) and
+/// E[ln N̂] ≈ ln floor − rel²/2, so E[SNR] ≈ 20·log10(m/floor) + (10/ln 10)·(rel² −
+/// var_A/m²): −0.31 dB at A/floor = 3, −0.0002 dB at 130.
+pub fn snr_closed_db(a_eff: f64, floor: f64, floor_rel_sd: f64) -> f64 {
+    let m = super::super::stats::rician_mean(a_eff, floor);
+    let var_a = 2.0 / std::f64::consts::PI * floor * floor;
+    20.0 * (m / floor).log10()
+        + 10.0 / std::f64::consts::LN_10 * (floor_rel_sd.powi(2) - var_a / (m * m))
 }
 
 /// The expected tone amplitude (µm): the mixture's mean follows the signal with gain
