@@ -32,7 +32,7 @@ mod rows;
 mod spec;
 pub use closed_form::{
     band_bins, closed_form_amp_um, closed_form_noise_on_bins_um, closed_form_noise_um,
-    snr_closed_db,
+    largest_bin_um, peak_band_bins, snr_closed_db,
 };
 pub use probe_runs::{ProbeRecord, ProbeRun};
 pub use rows::{

@@ -179,6 +179,7 @@ pub fn amplitude_row(
             &values,
             &run.seeds,
             paper,
+            cf.floor_um,
             quick,
             "ΣΔ: the record's 16 largest DFT bins and their neighbours probed, the largest interpolated",
         );
