@@ -16,6 +16,7 @@ pub mod lef;
 pub mod liberty;
 pub mod markdown;
 pub mod memory;
+pub mod paper_memory;
 pub mod pdk;
 pub mod plot;
 pub mod scaling;

@@ -174,6 +174,9 @@ pub fn render(r: &SizeReport) -> String {
         m.compression_vs_raw,
         m.compression_in_values,
     );
+    if !r.paper_section8.is_empty() {
+        let _ = writeln!(out, "{}", crate::paper_memory::markdown(&r.paper_section8));
+    }
     let _ = writeln!(out, "## Area\n");
     area_block(&mut out, &r.area, d.bins);
     let _ = writeln!(out, "\n## Timing\n");

@@ -8,6 +8,7 @@ use crate::corners::{CornerTiming, sky130_corners};
 use crate::error::{EdaError, Result};
 use crate::liberty::Liberty;
 use crate::memory::{Memory, MemoryInput, memory};
+use crate::paper_memory::{PaperFigure, section8};
 use crate::scaling::{
     AreaModel, BinFit, bins_that_fit, flop_only_bins, implied_model, node_factor,
 };
@@ -172,6 +173,10 @@ pub struct SizeReport {
     pub design: Design,
     /// Widths, bytes, compression.
     pub memory: Memory,
+    /// The paper's Section 8 memory example computed, its printed figures beside
+    /// ([`crate::paper_memory`]); empty in reports written before it existed.
+    #[serde(default)]
+    pub paper_section8: Vec<PaperFigure>,
     /// Area on the timing liberty.
     pub area: AreaSection,
     /// Timing, when the liberty carries it.
@@ -453,6 +458,7 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
         schema: SCHEMA.to_string(),
         design: d.clone(),
         memory: mem,
+        paper_section8: section8()?,
         area,
         timing,
         sky130,

@@ -511,6 +511,10 @@ pub fn markdown(a: &ArraySizeReport) -> String {
         t.readout_bits_per_s / 1e6,
         t.reduction
     );
+    // The paper's per-pixel figure beside: one source of the numbers (`paper_memory`).
+    if let Ok(figs) = tofprobe_eda::paper_memory::section8() {
+        m += &format!("\n{}", tofprobe_eda::paper_memory::markdown(&figs));
+    }
     m += "\nAssumptions:\n\n";
     for s in &a.assumptions {
         m += &format!("- {s}\n");

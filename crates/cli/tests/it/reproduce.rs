@@ -1,7 +1,9 @@
 //! `tofprobe reproduce --quick --json` through the binary (the documented smoke test; the
 //! full run is the benchmark): every Table 2 noise and amplitude row carries its seeds
 //! (≥ 5), the band it is read on (noise rows: the DFT's 1–10 kHz, also for ΣΔ) and its
-//! z-scores; the run passes. The same run writes the paper's figures (Fig. 2–9, 3, 12) into
+//! z-scores; every Table 2 row of the DFT, ΣΔ and bit-true columns (noise, "A meas.", SNR)
+//! shows the paper's printed value, the probe rows their closed form and the same records'
+//! DFT apart, each column on seeds of its own; the run passes. The same run writes the paper's figures (Fig. 2–9, 3, 12) into
 //! `--out` as one set: every file is listed under `figures` in the JSON, is an SVG, carries
 //! its title, axis labels and the paper's printed values as text, and holds no NaN/inf.
 
@@ -43,13 +45,19 @@ fn quick_json_rows_carry_seeds_bands_and_z_scores() {
     for r in family("Table 2 ΣΔ noise") {
         assert_eq!(r["band_hz"], serde_json::json!([1000.0, 10000.0]), "{r}");
     }
-    // The figure points are multi-seed too: Fig. 4, the hold's corners (Fig. 6), the ΣΔ
-    // noise and amplitude rows, each with its seeds listed and a seed-to-seed sd.
+    // The figure points are multi-seed too: Fig. 4, the hold's corners (Fig. 6), the probe
+    // columns' rows, each with its seeds listed and a seed-to-seed sd.
     for (f, count) in [
         ("Fig. 4", 6),
         ("1NN hold f_3dB", 3),
+        ("Table 2 amplitude", 18),
+        ("Table 2 SNR", 14),
         ("Table 2 ΣΔ noise", 18),
-        ("Table 2 ΣΔ amplitude", 14),
+        ("Table 2 ΣΔ amplitude", 18),
+        ("Table 2 ΣΔ SNR", 14),
+        ("Table 2 bit-true noise", 18),
+        ("Table 2 bit-true amplitude", 14),
+        ("Table 2 bit-true SNR", 14),
     ] {
         assert_eq!(family(f).count(), count, "{f}");
         for r in family(f) {
@@ -57,7 +65,85 @@ fn quick_json_rows_carry_seeds_bands_and_z_scores() {
             assert!(r["seed_sd"].as_f64().is_some_and(|s| s > 0.0), "{r}");
         }
     }
-    assert_eq!(family("Table 2 amplitude").count(), 14);
+    check_table2_paper_values(rows);
+    check_own_seeds(rows);
+}
+
+/// Every Table 2 row of every column (DFT, ΣΔ, bit-true; noise, "A meas.", SNR) shows the
+/// paper's printed value from crates/experiments/data/paper/table2.tsv — the DFT's for the
+/// DFT rows, the ΣΔ's for the probe rows — and the probe rows name the closed form and,
+/// apart, the same records' DFT. The ΣΔ rows without a prefilter have no printed value.
+fn check_table2_paper_values(rows: &[serde_json::Value]) {
+    let printed = tofprobe_experiments::paper::table2::ROWS.clone();
+    let mut shown = 0;
+    for r in rows.iter().filter(|r| {
+        let f = r["family"].as_str().unwrap_or("");
+        f.starts_with("Table 2") && !f.ends_with("without prefilter")
+    }) {
+        let family = r["family"].as_str().unwrap();
+        let spec = printed
+            .iter()
+            .find(|s| s.label() == r["label"].as_str().unwrap())
+            .unwrap_or_else(|| panic!("no printed row for {r}"));
+        let probe = family.contains("ΣΔ") || family.contains("bit-true");
+        let p = &spec.printed;
+        let want = if family.ends_with("noise") {
+            p.noise_um.of(probe)
+        } else if family.ends_with("amplitude") {
+            p.amp_um.of(probe)
+        } else {
+            p.snr_db.expect("an SNR row has a printed SNR").of(probe)
+        };
+        assert_eq!(r["paper"].as_f64(), Some(want), "{r}");
+        if probe {
+            assert!(
+                r["closed_form"].as_f64().is_some() || spec.amp_um.is_none(),
+                "{r}"
+            );
+            assert!(r["same_record_dft"].as_f64().is_some(), "{r}");
+        }
+        if family.ends_with("SNR") {
+            assert!(
+                r["note"].as_str().unwrap().contains("ERRATUM (definition)"),
+                "{r}"
+            );
+        }
+        shown += 1;
+    }
+    // 18 + 18 + 14 DFT rows, 18 + 18 + 14 ΣΔ rows, 18 + 14 + 14 bit-true rows.
+    assert_eq!(shown, 146);
+}
+
+/// The DFT, ΣΔ and bit-true rows of one Table 2 row run on seeds of their own.
+fn check_own_seeds(rows: &[serde_json::Value]) {
+    let mut by_label: std::collections::BTreeMap<&str, Vec<(&str, Vec<u64>)>> = Default::default();
+    for r in rows.iter().filter(|r| {
+        r["family"]
+            .as_str()
+            .is_some_and(|f| f.starts_with("Table 2") && f.ends_with("noise"))
+    }) {
+        let seeds = r["seeds"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_u64().unwrap())
+            .collect();
+        by_label
+            .entry(r["label"].as_str().unwrap())
+            .or_default()
+            .push((r["family"].as_str().unwrap(), seeds));
+    }
+    assert_eq!(by_label.len(), 18);
+    for (label, cols) in by_label {
+        assert_eq!(cols.len(), 3, "{label}: {cols:?}");
+        let all: std::collections::BTreeSet<u64> =
+            cols.iter().flat_map(|c| c.1.iter().copied()).collect();
+        assert_eq!(
+            all.len(),
+            cols.iter().map(|c| c.1.len()).sum::<usize>(),
+            "{label}"
+        );
+    }
 }
 
 /// (file, figure, texts it must hold): title, axis labels, the paper's printed values.
@@ -85,7 +171,7 @@ const FIGURES: &[(&str, &str, &[&str])] = &[
             "ρ_b",
             "amplitude / A",
             "e^(−ρ_b/2)",
-            "99.6 / 95.7 / 92.6 / 88.8 / 98.3 / 55.1 µm",
+            "99.63 / 95.71 / 92.61 / 88.75 / 98.31 / 55.14 µm",
         ],
     ),
     (
@@ -127,7 +213,7 @@ const FIGURES: &[(&str, &str, &[&str])] = &[
         &[
             "ρ_s",
             "µm",
-            "131.3 / 114.8 / 102.2 / 102.3 µm",
+            "131.34 / 114.76 / 102.22 / 102.3 µm",
             "44.42 / 23.57 / 13.11 / 5.52 µm",
         ],
     ),

@@ -105,6 +105,30 @@ fn tiny_pixel_json_report() {
     assert!((fps - 10e6 / 4096.0).abs() < 1e-9);
     assert!(v["timing"]["sta"]["f_max_mhz"].as_f64().unwrap() > 0.0);
     assert!(v["sky130"].is_null());
+    // The paper's Section 8 example, computed beside its printed figures: 17.5 MB / 832 B
+    // is 21,033.7×, not the printed ≈ 22,400×; 26 bits only without a sign.
+    let s8 = v["paper_section8"].as_array().expect("paper_section8");
+    let fig = |name: &str| {
+        s8.iter()
+            .find(|f| f["figure"].as_str().unwrap().starts_with(name))
+            .unwrap_or_else(|| panic!("{name}: {s8:?}"))
+    };
+    let c = fig("compression, timestamps");
+    assert!((c["computed"].as_f64().unwrap() - 17.5e6 / 832.0).abs() < 1e-6);
+    assert_eq!(
+        (c["printed"].as_f64(), c["differs"].as_bool()),
+        (Some(22_400.0), Some(true))
+    );
+    let signed = fig("I/Q register width, two's complement (±");
+    assert_eq!(
+        (signed["computed"].as_f64(), signed["differs"].as_bool()),
+        (Some(27.0), Some(true))
+    );
+    let md = std::fs::read_to_string(set.join("size-report.md")).unwrap();
+    assert!(
+        md.contains("| 21,033.7 × | 22,400 × | **differs** |"),
+        "{md}"
+    );
 }
 
 #[test]

@@ -132,8 +132,8 @@ pub fn fig7(s: &BandSpectrum, n: u64, quick: bool) -> Result<Chart, ExperimentEr
             FIG7_PRINTED_NOISE_UM,
         ));
         lines.push(flat(
-            format!("paper, Table 2 (true): {} µm", spec.paper_noise_um),
-            spec.paper_noise_um,
+            format!("paper, Table 2 (true): {} µm", spec.printed.noise_um.dft),
+            spec.printed.noise_um.dft,
         ));
     }
     lines.push(flat(
@@ -145,8 +145,7 @@ pub fn fig7(s: &BandSpectrum, n: u64, quick: bool) -> Result<Chart, ExperimentEr
         format!(
             "paper: Fig. 7 prints an average noise of {FIG7_PRINTED_NOISE_UM} µm; its Table 2 \
              gives {} µm (DFT) / {} µm (ΣΔ) for this scene — the caption is an erratum",
-            spec.paper_noise_um,
-            spec.paper_sd_noise_um.unwrap_or(spec.paper_noise_um)
+            spec.printed.noise_um.dft, spec.printed.noise_um.sd
         ),
         format!(
             "measured: mean |Y| {:.3} µm (DFT), {:.3} µm (ΣΔ); ΣΔ error {:.3}× the floor",
@@ -198,8 +197,8 @@ pub fn fig8(s: &BandSpectrum, n: u64, quick: bool) -> Result<Chart, ExperimentEr
     let mut notes = vec![scene_note(&spec, n)];
     notes.push(format!(
         "paper (Table 2): amplitude {} µm, noise floor {} µm{}",
-        spec.paper_amp_um.unwrap_or(0.0),
-        spec.paper_noise_um,
+        spec.printed.amp_um.dft,
+        spec.printed.noise_um.dft,
         if quick {
             " (QUICK RUN: this record is shorter, its floor higher)"
         } else {
@@ -227,7 +226,7 @@ pub fn fig8(s: &BandSpectrum, n: u64, quick: bool) -> Result<Chart, ExperimentEr
             Series::new("ΣΔ probing", sd),
             Series::new("DFT (same record)", dft),
             flat("A = 100 µm (scene)", spec.amp_um.unwrap_or(0.0)),
-            flat("paper floor (Table 2, N = 10^7)", spec.paper_noise_um),
+            flat("paper floor (Table 2, N = 10^7)", spec.printed.noise_um.dft),
         ],
         notes,
         ..Chart::default()

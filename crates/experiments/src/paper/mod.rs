@@ -62,6 +62,11 @@ pub struct Row {
     pub measured: f64,
     /// Closed-form prediction, where there is one (for Spread rows: shown, not tested).
     pub closed_form: Option<f64>,
+    /// A probe row's (ΣΔ, bit-true) second reference: the same records read by the DFT on
+    /// the same bins. The row passes only if it is also within `same_record_tolerance`.
+    pub same_record_dft: Option<f64>,
+    /// |measured − same_record_dft| allowed (the row's unit).
+    pub same_record_tolerance: Option<f64>,
     pub tolerance: Tolerance,
     pub pass: bool,
     /// Extra context shown in the table (e.g. the Blackman value, the ZOH approximation).
@@ -119,6 +124,8 @@ impl Row {
             design,
             measured,
             closed_form,
+            same_record_dft: None,
+            same_record_tolerance: None,
             tolerance,
             pass,
             note,
@@ -131,6 +138,17 @@ impl Row {
     }
 }
 
+impl Row {
+    /// Adds the same-record reference of a probe row: the row passes only if it also holds
+    /// |measured − reference| ≤ tolerance (an absent or non-finite reference fails).
+    pub fn with_same_record(mut self, reference: f64, tolerance: f64) -> Row {
+        self.same_record_dft = Some(reference);
+        self.same_record_tolerance = Some(tolerance);
+        self.pass &= reference.is_finite() && (self.measured - reference).abs() <= tolerance;
+        self
+    }
+}
+
 fn fmt_opt(v: Option<f64>) -> String {
     v.map_or_else(|| "–".to_string(), |v| format!("{v:.4}"))
 }
@@ -138,8 +156,8 @@ fn fmt_opt(v: Option<f64>) -> String {
 /// The Markdown table.
 pub fn markdown(rows: &[Row]) -> String {
     let mut s = String::from(
-        "| experiment | row | unit | paper | corrected | measured | closed form / reference | tolerance | pass | note |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n",
+        "| experiment | row | unit | paper | corrected | measured | closed form / reference | same-record DFT | tolerance | pass | note |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let tol = match r.tolerance {
@@ -167,7 +185,7 @@ pub fn markdown(rows: &[Row]) -> String {
             )
         };
         s += &format!(
-            "| {} | {} | {} | {} | {} | {:.4} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {:.4} | {} | {} | {} | {} | {} |\n",
             r.family,
             // A literal | (as in |w|) would split the Markdown cell.
             r.label.replace('|', "\\|"),
@@ -176,6 +194,10 @@ pub fn markdown(rows: &[Row]) -> String {
             fmt_opt(r.design),
             r.measured,
             fmt_opt(r.closed_form),
+            match (r.same_record_dft, r.same_record_tolerance) {
+                (Some(v), Some(t)) => format!("{v:.4} ± {t:.4}"),
+                _ => "–".to_string(),
+            },
             tol,
             if r.pass { "pass" } else { "FAIL" },
             (stats + &r.note).replace('|', "\\|")

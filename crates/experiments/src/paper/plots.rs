@@ -85,14 +85,14 @@ pub fn charts(results: &[RowResult], quick: bool) -> Vec<Chart> {
             "paper",
             chosen
                 .iter()
-                .map(|r| (r.spec.sigma_s_mm, r.spec.paper_noise_um))
+                .map(|r| (r.spec.sigma_s_mm, r.spec.printed.noise_um.dft))
                 .collect(),
         ));
         noise.notes.push(format!(
             "paper: {} µm",
             chosen
                 .iter()
-                .map(|r| format!("{}", r.spec.paper_noise_um))
+                .map(|r| format!("{}", r.spec.printed.noise_um.dft))
                 .collect::<Vec<_>>()
                 .join(" / ")
         ));
@@ -208,7 +208,11 @@ pub fn fig5(results: &[RowResult], quick: bool) -> Chart {
         "paper (Table 2)",
         printed
             .iter()
-            .filter_map(|r| r.spec.paper_amp_um.map(|a| (r.spec.rho_b, rel(r, a))))
+            .filter_map(|r| {
+                r.spec
+                    .amp_um
+                    .map(|_| (r.spec.rho_b, rel(r, r.spec.printed.amp_um.dft)))
+            })
             .collect(),
     ));
     let list = |f: &dyn Fn(&RowResult) -> String| {
@@ -218,7 +222,7 @@ pub fn fig5(results: &[RowResult], quick: bool) -> Chart {
         format!("ρ_b = {}", list(&|r| format!("{}", r.spec.rho_b))),
         format!(
             "paper: {} µm",
-            list(&|r| format!("{}", r.spec.paper_amp_um.unwrap_or(0.0)))
+            list(&|r| format!("{}", r.spec.printed.amp_um.dft))
         ),
         format!(
             "measured: {} µm{}",
@@ -296,19 +300,19 @@ pub fn fig9(results: &[RowResult], quick: bool) -> Chart {
         .push(format!("ρ_s = {}", list(&|r| format!("{}", r.spec.rho_s))));
     c.points.push(Series::new(
         "paper noise floor",
-        at(&|r| r.spec.paper_noise_um),
+        at(&|r| r.spec.printed.noise_um.dft),
     ));
     c.notes.push(format!(
         "paper noise: {} µm",
-        list(&|r| format!("{}", r.spec.paper_noise_um))
+        list(&|r| format!("{}", r.spec.printed.noise_um.dft))
     ));
     c.points.push(Series::new(
         "paper amplitude",
-        at(&|r| r.spec.paper_amp_um.unwrap_or(0.0)),
+        at(&|r| r.spec.printed.amp_um.dft),
     ));
     c.notes.push(format!(
         "paper amplitude: {} µm",
-        list(&|r| format!("{}", r.spec.paper_amp_um.unwrap_or(0.0)))
+        list(&|r| format!("{}", r.spec.printed.amp_um.dft))
     ));
     c.notes.push(format!(
         "measured noise {} µm, amplitude {} µm",

@@ -22,9 +22,14 @@ use tofprobe_pixel::sizing::{
 use tofprobe_pixel::{PixelParams, TransactionModel};
 
 use super::setup::FS_HZ;
-use super::table2::{BAND, BIT_TRUE, DFT, F0_HZ, Measurement, RowResult, SD, SD_RAW};
-use super::{Row, Tolerance};
+use super::table2::{BAND, F0_HZ};
 use crate::ExperimentError;
+
+mod rows;
+pub use rows::{
+    AMP_REL, NOISE_REL, ProbeClosedForm, RAW_FACTOR_DESIGN, RAW_FACTOR_MIN, amplitude_row,
+    noise_row, probe_closed_form, rows, snr_row,
+};
 
 /// Prefilter coefficient α = 2^−S of the pixel (S = 5).
 pub const SHIFT: u32 = 5;
@@ -152,6 +157,32 @@ impl ProbeSetup {
     }
 }
 
+/// The pixel's parameters and register words after the record's detections (codes 0..`codes`).
+fn bit_true_words(
+    setup: &ProbeSetup,
+    detections: &[Option<u32>],
+    codes: u32,
+) -> Result<(PixelParams, Vec<i64>), ExperimentError> {
+    let p = setup.pixel_params(codes)?;
+    let mut tm = TransactionModel::new(&p)?;
+    for (i, chunk) in detections.chunks(1 << 16).enumerate() {
+        tm.run(chunk, Some(&setup.rom.image), (i as u64) << 16)?;
+    }
+    Ok((p, tm.readout().words))
+}
+
+/// The bit-true pixel's normalised phasors of one record (codes), without the check
+/// against the float ΣΔ ([`bit_true`] runs it).
+pub fn bit_true_phasors(
+    setup: &ProbeSetup,
+    detections: &[Option<u32>],
+    codes: u32,
+) -> Result<Vec<Phasor>, ExperimentError> {
+    let (p, words) = bit_true_words(setup, detections, codes)?;
+    let sums = tofprobe_pixel::spectrum::register_sums(&p, &words);
+    Ok(setup.phasors(&sums, Some(alpha())))
+}
+
 /// The bit-true run of one record against the float ΣΔ on the same held codes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BitTrue {
@@ -183,12 +214,7 @@ pub fn bit_true(
     detections: &[Option<u32>],
     codes: u32,
 ) -> Result<BitTrue, ExperimentError> {
-    let p = setup.pixel_params(codes)?;
-    let mut tm = TransactionModel::new(&p)?;
-    for (i, chunk) in detections.chunks(1 << 16).enumerate() {
-        tm.run(chunk, Some(&setup.rom.image), (i as u64) << 16)?;
-    }
-    let words = tm.readout().words;
+    let (p, words) = bit_true_words(setup, detections, codes)?;
     let bit_sums = tofprobe_pixel::spectrum::register_sums(&p, &words);
     let scale = f64::from(1u32 << p.register_frac_bits());
     let phasors = setup.phasors(&bit_sums, Some(alpha()));
@@ -247,191 +273,6 @@ pub fn bit_true(
     })
 }
 
-/// ΣΔ noise within this of the DFT noise on the same bins of the same record (issue 4).
-pub const NOISE_REL: f64 = 0.03;
-/// ΣΔ tone amplitude within this of the DFT's at the same bin of the same record.
-pub const AMP_REL: f64 = 0.01;
-/// "Several times the floor": the unprefiltered ΣΔ error must be at least this many
-/// noise floors. DESIGN.md reports ≈ 6×, the dsp unit test 4.9× on white noise; 3× keeps
-/// a margin below both while staying an order of magnitude above the prefiltered error
-/// (≈ 0.2×), so the row fails if the prefilter stopped mattering.
-pub const RAW_FACTOR_MIN: f64 = 3.0;
-/// The design value of that factor (DESIGN.md).
-pub const RAW_FACTOR_DESIGN: f64 = 6.0;
-
-/// What the ΣΔ noise row says of the paper's ΣΔ value: shown where DESIGN.md records it
-/// (the four noise-only rows); where it does not, that it is missing — never "shown"
-/// beside an empty paper column.
-pub fn paper_sd_note(paper: Option<f64>) -> String {
-    match paper {
-        Some(p) => format!("paper ΣΔ {p} µm shown, not tested (the DFT row tests the floor)"),
-        None => "the paper's ΣΔ value of this row is not in DESIGN.md's table (it records \
-                 only the DFT columns there), so none is shown"
-            .to_string(),
-    }
-}
-
-/// The ΣΔ rows of one Table 2 row: ΣΔ noise and amplitude against the DFT of the same
-/// record on the same bins, the unprefiltered error factor, the bit-true check.
-pub fn rows(r: &RowResult) -> Vec<Row> {
-    let get = |name: &str| -> Option<&Measurement> {
-        r.columns.iter().find(|(n, _)| *n == name).map(|(_, m)| m)
-    };
-    let mut out = Vec::new();
-    let (Some(dft), Some(sd)) = (get(DFT), get(SD)) else {
-        return out;
-    };
-    let label = r.spec.label();
-    let dft_noise = noise_um(&dft.phasors);
-    let sd_err = error_um(&sd.phasors, &dft.phasors);
-    let bins = dft.phasors.len().saturating_sub(1);
-    // Per seed (seed 0 alone if the other seeds did not run the ΣΔ column): ΣΔ noise, the
-    // DFT's noise on the same bins of the same record, the ΣΔ error, the two amplitudes.
-    let per_seed: Vec<[f64; 5]> = if r.probe_seeds.is_empty() {
-        vec![[
-            sd.noise_um,
-            dft_noise,
-            sd_err,
-            sd.amp_um.unwrap_or(0.0),
-            norm(dft.phasors[0]) * 1e3,
-        ]]
-    } else {
-        r.probe_seeds
-            .iter()
-            .map(|(d, s)| {
-                [
-                    s.noise_um,
-                    noise_um(&d.phasors),
-                    error_um(&s.phasors, &d.phasors),
-                    s.amp_um.unwrap_or(0.0),
-                    norm(d.phasors[0]) * 1e3,
-                ]
-            })
-            .collect()
-    };
-    let seeds = &r.seeds[..per_seed.len().min(r.seeds.len())];
-    let col = |i: usize| per_seed.iter().map(|v| v[i]).collect::<Vec<f64>>();
-    let mean = |i: usize| super::stats::mean_sd(&col(i)).0;
-    let (sd_noise, ref_noise, mean_err) = (mean(0), mean(1), mean(2));
-    let st = super::stats::seed_stats(&col(0), 0.0, r.spec.paper_sd_noise_um, Some(ref_noise));
-    out.push(
-        Row::judge(
-            "Table 2 ΣΔ noise",
-            label.clone(),
-            "µm",
-            r.spec.paper_sd_noise_um,
-            None,
-            sd_noise,
-            Some(ref_noise),
-            Tolerance::Reference { rel: NOISE_REL },
-            format!(
-                "mean over {} seeds; ref: DFT of the same records on the same {bins} bins \
-                 ({}–{} Hz); ΣΔ error {:.3}× the floor; {}",
-                per_seed.len(),
-                NOISE_SPAN_HZ.0,
-                NOISE_SPAN_HZ.1,
-                mean_err / ref_noise,
-                paper_sd_note(r.spec.paper_sd_noise_um)
-            ),
-        )
-        .with_seeds(seeds, &st, Some(NOISE_SPAN_HZ)),
-    );
-    if let (Some(_), Some(_)) = (sd.amp_um, r.spec.amp_um) {
-        let (a_sd, a_dft) = (mean(3), mean(4));
-        // The ΣΔ error at the tone bin is the same mixing noise as at the noise bins; its
-        // projection on the tone moves |Y| by ≈ |e|·cos θ (std ≈ ē/1.13 for a Rayleigh
-        // |e| of mean ē). Where 3ē exceeds 1% of A (low SNR: A/floor below ≈ 3·0.2/0.01 =
-        // 60) 1% cannot hold for any ΣΔ readout, so the tolerance is 3ē (≈ 3.4σ) there;
-        // over S seeds the mean's error is smaller, so this stays conservative.
-        let rel_err = 3.0 * mean_err / a_dft;
-        let (rel, why) = if rel_err > AMP_REL {
-            (
-                rel_err,
-                format!(
-                    "tolerance 3ē = {:.3} µm (ē: mean ΣΔ error on the noise bins; 1% needs A/floor ≳ 60)",
-                    3.0 * mean_err
-                ),
-            )
-        } else {
-            (AMP_REL, "tolerance 1%".to_string())
-        };
-        let st = super::stats::seed_stats(&col(3), 0.0, None, Some(a_dft));
-        out.push(
-            Row::judge(
-                "Table 2 ΣΔ amplitude",
-                label.clone(),
-                "µm",
-                None,
-                None,
-                a_sd,
-                Some(a_dft),
-                Tolerance::Reference { rel },
-                format!(
-                    "mean over {} seeds; ref: DFT of the same records at the tone bin ({:.0} Hz); \
-                     {why}; paper's one measured amplitude is in the DFT row ({:.2} µm)",
-                    per_seed.len(),
-                    F0_HZ,
-                    r.spec.paper_amp_um.unwrap_or(f64::NAN)
-                ),
-            )
-            .with_seeds(seeds, &st, None),
-        );
-    }
-    if let Some(raw) = get(SD_RAW) {
-        let factor = error_um(&raw.phasors, &dft.phasors) / dft_noise;
-        out.push(Row::judge(
-            "Table 2 ΣΔ without prefilter",
-            label.clone(),
-            "× floor",
-            None,
-            Some(RAW_FACTOR_DESIGN),
-            factor,
-            None,
-            Tolerance::AtLeast {
-                min: RAW_FACTOR_MIN,
-            },
-            format!(
-                "seed 0; mean |Y_ΣΔ − Y_DFT| / DFT floor over {bins} bins; with the prefilter {:.3}×; \
-                 noise read without it {:.3} µm vs {dft_noise:.3}",
-                sd_err / dft_noise,
-                raw.noise_um
-            ),
-        ));
-    }
-    if let Some(bt) = get(BIT_TRUE)
-        && let Some(check) = &bt.bit_true
-    {
-        let max_diff = bt_diff_um(check);
-        let mut row = Row::judge(
-            "Table 2 bit-true",
-            label,
-            "µm",
-            None,
-            None,
-            bt.noise_um,
-            Some(sd.noise_um),
-            Tolerance::Bound,
-            format!(
-                "seed 0; W = {}, T = {}, F = {FRAC_BITS}, S = {SHIFT}; per register |bit − float| ≤ \
-                 2^(S−F−1)(N−1−m+|Σs|): worst {:.3} codes of {:.0} ({:.2e}); max |Y_bit − Y_float(same codes)| \
-                 {max_diff:.3} µm; amplitude {}",
-                check.width,
-                check.tdc_bits,
-                check.worst_codes,
-                check.bound_codes,
-                check.worst_ratio,
-                bt.amp_um.map_or_else(
-                    || "–".into(),
-                    |a| format!("{a:.3} µm (ΣΔ {:.3})", sd.amp_um.unwrap_or(f64::NAN))
-                )
-            ),
-        );
-        row.pass = row.measured.is_finite() && check.worst_ratio <= 1.0;
-        out.push(row);
-    }
-    out
-}
-
 /// Largest |Y_bit − Y_float| over the bins (same codes), µm.
 pub fn bt_diff_um(b: &BitTrue) -> f64 {
     b.phasors
@@ -460,6 +301,9 @@ pub fn error_um(a: &[Phasor], b: &[Phasor]) -> f64 {
 }
 
 #[cfg(test)]
+mod power_tests;
+
+#[cfg(test)]
 pub(crate) mod tests {
     /// The shared ROM without the stability sweep (seconds in a debug build): the
     /// modulator is the default one, and A_p = 0.5 is well inside its measured limit
@@ -470,30 +314,9 @@ pub(crate) mod tests {
     }
 
     use super::super::table2::{
-        RowRecord, Spec, bit_true_column, dft_column, sd_column, sd_raw_column,
+        Measurement, RowRecord, Spec, bit_true_column, dft_column, sd_column, sd_raw_column,
     };
     use super::*;
-
-    /// The note says "shown" exactly where a paper ΣΔ value is attached (the defect: every
-    /// ΣΔ row said "paper ΣΔ shown" while 28 of 32 had none); the four DESIGN.md records
-    /// are the noise-only rows.
-    #[test]
-    fn the_paper_sd_note_matches_the_value() {
-        use super::super::table2::ROWS;
-        for spec in ROWS {
-            let note = paper_sd_note(spec.paper_sd_noise_um);
-            assert_eq!(
-                note.contains("shown,"),
-                spec.paper_sd_noise_um.is_some(),
-                "{note}"
-            );
-        }
-        let with = ROWS
-            .iter()
-            .filter(|s| s.paper_sd_noise_um.is_some())
-            .count();
-        assert_eq!(with, 4);
-    }
 
     /// A small-N (2^16) Table 2 scene with a strong tone (σ_s = 3 mm, ρ_s = 1, 3 mm at
     /// 4.5 kHz) so that the 1% amplitude test is meaningful: the floor is ≈ 2.25 µm ·
@@ -523,9 +346,7 @@ pub(crate) mod tests {
             rho_s,
             rho_b: 0.0,
             amp_um: Some(3000.0),
-            paper_noise_um: 2.25,
-            paper_amp_um: Some(3000.0),
-            paper_sd_noise_um: None,
+            printed: super::super::table2::ROWS[4].printed,
         }
     }
 

@@ -1,16 +1,17 @@
-//! Table 2 (1 s, f_s = 10 MHz, Blackman): the DFT noise floor and the measured amplitude
-//! of every row, against the paper and the closed form (eq. 12 extended for the hold and
-//! the background mixture, `tofprobe_dsp::closed_form`).
+//! Table 2 (1 s, f_s = 10 MHz, Blackman): every printed value — the DFT and two-level ΣΔ
+//! noise floor, measured amplitude and SNR — re-measured, each row beside the paper's value
+//! (`data/paper/table2.tsv`, [`printed`]) and judged against the closed form (eq. 12
+//! extended for the hold and the background mixture, `tofprobe_dsp::closed_form`).
 //!
-//! Per row and per seed of the row's own seeds ([`seeds_for`]): a full record → 1NN hold (raw held depth, no
-//! prefilter) → full Blackman FFT → noise floor (mean |Y| over 1–10 kHz, DC and ±8 bins
-//! around the tone excluded) and the interpolated peak; the rows show mean ± sd over the
-//! seeds and are judged by `super::stats` (tolerance from the spread and the number of
-//! band bins). Seed 0 also runs every other column. Every column is a [`Column`]: a function from a row's record to
-//! (noise, amplitude) plus, for the probe columns, phasors at the shared probe bins. The
-//! float ΣΔ (with and without prefilter) and bit-true columns and their rows are in
-//! `super::sigma_delta`; the DFT column also reads its spectrum at those probe bins so the
-//! ΣΔ columns are compared with the DFT of the same record on the same bins.
+//! Three columns, each on its own records ([`spec::seeds_for_set`]): the DFT (a full record
+//! → 1NN hold (raw held depth, no prefilter) → full Blackman FFT → noise floor = mean |Y|
+//! over 1–10 kHz with DC and ±8 bins around the tone excluded, and "A meas." = the
+//! interpolated peak: the tone, or on a row without one the spectrum's largest value over
+//! [`PEAK_BAND`]); the float ΣΔ and the bit-true pixel (`super::sigma_delta`: the same
+//! kind of record probed at the shared probe bins, each record also read by the DFT on
+//! those bins — the same-record reference). The rows show mean ± sd over a column's seeds
+//! and are judged by `super::stats` (tolerance from the spread). Every column is a
+//! [`Column`]: a function from a record to a [`Measurement`].
 
 use rayon::prelude::*;
 use tofprobe_dsp::Window;
@@ -19,154 +20,64 @@ use tofprobe_dsp::stats::{NoiseBand, interpolate_peak, noise_floor};
 use tofprobe_scene::PhotonSource;
 
 use super::chart::Curve;
-use super::setup::{FS_HZ, LSB_MM, Setup};
+use super::setup::{FS_HZ, LSB_MM};
 use super::sigma_delta::{self, Phasor, ProbeSetup};
-use super::stats::{self, K};
+use super::stats;
 use crate::ExperimentError;
 
 mod closed_form;
+pub mod printed;
+mod probe_runs;
 mod rows;
-pub use closed_form::{band_bins, closed_form_amp_um, closed_form_noise_um};
-pub use rows::{AMP_MIN_SNR, amplitude_row, eq12_row, noise_row, rows_of};
+mod spec;
+pub use closed_form::{
+    band_bins, closed_form_amp_um, closed_form_noise_on_bins_um, closed_form_noise_um,
+    largest_bin_um, peak_band_bins, snr_closed_db,
+};
+pub use probe_runs::{ProbeRecord, ProbeRun};
+pub use rows::{
+    amplitude_row, eq12_row, largest_value_row, noise_row, paper_note, rms_over_mean_db, rows_of,
+    snr_row,
+};
+pub use spec::{
+    AMP_BIAS_UM, AMP_MIN_SNR, FULL_N, MAX_SEEDS, NOISE_BIAS, PROBE_EPS2_MAX, ROWS, SeedSet, Spec,
+    probe_noise_seeds, seeds_for, seeds_for_set,
+};
 
 /// The analysis window of Table 2.
 pub const WINDOW: Window = Window::Blackman;
 /// The noise band (Hz).
 pub const BAND: (f64, f64) = (1_000.0, 10_000.0);
+/// Where a row without a tone reads its "A meas." (the spectrum's largest value, Hz): the
+/// paper truncates its spectra at 20 kHz; from the noise band's lower edge, where a static
+/// depth's leakage through the Blackman sidelobes is gone.
+pub const PEAK_BAND: (f64, f64) = (BAND.0, 20_000.0);
+/// The spectrum's largest bins a row without a tone hands to the probe columns (largest
+/// first): the probe reads them and their neighbours to find its own largest value.
+pub const TOP_BINS: usize = 16;
 /// The tone frequency of the amplitude rows.
 pub const F0_HZ: f64 = 4_500.0;
 /// The seeds of a row not in [`ROWS`] (tests' own specs), and the count every row has at
 /// least: noise floor and amplitude are means over a row's seeds ([`seeds_for`]).
 pub const SEEDS: &[u64] = stats::SEEDS;
-/// The amplitude bias a full-length tested amplitude row must catch (µm): its seed count
-/// makes K·se ≤ this ([`seeds_for`]).
-pub const AMP_BIAS_UM: f64 = 10.0;
-/// The most seeds a row gets (a full record costs ≈ 1 s of CPU per seed).
-pub const MAX_SEEDS: usize = 64;
-/// Record length from which rows get their powered seed counts (shorter `--quick`
-/// records keep [`SEEDS`]'s count: their floors are too high for a 10 µm test anyway).
-pub const FULL_N: u64 = 10_000_000;
-/// The float ΣΔ column runs on this many of a row's seeds (its rows compare ΣΔ with the
-/// DFT of the same records, a paired difference that needs no more).
-pub const SD_SEEDS: usize = 5;
-
-/// A row's own seeds: rows share none (row i of [`ROWS`] draws from 1000·(i + 1) on, so
-/// their statistics are independent), and a tested amplitude row of a full record has
-/// enough that a [`AMP_BIAS_UM`] bias fails its K·se test: S = ⌈(K·sd/bias)²⌉ with sd the
-/// predicted sd of one seed's amplitude, floor·sqrt(2/π) (`amplitude_row`), between
-/// [`SEEDS`]'s count and [`MAX_SEEDS`]. A spec outside [`ROWS`] gets [`SEEDS`].
-pub fn seeds_for(spec: &Spec, n: u64) -> Result<Vec<u64>, ExperimentError> {
-    let Some(i) = ROWS.iter().position(|r| r == spec) else {
-        return Ok(SEEDS.to_vec());
-    };
-    let mut count = SEEDS.len();
-    if n >= FULL_N
-        && let Some(amp) = closed_form_amp_um(spec)?
-    {
-        let floor = closed_form_noise_um(spec, n as usize)?;
-        if amp / floor >= AMP_MIN_SNR {
-            let sd = floor * (2.0 / std::f64::consts::PI).sqrt();
-            let want = (K * sd / AMP_BIAS_UM).powi(2).ceil() as usize;
-            count = want.clamp(SEEDS.len(), MAX_SEEDS);
-        }
-    }
-    let base = 1000 * (i as u64 + 1);
-    Ok((base..base + count as u64).collect())
-}
-/// Relative tolerance of the noise rows.
+/// Relative tolerance of the eq. 12 row.
 pub const NOISE_REL: f64 = 0.05;
 
-/// One row of Table 2 as printed.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Spec {
-    pub sigma_s_mm: f64,
-    pub rho_s: f64,
-    pub rho_b: f64,
-    /// Tone amplitude (µm) at [`F0_HZ`], or none.
-    pub amp_um: Option<f64>,
-    /// The paper's DFT noise floor (µm).
-    pub paper_noise_um: f64,
-    /// The paper's DFT measured amplitude (µm).
-    pub paper_amp_um: Option<f64>,
-    /// The paper's ΣΔ noise floor (µm), where it prints one.
-    pub paper_sd_noise_um: Option<f64>,
-}
-
-const fn row(s: f64, rs: f64, rb: f64, a: f64, noise: f64, meas: f64) -> Spec {
-    Spec {
-        sigma_s_mm: s,
-        rho_s: rs,
-        rho_b: rb,
-        amp_um: if a > 0.0 { Some(a) } else { None },
-        paper_noise_um: noise,
-        paper_amp_um: if a > 0.0 { Some(meas) } else { None },
-        paper_sd_noise_um: None,
-    }
-}
-
-/// A row whose ΣΔ noise the paper prints beside the DFT one.
-const fn row_sd(s: f64, noise: f64, sd: f64) -> Spec {
-    let mut r = row(s, 1.0, 0.0, 0.0, noise, 0.0);
-    r.paper_sd_noise_um = Some(sd);
-    r
-}
-
-/// Every DFT row of Table 2 (DESIGN.md, "Numbers to reproduce").
-pub const ROWS: &[Spec] = &[
-    row_sd(3.0, 2.25, 2.26),
-    row_sd(7.5, 5.47, 5.49),
-    row_sd(15.0, 10.85, 10.88),
-    row_sd(30.0, 22.24, 22.32),
-    row(3.0, 1.0, 0.0, 10.0, 2.26, 8.27),
-    row(3.0, 1.0, 0.0, 30.0, 2.23, 30.49),
-    row(3.0, 1.0, 0.0, 100.0, 2.19, 97.65),
-    row(3.0, 1.0, 0.0, 300.0, 2.23, 298.34),
-    row(7.5, 1.0, 0.0, 100.0, 5.52, 102.3),
-    row(7.5, 0.3, 0.0, 100.0, 13.11, 102.2),
-    row(7.5, 0.1, 0.0, 100.0, 23.57, 114.8),
-    row(7.5, 0.03, 0.0, 100.0, 44.42, 131.3),
-    row(7.5, 0.3, 0.01, 100.0, 13.95, 99.6),
-    row(7.5, 0.3, 0.025, 100.0, 14.59, 95.7),
-    row(7.5, 0.3, 0.05, 100.0, 15.29, 92.6),
-    row(7.5, 0.3, 0.075, 100.0, 16.12, 88.8),
-    row(7.5, 0.3, 0.1, 100.0, 16.33, 98.3),
-    row(7.5, 0.3, 0.3, 100.0, 16.93, 55.1),
-];
-
-impl Spec {
-    pub fn setup(&self) -> Setup {
-        Setup {
-            sigma_s_mm: self.sigma_s_mm,
-            lsb_mm: LSB_MM,
-            rho_s: self.rho_s,
-            rho_b: self.rho_b,
-            window_mm: Setup::window_for(self.sigma_s_mm, self.rho_b),
-            tone: self.amp_um.map(|a| (F0_HZ, a * 1e-3)),
-        }
-    }
-
-    pub fn label(&self) -> String {
-        let tone = self
-            .amp_um
-            .map_or_else(|| "no tone".into(), |a| format!("A={a} µm@{F0_HZ} Hz"));
-        format!(
-            "σ_s={} mm ρ_s={} ρ_b={} {tone}",
-            self.sigma_s_mm, self.rho_s, self.rho_b
-        )
-    }
-}
-
-/// What a column measures on one record: noise floor and (tone rows) amplitude, µm.
-/// Columns that read the shared probe bins also return their phasors there (tone bin
-/// first, mm) so that the table can compare columns bin by bin on the same record.
+/// What a column measures on one record: noise floor and "A meas." (µm). Columns that read
+/// the shared probe bins also return their phasors there (tone bin first, mm) so that the
+/// table can compare columns bin by bin on the same record.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measurement {
     pub noise_um: f64,
+    /// "A meas.": the tone's amplitude, or on a row without a tone the spectrum's largest
+    /// value over [`PEAK_BAND`] (the paper's definition for both).
     pub amp_um: Option<f64>,
     /// Phasors at the probe bins of [`ProbeSetup`] (mm), empty if not measured.
     pub phasors: Vec<Phasor>,
     /// Bit-true column: its check against the float ΣΔ.
     pub bit_true: Option<sigma_delta::BitTrue>,
+    /// A row without a tone, DFT: the [`TOP_BINS`] largest bins over [`PEAK_BAND`].
+    pub top_bins: Vec<u64>,
 }
 
 /// The data a column sees: the row, its source, the detections of the whole record, and
@@ -211,7 +122,7 @@ pub const SD: &str = "ΣΔ";
 pub const SD_RAW: &str = "ΣΔ no prefilter";
 pub const BIT_TRUE: &str = "bit-true";
 
-/// The columns measured from seed 0 of every row.
+/// The columns of the table (the first is the DFT, which the row's seed statistics use).
 pub const COLUMNS: &[Column] = &[
     Column {
         name: DFT,
@@ -245,8 +156,8 @@ pub fn held_record(rec: &RowRecord<'_>) -> Result<Vec<f64>, ExperimentError> {
     crate::records::held_record(rec.source, rec.detections, 0.0)
 }
 
-/// The full-FFT column: noise floor over the band, peak by quadratic interpolation, and
-/// the normalised complex bins 2/(N·G)·X[k] at the probe bins.
+/// The full-FFT column: noise floor over the band, "A meas." by quadratic interpolation,
+/// and the normalised complex bins 2/(N·G)·X[k] at the probe bins.
 pub fn dft_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, ExperimentError> {
     let held = held_record(rec)?;
     let n = held.len();
@@ -271,13 +182,15 @@ pub fn dft_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, Experiment
 }
 
 /// Measurement of a probe readout: noise = mean magnitude of the noise bins, amplitude =
-/// magnitude of the tone bin (tone rows).
+/// magnitude of the tone bin (tone rows; a row without one reads its largest value
+/// separately, `probe_runs`).
 fn probe_measurement(rec: &RowRecord<'_>, phasors: Vec<Phasor>) -> Measurement {
     Measurement {
         noise_um: sigma_delta::noise_um(&phasors),
         amp_um: rec.spec.amp_um.map(|_| sigma_delta::norm(phasors[0]) * 1e3),
         phasors,
         bit_true: None,
+        top_bins: Vec::new(),
     }
 }
 
@@ -312,11 +225,16 @@ pub fn sd_raw_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, Experim
     sd_probe(rec, None).map(Some)
 }
 
-/// The bit-true column: the record's TDC codes through the transaction model.
+/// The TDC codes a row's records hold (0..codes).
+fn codes_of(spec: &Spec) -> u32 {
+    (spec.setup().window_mm / LSB_MM).ceil() as u32
+}
+
+/// The bit-true column: the record's TDC codes through the transaction model, checked
+/// register by register against the float ΣΔ on the same codes.
 pub fn bit_true_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, ExperimentError> {
-    let codes = (rec.spec.setup().window_mm / LSB_MM).ceil() as u32;
     let probe = rec.probe()?;
-    let bt = sigma_delta::bit_true(probe, rec.detections, codes)?;
+    let bt = sigma_delta::bit_true(probe, rec.detections, codes_of(rec.spec))?;
     // Codes are 1 mm (LSB_MM), so the phasors are already in mm.
     let mut m = probe_measurement(
         rec,
@@ -326,7 +244,21 @@ pub fn bit_true_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, Exper
     Ok(Some(m))
 }
 
-/// Noise floor and amplitude of a one-sided amplitude spectrum (mm) → µm.
+/// The bit-true pixel's readout of the record without the float check (the rows' other
+/// seeds: the check's bound holds per register whatever the record, and the first seed
+/// runs it).
+pub fn bit_true_readout(rec: &RowRecord<'_>) -> Result<Measurement, ExperimentError> {
+    let probe = rec.probe()?;
+    let phasors = sigma_delta::bit_true_phasors(probe, rec.detections, codes_of(rec.spec))?;
+    Ok(probe_measurement(
+        rec,
+        phasors.iter().map(|p| p.map(|v| v * LSB_MM)).collect(),
+    ))
+}
+
+/// Noise floor and "A meas." of a one-sided amplitude spectrum (mm) → µm: the tone's
+/// interpolated peak, or without a tone the largest bin over [`PEAK_BAND`] interpolated the
+/// same way (with the [`TOP_BINS`] largest bins kept for the probe columns).
 pub fn measure_spectrum(
     spectrum: &[f64],
     n: usize,
@@ -335,64 +267,50 @@ pub fn measure_spectrum(
     let k0 = tone_bin(n);
     let tones: Vec<f64> = if tone { vec![k0 as f64] } else { vec![] };
     let noise = noise_floor(spectrum, n, FS_HZ, &NoiseBand::new(BAND.0, BAND.1), &tones)?;
-    let amp = if tone {
-        Some(interpolate_peak(spectrum, k0, 2)?.amplitude * 1e3)
+    let (amp, top_bins) = if tone {
+        (interpolate_peak(spectrum, k0, 2)?.amplitude, Vec::new())
     } else {
-        None
+        let top = largest_bins(spectrum, n, TOP_BINS);
+        let k = *top.first().ok_or_else(|| {
+            ExperimentError::option("pulses", n, "a record whose bins reach 1–20 kHz")
+        })?;
+        (interpolate_peak(spectrum, k as usize, 0)?.amplitude, top)
     };
     Ok(Measurement {
         noise_um: noise * 1e3,
-        amp_um: amp,
+        amp_um: Some(amp * 1e3),
         phasors: Vec::new(),
         bit_true: None,
+        top_bins,
     })
 }
 
-/// One seed's record: the DFT column's noise floor and amplitude (µm) and, when the ΣΔ
-/// column runs (`probe_sd`), the DFT and float-ΣΔ measurements at the shared probe bins.
-fn seed_measurement(
-    spec: &Spec,
-    n: u64,
-    seed: u64,
-    probe_sd: Option<&ProbeSetup>,
-) -> Result<(Measurement, Option<Measurement>), ExperimentError> {
-    let source = spec.setup().source(seed)?;
-    let detections = source.record(n);
-    if let Some(probe) = probe_sd {
-        let rec = RowRecord {
-            spec,
-            source: &source,
-            detections: &detections,
-            probe: Some(probe),
-        };
-        let dft =
-            dft_column(&rec)?.ok_or_else(|| ExperimentError::option("columns", DFT, "DFT"))?;
-        let sd = sd_column(&rec)?;
-        return Ok((dft, sd));
-    }
-    let held = crate::records::held_record(&source, &detections, 0.0)?;
-    drop(detections);
-    let spectrum = amplitude_spectrum(&held, WINDOW)?;
-    drop(held);
-    Ok((
-        measure_spectrum(&spectrum, n as usize, spec.amp_um.is_some())?,
-        None,
-    ))
+/// The `count` largest bins of `spectrum` over [`PEAK_BAND`], largest first (bins whose
+/// both neighbours exist).
+pub fn largest_bins(spectrum: &[f64], n: usize, count: usize) -> Vec<u64> {
+    let df = FS_HZ / n as f64;
+    let lo = ((PEAK_BAND.0 / df).ceil() as usize).max(1);
+    let hi = ((PEAK_BAND.1 / df).floor() as usize).min(spectrum.len().saturating_sub(2));
+    let mut bins: Vec<usize> = (lo..=hi).collect();
+    bins.sort_by(|&a, &b| spectrum[b].total_cmp(&spectrum[a]));
+    bins.into_iter().take(count).map(|k| k as u64).collect()
 }
 
 /// Everything measured for one row.
 #[derive(Debug, Clone)]
 pub struct RowResult {
     pub spec: Spec,
-    /// Per column, the seed-0 measurement.
-    pub columns: Vec<(&'static str, Measurement)>,
-    /// The row's seeds ([`seeds_for`]).
+    /// Pulses of every record of the row (N).
+    pub pulses: u64,
+    /// The DFT column's seed-0 measurement (phasors at the probe bins included).
+    pub dft0: Measurement,
+    /// The DFT column's seeds ([`seeds_for`]).
     pub seeds: Vec<u64>,
     /// DFT noise floors of all seeds (`seeds` order), µm.
     pub noises_um: Vec<f64>,
     /// Band bins the floor averages.
     pub band_bins: usize,
-    /// Amplitudes of all seeds (DFT), µm.
+    /// DFT "A meas." of all seeds (the tone, or the largest value without one), µm.
     pub amps_um: Vec<f64>,
     pub closed_form_um: f64,
     /// Closed-form expected amplitude g·|H(ρ_v, ω0)|·A (µm), tone rows.
@@ -402,17 +320,33 @@ pub struct RowResult {
     pub spectrum: Vec<(f64, f64)>,
     /// The same groups' largest bin (Hz, µm): where a tone is, its height.
     pub spectrum_max: Vec<(f64, f64)>,
-    /// Per seed of the first [`SD_SEEDS`] of `seeds` (when the ΣΔ column ran): the DFT and the float ΣΔ (with the
-    /// prefilter) of that seed's record at the shared probe bins.
-    pub probe_seeds: Vec<(Measurement, Measurement)>,
+    /// The probe columns that ran (float ΣΔ, bit-true), each on its own seeds.
+    pub probes: Vec<ProbeRun>,
+}
+
+impl RowResult {
+    /// The probe column `name` ([`SD`], [`BIT_TRUE`]), if it ran.
+    pub fn probe(&self, name: &str) -> Option<&ProbeRun> {
+        self.probes.iter().find(|p| p.column == name)
+    }
+}
+
+/// One DFT seed's noise floor and "A meas." (µm).
+fn dft_seed(spec: &Spec, n: u64, seed: u64) -> Result<Measurement, ExperimentError> {
+    let source = spec.setup().source(seed)?;
+    let detections = source.record(n);
+    let held = crate::records::held_record(&source, &detections, 0.0)?;
+    drop(detections);
+    let spectrum = amplitude_spectrum(&held, WINDOW)?;
+    drop(held);
+    measure_spectrum(&spectrum, n as usize, spec.amp_um.is_some())
 }
 
 /// Runs one row with the given columns ([`COLUMNS`] for the full table; the first must be
-/// the DFT column, which the seed statistics use): seed 0 in full, the other seeds of
-/// the row's seeds ([`seeds_for`]) through the DFT column (noise floor and amplitude) and, if the ΣΔ column is
-/// among `columns_to_run`, the float ΣΔ column too (the ΣΔ rows are means over the seeds;
-/// the unprefiltered and bit-true columns stay seed 0). `bench dsp` times the DFT rows
-/// alone this way.
+/// the DFT column, which the seed statistics use): the DFT column on its seeds
+/// ([`seeds_for`]; seed 0 in full, with the plotted spectrum), then each probe column
+/// among `columns_to_run` (ΣΔ, bit-true; they need `probe`) on its own seeds
+/// (`probe_runs`). `bench dsp` times the DFT rows alone this way.
 pub fn run_row_with(
     spec: &Spec,
     n: u64,
@@ -429,12 +363,7 @@ pub fn run_row_with(
         detections: &detections,
         probe,
     };
-    let mut columns = Vec::new();
-    for c in columns_to_run {
-        if let Some(m) = (c.measure)(&rec)? {
-            columns.push((c.name, m));
-        }
-    }
+    let dft0 = dft_column(&rec)?.ok_or_else(|| ExperimentError::option("columns", DFT, DFT))?;
     // The seed-0 spectrum again for the plot (cheap next to the Monte Carlo; keeps
     // the column functions pure).
     let held = held_record(&rec)?;
@@ -442,32 +371,30 @@ pub fn run_row_with(
     let spectrum = amplitude_spectrum(&held, WINDOW)?;
     drop(held);
     let (plot, plot_max) = decimate(&spectrum, n as usize);
-    let probe_sd = probe.filter(|_| columns_to_run.iter().any(|c| c.name == SD));
-    let rest: Result<Vec<(Measurement, Option<Measurement>)>, ExperimentError> = seeds[1..]
+    drop(spectrum);
+    let rest: Result<Vec<Measurement>, ExperimentError> = seeds[1..]
         .par_iter()
-        .enumerate()
-        .map(|(i, &s)| seed_measurement(spec, n, s, probe_sd.filter(|_| i + 1 < SD_SEEDS)))
+        .map(|&s| dft_seed(spec, n, s))
         .collect();
     let rest = rest?;
-    let seed_ms: Vec<&Measurement> = std::iter::once(&columns[0].1)
-        .chain(rest.iter().map(|r| &r.0))
-        .collect();
-    let seed0_sd = columns.iter().find(|(c, _)| *c == SD).map(|(_, m)| m);
-    let probe_seeds: Vec<(Measurement, Measurement)> = match seed0_sd {
-        Some(sd0) if probe_sd.is_some() => std::iter::once((columns[0].1.clone(), sd0.clone()))
-            .chain(
-                rest.iter()
-                    .filter_map(|(d, sd)| sd.as_ref().map(|sd| (d.clone(), sd.clone()))),
-            )
-            .collect(),
-        _ => Vec::new(),
-    };
+    let seed_ms: Vec<&Measurement> = std::iter::once(&dft0).chain(rest.iter()).collect();
     let noises_um: Vec<f64> = seed_ms.iter().map(|m| m.noise_um).collect();
     let amps_um: Vec<f64> = seed_ms.iter().filter_map(|m| m.amp_um).collect();
+    let mut probes = Vec::new();
+    if let Some(probe) = probe {
+        let has = |name: &str| columns_to_run.iter().any(|c| c.name == name);
+        if has(SD) {
+            probes.push(ProbeRun::float_sd(spec, n, probe, has(SD_RAW))?);
+        }
+        if has(BIT_TRUE) {
+            probes.push(ProbeRun::bit_true(spec, n, probe)?);
+        }
+    }
     Ok(RowResult {
         spec: *spec,
+        pulses: n,
+        dft0,
         seeds,
-        columns,
         noises_um,
         band_bins: band_bins(spec, n as usize)?,
         amps_um,
@@ -475,7 +402,7 @@ pub fn run_row_with(
         amp_closed_um: closed_form_amp_um(spec)?,
         spectrum: plot,
         spectrum_max: plot_max,
-        probe_seeds,
+        probes,
     })
 }
 

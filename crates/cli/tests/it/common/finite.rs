@@ -27,10 +27,14 @@ pub const NULLABLE: &[&str] = &[
     "paper",
     "design",
     "closed_form",
+    "same_record_dft",
+    "same_record_tolerance",
     "seed_sd",
     "z_paper",
     "z_closed_form",
     "band_hz",
+    // size: the paper's Section 8 figures that the paper does not print.
+    "printed",
     // size: figures of a tool that was not run (--no-sky130, no timing on the liberty).
     "model",
     "sky130",

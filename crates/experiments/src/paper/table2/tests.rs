@@ -2,6 +2,18 @@
 
 use super::*;
 use crate::paper::Tolerance;
+use crate::paper::stats::K;
+
+/// A measurement of noise `noise` µm and "A meas." `amp` µm, nothing else.
+pub(crate) fn measurement(noise: f64, amp: Option<f64>) -> Measurement {
+    Measurement {
+        noise_um: noise,
+        amp_um: amp,
+        phasors: Vec::new(),
+        bit_true: None,
+        top_bins: Vec::new(),
+    }
+}
 
 /// The plotted spectrum is the level of the spectrum: on a flat Rayleigh floor (mean
 /// sqrt(π/2) = 1.2533 mm, drawn from a fixed LCG) the median group mean above 10 kHz
@@ -39,15 +51,16 @@ fn decimated_spectrum_is_the_group_mean() {
 
 /// A short record (2^18 pulses, 38 Hz bins) of the σ_s = 7.5 mm, ρ_s = 0.3 row: the
 /// band holds ≈ 220 bins, ≈ 110 independent ones under Blackman, so the mean Rayleigh
-/// magnitude has a standard error ≈ 0.52/sqrt(110) ≈ 5%; 15% is 3σ. The ΣΔ column runs
-/// on every seed.
+/// magnitude has a standard error ≈ 0.52/sqrt(110) ≈ 5%; 15% is 3σ. The probe columns run
+/// on their own seeds (none shared with the DFT column or each other), every record read
+/// by the DFT on the probe bins too, and their rows carry the paper's ΣΔ values.
 #[test]
 fn short_row_matches_closed_form() {
     let spec = ROWS[9];
     let n = 1u64 << 18;
     let probe = crate::paper::sigma_delta::tests::setup_for_tests(n);
     let r = run_row_with(&spec, n, Some(&probe), COLUMNS).unwrap();
-    let m = &r.columns[0].1;
+    let m = &r.dft0;
     assert!(
         (m.noise_um / r.closed_form_um - 1.0).abs() < 0.15,
         "{} vs {}",
@@ -56,19 +69,36 @@ fn short_row_matches_closed_form() {
     );
     assert_eq!(r.amps_um.len(), SEEDS.len());
     assert_eq!(r.noises_um.len(), SEEDS.len());
-    // The ΣΔ noise and amplitude rows are means over every seed, each seed's ΣΔ read
-    // against the DFT of its own record (the 3% / 3ē tolerances of `sigma_delta`).
-    assert_eq!(r.probe_seeds.len(), SEEDS.len());
-    // The row's own seeds (row 9 of ROWS: 10000..10005), shared with no other row.
+    // The row's own seeds (row 9 of ROWS: 10000..10005 for the DFT, 10100.. for the ΣΔ,
+    // 10200.. for the bit-true pixel).
     assert_eq!(r.seeds, (10_000..10_005).collect::<Vec<u64>>());
-    let sd_rows = crate::paper::sigma_delta::rows(&r);
-    for fam in ["Table 2 ΣΔ noise", "Table 2 ΣΔ amplitude"] {
-        let row = sd_rows.iter().find(|x| x.family == fam).expect(fam);
-        assert_eq!(row.seeds, r.seeds, "{row:?}");
+    let sd = r.probe(SD).expect("ΣΔ ran");
+    let bt = r.probe(BIT_TRUE).expect("bit-true ran");
+    assert_eq!(sd.seeds, (10_100..10_105).collect::<Vec<u64>>());
+    assert_eq!(bt.seeds, (10_200..10_205).collect::<Vec<u64>>());
+    assert_eq!(sd.records.len(), SEEDS.len());
+    assert!(bt.check.as_ref().is_some_and(|c| c.worst_ratio <= 1.0));
+    let rows = crate::paper::sigma_delta::rows(&r, true);
+    for fam in [
+        "Table 2 ΣΔ noise",
+        "Table 2 ΣΔ amplitude",
+        "Table 2 ΣΔ SNR",
+        "Table 2 bit-true noise",
+        "Table 2 bit-true amplitude",
+        "Table 2 bit-true SNR",
+    ] {
+        let row = rows.iter().find(|x| x.family == fam).expect(fam);
+        let st = if fam.contains("ΣΔ") { sd } else { bt };
+        assert_eq!(row.seeds, st.seeds, "{row:?}");
         assert!(row.pass && row.seed_sd.is_some_and(|s| s > 0.0), "{row:?}");
+        assert!(
+            row.paper.is_some() && row.same_record_dft.is_some(),
+            "{row:?}"
+        );
+        assert!(row.closed_form.is_some(), "{row:?}");
     }
     let dft_only = run_row_with(&spec, n, Some(&probe), &COLUMNS[..1]).unwrap();
-    assert!(dft_only.probe_seeds.is_empty());
+    assert!(dft_only.probes.is_empty());
 }
 
 /// Statistical power: at N = 10^7 every tested amplitude row has seeds enough that a
@@ -81,7 +111,7 @@ fn a_ten_micron_amplitude_bias_fails_every_tested_row() {
     let n = FULL_N;
     let mut all: Vec<u64> = Vec::new();
     let mut tested = 0;
-    for spec in ROWS {
+    for spec in ROWS.iter() {
         let seeds = seeds_for(spec, n).unwrap();
         eprintln!("{}: {} seeds from {}", spec.label(), seeds.len(), seeds[0]);
         all.extend(&seeds);
@@ -106,8 +136,9 @@ fn a_ten_micron_amplitude_bias_fails_every_tested_row() {
         let row_with = |amps: Vec<f64>| {
             let r = RowResult {
                 spec: *spec,
+                pulses: n,
+                dft0: measurement(floor, None),
                 seeds: (0..amps.len() as u64).collect(),
-                columns: Vec::new(),
                 noises_um: vec![floor; amps.len()],
                 band_bins: 100,
                 amps_um: amps,
@@ -115,9 +146,9 @@ fn a_ten_micron_amplitude_bias_fails_every_tested_row() {
                 amp_closed_um: Some(amp),
                 spectrum: Vec::new(),
                 spectrum_max: Vec::new(),
-                probe_seeds: Vec::new(),
+                probes: Vec::new(),
             };
-            amplitude_row(&r).unwrap()
+            amplitude_row(&r, false).unwrap()
         };
         let row = row_with(draws(seeds.len(), 0.0));
         if matches!(row.tolerance, Tolerance::Untested) {
