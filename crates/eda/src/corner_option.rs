@@ -57,6 +57,10 @@ pub struct CornerOption {
     pub note: String,
 }
 
+/// Candidates synthesised at most per missed corner by default (`tofprobe size
+/// --corner-trials`, and `tofprobe layout`'s search for a corner missed after routing).
+pub const DEFAULT_TRIALS: usize = 3;
+
 /// How a candidate is judged at a missed corner.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Criterion {

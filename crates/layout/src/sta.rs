@@ -285,7 +285,10 @@ mod tests {
         assert_eq!(t.hold_groups[0].group, "**clock_gating_default**");
         assert_eq!(t.hold_groups[0].slack_ns, 6.51);
         assert_eq!(t.hold_slack_ns, -1.6524, "{t:?}");
-        assert_eq!(t.hold_path, ("wd_0_DFFPOSX1_Q".into(), "y[0]_LATCH_Q".into()));
+        assert_eq!(
+            t.hold_path,
+            ("wd_0_DFFPOSX1_Q".into(), "y[0]_LATCH_Q".into())
+        );
         assert_eq!(t.hold_slack_registers_ns, -1.6524);
         assert_eq!(t.hold_registers_path.1, "y[0]_LATCH_Q");
         assert!(!t.met(), "a hold violation between registers is a miss");
@@ -308,15 +311,22 @@ mod tests {
         let first_group = &hold[..hold.find("Startpoint: wd_0").unwrap()];
         let worst_line = &hold[hold.find("TOFPROBE-WORST").unwrap()..];
         let cut = format!("{head}== hold\n{first_group}{worst_line}== hold-registers{regs}");
-        let e = parse(&cut, 6.25, 0, Path::new("l")).unwrap_err().to_string();
+        let e = parse(&cut, 6.25, 0, Path::new("l"))
+            .unwrap_err()
+            .to_string();
         assert!(
             e.contains("6.5100") && e.contains("-1.6524") && e.contains("clock_gating"),
             "{e}"
         );
         // No paths at all: named.
-        let e = parse("== setup\n== hold\n== hold-registers\n", 6.25, 0, Path::new("l"))
-            .unwrap_err()
-            .to_string();
+        let e = parse(
+            "== setup\n== hold\n== hold-registers\n",
+            6.25,
+            0,
+            Path::new("l"),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("a setup path"), "{e}");
     }
 
