@@ -93,7 +93,6 @@ pub fn time(i: &TimingInputs<'_>) -> Result<Timed> {
     let post_route = post(&i.liberty.path, "typical")?;
     let mut corners = Vec::new();
     let mut corner_options = Vec::new();
-    let clock_mhz = 1e3 / i.period_ns;
     for (library, corner, path) in &i.corners {
         let synth_t = tofprobe_eda::corners::time_cached(i.synthesis, path, corner, "clk")?;
         let post_route = if *path == i.liberty.path {
@@ -101,23 +100,12 @@ pub fn time(i: &TimingInputs<'_>) -> Result<Timed> {
         } else {
             post(path, corner)?
         };
-        if post_route.setup_slack_ns < 0.0 {
-            // The search starts from the routed f_max and judges each candidate's
-            // synthesis f_max scaled by what routing cost this pixel at this corner.
-            let row = CornerTiming::new(
-                library,
-                corner,
-                path,
-                &tofprobe_eda::sta::Timing {
-                    critical_path_ns: 1e3 / post_route.f_max_mhz,
-                    f_max_mhz: post_route.f_max_mhz,
-                    startpoint: post_route.setup_path.0.clone(),
-                    endpoint: post_route.setup_path.1.clone(),
-                    path_cells: 0,
-                },
-                clock_mhz,
-                i.design.laser_rate_hz,
-            );
+        if let Some((row, criterion)) = missed_corner(
+            (library, corner, path),
+            &post_route,
+            synth_t.f_max_mhz,
+            i.design.laser_rate_hz,
+        ) {
             corner_options.push(tofprobe_eda::corner_option::find(
                 i.provider,
                 &i.design,
@@ -126,7 +114,7 @@ pub fn time(i: &TimingInputs<'_>) -> Result<Timed> {
                 "clk",
                 i.cache,
                 DEFAULT_TRIALS,
-                Criterion::post_route(post_route.f_max_mhz / synth_t.f_max_mhz),
+                criterion,
                 i.synthesis.total_area_um2,
             )?);
         }
@@ -143,4 +131,83 @@ pub fn time(i: &TimingInputs<'_>) -> Result<Timed> {
         corners,
         corner_options,
     })
+}
+
+/// For a corner whose post-route setup fails: the row the option search starts from (the
+/// routed f_max at the corner) and its criterion (each candidate's synthesis f_max scaled
+/// by what routing cost this pixel there, `post-route / synthesis f_max`, slack ≥ 0).
+pub fn missed_corner(
+    (library, corner, liberty): (&str, &str, &Path),
+    post: &PostRoute,
+    synthesis_f_max_mhz: f64,
+    laser_rate_hz: f64,
+) -> Option<(CornerTiming, Criterion)> {
+    if post.setup_slack_ns >= 0.0 {
+        return None;
+    }
+    let row = CornerTiming::new(
+        library,
+        corner,
+        liberty,
+        &tofprobe_eda::sta::Timing {
+            critical_path_ns: 1e3 / post.f_max_mhz,
+            f_max_mhz: post.f_max_mhz,
+            startpoint: post.setup_path.0.clone(),
+            endpoint: post.setup_path.1.clone(),
+            path_cells: 0,
+        },
+        1e3 / post.period_ns,
+        laser_rate_hz,
+    );
+    Some((
+        row,
+        Criterion::post_route(post.f_max_mhz / synthesis_f_max_mhz),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_corner_missed_after_routing_starts_the_search_at_its_routed_f_max() {
+        // The 2-bin pixel's recorded post-route timing (osu018, 6.25 ns: met) moved to a
+        // corner that misses: post-route 40 MHz where synthesis gave 44.4 MHz.
+        let clean: crate::report::LayoutReport =
+            serde_json::from_str(include_str!("../testdata/layout-report-2bin-osu018.json"))
+                .unwrap();
+        let met = &clean.post_route;
+        assert!(
+            missed_corner(
+                ("osu018_stdcells", "typical", Path::new("l")),
+                met,
+                316.8,
+                10e6
+            )
+            .is_none()
+        );
+        let mut slow = met.clone();
+        slow.f_max_mhz = 40.0;
+        slow.setup_slack_ns = 6.25 - 25.0;
+        let (row, c) =
+            missed_corner(("lib", "ss", Path::new("ss.lib")), &slow, 44.4, 10e6).unwrap();
+        assert_eq!(
+            (row.f_max_mhz, row.clock_mhz, row.meets_clock),
+            (40.0, 160.0, false)
+        );
+        assert!((c.derate - 40.0 / 44.4).abs() < 1e-12 && c.margin_percent == 0.0);
+        // The 2-bin pixel: P = 2B = 4 operations a pulse, configured C = 16 (160 MHz). At
+        // 40 MHz with no margin the search starts at K = 4 (A = 1, 40 MHz), then A = 2 (K =
+        // 2) and A = 4 (K = 1).
+        assert_eq!(
+            tofprobe_eda::corner_option::candidates_with(
+                4,
+                16,
+                10e6,
+                row.f_max_mhz,
+                c.margin_percent
+            ),
+            vec![(1, 4), (2, 2), (4, 1)]
+        );
+    }
 }
