@@ -391,11 +391,12 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
     let mut corner_options = Vec::new();
     let missed = timing_corners.iter().filter(|c| !c.meets_margin);
     for row in missed.take_while(|_| req.corner_trials > 0) {
-        // The timing liberty's own row, or a sky130 corner (mapped on sky130 tt).
-        let map_on = if row.library == lib.name {
-            &lib
-        } else if let Some(sky) = &sky_typical {
-            sky
+        // The timing liberty's own row, or a sky130 corner (mapped on sky130 tt), and the
+        // configured pixel's area there (the option's area is compared with it).
+        let (map_on, configured_area) = if row.library == lib.name {
+            (&lib, main.synthesis.total_area_um2)
+        } else if let (Some(sky), Some(s)) = (&sky_typical, &sky130) {
+            (sky, s.area.total_area_um2)
         } else {
             continue;
         };
@@ -407,6 +408,8 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
             &req.clock_port,
             &req.cache,
             req.corner_trials,
+            crate::corner_option::Criterion::SYNTHESIS,
+            configured_area,
         )?);
     }
 

@@ -100,6 +100,13 @@ pub fn time_netlist(
 /// Parses `report_checks` output: the path of each path group (`clk`, and the clock gating
 /// checks of a latch-and-AND clock gate), the one that needs the longest clock period.
 pub fn parse_report(text: &str) -> Result<Timing> {
+    parse_report_at(text, PROBE_PERIOD_NS)
+}
+
+/// [`parse_report`] of a report at the clock period `period_ns` (the post-route timing's
+/// setup paths at the configuration's clock, `tofprobe_layout::sta`): each path's minimum
+/// period scaled from its launch and capture edges within `period_ns`.
+pub fn parse_report_at(text: &str, period_ns: f64) -> Result<Timing> {
     let err = |what| EdaError::Parse {
         tool: "sta",
         what,
@@ -107,7 +114,7 @@ pub fn parse_report(text: &str) -> Result<Timing> {
     };
     let mut best: Option<Timing> = None;
     for block in text.split("Startpoint:").skip(1) {
-        let t = parse_path(&format!("Startpoint:{block}"))?;
+        let t = parse_path(&format!("Startpoint:{block}"), period_ns)?;
         if best
             .as_ref()
             .is_none_or(|b| t.critical_path_ns > b.critical_path_ns)
@@ -123,7 +130,7 @@ pub fn parse_report(text: &str) -> Result<Timing> {
 /// gate's latch opens on the falling edge, L = P/2) and captured at C (P, or P/2 for the
 /// gating check of a gate on the inverted clock) with slack s needs (C − L − s)·P/(C − L);
 /// for a flop-to-flop path (L = 0, C = P) that is P − s = arrival + setup.
-fn parse_path(text: &str) -> Result<Timing> {
+fn parse_path(text: &str, period_ns: f64) -> Result<Timing> {
     let err = |what| EdaError::Parse {
         tool: "sta",
         what,
@@ -152,7 +159,7 @@ fn parse_path(text: &str) -> Result<Timing> {
         .find(|l| l.contains(" clock ") && l.trim_end().ends_with("edge)"))
         .and_then(|l| l.split_whitespace().nth(1))
         .and_then(|v| v.parse::<f64>().ok())
-        .filter(|l| (0.0..PROBE_PERIOD_NS).contains(l))
+        .filter(|l| (0.0..period_ns).contains(l))
         .unwrap_or(0.0);
     // Cells on the path: lines "delay time ^/v inst/PIN (CELL)" with an output pin,
     // between the clock's launch and the arrival, excluding the launching flop's CLK.
@@ -174,9 +181,9 @@ fn parse_path(text: &str) -> Result<Timing> {
         .find(|l| l.contains(" clock ") && l.trim_end().ends_with("edge)"))
         .and_then(|l| l.split_whitespace().nth(1))
         .and_then(|v| v.parse::<f64>().ok())
-        .filter(|c| *c > launch && *c <= PROBE_PERIOD_NS)
-        .unwrap_or(PROBE_PERIOD_NS);
-    let open = PROBE_PERIOD_NS - launch;
+        .filter(|c| *c > launch && *c <= period_ns)
+        .unwrap_or(period_ns);
+    let open = period_ns - launch;
     // A latch endpoint (a latch-and-AND clock gate's enable latch, open while clk is low):
     // OpenSTA requires the data at the opening edge and lets it borrow up to the closing
     // edge, the next rising edge of clk. So its constraint is a full cycle: the arrival
@@ -189,8 +196,8 @@ fn parse_path(text: &str) -> Result<Timing> {
         .and_then(|v| v.parse::<f64>().ok());
     let window = capture - launch;
     let critical = match (latch_endpoint, arrival) {
-        (true, Some(a)) => (a - launch) * PROBE_PERIOD_NS / open,
-        _ => (window - slack) * PROBE_PERIOD_NS / window,
+        (true, Some(a)) => (a - launch) * period_ns / open,
+        _ => (window - slack) * period_ns / window,
     };
     // The report prints 4 digits; round away the binary noise of 1000 − slack.
     let critical = (critical * 1e4).round() / 1e4;

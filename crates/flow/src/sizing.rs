@@ -40,7 +40,7 @@ pub struct SizeOptions {
 }
 
 /// `tofprobe size`'s default [`SizeOptions::corner_trials`].
-pub const DEFAULT_CORNER_TRIALS: usize = 3;
+pub const DEFAULT_CORNER_TRIALS: usize = tofprobe_eda::corner_option::DEFAULT_TRIALS;
 
 /// The B sweep: `a.sweep_bins`, or 4, 8 and the configured B (those ≤ B).
 fn sweep_bins_of(a: &SizeOptions, bins: u64) -> Vec<u64> {

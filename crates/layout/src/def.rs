@@ -190,6 +190,70 @@ fn segment_length(t: &[&str]) -> f64 {
     len
 }
 
+/// One DEF section's declared count (`NETS 2702 ;`) and the entries it lists.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SectionCount {
+    /// The section (`SPECIALNETS`).
+    pub section: String,
+    /// The count its header declares.
+    pub declared: u64,
+    /// The entries (`- NAME …`) it lists.
+    pub listed: u64,
+}
+
+/// Every counted section of a DEF (a header `NAME N ;` closed by `END NAME`) with its
+/// declared and listed counts.
+pub fn section_counts(text: &str) -> Vec<SectionCount> {
+    let mut out: Vec<SectionCount> = Vec::new();
+    let mut open: Option<usize> = None;
+    for line in text.lines() {
+        let t: Vec<&str> = line.split_whitespace().collect();
+        if let Some(i) = open {
+            if t.as_slice() == ["END", out[i].section.as_str()] {
+                open = None;
+            } else if t.first() == Some(&"-") {
+                out[i].listed += 1;
+            }
+            continue;
+        }
+        if let [name, n, ";"] = t.as_slice()
+            && name.chars().all(|c| c.is_ascii_uppercase())
+            && let Ok(declared) = n.parse::<u64>()
+        {
+            out.push(SectionCount {
+                section: name.to_string(),
+                declared,
+                listed: 0,
+            });
+            open = Some(out.len() - 1);
+        }
+    }
+    out
+}
+
+/// The DEF with every section's declared count set to the entries it lists. qrouter 1.4
+/// declares its routed DEF's SPECIALNETS as the nets it wrote plus the input's special
+/// nets, which it had written among them (the 2-bin pixel: 359 declared, 357 listed).
+pub fn fix_counts(text: &str) -> String {
+    let counts = section_counts(text);
+    let mut out = String::with_capacity(text.len());
+    let mut next = counts.iter();
+    let mut want = next.next();
+    for line in text.lines() {
+        if let Some(c) = want {
+            let t: Vec<&str> = line.split_whitespace().collect();
+            if t.len() == 3 && t[0] == c.section && t[2] == ";" && t[1].parse::<u64>().is_ok() {
+                out += &format!("{} {} ;\n", c.section, c.listed);
+                want = next.next();
+                continue;
+            }
+        }
+        out += line;
+        out.push('\n');
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -226,5 +290,31 @@ mod tests {
                    - a NAND9 + PLACED ( 0 0 ) N ;\nEND COMPONENTS\n";
         let e = parse_def(def, &lef_sizes(LEF), "FILL", Path::new("x.def")).unwrap_err();
         assert!(e.to_string().contains("`NAND9`"), "{e}");
+    }
+
+    #[test]
+    fn declared_counts_are_set_to_the_entries_listed() {
+        // The 2-bin pixel's routed DEF as qrouter wrote it: SPECIALNETS declared 359 and
+        // listed 357 (shortened here to 3 declared, 2 listed, with an empty entry).
+        let def = "VERSION 5.6 ;\nPINS 1 ;\n- clk + NET clk\n  + LAYER metal2 ( -15 -15 ) ( 15 15 )\n  + PLACED ( 0 0 ) N ;\nEND PINS\n\
+                   NETS 1 ;\n- clk\n  ( PIN clk )\n+ ROUTED metal2 ( 0 0 ) ( 0 100 ) ;\nEND NETS\n\
+                   SPECIALNETS 3 ;\n- clk_bF$buf50\n;\n- vdd\n+ FIXED metal1 40 ( 0 0 ) ( 100 0 ) ;\nEND SPECIALNETS\nEND DESIGN\n";
+        let before = section_counts(def);
+        assert_eq!(
+            before
+                .iter()
+                .map(|c| (c.section.as_str(), c.declared, c.listed))
+                .collect::<Vec<_>>(),
+            vec![("PINS", 1, 1), ("NETS", 1, 1), ("SPECIALNETS", 3, 2)]
+        );
+        let fixed = fix_counts(def);
+        assert!(fixed.contains("SPECIALNETS 2 ;\n"), "{fixed}");
+        assert!(
+            section_counts(&fixed)
+                .iter()
+                .all(|c| c.declared == c.listed)
+        );
+        // Nothing else changed.
+        assert_eq!(fixed.replace("SPECIALNETS 2 ;", "SPECIALNETS 3 ;"), def);
     }
 }

@@ -10,103 +10,13 @@ use tofprobe_eda::liberty::Liberty;
 use tofprobe_eda::scaling::AreaModel;
 
 use crate::error::{LayoutError, Result};
+pub use crate::options::{
+    AUTO_CLEANUP_MAX_CELLS, AUTO_DENSITY_LARGE, AUTO_DENSITY_SMALL, Density, MAX_ATTEMPTS,
+    MIN_DENSITY, RouteCleanup, check_options, densities,
+};
 use crate::qflow::{Project, route_verdict};
 use crate::report::{Attempt, LayoutReport, SCHEMA, Step, SynthFigures};
 use crate::tech::{Tech, TechFiles};
-
-/// Densities below this are not tried (the macro would be mostly fill).
-pub const MIN_DENSITY: f64 = 0.2;
-/// Placement attempts at most (the asked density, then 0.1 lower each time).
-pub const MAX_ATTEMPTS: usize = 3;
-/// Above this many cells `RouteCleanup::Auto` skips qrouter's stage 3: on the default
-/// pixel (9,248 cells) it re-routed 40–60 nets a minute after stages 1 and 2 had routed
-/// all 9,435 nets in ≈ 47 min, i.e. hours for wirelength alone; the 2-bin pixel (2,627
-/// cells) keeps it (it takes a minute there).
-pub const AUTO_CLEANUP_MAX_CELLS: u64 = 5_000;
-
-/// Whether qrouter runs its stage 3, the cleanup that rips up and re-routes every routed
-/// net. Stages 1 and 2 (route, then rip up and re-route the failures) leave every net
-/// routed; stage 3 shortens the wires and removes defects stage 2 can leave (the default
-/// pixel's stage-2 route had 3 DRC errors and one open net, which the ECO re-route,
-/// `crate::repair`, clears by re-routing two nets; docs/layout.md).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RouteCleanup {
-    /// On up to [`AUTO_CLEANUP_MAX_CELLS`] cells, off above.
-    Auto,
-    /// Always (qflow's own `qrouter::standard_route`).
-    On,
-    /// Never (`qrouter::standard_route` with its `nocleanup` argument).
-    Off,
-}
-
-impl RouteCleanup {
-    /// Parses `auto`, `on` or `off` (the CLI's `--route-cleanup`).
-    pub fn parse(s: &str) -> Result<RouteCleanup> {
-        match s {
-            "auto" => Ok(RouteCleanup::Auto),
-            "on" => Ok(RouteCleanup::On),
-            "off" => Ok(RouteCleanup::Off),
-            _ => Err(LayoutError::Option {
-                option: "route-cleanup",
-                value: s.into(),
-                allowed: "auto, on or off".into(),
-            }),
-        }
-    }
-
-    /// Whether stage 3 runs for a netlist of `cells` cells.
-    pub fn runs(self, cells: u64) -> bool {
-        match self {
-            RouteCleanup::Auto => cells <= AUTO_CLEANUP_MAX_CELLS,
-            RouteCleanup::On => true,
-            RouteCleanup::Off => false,
-        }
-    }
-}
-
-/// The density `Density::Auto` asks for up to [`AUTO_CLEANUP_MAX_CELLS`] cells (the 2-bin
-/// pixel routes clean there, stage 3 included) and above ([`AUTO_DENSITY_LARGE`]).
-pub const AUTO_DENSITY_SMALL: f64 = 0.6;
-/// The density `Density::Auto` asks for above [`AUTO_CLEANUP_MAX_CELLS`] cells: the default
-/// pixel (9,248 cells) routes every net at 0.5 with stages 1 and 2 and is clean after the
-/// ECO re-route (docs/layout.md); at 0.6 stage 2 had not finished after 34 min.
-pub const AUTO_DENSITY_LARGE: f64 = 0.5;
-
-/// The target placement density asked for: a number, or `auto` (by the netlist's size).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Density {
-    /// [`AUTO_DENSITY_SMALL`] up to [`AUTO_CLEANUP_MAX_CELLS`] cells, [`AUTO_DENSITY_LARGE`] above.
-    Auto,
-    /// This density (cells / core), [`MIN_DENSITY`] ..= 0.95.
-    Fixed(f64),
-}
-
-impl Density {
-    /// Parses `auto` or a number (the CLI's `--density`); the range is checked by
-    /// [`check_options`].
-    pub fn parse(s: &str) -> Result<Density> {
-        if s == "auto" {
-            return Ok(Density::Auto);
-        }
-        s.trim()
-            .parse::<f64>()
-            .map(Density::Fixed)
-            .map_err(|_| LayoutError::Option {
-                option: "density",
-                value: s.into(),
-                allowed: format!("auto or a number {MIN_DENSITY} ..= 0.95, e.g. 0.5"),
-            })
-    }
-
-    /// The density to place a netlist of `cells` cells at.
-    pub fn target(self, cells: u64) -> f64 {
-        match self {
-            Density::Auto if cells <= AUTO_CLEANUP_MAX_CELLS => AUTO_DENSITY_SMALL,
-            Density::Auto => AUTO_DENSITY_LARGE,
-            Density::Fixed(d) => d,
-        }
-    }
-}
 
 /// What to lay out and how.
 #[derive(Debug, Clone, PartialEq)]
@@ -136,37 +46,6 @@ pub struct LayoutRun {
     pub files: Vec<(String, PathBuf)>,
     /// The qflow project directory (logs of every tool).
     pub project: PathBuf,
-}
-
-/// Checks the request's numbers before anything runs.
-pub fn check_options(density: Density, node_nm: f64) -> Result<()> {
-    if let Density::Fixed(density) = density
-        && !(density.is_finite() && (MIN_DENSITY..=0.95).contains(&density))
-    {
-        return Err(LayoutError::Option {
-            option: "density",
-            value: density.to_string(),
-            allowed: format!(
-                "auto or {MIN_DENSITY} ..= 0.95 (0.5 routes the default pixel on osu018)"
-            ),
-        });
-    }
-    if !(node_nm.is_finite() && node_nm > 0.0 && node_nm <= 1000.0) {
-        return Err(LayoutError::Option {
-            option: "node-nm",
-            value: node_nm.to_string(),
-            allowed: "0 < node ≤ 1000 (nm), e.g. 40".into(),
-        });
-    }
-    Ok(())
-}
-
-/// The densities tried for a request of `d`.
-pub fn densities(d: f64) -> Vec<f64> {
-    (0..MAX_ATTEMPTS)
-        .map(|i| ((d - 0.1 * i as f64) * 100.0).round() / 100.0)
-        .filter(|&x| x >= MIN_DENSITY - 1e-9)
-        .collect()
 }
 
 /// Lays out `design`; `progress` hears each step's name as it starts.
@@ -268,6 +147,7 @@ pub fn run(
         progress(&format!("placement at density {d}"));
         let t = Instant::now();
         project.stage("placement", "place", "place.log")?;
+        project.keep_routes_inside()?;
         timed(&mut steps, &format!("placement (graywolf, density {d})"), t);
         progress("routing");
         let t = Instant::now();
@@ -306,6 +186,7 @@ pub fn run(
     }
 
     // 3. Checks and views; a dirty route is repaired by re-routing the nets at its errors.
+    let die_growth = project.grow_die()?;
     progress("DRC, extraction, LEF, LVS");
     let first = project.checks()?;
     steps.push(Step {
@@ -335,37 +216,42 @@ pub fn run(
     project.stage("GDS", "gdsii", "gdsii.log")?;
     timed(&mut steps, "GDS (magic)", t);
 
-    // 4. Post-route timing.
+    // 4. The routed DEF's boundary and counts, the GDS read back, the laid-out netlist
+    // proven equivalent to the RTL.
+    progress("boundary, GDS, equivalence");
+    let t = Instant::now();
+    let def_path = project.layout_file("def");
+    let def_text =
+        std::fs::read_to_string(&def_path).map_err(|e| LayoutError::io("reading", &def_path, e))?;
+    let geometry = crate::boundary::Geometry::from_lef(&[
+        &std::fs::read_to_string(&tech.tech_lef)
+            .map_err(|e| LayoutError::io("reading", &tech.tech_lef, e))?,
+        &lef_text,
+    ]);
+    let def_boundary = crate::boundary::outside_die(&def_text, &geometry, &sizes, &def_path)?;
+    let def_counts = crate::def::section_counts(&def_text);
+    let frame = crate::die::frame(&def_text, &def_path)?;
+    let u = frame.units;
+    let gds = crate::gds::inspect(
+        &project.layout_file("gds"),
+        (
+            frame.die.0 / u,
+            frame.die.1 / u,
+            frame.die.2 / u,
+            frame.die.3 / u,
+        ),
+        &dir.join("layout"),
+    )?;
+    let equivalence = laid_out_proof(&project, &provider, &def_text, syn, &tech, req, b, w)?;
+    timed(
+        &mut steps,
+        "boundary, GDS (klayout), equivalence (yosys)",
+        t,
+    );
+
+    // 5. Post-route timing at every corner, the option for a corner missed.
     progress("post-route timing");
     let t = Instant::now();
-    let rc_path = project.layout_file("rc");
-    let rc =
-        std::fs::read_to_string(&rc_path).map_err(|e| LayoutError::io("reading", &rc_path, e))?;
-    let mut nets = crate::spef::parse_rc(&rc, &rc_path)?;
-    let netlist = project.synthesis_file("rtlnopwr.v");
-    let verilog =
-        std::fs::read_to_string(&netlist).map_err(|e| LayoutError::io("reading", &netlist, e))?;
-    crate::spef::rename_to_netlist(&mut nets, &verilog);
-    let spef_path = project.layout_file("spef");
-    std::fs::write(&spef_path, crate::spef::write_spef(&top, &nets))
-        .map_err(|e| LayoutError::io("writing", &spef_path, e))?;
-    let spef_nets = nets.iter().filter(|n| !n.points.is_empty()).count();
-    let post = |lib: &Path, corner: &str| {
-        crate::sta::run(
-            lib,
-            &netlist,
-            &spef_path,
-            &top,
-            period_ns,
-            spef_nets,
-            &dir.join("layout"),
-            corner,
-        )
-    };
-    let post_route = post(&tech.liberty, "typical")?;
-    // Every corner: the synthesis netlist timed on each liberty (the size report's
-    // figures, cached), the routed one with the same wires.
-    let mut corners = Vec::new();
     let corner_libs: Vec<(String, String, PathBuf)> = match &sky130_pdk {
         Some(pdk) => pdk
             .corners
@@ -380,32 +266,33 @@ pub fn run(
             .collect::<Result<_>>()?,
         None => vec![(lib.name.clone(), "typical".into(), tech.liberty.clone())],
     };
-    for (library, corner, path) in corner_libs {
-        let synth_t = tofprobe_eda::corners::time_cached(syn, &path, &corner, "clk")?;
-        let post_route = if path == tech.liberty {
-            post_route.clone()
-        } else {
-            post(&path, &corner)?
-        };
-        corners.push(crate::report::CornerRow {
-            library,
-            corner,
-            synthesis_f_max_mhz: synth_t.f_max_mhz,
-            synthesis_slack_ns: period_ns - synth_t.critical_path_ns,
-            post_route,
-        });
-    }
+    let timed_corners = crate::corners::time(&crate::corners::TimingInputs {
+        project: &project,
+        synthesis: syn,
+        liberty: &lib,
+        corners: corner_libs,
+        design: tofprobe_eda::size_report::Design {
+            bins: b,
+            width: w,
+            registers: pixel.registers() as u64,
+            ops_per_pulse: pixel.ops_per_pulse() as u64,
+            adders: pixel.adders as u64,
+            cycles_per_pulse: pixel.cycles_per_pulse as u64,
+            laser_rate_hz: design.sensor().laser_rate_hz,
+        },
+        provider: &provider,
+        cache: &req.cache,
+        period_ns,
+    })?;
+    let netlist = project.synthesis_file("rtlnopwr.v");
     timed(&mut steps, "post-route timing (OpenSTA + SPEF)", t);
 
-    // 5. Picture, figures, bins per pitch.
+    // 6. Picture, figures, bins per pitch.
     progress("picture");
     let t = Instant::now();
     let png = project.layout_file("png");
     crate::picture::draw(&project.layout_file("gds"), &png, 1600, &dir.join("layout"))?;
     timed(&mut steps, "picture (klayout)", t);
-    let def_path = project.layout_file("def");
-    let def_text =
-        std::fs::read_to_string(&def_path).map_err(|e| LayoutError::io("reading", &def_path, e))?;
     let def = crate::def::parse_def(&def_text, &sizes, &tech.fill, &def_path)?;
     let model = AreaModel::fit(
         &points
@@ -433,7 +320,7 @@ pub fn run(
         slack_ns: main.timing.as_ref().map(|t| period_ns - t.critical_path_ns),
         key: syn.key.clone(),
     };
-    let report = LayoutReport {
+    let mut report = LayoutReport {
         schema: SCHEMA.into(),
         tech: tech.tech.name().into(),
         config: design.origin.clone(),
@@ -450,13 +337,21 @@ pub fn run(
         lvs_result,
         lvs_errors,
         repair,
-        post_route,
+        post_route: timed_corners.post_route,
         bins_per_pitch,
         steps,
         clock_buffers,
-        corners,
+        corners: timed_corners.corners,
+        die_growth: Some(die_growth),
+        def_boundary: Some(def_boundary),
+        def_counts,
+        gds: Some(gds),
+        equivalence: Some(equivalence),
+        corner_options: timed_corners.corner_options,
+        failures: vec![],
         notes: notes(&tech, other, route_cleanup),
     };
+    report.failures = crate::verdict::failures(&report);
     let ext = |e: &str| project.layout_file(e);
     let files = vec![
         (format!("{top}.def"), ext("def")),
@@ -464,6 +359,10 @@ pub fn run(
         (format!("{top}.lef"), ext("lef")),
         (format!("{top}.spef"), ext("spef")),
         (format!("{top}.v"), netlist),
+        (
+            format!("{top}.laid-out.v"),
+            project.layout_file("laid-out.v"),
+        ),
         ("layout.png".to_string(), png),
     ];
     Ok(LayoutRun {
@@ -471,6 +370,71 @@ pub fn run(
         files,
         project: dir,
     })
+}
+
+/// The routed DEF's netlist (`layout/TOP.laid-out.v`, [`crate::netlist::from_def`]) proven
+/// equivalent to the pixel's RTL by the project's proof (`tofprobe_eda::equiv`, cached
+/// beside the sign-off proofs); an unproven pair is the report's verdict, not an error.
+#[allow(clippy::too_many_arguments)]
+fn laid_out_proof(
+    project: &Project,
+    provider: &GeneratedPixel,
+    def_text: &str,
+    syn: &tofprobe_eda::synth::Synthesis,
+    tech: &TechFiles,
+    req: &LayoutRequest,
+    b: u64,
+    w: u32,
+) -> Result<crate::netlist::LaidOutProof> {
+    use tofprobe_eda::analysis::RtlProvider as _;
+    let def_path = project.layout_file("def");
+    let synthesised = std::fs::read_to_string(&syn.netlist_verilog)
+        .map_err(|e| LayoutError::io("reading", &syn.netlist_verilog, e))?;
+    let laid = crate::netlist::from_def(def_text, &synthesised, &project.top, &def_path)?;
+    let path = project.layout_file("laid-out.v");
+    std::fs::write(&path, &laid.verilog).map_err(|e| LayoutError::io("writing", &path, e))?;
+    let work = project.dir.join("equiv");
+    std::fs::create_dir_all(&work).map_err(|e| LayoutError::io("creating", &work, e))?;
+    let rtl = provider.rtl(b, w, &work)?;
+    let spec = tofprobe_eda::equiv::EquivSpec {
+        rtl: rtl.sources,
+        top: rtl.top,
+        params: rtl.params,
+        netlist: path.clone(),
+        liberty: tech.liberty.clone(),
+    };
+    let proof = tofprobe_eda::equiv::check_equivalence_cached(
+        &spec,
+        &work,
+        Some(&req.cache.join("equiv-proofs")),
+    );
+    let name = format!("{}.laid-out.v", project.top);
+    let base = crate::netlist::LaidOutProof {
+        netlist: name,
+        cells: laid.cells,
+        physical_only: laid.physical_only,
+        points: 0,
+        proven: 0,
+        first_unproven: String::new(),
+        seconds: 0.0,
+        cached: false,
+    };
+    match proof {
+        Ok(e) => Ok(crate::netlist::LaidOutProof {
+            points: e.points,
+            proven: e.proven,
+            seconds: e.seconds,
+            cached: e.cached,
+            ..base
+        }),
+        Err(tofprobe_eda::EdaError::NotEquivalent(f)) => Ok(crate::netlist::LaidOutProof {
+            points: f.total,
+            proven: f.total - f.unproven,
+            first_unproven: f.first,
+            ..base
+        }),
+        Err(e) => Err(e.into()),
+    }
 }
 
 fn notes(tech: &TechFiles, other_b: u64, route_cleanup: bool) -> Vec<String> {
@@ -486,7 +450,7 @@ fn notes(tech: &TechFiles, other_b: u64, route_cleanup: bool) -> Vec<String> {
         format!("Routing: qrouter's stages 1 and 2 only (every net routed); stage 3, the cleanup that re-routes each net, was skipped (`--route-cleanup`, auto above {AUTO_CLEANUP_MAX_CELLS} cells): the wirelength and the post-route wires are those of stage 2, a little longer than a cleaned-up route; defects stage 3 would remove are repaired by the ECO re-route (the nets at the DRC boxes and netgen's unmatched nets re-routed, DRC and LVS run again) or show in the verdicts.")
     });
     if tech.tech == Tech::Osu018 {
-        n.push("osu018: Debian's qflow-tech-osu018 has no cell GDS, so the GDS and the picture hold the cells' LEF abstracts (pins and obstructions) with the routing, and magic's DRC checks the routing and the abstracts, not the cells' transistors.".into());
+        n.push("osu018: Debian's qflow-tech-osu018 has no cell GDS, so the GDS holds the routing and pins only: its cell masters are empty references (see \"GDS holds\"), it is not a standalone stream, and the picture shows the routing. magic's DRC checks the routing against the cells' LEF abstracts (pins, obstructions), not the cells' transistors.".into());
     }
     n
 }
@@ -496,47 +460,4 @@ pub fn project_dir(cache: &Path, tech: Tech, synthesis_key: &str) -> PathBuf {
     cache
         .join("layout")
         .join(format!("{}-{synthesis_key}", tech.name()))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn route_cleanup_auto_keeps_stage_3_for_small_pixels_only() {
-        // The 2-bin pixel (2,627 cells) keeps it, the default (9,248 cells) skips it.
-        assert!(RouteCleanup::Auto.runs(2_627));
-        assert!(RouteCleanup::Auto.runs(AUTO_CLEANUP_MAX_CELLS));
-        assert!(!RouteCleanup::Auto.runs(9_248));
-        assert!(RouteCleanup::On.runs(9_248));
-        assert!(!RouteCleanup::Off.runs(10));
-        assert_eq!(RouteCleanup::parse("off").unwrap(), RouteCleanup::Off);
-        let e = RouteCleanup::parse("never").unwrap_err().to_string();
-        assert!(
-            e.contains("route-cleanup") && e.contains("auto, on or off"),
-            "{e}"
-        );
-    }
-
-    #[test]
-    fn density_auto_follows_the_netlist_size() {
-        // The 2-bin pixel (2,627 cells) at 0.6, where it routes clean with stage 3; the
-        // default (9,248 cells) at 0.5, where it routes clean after the ECO re-route.
-        assert_eq!(Density::Auto.target(2_627), 0.6);
-        assert_eq!(Density::Auto.target(AUTO_CLEANUP_MAX_CELLS), 0.6);
-        assert_eq!(Density::Auto.target(9_248), 0.5);
-        assert_eq!(Density::Fixed(0.45).target(9_248), 0.45);
-        assert_eq!(Density::parse("auto").unwrap(), Density::Auto);
-        assert_eq!(Density::parse("0.55").unwrap(), Density::Fixed(0.55));
-        let e = Density::parse("dense").unwrap_err().to_string();
-        assert!(
-            e.contains("--density = dense") && e.contains("auto or a number"),
-            "{e}"
-        );
-        assert!(check_options(Density::Auto, 40.0).is_ok());
-        let e = check_options(Density::Fixed(0.99), 40.0)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("0.5 routes the default pixel"), "{e}");
-    }
 }

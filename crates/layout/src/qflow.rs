@@ -22,6 +22,10 @@ pub struct Project {
     pub tech: TechFiles,
 }
 
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|e| LayoutError::io("reading", path, e))
+}
+
 fn write(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).map_err(|e| LayoutError::io("writing", path, e))
 }
@@ -126,6 +130,31 @@ impl Project {
         }
     }
 
+    /// After placement: qrouter kept on the die's tracks, the keep-out of
+    /// [`crate::die::keep_out`] inserted into the router configuration before its
+    /// `read_def` (the placed DEF, `layout/TOP.def`, gives the die and tracks).
+    pub fn keep_routes_inside(&self) -> Result<()> {
+        let (def, cfg) = (self.layout_file("def"), self.layout_file("cfg"));
+        let text = read(&def)?;
+        let lines = crate::die::keep_out(&crate::die::frame(&text, &def)?);
+        let with =
+            crate::die::with_keep_out(&read(&cfg)?, &lines).ok_or_else(|| LayoutError::Parse {
+                tool: "qflow (router configuration)",
+                what: "`read_def`".into(),
+                path: cfg.clone(),
+            })?;
+        write(&cfg, &with)
+    }
+
+    /// After routing: the routed DEF's die grown to hold the wires on its edge tracks,
+    /// the pins extended to it ([`crate::die::grow_die`]).
+    pub fn grow_die(&self) -> Result<crate::die::Growth> {
+        let def = self.layout_file("def");
+        let (grown, growth) = crate::die::grow_die(&read(&def)?, &def)?;
+        write(&def, &grown)?;
+        Ok(growth)
+    }
+
     /// magic's reasons for the DRC errors of the routed macro: each rule broken and how
     /// many boxes break it, and every error box (`drc listall why` on the layout database
     /// the DRC stage checked; the boxes are what the ECO re-route maps to nets).
@@ -161,11 +190,16 @@ impl Project {
         ))
     }
 
-    /// The checks of the routed DEF (`layout/TOP.def`): magic reads it (qflow's `migrate`:
+    /// The checks of the routed DEF (`layout/TOP.def`, its section counts set to its
+    /// entries first, [`crate::def::fix_counts`]): magic reads it (qflow's `migrate`:
     /// layout database, extraction, LEF), counts the DRC errors (with their rules and
     /// boxes when there are any), and netgen compares the extraction with the netlist.
     pub fn checks(&self) -> Result<Checks> {
         let start = std::time::Instant::now();
+        // Every DEF magic reads has its sections' counts right (qrouter's SPECIALNETS
+        // count is not; the ECO's splice changes the entries).
+        let def = self.layout_file("def");
+        write(&def, &crate::def::fix_counts(&read(&def)?))?;
         self.stage("layout database", "migrate", "migrate.log")?;
         let (drc_log, _) = self.stage("DRC", "drc", "drc.log")?;
         let drc_errors = drc_log

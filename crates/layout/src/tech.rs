@@ -67,6 +67,8 @@ pub struct TechFiles {
     pub liberty: PathBuf,
     /// The cell LEF.
     pub cell_lef: PathBuf,
+    /// The technology LEF (routing layers' widths, vias): osu018's is its cell LEF.
+    pub tech_lef: PathBuf,
     /// The fill cell.
     pub fill: String,
     /// The buffer (cell, input pin, output pin) the BLIF conversion drives ports with.
@@ -81,6 +83,7 @@ impl TechFiles {
             tech: Tech::Osu018,
             liberty: dir.join("osu018_stdcells.lib"),
             cell_lef: dir.join("osu018_stdcells.lef"),
+            tech_lef: dir.join("osu018_stdcells.lef"),
             dir,
             name: "osu018".into(),
             fill: "FILL".into(),
@@ -151,6 +154,7 @@ impl TechFiles {
             name: "sky130".into(),
             liberty,
             cell_lef,
+            tech_lef: tlef,
             fill: "sky130_fd_sc_hd__fill_1".into(),
             buffer: ("sky130_fd_sc_hd__buf_1", "A", "X"),
         })

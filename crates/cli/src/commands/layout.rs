@@ -2,7 +2,8 @@
 //! [--route-cleanup auto|on|off] [--json]`: the
 //! configured pixel placed, routed, checked (DRC, LVS), timed after routing and drawn
 //! (tofprobe_layout, docs/layout.md). DIR receives one output set, whole or absent: the
-//! DEF, GDS and LEF of the macro, the SPEF and placed netlist, `layout.png`,
+//! DEF, GDS and LEF of the macro, the SPEF, the placed netlist and the laid-out one (the
+//! routed DEF's, proven equivalent to the RTL), `layout.png`,
 //! `layout-report.md` and `layout-report.json`, and the marker `tofprobe-set.toml`.
 
 use std::path::PathBuf;
@@ -50,7 +51,9 @@ pub struct LayoutArgs {
     pub json: bool,
 }
 
-/// Runs `tofprobe layout`; the verdict is FAIL when DRC or LVS is not clean.
+/// Runs `tofprobe layout`; the verdict is FAIL (exit 1, the output set written) when a
+/// check fails: DRC, LVS, the laid-out netlist's equivalence, setup or register-to-register
+/// hold after routing, a shape past the die, a DEF count (`LayoutReport::failures`).
 pub fn run(a: &LayoutArgs) -> Result<crate::commands::Verdict, CliError> {
     let tech = Tech::parse(&a.tech)?;
     let route_cleanup = tofprobe_layout::flow::RouteCleanup::parse(&a.route_cleanup)?;
@@ -102,5 +105,10 @@ pub fn run(a: &LayoutArgs) -> Result<crate::commands::Verdict, CliError> {
             run.project.display()
         );
     }
-    Ok(crate::commands::Verdict::of(report.clean()))
+    // The set is written whatever the verdict: a failed check's report and picture are
+    // what the user reads next.
+    for f in &report.failures {
+        eprintln!("layout: FAILED {f}");
+    }
+    Ok(crate::commands::Verdict::of(report.passed()))
 }

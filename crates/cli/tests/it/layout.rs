@@ -1,7 +1,8 @@
 //! `tofprobe layout` through the binary: a 2-bin pixel placed and routed on osu018 (qflow's
 //! graywolf and qrouter), DRC-clean (magic) and LVS-matched (netgen) against its netlist,
-//! timed after routing with the routed wires (OpenSTA + SPEF), drawn (klayout), and written
-//! as one output set that `check-set` accepts. Its cold cost is the place and route
+//! its laid-out netlist proven equivalent to the RTL, every shape inside the die, timed
+//! after routing with the routed wires (OpenSTA + SPEF, every path group), drawn
+//! (klayout), and written as one output set that `check-set` accepts. Its cold cost is the place and route
 //! (≈ 4 minutes on two shared cores, qrouter most of it). Bad options fail before any tool
 //! runs, naming the option and a value that works.
 
@@ -119,6 +120,7 @@ fn a_two_bin_pixel_routes_drc_and_lvs_clean_on_osu018() {
         "tofprobe_pixel.gds",
         "tofprobe_pixel.lef",
         "tofprobe_pixel.spef",
+        "tofprobe_pixel.laid-out.v",
     ] {
         assert!(std::fs::metadata(out.join(f)).unwrap().len() > 1000, "{f}");
     }
@@ -131,6 +133,100 @@ fn a_two_bin_pixel_routes_drc_and_lvs_clean_on_osu018() {
     );
     let md = std::fs::read_to_string(out.join("layout-report.md")).unwrap();
     assert!(md.contains("| DRC errors (magic) | 0 |"), "{md}");
+    assert!(md.contains("## Verdict\n\n**PASS**"), "{md}");
+    assert_eq!(r["failures"], serde_json::json!([]), "{r}");
+    // Timing: the worst of every path group, OpenSTA's own worst slack (the reader checks
+    // that itself); hold judged between registers.
+    let groups = p["hold_groups"].as_array().unwrap();
+    let worst = groups
+        .iter()
+        .map(|g| g["slack_ns"].as_f64().unwrap())
+        .fold(f64::MAX, f64::min);
+    assert_eq!(worst, p["hold_slack_ns"].as_f64().unwrap(), "{p}");
+    assert!(
+        p["setup_slack_ns"].as_f64().unwrap() >= 0.0
+            && p["hold_slack_registers_ns"].as_f64().unwrap() >= 0.0,
+        "{p}"
+    );
+
+    // The laid-out netlist (the routed DEF's cells and nets, clock buffers included, fill
+    // left out) proven equivalent to the RTL, and written into the set.
+    let e = &r["equivalence"];
+    assert!(
+        e["points"].as_u64().unwrap() > 100 && e["proven"] == e["points"],
+        "{e}"
+    );
+    assert_eq!(e["cells"], def["cells"], "{e}");
+    let laid = std::fs::read_to_string(out.join("tofprobe_pixel.laid-out.v")).unwrap();
+    assert!(
+        laid.matches("  CLKBUF1 ").count() > 40,
+        "the clock tree's buffers are in it"
+    );
+
+    // Every shape inside the die, in the DEF and the GDS; the macro's LEF is the die; the
+    // DEF's sections list what they declare. Checked here again, naively: every route
+    // point and pin placement of the DEF lies in its DIEAREA, and every section's `- `
+    // entries number what its header says.
+    assert_eq!(r["def_boundary"]["outside"], 0, "{r}");
+    assert_eq!(r["gds"]["outside"], 0, "{r}");
+    // osu018 has no cell GDS: the stream's cells are empty and the report says so.
+    assert_eq!(r["gds"]["empty_cells"], r["gds"]["cells"], "{r}");
+    assert!(md.contains("| GDS holds | routing and pins only"), "{md}");
+    let def_text = std::fs::read_to_string(out.join("tofprobe_pixel.def")).unwrap();
+    let die: Vec<f64> = def_text
+        .lines()
+        .find_map(|l| l.strip_prefix("DIEAREA"))
+        .unwrap()
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let mut section: Option<(String, u64, u64)> = None;
+    let mut last = (0.0, 0.0);
+    for line in def_text.lines() {
+        let t: Vec<&str> = line.split_whitespace().collect();
+        if let [name, n, ";"] = t.as_slice()
+            && let Ok(n) = n.parse::<u64>()
+            && name.chars().all(|c| c.is_ascii_uppercase())
+        {
+            section = Some((name.to_string(), n, 0));
+        } else if let Some((name, declared, listed)) = section.as_mut() {
+            if t.as_slice() == ["END", name.as_str()] {
+                assert_eq!(*declared, *listed, "{name}");
+                section = None;
+            } else if t.first() == Some(&"-") {
+                *listed += 1;
+            }
+        }
+        for w in t.windows(4).filter(|w| w[0] == "(" && w[3] == ")") {
+            let x = if w[1] == "*" {
+                last.0
+            } else {
+                w[1].parse().unwrap_or(last.0)
+            };
+            let y = if w[2] == "*" {
+                last.1
+            } else {
+                w[2].parse().unwrap_or(last.1)
+            };
+            last = (x, y);
+            let placed = t.contains(&"PLACED")
+                || t.contains(&"ROUTED")
+                || t.contains(&"NEW")
+                || t.contains(&"FIXED");
+            if placed && !t.contains(&"RECT") && !t.contains(&"LAYER") {
+                assert!(
+                    x >= die[0] && x <= die[2] && y >= die[1] && y <= die[3],
+                    "({x}, {y}) outside {die:?}: {line}"
+                );
+            }
+        }
+    }
+    let size = format!(
+        "SIZE {:.3} BY {:.3} ;",
+        def["die_width_um"].as_f64().unwrap(),
+        def["die_height_um"].as_f64().unwrap()
+    );
+    assert!(lef.contains(&size), "{size} in the LEF");
 
     // `size --layout-report`: the macro's post-route corners beside the size report's
     // synthesis corners (the same pixel: one osu018 synthesis, cached by the layout run).
