@@ -24,6 +24,13 @@ pub enum ArrayError {
     /// A tile set that cannot be merged (not one, or not of the same run as the others).
     #[error("tile set {}: {message}", path.display())]
     TileSet { path: PathBuf, message: String },
+    /// A command-line option of an array command out of range (`--shard`, `--max-out-gib`).
+    #[error("--{option} = {value} is out of range: allowed {allowed}")]
+    Option {
+        option: String,
+        value: String,
+        allowed: String,
+    },
     /// An output file that cannot be written.
     #[error("cannot write {}: {message}", path.display())]
     Output { path: PathBuf, message: String },

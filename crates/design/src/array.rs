@@ -24,9 +24,17 @@ pub const MAX_SIDE: u32 = 4096;
 /// Most pixel-pulses an array frame may cost (R·C·N): 2^40 ≈ 1.1·10^12, a 256 × 256 array
 /// over a 1 s frame at 10 MHz and about three hours at the model's 10^8 pixel-pulses/s.
 pub const MAX_PIXEL_PULSES: u64 = 1 << 40;
-/// Largest memory an array's registers, spectra and maps may take (bytes): 4 GiB, a sixth
-/// of the 24 GiB machines the project runs on.
+/// Largest memory an array command (`simulate`, `merge`, a shard) may hold, in bytes: 4 GiB,
+/// a sixth of the 24 GiB machines the project runs on. It counts everything the command
+/// holds ([`SensorArray::bytes_needed`]): the per-pixel data and [`FIXED_BYTES`].
 pub const MAX_ARRAY_BYTES: u64 = 4 << 30;
+/// What an array command holds whatever the array's size: the program and its libraries,
+/// the probe ROM (≤ 16 MB at its largest periodic depth) and the driver's folded tables,
+/// the streaming buffers of the threads (512 kB each), the allocator's arenas. Measured:
+/// a 4 × 4 array peaks at 12–40 MB resident (crates/cli/tests/it/array_memory.rs); 256 MiB
+/// leaves room for a periodic ROM at its largest depth, whose construction peaks near 340 MB
+/// before any per-pixel memory is taken.
+pub const FIXED_BYTES: u64 = 256 << 20;
 
 /// The `[array]` section as written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -212,11 +220,96 @@ impl SensorArray {
         tofprobe_pixel::Superpixel::new(self.superpixel as u32, tdc_bits).map(Some)
     }
 
-    /// The bytes an array of `registers` words and `bins` spectral bins per pixel needs:
-    /// the registers (i64), amplitude and phase per bin (f64), and the two maps.
-    pub fn bytes_needed(rows: u64, cols: u64, registers: u64, bins: u64) -> u64 {
+    /// The bytes one pixel costs an array command at its peak (the frame and the maps are
+    /// held together while the set is written; every file is streamed, so no file adds
+    /// to it): its `registers` words (i64) and detections (8); the ρ_s and ρ_b maps of its
+    /// `spads` SPADs (16 each, kept in the design); and what is read from the frame —
+    /// Fourier (`bins` > 0): amplitude and phase per bin (16 each) and the strongest bin (8);
+    /// Haar (`bins` = 0): the transition time (8) and its point of the plane fit (24).
+    /// `merge`'s coverage table (4 per pixel) is freed before the maps are made.
+    pub fn bytes_per_pixel(registers: u64, bins: u64, spads: u64) -> u64 {
+        let analysis = if bins > 0 { 16 * bins + 8 } else { 32 };
+        8 * registers + 8 + 16 * spads + analysis
+    }
+
+    /// The bytes an array command holds for `rows` × `cols` pixels
+    /// ([`Self::bytes_per_pixel`] each, and [`FIXED_BYTES`]), saturating.
+    pub fn bytes_needed(rows: u64, cols: u64, registers: u64, bins: u64, spads: u64) -> u64 {
         rows.saturating_mul(cols)
-            .saturating_mul(8 * (registers + 2 * bins + 2))
+            .saturating_mul(Self::bytes_per_pixel(registers, bins, spads))
+            .saturating_add(FIXED_BYTES)
+    }
+
+    /// Checks a resolved array received whole (a tile set's manifest, a worker's design):
+    /// [`Self::check_shape`], then maps of one value per SPAD, finite and in range. What a
+    /// resolution produced always passes; a tampered one is refused before anything is
+    /// sized from it.
+    pub fn check_received(&self, registers: usize, bins: usize) -> Result<(), String> {
+        self.check_shape(registers, bins)?;
+        let spads = self.spad_rows() * self.spad_cols();
+        for (name, map, max) in [
+            ("signal", &self.signal_rate, 1.0),
+            ("background", &self.background_rate, 20.0),
+        ] {
+            if map.len() != spads {
+                return Err(format!(
+                    "the {name} map has {} values for {} × {} SPADs",
+                    map.len(),
+                    self.spad_rows(),
+                    self.spad_cols()
+                ));
+            }
+            if let Some(v) = map
+                .iter()
+                .find(|v| !(v.is_finite() && (0.0..=max).contains(*v)))
+            {
+                return Err(format!(
+                    "the {name} map holds the rate {v}: allowed 0..={max}"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The shape of a received array, its maps aside: G within 1..=4, rows and columns of
+    /// SPADs within 1..=[`MAX_SIDE`], pitch and mapping finite and positive, and the memory
+    /// within [`MAX_ARRAY_BYTES`] for `registers` words and `bins` bins per pixel (so
+    /// nothing sized from it can overflow or exceed the cap).
+    pub fn check_shape(&self, registers: usize, bins: usize) -> Result<(), String> {
+        let g = self.superpixel;
+        let max_g = tofprobe_pixel::superpixel::MAX_SUPERPIXEL as usize;
+        if !(1..=max_g).contains(&g) {
+            return Err(format!("array.superpixel = {g}: allowed 1..={max_g}"));
+        }
+        for (name, v) in [("rows", self.rows), ("cols", self.cols)] {
+            if v == 0 || v.saturating_mul(g) > MAX_SIDE as usize {
+                return Err(format!(
+                    "array.{name} = {v} pixels of {g} × {g} SPADs: allowed 1..={MAX_SIDE} SPADs"
+                ));
+            }
+        }
+        if !(self.mm_per_pixel.is_finite() && self.mm_per_pixel > 0.0)
+            || !(self.pitch_um.is_finite() && self.pitch_um > 0.0)
+        {
+            return Err(format!(
+                "pitch {} µm, {} mm per pixel: both must be finite and positive",
+                self.pitch_um, self.mm_per_pixel
+            ));
+        }
+        let need = Self::bytes_needed(
+            self.rows as u64,
+            self.cols as u64,
+            registers as u64,
+            bins as u64,
+            (g * g) as u64,
+        );
+        if need > MAX_ARRAY_BYTES {
+            return Err(format!(
+                "{} × {} pixels need {need} bytes: allowed at most {MAX_ARRAY_BYTES}",
+                self.rows, self.cols
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -270,16 +363,37 @@ pub fn resolve_array(
     }
     // The pixels: G × G SPADs each.
     let (prows, pcols) = (a.rows / g, a.cols / g);
-    let need = SensorArray::bytes_needed(prows.into(), pcols.into(), registers as u64, bins as u64);
+    let analysis_bins = match pixel.mode {
+        tofprobe_pixel::Mode::Fourier => bins as u64,
+        tofprobe_pixel::Mode::Haar => 0,
+    };
+    let spads = u64::from(g) * u64::from(g);
+    let need = SensorArray::bytes_needed(
+        prows.into(),
+        pcols.into(),
+        registers as u64,
+        analysis_bins,
+        spads,
+    );
     if need > MAX_ARRAY_BYTES {
-        let per_pixel = 8 * (registers as u64 + 2 * bins as u64 + 2);
-        let side = ((MAX_ARRAY_BYTES / per_pixel) as f64).sqrt().floor() as u64;
+        let per_pixel = SensorArray::bytes_per_pixel(registers as u64, analysis_bins, spads);
+        // The largest square of SPADs (a multiple of G) whose pixels fit.
+        let pixels = (MAX_ARRAY_BYTES - FIXED_BYTES) / per_pixel;
+        let side = ((pixels as f64).sqrt().floor() as u64) * u64::from(g);
         return Err(err(format!(
-            "array.rows × array.cols = {} × {} needs {:.1} GiB for its registers ({registers} \
-             per pixel), spectra and maps: allowed at most {} GiB; {side} × {side} pixels fit",
-            prows,
-            pcols,
+            "array.rows × array.cols = {} × {} needs {:.2} GiB at its peak ({per_pixel} bytes \
+             per pixel: {registers} registers, the detections, the rate maps and the {} maps, \
+             with {} MiB for the ROM and the program): allowed at most {} GiB; \
+             array.rows = array.cols = {side} fits",
+            a.rows,
+            a.cols,
             need as f64 / (1u64 << 30) as f64,
+            if analysis_bins > 0 {
+                "amplitude and phase"
+            } else {
+                "transition-time"
+            },
+            FIXED_BYTES >> 20,
             MAX_ARRAY_BYTES >> 30
         )));
     }
