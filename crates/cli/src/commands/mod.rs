@@ -14,6 +14,7 @@ pub mod reproduce;
 pub mod rtl;
 pub mod simulate;
 pub mod size;
+pub mod tile_arg;
 pub mod tradeoff;
 pub mod vectors;
 

@@ -42,4 +42,5 @@ mod resolution;
 mod shard;
 mod signals;
 mod size;
+mod tile_option;
 mod tradeoff;
