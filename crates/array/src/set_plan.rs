@@ -62,6 +62,11 @@ fn shape(design: &ResolvedDesign) -> Result<(usize, usize), ArrayError> {
 /// exactly ([`crate::uff::file_bytes`]), the SVGs from their per-cell bounds.
 pub fn array_set(design: &ResolvedDesign) -> Result<Vec<SetFile>, ArrayError> {
     let (r, c) = shape(design)?;
+    Ok(array_set_of(design, r, c))
+}
+
+/// [`array_set`] for `r` × `c` pixels of `design`'s pixel.
+fn array_set_of(design: &ResolvedDesign, r: usize, c: usize) -> Vec<SetFile> {
     let k = design.pixel.registers();
     let pixels = (r as u64).saturating_mul(c as u64);
     let heat = FRAME_BYTES.saturating_add(pixels.saturating_mul(CELL_BYTES));
@@ -92,7 +97,7 @@ pub fn array_set(design: &ResolvedDesign) -> Result<Vec<SetFile>, ArrayError> {
     }
     let bins = design.bins.len() as u64;
     out.push(file(SUMMARY, SUMMARY_BYTES + bins * SUMMARY_BIN_BYTES));
-    Ok(out)
+    out
 }
 
 /// The tile set's files for the rectangle `rows` × `cols` of `design`'s array: the tile's
@@ -118,17 +123,28 @@ pub fn total_bytes(files: &[SetFile]) -> u64 {
     files.iter().fold(0u64, |a, f| a.saturating_add(f.bytes))
 }
 
-/// What makes a set too large fit: the option, and the largest square array that fits
-/// `max` bytes when the set grows with the pixels.
-fn what_fits(design: &ResolvedDesign, files: &[SetFile], max: u64) -> String {
-    let pixels = design.array.as_ref().map_or(1, |a| a.pixels().max(1)) as u64;
-    let per_pixel = (total_bytes(files) / pixels).max(1);
-    let side = ((max / per_pixel) as f64).sqrt().floor() as u64;
+/// What makes an array set too large fit in `max` bytes: its cost per pixel (the growth
+/// from one pixel to two) and the largest square array of SPADs that fits.
+fn what_fits(design: &ResolvedDesign, max: u64) -> String {
+    let one = total_bytes(&array_set_of(design, 1, 1));
+    let per_pixel = total_bytes(&array_set_of(design, 1, 2))
+        .saturating_sub(one)
+        .max(1);
     let g = design.array.as_ref().map_or(1, |a| a.superpixel as u64);
+    let side = ((max.saturating_sub(one) / per_pixel + 1) as f64)
+        .sqrt()
+        .floor() as u64;
+    if max < one {
+        return format!(
+            "≈ {} per pixel, and {} for even one pixel",
+            human_bytes(per_pixel),
+            human_bytes(one)
+        );
+    }
     format!(
-        "≈ {} per pixel: array.rows = array.cols = {} (SPADs) fits, or fewer bins (pixel.bins)",
+        "≈ {} per pixel: array.rows = array.cols = {} SPADs fits, or fewer bins (pixel.bins)",
         human_bytes(per_pixel),
-        (side * g).max(g)
+        side.max(1) * g
     )
 }
 
@@ -152,15 +168,15 @@ pub fn open(
             .unwrap_or_default();
         return Err(ArrayError::Option {
             option: "max-out-gib".into(),
-            value: format!("{:.3}", max_bytes as f64 / (1u64 << 30) as f64),
+            value: tofprobe_io::text::number(max_bytes as f64 / (1u64 << 30) as f64),
             allowed: format!(
-                "at least {:.3} (default 16) for this set: {} of {} files would take ≈ \
+                "at least {} (default 16) for this set: {} of {} files would take ≈ \
                  {}{largest}; nothing was run or written ({})",
-                total as f64 / (1u64 << 30) as f64,
+                tofprobe_io::text::number(total as f64 / (1u64 << 30) as f64),
                 dir.display(),
                 files.len() + 1,
                 human_bytes(total),
-                what_fits(design, files, max_bytes)
+                what_fits(design, max_bytes)
             ),
         });
     }
@@ -173,6 +189,6 @@ pub fn open(
     set.protect(MARKER, &names).map_err(out)?;
     let free = tofprobe_io::disk::free_bytes(dir).map_err(out)?;
     let room = free.saturating_sub(tofprobe_io::disk::MARGIN_BYTES);
-    tofprobe_io::disk::check_room(dir, total, &what_fits(design, files, room)).map_err(out)?;
+    tofprobe_io::disk::check_room(dir, total, &what_fits(design, room)).map_err(out)?;
     Ok(set)
 }

@@ -31,9 +31,10 @@ pub const MAX_ARRAY_BYTES: u64 = 4 << 30;
 /// What an array command holds whatever the array's size: the program and its libraries,
 /// the probe ROM (≤ 16 MB at its largest periodic depth) and the driver's folded tables,
 /// the streaming buffers of the threads (512 kB each), the allocator's arenas. Measured:
-/// a 4 × 4 array peaks at 12–40 MB resident (crates/cli/tests/it/array_memory.rs); 256 MiB
-/// leaves room for a periodic ROM at its largest depth, whose construction peaks near 340 MB
-/// before any per-pixel memory is taken.
+/// `simulate --out` of a 4 × 4 array peaks at 7–10 MB resident
+/// (crates/cli/tests/it/array_memory.rs); 256 MiB leaves room for a periodic ROM at its
+/// largest depth, whose construction peaks near 340 MB before any per-pixel memory is
+/// taken (every array command builds the ROM before it allocates the frame).
 pub const FIXED_BYTES: u64 = 256 << 20;
 
 /// The `[array]` section as written.

@@ -25,9 +25,9 @@ pub fn free_bytes(path: &Path) -> std::io::Result<u64> {
     }
 }
 
-/// Space kept free beyond a set's estimate (the file system's metadata, the marker, other
-/// writers): 64 MiB.
-pub const MARGIN_BYTES: u64 = 64 << 20;
+/// Space kept free beyond a set's estimate (the file system's metadata, the marker, the
+/// directory entries): 1 MiB.
+pub const MARGIN_BYTES: u64 = 1 << 20;
 
 /// Refuses a set of `estimate` bytes that does not fit, with [`MARGIN_BYTES`] to spare, in
 /// the free space of the file system of `dir`; `what` names the set and how to make it

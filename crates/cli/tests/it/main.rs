@@ -4,6 +4,7 @@
 
 mod adders_auto;
 mod array;
+mod array_memory;
 mod array_rtl;
 mod array_sets;
 mod array_size;
