@@ -16,6 +16,7 @@ mod bounds;
 mod cli;
 mod committed;
 mod common;
+mod concurrency;
 mod core;
 mod cosim_directed;
 mod cosim_exact;
