@@ -21,6 +21,12 @@ use crate::error::DesignError;
 
 /// Largest rows or columns.
 pub const MAX_SIDE: u32 = 4096;
+/// Bounds of a pixel's size on the scene plane (mm), written or from the field of view:
+/// a micrometre to ten metres.
+pub const MIN_MM_PER_PIXEL: f64 = 1e-3;
+pub const MAX_MM_PER_PIXEL: f64 = 1e4;
+/// Smallest pixel pitch on the die (µm): a nanometre-scale pitch is no pixel.
+pub const MIN_PITCH_UM: f64 = 1e-3;
 /// Most pixel-pulses an array frame may cost (R·C·N): 2^40 ≈ 1.1·10^12, a 256 × 256 array
 /// over a 1 s frame at 10 MHz and about three hours at the model's 10^8 pixel-pulses/s.
 pub const MAX_PIXEL_PULSES: u64 = 1 << 40;
@@ -408,17 +414,21 @@ pub fn resolve_array(
             a.rows, a.cols,
         )));
     }
-    if !(a.pitch_um.is_finite() && a.pitch_um > 0.0 && a.pitch_um <= 1e4) {
+    let num = tofprobe_io::text::number;
+    if !(a.pitch_um.is_finite() && (MIN_PITCH_UM..=1e4).contains(&a.pitch_um)) {
         return Err(err(format!(
-            "array.pitch_um = {} is out of range: allowed 0 < pitch_um <= 10000 (e.g. 30)",
-            a.pitch_um
+            "array.pitch_um = {} is out of range: allowed {} <= pitch_um <= 10000 (e.g. 30)",
+            num(a.pitch_um),
+            num(MIN_PITCH_UM)
         )));
     }
     let mm_per_pixel = match (a.mm_per_pixel, a.field_of_view_deg, a.distance_mm) {
         (Some(s), None, None) => {
-            if !(s.is_finite() && s > 0.0 && s <= 1e4) {
+            if !(s.is_finite() && (MIN_MM_PER_PIXEL..=MAX_MM_PER_PIXEL).contains(&s)) {
                 return Err(err(format!(
-                    "array.mm_per_pixel = {s} is out of range: allowed 0 < mm_per_pixel <= 10000"
+                    "array.mm_per_pixel = {} is out of range: allowed {} <= mm_per_pixel <= 10000",
+                    num(s),
+                    num(MIN_MM_PER_PIXEL)
                 )));
             }
             s
@@ -426,15 +436,35 @@ pub fn resolve_array(
         (None, Some(fov), Some(d)) => {
             if !(fov.is_finite() && fov > 0.0 && fov < 180.0) {
                 return Err(err(format!(
-                    "array.field_of_view_deg = {fov} is out of range: allowed 0 < fov < 180"
+                    "array.field_of_view_deg = {} is out of range: allowed 0 < fov < 180",
+                    num(fov)
                 )));
             }
             if !(d.is_finite() && d > 0.0 && d <= 1e7) {
                 return Err(err(format!(
-                    "array.distance_mm = {d} is out of range: allowed 0 < distance_mm <= 1e7"
+                    "array.distance_mm = {} is out of range: allowed 0 < distance_mm <= 1e7",
+                    num(d)
                 )));
             }
-            2.0 * d * (fov.to_radians() / 2.0).tan() / f64::from(a.cols)
+            let s = 2.0 * d * (fov.to_radians() / 2.0).tan() / f64::from(a.cols);
+            // The mapping's result within the bounds `mm_per_pixel` has when written.
+            if !(s.is_finite() && (MIN_MM_PER_PIXEL..=MAX_MM_PER_PIXEL).contains(&s)) {
+                let want = if s.is_finite() && s > MAX_MM_PER_PIXEL {
+                    "a narrower field of view or a nearer plane"
+                } else {
+                    "a wider field of view or a farther plane"
+                };
+                return Err(err(format!(
+                    "array.field_of_view_deg = {} and array.distance_mm = {} over {} columns give \
+                     {} mm per pixel: allowed {} ..= 10000 (what array.mm_per_pixel allows); {want}",
+                    num(fov),
+                    num(d),
+                    a.cols,
+                    num(s),
+                    num(MIN_MM_PER_PIXEL)
+                )));
+            }
+            s
         }
         _ => {
             // Name the keys written (their dotted paths), not only the section.
@@ -537,12 +567,15 @@ fn rate_map(
         Some(RateMap::Image { path, scale }) => {
             if !(scale.is_finite() && *scale >= 0.0) {
                 return Err(format!(
-                    "{field}.scale = {scale} is out of range: allowed >= 0 (1: the image as it is)"
+                    "{field}.scale = {} is out of range: allowed >= 0 (1: the image as it is)",
+                    tofprobe_io::text::number(*scale)
                 ));
             }
             let p = base.join(path);
+            // A path is echoed at most 200 characters (a 4 kB path made a 4 kB message).
+            let shown = tofprobe_io::text::clip(path, 200);
             let img = crate::rate_image::read(&p, rows, cols)
-                .map_err(|m| format!("{field}.path = \"{path}\": {m}"))?;
+                .map_err(|m| format!("{field}.path = \"{shown}\": {m}"))?;
             img.into_iter().map(|v| v * scale).collect()
         }
     };
@@ -552,9 +585,10 @@ fn rate_map(
         .find(|(_, v)| !(v.is_finite() && (0.0..=max).contains(*v)))
     {
         return Err(format!(
-            "{field} gives pixel ({}, {}) the rate {v}: allowed 0..={max} (a {} rate per pulse)",
+            "{field} gives pixel ({}, {}) the rate {}: allowed 0..={max} (a {} rate per pulse)",
             i / cols,
             i % cols,
+            tofprobe_io::text::number(*v),
             if max == 1.0 {
                 "signal-photon probability; scale the map down"
             } else {

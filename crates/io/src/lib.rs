@@ -26,7 +26,7 @@ pub mod text;
 pub use atomic::{write_atomic, write_svg_atomic};
 pub use bounded::{read_bounded, read_bounded_text};
 pub use marker::{SET_MARKER, SetStatus, check_set, inspect_set};
-pub use set::{OutputSet, STAGE_PREFIX, recover};
+pub use set::{OutputSet, STAGE_PREFIX, committed_sets, recover};
 
 /// FNV-1a 64-bit offset basis: the hash of no bytes.
 pub const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;

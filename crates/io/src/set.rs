@@ -241,7 +241,11 @@ impl OutputSet {
             std::fs::File::open(&commit)?.sync_all()?;
             self.done = true;
             finish(&self.target, &self.stage, &list, kill_hook())
-        })
+        })?;
+        if let Ok(mut v) = COMMITTED.lock() {
+            v.push(self.target.clone());
+        }
+        Ok(())
     }
 
     fn remove_created_target(&self) {
@@ -290,6 +294,16 @@ pub(crate) fn interrupted_commit(target: &Path) -> Option<(u32, Vec<String>, Vec
         return Some((pid, moved, pending));
     }
     None
+}
+
+/// The target directories of the sets this process committed, in order.
+static COMMITTED: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// The directories of the sets this process committed so far (whole on disk), for a
+/// command that fails afterwards to say which sets it left written: a full standard
+/// output after the commit is an error (exit 2), the set stays whole.
+pub fn committed_sets() -> Vec<PathBuf> {
+    COMMITTED.lock().map(|v| v.clone()).unwrap_or_default()
 }
 
 /// Prefix of a `COMMIT` line naming a file of the old set to remove (a staged name never

@@ -54,7 +54,8 @@ pub enum Command {
     Layout(layout::LayoutArgs),
     /// The speed/accuracy trade: every fidelity level timed and scored per scene.
     Tradeoff(tradeoff::TradeoffArgs),
-    /// Check that a directory holds a whole output set (rtl, vectors, reproduce, flow).
+    /// Check that a directory holds a whole output set (rtl, vectors, reproduce, flow,
+    /// layout, an array's set, a tile set).
     CheckSet(check_set::CheckSetArgs),
 }
 

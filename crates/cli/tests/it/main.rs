@@ -5,6 +5,7 @@
 mod adders_auto;
 mod array;
 mod array_memory;
+mod array_refusals;
 mod array_rtl;
 mod array_sets;
 mod array_size;
