@@ -259,6 +259,7 @@ pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
     };
     let chip = Chip::of(&design, &overrides, purpose)?;
     let p = chip.pixel;
+    super::check_stimulus(a.frames, p.frame_pulses, a.frame_pulses.is_some())?;
     let rom_note = if a.rtl.is_some() {
         format!(
             "ROM of --rtl checked against the configuration's: {}",

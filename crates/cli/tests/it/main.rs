@@ -28,6 +28,7 @@ mod finite_json;
 mod flow;
 mod fuzz_binary;
 mod fuzz_records;
+mod fuzz_sets;
 mod haar;
 mod junit;
 mod layout;
