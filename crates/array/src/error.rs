@@ -27,6 +27,13 @@ pub enum ArrayError {
     /// The host stopped the run (`tofprobe_io::watch::Watch::stop`: Ctrl-C in Python).
     #[error("stopped before the end (interrupted)")]
     Stopped,
+    /// A command-line option of an array command out of range (`--shard`, `--max-out-gib`).
+    #[error("--{option} = {value} is out of range: allowed {allowed}")]
+    Option {
+        option: String,
+        value: String,
+        allowed: String,
+    },
     /// An output file that cannot be written.
     #[error("cannot write {}: {message}", path.display())]
     Output { path: PathBuf, message: String },

@@ -18,8 +18,10 @@ pub mod plot;
 pub mod rtl;
 mod rtl_run;
 pub mod rtl_vectors;
+pub mod set_plan;
 pub mod shadow;
 pub mod shard;
+mod tile_set;
 pub mod uff;
 
 pub use error::ArrayError;

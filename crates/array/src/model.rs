@@ -256,34 +256,53 @@ pub fn run_tile_watched(
     let w = cols.len();
     let at = |i: usize| (rows.start + i / w, cols.start + i % w);
     let count = rows.len() * w;
-    let pixels: Vec<(Vec<i64>, u64)> = match rom {
-        // A folded pixel: groups of LANES pixels (row-major over the tile) in lockstep.
-        Some(rom) if fold_pays(&design.pixel) => (0..count.div_ceil(LANES))
-            .into_par_iter()
-            .map(|g| {
-                let group: Vec<_> = (g * LANES..((g + 1) * LANES).min(count)).map(at).collect();
-                group_watched(design, rom, &group, watch)
-            })
-            .collect::<Result<Vec<_>, _>>()?
-            .into_iter()
-            .flatten()
-            .collect(),
-        _ => (0..count)
-            .into_par_iter()
-            .map(|i| pixel_watched(design, rom, at(i).0, at(i).1, watch))
-            .collect::<Result<_, _>>()?,
+    let k = design.pixel.registers();
+    // The tile's registers and detections are filled in place, pixel by pixel (a group of
+    // LANES at a time): nothing per pixel is held besides them (the memory the resolution
+    // counts, `SensorArray::bytes_per_pixel`).
+    let mut registers = vec![0i64; count * k];
+    let mut detections = vec![0u64; count];
+    let put = |words: &[i64], out: &mut [i64], (r, c): (usize, usize)| {
+        if words.len() != out.len() {
+            return Err(ArrayError::Shape(format!(
+                "pixel ({r}, {c}) read out {} registers, not {}",
+                words.len(),
+                out.len()
+            )));
+        }
+        out.copy_from_slice(words);
+        Ok(())
     };
-    let registers_per_pixel = design.pixel.registers();
-    let mut registers = Vec::with_capacity(pixels.len() * registers_per_pixel);
-    let mut detections = Vec::with_capacity(pixels.len());
-    for (words, d) in pixels {
-        registers.extend(words);
-        detections.push(d);
+    match rom {
+        // A folded pixel: groups of LANES pixels (row-major over the tile) in lockstep.
+        Some(rom) if fold_pays(&design.pixel) => registers
+            .par_chunks_mut(LANES * k.max(1))
+            .zip(detections.par_chunks_mut(LANES))
+            .enumerate()
+            .try_for_each(|(g, (regs, dets))| {
+                let group: Vec<_> = (g * LANES..g * LANES + dets.len()).map(at).collect();
+                let out = group_watched(design, rom, &group, watch)?;
+                for (j, (words, d)) in out.into_iter().enumerate() {
+                    put(&words, &mut regs[j * k..(j + 1) * k], group[j])?;
+                    dets[j] = d;
+                }
+                Ok::<(), ArrayError>(())
+            })?,
+        _ => registers
+            .par_chunks_mut(k.max(1))
+            .zip(detections.par_iter_mut())
+            .enumerate()
+            .try_for_each(|(i, (regs, det))| {
+                let (words, d) = pixel_watched(design, rom, at(i).0, at(i).1, watch)?;
+                put(&words, &mut regs[..k], at(i))?;
+                *det = d;
+                Ok::<(), ArrayError>(())
+            })?,
     }
     Ok(Tile {
         rows,
         cols,
-        registers_per_pixel,
+        registers_per_pixel: k,
         registers,
         detections,
     })
@@ -338,6 +357,13 @@ pub fn run_array(
     rom: Option<&RomImage>,
 ) -> Result<ArrayFrame, ArrayError> {
     let (r, c) = shape(design)?;
+    // The whole array as one tile: its vectors are the frame's, moved, not copied.
     let t = run_tile(design, rom, 0..r, 0..c)?;
-    merge(r, c, &[t])
+    Ok(ArrayFrame {
+        rows: r,
+        cols: c,
+        registers_per_pixel: t.registers_per_pixel,
+        registers: t.registers,
+        detections: t.detections,
+    })
 }

@@ -1,26 +1,31 @@
-//! One array simulation as one output set (whole or absent, `tofprobe_io::OutputSet`,
-//! `summary.json` written last as its completion file): the registers as `registers.npy`
-//! (int64 [R, C, K]) and the detections (`detections.npy`, [R, C]); for a Fourier frame
-//! `amplitude_um.npy` and `phase_deg.npy` ([B, R, C]), a heat map of amplitude and of phase
-//! per bin, each pixel's strongest bin, the animated deflection shape at the dominant bin
-//! and the Universal File Format file `vibration.uff`; for a Haar frame each pixel's
-//! transition time (`event_time_ms.npy`, −1 where none, and its heat map) and the edge
-//! velocity fitted from them; the summary with its figures, units
-//! and file names.
+//! One array simulation as one output set (whole or absent, `tofprobe_io::OutputSet`; the
+//! project's completion marker `tofprobe-set.toml` written last, after `summary.json`, so
+//! `tofprobe check-set` checks it and a later set replaces only the files it lists): the
+//! registers as `registers.npy` (int64 [R, C, K]) and the detections (`detections.npy`,
+//! [R, C]); for a Fourier frame `amplitude_um.npy` and `phase_deg.npy` ([B, R, C]), a heat
+//! map of amplitude and of phase per bin, each pixel's strongest bin, the animated
+//! deflection shape at the dominant bin and the Universal File Format file `vibration.uff`;
+//! for a Haar frame each pixel's transition time (`event_time_ms.npy`, −1 where none, and
+//! its heat map) and the edge velocity fitted from them; the summary with its figures,
+//! units and file names. Every file is streamed into the set as it is made (bounded
+//! buffers), and the set's size, directory and disk are checked before the model runs
+//! ([`crate::set_plan`]).
 
+use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
 use serde::Serialize;
 use tofprobe_design::ResolvedDesign;
 use tofprobe_dsp::sd::ProbeRom;
-use tofprobe_io::npy;
+use tofprobe_io::{OutputSet, npy};
 
 use crate::error::ArrayError;
 use crate::events::{EventMap, event_map};
 use crate::maps::{VibrationMaps, fourier_maps};
 use crate::model::{ArrayFrame, run_array};
-use crate::plot::{Scale, deflection_animation_svg, heat_map_svg};
+use crate::plot::{Scale, write_deflection_animation, write_heat_map};
+use crate::set_plan::{MARKER, SUMMARY};
 
 /// One bin's figures over the array.
 #[derive(Debug, Clone, Serialize)]
@@ -125,7 +130,7 @@ pub fn finish(
         })
         .unwrap_or_default();
     let summary = ArraySummary {
-        configuration: design.origin.clone(),
+        configuration: configuration_name(design),
         mode: design.pixel.mode.to_string(),
         rows: a.rows,
         cols: a.cols,
@@ -148,49 +153,56 @@ pub fn finish(
     Ok((frame, maps, events, summary))
 }
 
-/// The files of the set, in order, without the summary.
-pub fn files(
+/// The configuration's name in the set: its file name (`plate.toml`), or the embedded
+/// default's name; never the path as typed, so the set's bytes do not depend on where the
+/// configuration lies or how its path was spelled.
+pub fn configuration_name(design: &ResolvedDesign) -> String {
+    std::path::Path::new(&design.origin)
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| design.origin.clone())
+}
+
+/// Streams the files of the set (all but the summary) into `set`, each written as it is
+/// made through a bounded buffer; returns their names in order.
+fn stream_files(
+    set: &mut OutputSet,
     design: &ResolvedDesign,
     frame: &ArrayFrame,
     maps: Option<&VibrationMaps>,
     events: Option<&EventMap>,
-) -> Result<Vec<(String, Vec<u8>)>, ArrayError> {
+) -> Result<Vec<String>, ArrayError> {
     let (r, c) = (frame.rows, frame.cols);
-    let io = |name: &str, e: String| ArrayError::Output {
-        path: name.into(),
-        message: e,
+    let dir = set.target().to_path_buf();
+    let mut names = Vec::new();
+    let mut add = |set: &mut OutputSet,
+                   name: &str,
+                   write: &mut dyn FnMut(&mut dyn Write) -> std::io::Result<()>|
+     -> Result<(), ArrayError> {
+        set.add_streamed(name, |w| write(w))
+            .map_err(|e| ArrayError::Output {
+                path: dir.join(name),
+                message: e.to_string(),
+            })?;
+        names.push(name.to_string());
+        Ok(())
     };
-    let mut out = vec![
-        (
-            "registers.npy".to_string(),
-            npy::to_bytes(&[r, c, frame.registers_per_pixel], &frame.registers)
-                .map_err(|e| io("registers.npy", e.to_string()))?,
-        ),
-        (
-            "detections.npy".to_string(),
-            npy::to_bytes(
-                &[r, c],
-                &frame
-                    .detections
-                    .iter()
-                    .map(|&d| d as i64)
-                    .collect::<Vec<_>>(),
-            )
-            .map_err(|e| io("detections.npy", e.to_string()))?,
-        ),
-    ];
+    add(set, "registers.npy", &mut |w| {
+        npy::write(w, &[r, c, frame.registers_per_pixel], &frame.registers)
+    })?;
+    add(set, "detections.npy", &mut |w| {
+        npy::write_iter(w, &[r, c], frame.detections.iter().map(|&d| d as i64))
+    })?;
     let mm = design.array.as_ref().map_or(1.0, |a| a.mm_per_pixel);
     if let Some(e) = events {
-        out.push((
-            "event_time_ms.npy".into(),
-            npy::to_bytes(&[r, c], &e.time_ms)
-                .map_err(|x| io("event_time_ms.npy", x.to_string()))?,
-        ));
-        // Pixels without a transition (−1) drawn as 0 ms.
-        let shown: Vec<f64> = e.time_ms.iter().map(|&t| t.max(0.0)).collect();
-        out.push((
-            "event_time.svg".into(),
-            heat_map_svg(
+        add(set, "event_time_ms.npy", &mut |w| {
+            npy::write(w, &[r, c], &e.time_ms)
+        })?;
+        add(set, "event_time.svg", &mut |w| {
+            // Pixels without a transition (−1) drawn as 0 ms.
+            let shown = |i: usize| e.time_ms[i].max(0.0);
+            write_heat_map(
+                w,
                 "transition time per pixel",
                 "time (ms)",
                 &shown,
@@ -199,23 +211,18 @@ pub fn files(
                 mm,
                 Scale::Amplitude,
             )
-            .map_err(|x| io("event_time.svg", x))?
-            .into_bytes(),
-        ));
+        })?;
     }
     let Some(m) = maps else {
-        return Ok(out);
+        return Ok(names);
     };
     let b = m.bins();
-    out.push((
-        "amplitude_um.npy".into(),
-        npy::to_bytes(&[b, r, c], &m.amplitude_um)
-            .map_err(|e| io("amplitude_um.npy", e.to_string()))?,
-    ));
-    out.push((
-        "phase_deg.npy".into(),
-        npy::to_bytes(&[b, r, c], &m.phase_deg).map_err(|e| io("phase_deg.npy", e.to_string()))?,
-    ));
+    add(set, "amplitude_um.npy", &mut |w| {
+        npy::write(w, &[b, r, c], &m.amplitude_um)
+    })?;
+    add(set, "phase_deg.npy", &mut |w| {
+        npy::write(w, &[b, r, c], &m.phase_deg)
+    })?;
     for k in 0..b {
         let f = m.frequencies_hz[k];
         for (kind, unit, values, scale) in [
@@ -227,39 +234,36 @@ pub fn files(
             ),
             ("phase", "phase (degrees)", m.phase(k), Scale::Phase),
         ] {
-            let name = format!("{kind}_bin{k:02}.svg");
-            let svg = heat_map_svg(
-                &format!("{kind} at {f:.1} Hz (bin {k})"),
-                unit,
-                values,
-                r,
-                c,
-                mm,
-                scale,
-            )
-            .map_err(|e| io(&name, e))?;
-            out.push((name, svg.into_bytes()));
+            add(set, &format!("{kind}_bin{k:02}.svg"), &mut |w| {
+                write_heat_map(
+                    w,
+                    &format!("{kind} at {f:.1} Hz (bin {k})"),
+                    unit,
+                    &|i| values[i],
+                    r,
+                    c,
+                    mm,
+                    scale,
+                )
+            })?;
         }
     }
-    let strongest: Vec<f64> = m.strongest_bin.iter().map(|&k| k as f64).collect();
-    out.push((
-        "strongest_bin.svg".into(),
-        heat_map_svg(
+    add(set, "strongest_bin.svg", &mut |w| {
+        write_heat_map(
+            w,
             "strongest bin per pixel",
             "bin index",
-            &strongest,
+            &|i| m.strongest_bin[i] as f64,
             r,
             c,
             mm,
             Scale::Index,
         )
-        .map_err(|e| io("strongest_bin.svg", e))?
-        .into_bytes(),
-    ));
+    })?;
     let d = m.dominant_bin;
-    out.push((
-        "deflection.svg".into(),
-        deflection_animation_svg(
+    add(set, "deflection.svg", &mut |w| {
+        write_deflection_animation(
+            w,
             &format!(
                 "deflection shape at {:.1} Hz (bin {d}), one period per second",
                 m.frequencies_hz[d]
@@ -269,49 +273,83 @@ pub fn files(
             r,
             c,
         )
-        .into_bytes(),
-    ));
-    out.push((
-        "vibration.uff".into(),
-        crate::uff::write(design, m).into_bytes(),
-    ));
-    Ok(out)
+    })?;
+    let name = configuration_name(design);
+    add(set, "vibration.uff", &mut |w| {
+        crate::uff::write_to(w, &name, mm, m)
+    })?;
+    Ok(names)
+}
+
+/// How an array set is written: the largest set allowed (`--max-out-gib`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SetLimits {
+    pub max_set_bytes: u64,
+}
+
+impl Default for SetLimits {
+    fn default() -> Self {
+        SetLimits {
+            max_set_bytes: crate::set_plan::DEFAULT_MAX_SET_BYTES,
+        }
+    }
+}
+
+/// Starts the array set of `design` in `dir` after every check that needs no work
+/// ([`crate::set_plan::open`]: size, lock, foreign files, disk); the model runs after.
+pub fn open_set(
+    design: &ResolvedDesign,
+    dir: &Path,
+    limits: SetLimits,
+) -> Result<OutputSet, ArrayError> {
+    let files = crate::set_plan::array_set(design)?;
+    crate::set_plan::open(design, dir, &files, limits.max_set_bytes)
 }
 
 /// Runs the array and writes its set into `dir` (whole or absent); returns the summary.
-pub fn run_and_write(design: &ResolvedDesign, dir: &Path) -> Result<ArraySummary, ArrayError> {
+/// Everything that can be checked before the model runs is checked first
+/// ([`open_set`]).
+pub fn run_and_write(
+    design: &ResolvedDesign,
+    dir: &Path,
+    limits: SetLimits,
+) -> Result<ArraySummary, ArrayError> {
+    let set = open_set(design, dir, limits)?;
     let rom = design.probe_rom()?;
     let t0 = Instant::now();
     let frame = run_array(design, rom.as_ref().map(|r| &r.image))?;
-    write_set(design, rom.as_ref(), frame, t0.elapsed().as_secs_f64(), dir)
+    write_set(design, rom.as_ref(), frame, t0.elapsed().as_secs_f64(), set)
 }
 
 /// Writes the set of a frame that took `model_seconds` to run (one run, or merged tiles:
-/// `shard::merge_sets`) into `dir` (whole or absent); returns the summary.
+/// `shard::merge_sets`) into `set` (from [`open_set`]), each file streamed, the summary
+/// and then the completion marker last; returns the summary.
 pub fn write_set(
     design: &ResolvedDesign,
     rom: Option<&ProbeRom>,
     frame: ArrayFrame,
     model_seconds: f64,
-    dir: &Path,
+    mut set: OutputSet,
 ) -> Result<ArraySummary, ArrayError> {
+    let dir = set.target().to_path_buf();
     let (frame, maps, events, mut summary) = finish(design, rom, frame, model_seconds)?;
-    let files = files(design, &frame, maps.as_ref(), events.as_ref())?;
+    let mut files = stream_files(&mut set, design, &frame, maps.as_ref(), events.as_ref())?;
+    files.push(SUMMARY.into());
+    summary.files = files;
     let out_err = |e: std::io::Error| ArrayError::Output {
-        path: dir.to_path_buf(),
+        path: dir.clone(),
         message: e.to_string(),
     };
-    let mut set = tofprobe_io::OutputSet::begin(dir).map_err(out_err)?;
-    summary.files = files.iter().map(|(n, _)| n.clone()).collect();
-    summary.files.push("summary.json".into());
-    for (name, bytes) in &files {
-        set.add(name, bytes).map_err(out_err)?;
-    }
     let json = serde_json::to_string_pretty(&summary).map_err(|e| ArrayError::Output {
-        path: dir.join("summary.json"),
+        path: dir.join(SUMMARY),
         message: e.to_string(),
     })?;
-    set.add("summary.json", json.as_bytes()).map_err(out_err)?;
-    set.commit(Some("summary.json")).map_err(out_err)?;
+    set.add(SUMMARY, json.as_bytes()).map_err(out_err)?;
+    let preamble = format!(
+        "# Generated by tofprobe {}: the completion marker of an array set (each file's \
+         FNV-1a-64), written last; check it with `tofprobe check-set`.\n",
+        env!("CARGO_PKG_VERSION")
+    );
+    set.commit_marked(MARKER, &preamble).map_err(out_err)?;
     Ok(summary)
 }

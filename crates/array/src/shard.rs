@@ -2,31 +2,42 @@
 //! partitions an R × C array into n rectangles (row bands, then column pieces), [`share`]
 //! cuts a range of n items (a soak's configurations) into n contiguous shares, [`Shard`]
 //! is the `i/n` of a job array. [`run_shard`] runs share i of an array and writes its
-//! **tile set** (`tile.json`: the tile's registers and detections; `manifest.json`, written
-//! last: the configuration hash, the seed, the tile's rectangle, the resolved design);
-//! [`merge_sets`] checks a list of tile sets (same configuration, same seed, every pixel
-//! exactly once, each refusal naming the offending set) and writes the same output set
-//! `tofprobe simulate --out` writes. A tile's registers do not depend on the tiling, so
-//! the merged set equals the single run's byte for byte (its `summary.json` differs only
-//! in the timing figures, `model_seconds` summed over the tiles).
+//! **tile set**: the tile's registers and detections (`registers.npy`, `detections.npy`),
+//! its part of the SPAD rate maps (`signal_rate.npy`, `background_rate.npy`), the
+//! manifest (`manifest.json`: the resolved design's hash, the seed, the tile's rectangle,
+//! the resolved design without its maps) and the project's completion marker listing every
+//! file's hash, written last. [`merge_sets`] (`crate::tile_set`) checks a list of tile
+//! sets (whole, same design with its maps, same seed, every pixel exactly once, each
+//! refusal naming the offending set) and writes the same output set `tofprobe simulate
+//! --out` writes. A tile's registers do not depend on the tiling, so the merged set equals
+//! the single run's byte for byte (its `summary.json` differs only in the timing figures,
+//! `model_seconds` summed over the tiles).
 
 use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 use tofprobe_design::ResolvedDesign;
+use tofprobe_io::npy;
 
 use crate::error::ArrayError;
-use crate::model::{Tile, merge, run_tile};
-use crate::output::{ArraySummary, write_set};
+use crate::model::run_tile;
 
-/// The tile set's manifest, its completion file (written last).
+pub use crate::tile_set::{merge_sets, read_manifest};
+
+/// The tile set's manifest.
 pub const MANIFEST: &str = "manifest.json";
-/// The tile set's registers and detections.
-pub const TILE: &str = "tile.json";
-/// The `kind` a manifest carries.
-const KIND: &str = "tofprobe array tile set";
+/// The tile's registers, int64 [rows, cols, K].
+pub const REGISTERS: &str = "registers.npy";
+/// The tile's detections, int64 [rows, cols].
+pub const DETECTIONS: &str = "detections.npy";
+/// The tile's SPADs' ρ_s and ρ_b, float64 [rows·G, cols·G].
+pub const SIGNAL_MAP: &str = "signal_rate.npy";
+pub const BACKGROUND_MAP: &str = "background_rate.npy";
+/// The `kind` a manifest carries, and the version of the tile set's layout.
+pub(crate) const KIND: &str = "tofprobe array tile set";
+pub(crate) const VERSION: u32 = 2;
 
 /// Share `index` of `count` (0-based: a job array's task `0 .. count − 1`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -74,7 +85,7 @@ pub type Rect = (Range<usize>, Range<usize>);
 /// n bands of whole rows; n > R gives every row its own band, row r cut into n_r column
 /// pieces (the n_r share n over the rows). Deterministic, every pixel in exactly one tile.
 pub fn tiles(rows: usize, cols: usize, n: usize) -> Result<Vec<Rect>, ArrayError> {
-    let pixels = rows * cols;
+    let pixels = rows.saturating_mul(cols);
     if n == 0 || n > pixels {
         return Err(ArrayError::Shape(format!(
             "tiles = {n} for a {rows} × {cols} array: use 1 ..= {pixels} (one pixel per tile at most)"
@@ -96,34 +107,59 @@ pub fn tiles(rows: usize, cols: usize, n: usize) -> Result<Vec<Rect>, ArrayError
 
 /// The manifest of one tile set.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct TileManifest {
     pub kind: String,
-    /// FNV-1a 64 of the configuration document with its seed set to 0 ([`config_hash`]).
-    pub config_hash: String,
+    /// The tile set's layout (2: `.npy` files and the maps beside the manifest).
+    pub version: u32,
+    /// [`design_hash`] of the resolved design the shard ran, maps included.
+    pub design_hash: String,
     pub seed: u64,
     pub shard: Shard,
     pub array_rows: usize,
     pub array_cols: usize,
     pub rows: Range<usize>,
     pub cols: Range<usize>,
+    pub registers_per_pixel: usize,
     /// Wall time of the tile's model, s.
     pub model_seconds: f64,
-    /// The resolved design (`ResolvedDesign::to_json`), so a merge needs no configuration.
-    pub design: String,
+    /// The resolved design with its rate maps empty (they are in the set's `.npy` maps,
+    /// the tile's part of them), so a merge needs no configuration.
+    pub design: ResolvedDesign,
 }
 
-/// The configuration's hash: FNV-1a 64 of its document (TOML) with the seed set to 0, so
-/// two runs differing only in the seed share it (and [`merge_sets`] names the seed).
-pub fn config_hash(design: &ResolvedDesign) -> Result<String, ArrayError> {
-    let mut doc = design.document.clone();
-    doc.acquisition.seed = 0;
-    let text = toml::to_string(&doc)
-        .map_err(|e| ArrayError::Shape(format!("the configuration does not serialise: {e}")))?;
-    Ok(format!("{:016x}", tofprobe_io::fnv1a64(text.as_bytes())))
+/// The resolved design's hash: FNV-1a 64 of its JSON (the rate maps included, streamed:
+/// never held as text) with the seed set to 0 and without the configuration's path, so
+/// shards that differ only in the seed or the configuration's name share it (the merge
+/// names those apart), while a changed map image does not.
+pub fn design_hash(design: &ResolvedDesign) -> Result<String, ArrayError> {
+    let mut d = design.clone();
+    d.document.acquisition.seed = 0;
+    d.origin = String::new();
+    let mut sink = tofprobe_io::HashingWriter::new(std::io::sink());
+    serde_json::to_writer(&mut sink, &d)
+        .map_err(|e| ArrayError::Shape(format!("the design does not serialise: {e}")))?;
+    Ok(format!("{:016x}", sink.finish().1))
+}
+
+/// The rows × cols part of a row-major map of `width` columns.
+pub(crate) fn map_part(
+    map: &[f64],
+    width: usize,
+    rows: Range<usize>,
+    cols: Range<usize>,
+) -> Vec<f64> {
+    rows.flat_map(|r| {
+        map[r * width + cols.start..r * width + cols.end]
+            .iter()
+            .copied()
+    })
+    .collect()
 }
 
 /// Runs tile `shard` of the array of `design` ([`tiles`] of `shard.count`) on the current
-/// rayon pool and writes its tile set into `dir` (whole or absent, the manifest last).
+/// rayon pool and writes its tile set into `dir` (whole or absent, the marker last). The
+/// set is opened, and its size, directory and disk checked, before the model runs.
 pub fn run_shard(
     design: &ResolvedDesign,
     shard: Shard,
@@ -136,8 +172,19 @@ pub fn run_shard(
         ))
     })?;
     let count = usize::try_from(shard.count).unwrap_or(usize::MAX);
-    let parts = tiles(a.rows, a.cols, count)?;
+    let parts = tiles(a.rows, a.cols, count).map_err(|_| ArrayError::Option {
+        option: "shard".into(),
+        value: shard.to_string(),
+        allowed: format!(
+            "n ≤ {} for the {} × {} array (one pixel per tile at most)",
+            a.rows.saturating_mul(a.cols),
+            a.rows,
+            a.cols
+        ),
+    })?;
     let (rows, cols) = parts[shard.index as usize].clone();
+    let files = crate::set_plan::tile_set(design, rows.len(), cols.len());
+    let mut set = crate::set_plan::open(design, dir, &files, u64::MAX)?;
     let rom = design.probe_rom()?;
     let t0 = Instant::now();
     let tile = run_tile(
@@ -146,174 +193,58 @@ pub fn run_shard(
         rows.clone(),
         cols.clone(),
     )?;
+    let mut bare = design.clone();
+    if let Some(b) = bare.array.as_mut() {
+        b.signal_rate = Vec::new();
+        b.background_rate = Vec::new();
+    }
     let manifest = TileManifest {
         kind: KIND.into(),
-        config_hash: config_hash(design)?,
+        version: VERSION,
+        design_hash: design_hash(design)?,
         seed: design.document.acquisition.seed,
         shard,
         array_rows: a.rows,
         array_cols: a.cols,
-        rows,
-        cols,
+        rows: rows.clone(),
+        cols: cols.clone(),
+        registers_per_pixel: tile.registers_per_pixel,
         model_seconds: t0.elapsed().as_secs_f64(),
-        design: design.to_json()?,
+        design: bare,
     };
-    let out = |e: String| ArrayError::Output {
+    let out = |e: std::io::Error| ArrayError::Output {
         path: dir.to_path_buf(),
-        message: e,
+        message: e.to_string(),
     };
-    let tile_json = serde_json::to_vec(&tile).map_err(|e| out(e.to_string()))?;
-    let manifest_json = serde_json::to_vec_pretty(&manifest).map_err(|e| out(e.to_string()))?;
-    let mut set = tofprobe_io::OutputSet::begin(dir).map_err(|e| out(e.to_string()))?;
-    set.add(TILE, &tile_json).map_err(|e| out(e.to_string()))?;
-    set.add(MANIFEST, &manifest_json)
-        .map_err(|e| out(e.to_string()))?;
-    set.commit(Some(MANIFEST)).map_err(|e| out(e.to_string()))?;
+    let (rt, ct, g) = (rows.len(), cols.len(), a.superpixel);
+    let spads = (rows.start * g..rows.end * g, cols.start * g..cols.end * g);
+    set.add_streamed(REGISTERS, |w| {
+        npy::write(w, &[rt, ct, tile.registers_per_pixel], &tile.registers)
+    })
+    .map_err(out)?;
+    set.add_streamed(DETECTIONS, |w| {
+        npy::write_iter(w, &[rt, ct], tile.detections.iter().map(|&d| d as i64))
+    })
+    .map_err(out)?;
+    for (name, map) in [
+        (SIGNAL_MAP, &a.signal_rate),
+        (BACKGROUND_MAP, &a.background_rate),
+    ] {
+        let part = map_part(map, a.spad_cols(), spads.0.clone(), spads.1.clone());
+        set.add_streamed(name, |w| npy::write(w, &[rt * g, ct * g], &part))
+            .map_err(out)?;
+    }
+    set.add_streamed(MANIFEST, |w| {
+        serde_json::to_writer_pretty(&mut *w, &manifest).map_err(std::io::Error::other)
+    })
+    .map_err(out)?;
+    let preamble = format!(
+        "# Generated by tofprobe {}: the completion marker of the tile set of shard {shard} \
+         (each file's FNV-1a-64), written last; `tofprobe merge` and `tofprobe check-set` \
+         check it.\n",
+        env!("CARGO_PKG_VERSION")
+    );
+    set.commit_marked(crate::set_plan::MARKER, &preamble)
+        .map_err(out)?;
     Ok(manifest)
-}
-
-/// A tile set's refusal, naming the set.
-fn refuse(dir: &Path, message: impl Into<String>) -> ArrayError {
-    ArrayError::TileSet {
-        path: dir.to_path_buf(),
-        message: message.into(),
-    }
-}
-
-/// Reads one tile set: its manifest and its tile (checked against each other).
-pub fn read_set(dir: &Path) -> Result<(TileManifest, Tile), ArrayError> {
-    const CAP: u64 = 1 << 34;
-    let m = dir.join(MANIFEST);
-    if !m.is_file() {
-        return Err(refuse(
-            dir,
-            format!(
-                "no {MANIFEST}: not a tile set, or one whose run did not finish (rerun its --shard)"
-            ),
-        ));
-    }
-    let text = tofprobe_io::read_bounded_text(&m, CAP)
-        .map_err(|e| refuse(dir, format!("{MANIFEST}: {e}")))?;
-    let manifest: TileManifest =
-        serde_json::from_str(&text).map_err(|e| refuse(dir, format!("{MANIFEST}: {e}")))?;
-    if manifest.kind != KIND {
-        return Err(refuse(
-            dir,
-            format!("{MANIFEST} is a `{}`, not a `{KIND}`", manifest.kind),
-        ));
-    }
-    let text = tofprobe_io::read_bounded_text(&dir.join(TILE), CAP)
-        .map_err(|e| refuse(dir, format!("{TILE}: {e}")))?;
-    let tile: Tile =
-        serde_json::from_str(&text).map_err(|e| refuse(dir, format!("{TILE}: {e}")))?;
-    let pixels = tile.rows.len() * tile.cols.len();
-    if tile.rows != manifest.rows
-        || tile.cols != manifest.cols
-        || tile.detections.len() != pixels
-        || tile.registers.len() != pixels * tile.registers_per_pixel
-    {
-        return Err(refuse(
-            dir,
-            format!(
-                "{TILE} does not hold the rows {:?} × cols {:?} its manifest names",
-                manifest.rows, manifest.cols
-            ),
-        ));
-    }
-    Ok((manifest, tile))
-}
-
-/// Merges tile sets into the array's output set in `out` (what `tofprobe simulate --out`
-/// writes for the same configuration and seed). Refuses, naming the offending set: a
-/// directory that is not a finished tile set, a different configuration or seed than the
-/// first set, a tile overlapping another set's, and pixels in no set (naming the first
-/// pixel and the shares missing).
-pub fn merge_sets(dirs: &[PathBuf], out: &Path) -> Result<ArraySummary, ArrayError> {
-    let Some(first_dir) = dirs.first() else {
-        return Err(ArrayError::Shape(
-            "merge needs at least one tile set".into(),
-        ));
-    };
-    let mut sets = Vec::with_capacity(dirs.len());
-    for d in dirs {
-        sets.push((d.as_path(), read_set(d)?));
-    }
-    let (m0, _) = &sets[0].1;
-    let (nr, nc) = (m0.array_rows, m0.array_cols);
-    let mut owner: Vec<Option<usize>> = vec![None; nr * nc];
-    for (i, (dir, (m, _))) in sets.iter().enumerate() {
-        if m.config_hash != m0.config_hash || (m.array_rows, m.array_cols) != (nr, nc) {
-            return Err(refuse(
-                dir,
-                format!(
-                    "a different configuration (hash {}) than {} (hash {}): merge sets of one configuration",
-                    m.config_hash,
-                    first_dir.display(),
-                    m0.config_hash
-                ),
-            ));
-        }
-        if m.seed != m0.seed {
-            return Err(refuse(
-                dir,
-                format!(
-                    "seed {} differs from {}'s seed {}: merge sets of one seed",
-                    m.seed,
-                    first_dir.display(),
-                    m0.seed
-                ),
-            ));
-        }
-        if m.rows.end > nr || m.cols.end > nc {
-            return Err(refuse(
-                dir,
-                format!(
-                    "tile rows {:?} × cols {:?} lies outside the {nr} × {nc} array",
-                    m.rows, m.cols
-                ),
-            ));
-        }
-        for r in m.rows.clone() {
-            for c in m.cols.clone() {
-                if let Some(j) = owner[r * nc + c].replace(i) {
-                    return Err(refuse(
-                        dir,
-                        format!(
-                            "tile rows {:?} × cols {:?} overlaps {} at pixel ({r}, {c})",
-                            m.rows,
-                            m.cols,
-                            sets[j].0.display()
-                        ),
-                    ));
-                }
-            }
-        }
-    }
-    if let Some(p) = owner.iter().position(Option::is_none) {
-        let count = usize::try_from(m0.shard.count).unwrap_or(usize::MAX);
-        let missing: Vec<String> = tiles(nr, nc, count)
-            .map(|t| {
-                t.iter()
-                    .enumerate()
-                    .filter(|(_, (rs, cs))| owner[rs.start * nc + cs.start].is_none())
-                    .map(|(i, _)| format!("{i}/{count}"))
-                    .collect()
-            })
-            .unwrap_or_default();
-        return Err(refuse(
-            first_dir,
-            format!(
-                "the sets leave pixel ({}, {}) of the {nr} × {nc} array uncovered (missing shard(s): {})",
-                p / nc,
-                p % nc,
-                missing.join(", ")
-            ),
-        ));
-    }
-    let design = ResolvedDesign::from_json(&m0.design)?;
-    let seconds: f64 = sets.iter().map(|(_, (m, _))| m.model_seconds).sum();
-    let tiles: Vec<Tile> = sets.into_iter().map(|(_, (_, t))| t).collect();
-    let frame = merge(nr, nc, &tiles)?;
-    let rom = design.probe_rom()?;
-    write_set(&design, rom.as_ref(), frame, seconds, out)
 }

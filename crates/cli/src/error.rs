@@ -24,6 +24,9 @@ pub enum CliError {
     /// Tile sets that `merge` refuses (the message names the set).
     #[error("merge: {0}")]
     Merge(String),
+    /// An array run that cannot go ahead (the message names the array's key or the set).
+    #[error("array: {0}")]
+    Array(String),
     /// An output set read (`cosim --rtl`, `check-set`) is not whole: killed mid-commit or
     /// changed since (the message names the missing marker or the file that fails).
     #[error("{0}")]
@@ -90,7 +93,12 @@ impl From<tofprobe_array::ArrayError> for CliError {
             tofprobe_array::ArrayError::Design(d) => CliError::Design(d),
             tofprobe_array::ArrayError::Output { path, message } => CliError::output(path, message),
             e @ tofprobe_array::ArrayError::TileSet { .. } => CliError::Merge(e.to_string()),
-            other => CliError::option("array", other.to_string(), "an array the model can run"),
+            tofprobe_array::ArrayError::Option {
+                option,
+                value,
+                allowed,
+            } => CliError::option(option, value, allowed),
+            other => CliError::Array(other.to_string()),
         }
     }
 }

@@ -21,7 +21,10 @@ struct Cli {
 fn main() -> ExitCode {
     quiet_on_closed_pipe();
     remove_temporaries_on_interrupt();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(&e),
+    };
     let result = commands::run(cli.command);
     // Output still buffered (a `print!` without newline) fails here, not silently at exit.
     if let Err(e) = std::io::Write::flush(&mut std::io::stdout()) {
@@ -54,10 +57,47 @@ fn remove_temporaries_on_interrupt() {
     }
 }
 
+/// What clap ends the run with: `--help` and `--version` printed on standard output
+/// (and checked: into a full disk they are an error, exit 2, not a silent 0), usage
+/// errors on standard error with clap's status (2).
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    use std::io::Write;
+    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+        let mut out = std::io::stdout().lock();
+        let text = e.render().to_string();
+        return match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(err) if err.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::from(141),
+            Err(err) => stdout_failed(&err.to_string()),
+        };
+    }
+    let _ = e.print();
+    ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
+}
+
 /// Standard output cannot be written (`> /dev/full`, a full disk): an error, exit status 2.
+/// A set the command committed before is whole on disk, and the message names it: the
+/// set is the command's result, its summary on standard output a report of it.
 fn stdout_failed(message: &str) -> ExitCode {
-    eprintln!("error: cannot write to standard output: {message}");
+    eprintln!(
+        "error: cannot write to standard output: {message}{}",
+        written_note()
+    );
     ExitCode::from(2)
+}
+
+/// "; the output set(s) … were written whole before" for the sets this run committed.
+fn written_note() -> String {
+    let sets = tofprobe_io::committed_sets();
+    if sets.is_empty() {
+        return String::new();
+    }
+    let names: Vec<String> = sets.iter().map(|p| p.display().to_string()).collect();
+    format!(
+        "; the output set {} was written whole before (only its summary is missing)",
+        names.join(", ")
+    )
 }
 
 /// `tofprobe … | head` closes stdout early; `println!` then panics with "failed printing to
@@ -79,7 +119,10 @@ fn quiet_on_closed_pipe() {
                 std::process::exit(141);
             }
             let reason = msg.split(": ").skip(1).collect::<Vec<_>>().join(": ");
-            eprintln!("error: cannot write to standard output: {reason}");
+            eprintln!(
+                "error: cannot write to standard output: {reason}{}",
+                written_note()
+            );
             std::process::exit(2);
         }
         default(info);

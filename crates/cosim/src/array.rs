@@ -17,6 +17,11 @@ use crate::verilator::{
     BuildProfile, HarnessBuild, VERILATOR_FLAGS, build_key, cache_root, cached_entry, verilate,
 };
 
+/// The largest array (R × C pixels) co-simulated whole: 64 × 64, the paper's scale, whose
+/// Verilator build and short-frame run stay within minutes on two cores; a larger array
+/// (the RTL renders at any size) is co-simulated as a tile of it (`cosim --tile`).
+pub const MAX_COSIM_PIXELS: usize = 64 * 64;
+
 /// The array harness, embedded so the binary works outside the source tree.
 pub const ARRAY_HARNESS_CPP: &str = include_str!("../../../testbench/array_harness.cpp");
 

@@ -21,12 +21,27 @@ use crate::error::DesignError;
 
 /// Largest rows or columns.
 pub const MAX_SIDE: u32 = 4096;
+/// Bounds of a pixel's size on the scene plane (mm), written or from the field of view:
+/// a micrometre to ten metres.
+pub const MIN_MM_PER_PIXEL: f64 = 1e-3;
+pub const MAX_MM_PER_PIXEL: f64 = 1e4;
+/// Smallest pixel pitch on the die (µm): a nanometre-scale pitch is no pixel.
+pub const MIN_PITCH_UM: f64 = 1e-3;
 /// Most pixel-pulses an array frame may cost (R·C·N): 2^40 ≈ 1.1·10^12, a 256 × 256 array
 /// over a 1 s frame at 10 MHz and about three hours at the model's 10^8 pixel-pulses/s.
 pub const MAX_PIXEL_PULSES: u64 = 1 << 40;
-/// Largest memory an array's registers, spectra and maps may take (bytes): 4 GiB, a sixth
-/// of the 24 GiB machines the project runs on.
+/// Largest memory an array command (`simulate`, `merge`, a shard) may hold, in bytes: 4 GiB,
+/// a sixth of the 24 GiB machines the project runs on. It counts everything the command
+/// holds ([`SensorArray::bytes_needed`]): the per-pixel data and [`FIXED_BYTES`].
 pub const MAX_ARRAY_BYTES: u64 = 4 << 30;
+/// What an array command holds whatever the array's size: the program and its libraries,
+/// the probe ROM (≤ 16 MB at its largest periodic depth) and the driver's folded tables,
+/// the streaming buffers of the threads (512 kB each), the allocator's arenas. Measured:
+/// `simulate --out` of a 4 × 4 array peaks at 7–10 MB resident
+/// (crates/cli/tests/it/array_memory.rs); 256 MiB leaves room for a periodic ROM at its
+/// largest depth, whose construction peaks near 340 MB before any per-pixel memory is
+/// taken (every array command builds the ROM before it allocates the frame).
+pub const FIXED_BYTES: u64 = 256 << 20;
 
 /// The `[array]` section as written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -212,11 +227,96 @@ impl SensorArray {
         tofprobe_pixel::Superpixel::new(self.superpixel as u32, tdc_bits).map(Some)
     }
 
-    /// The bytes an array of `registers` words and `bins` spectral bins per pixel needs:
-    /// the registers (i64), amplitude and phase per bin (f64), and the two maps.
-    pub fn bytes_needed(rows: u64, cols: u64, registers: u64, bins: u64) -> u64 {
+    /// The bytes one pixel costs an array command at its peak (the frame and the maps are
+    /// held together while the set is written; every file is streamed, so no file adds
+    /// to it): its `registers` words (i64) and detections (8); the ρ_s and ρ_b maps of its
+    /// `spads` SPADs (16 each, kept in the design); and what is read from the frame —
+    /// Fourier (`bins` > 0): amplitude and phase per bin (16 each) and the strongest bin (8);
+    /// Haar (`bins` = 0): the transition time (8) and its point of the plane fit (24).
+    /// `merge`'s coverage table (4 per pixel) is freed before the maps are made.
+    pub fn bytes_per_pixel(registers: u64, bins: u64, spads: u64) -> u64 {
+        let analysis = if bins > 0 { 16 * bins + 8 } else { 32 };
+        8 * registers + 8 + 16 * spads + analysis
+    }
+
+    /// The bytes an array command holds for `rows` × `cols` pixels
+    /// ([`Self::bytes_per_pixel`] each, and [`FIXED_BYTES`]), saturating.
+    pub fn bytes_needed(rows: u64, cols: u64, registers: u64, bins: u64, spads: u64) -> u64 {
         rows.saturating_mul(cols)
-            .saturating_mul(8 * (registers + 2 * bins + 2))
+            .saturating_mul(Self::bytes_per_pixel(registers, bins, spads))
+            .saturating_add(FIXED_BYTES)
+    }
+
+    /// Checks a resolved array received whole (a tile set's manifest, a worker's design):
+    /// [`Self::check_shape`], then maps of one value per SPAD, finite and in range. What a
+    /// resolution produced always passes; a tampered one is refused before anything is
+    /// sized from it.
+    pub fn check_received(&self, registers: usize, bins: usize) -> Result<(), String> {
+        self.check_shape(registers, bins)?;
+        let spads = self.spad_rows() * self.spad_cols();
+        for (name, map, max) in [
+            ("signal", &self.signal_rate, 1.0),
+            ("background", &self.background_rate, 20.0),
+        ] {
+            if map.len() != spads {
+                return Err(format!(
+                    "the {name} map has {} values for {} × {} SPADs",
+                    map.len(),
+                    self.spad_rows(),
+                    self.spad_cols()
+                ));
+            }
+            if let Some(v) = map
+                .iter()
+                .find(|v| !(v.is_finite() && (0.0..=max).contains(*v)))
+            {
+                return Err(format!(
+                    "the {name} map holds the rate {v}: allowed 0..={max}"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The shape of a received array, its maps aside: G within 1..=4, rows and columns of
+    /// SPADs within 1..=[`MAX_SIDE`], pitch and mapping finite and positive, and the memory
+    /// within [`MAX_ARRAY_BYTES`] for `registers` words and `bins` bins per pixel (so
+    /// nothing sized from it can overflow or exceed the cap).
+    pub fn check_shape(&self, registers: usize, bins: usize) -> Result<(), String> {
+        let g = self.superpixel;
+        let max_g = tofprobe_pixel::superpixel::MAX_SUPERPIXEL as usize;
+        if !(1..=max_g).contains(&g) {
+            return Err(format!("array.superpixel = {g}: allowed 1..={max_g}"));
+        }
+        for (name, v) in [("rows", self.rows), ("cols", self.cols)] {
+            if v == 0 || v.saturating_mul(g) > MAX_SIDE as usize {
+                return Err(format!(
+                    "array.{name} = {v} pixels of {g} × {g} SPADs: allowed 1..={MAX_SIDE} SPADs"
+                ));
+            }
+        }
+        if !(self.mm_per_pixel.is_finite() && self.mm_per_pixel > 0.0)
+            || !(self.pitch_um.is_finite() && self.pitch_um > 0.0)
+        {
+            return Err(format!(
+                "pitch {} µm, {} mm per pixel: both must be finite and positive",
+                self.pitch_um, self.mm_per_pixel
+            ));
+        }
+        let need = Self::bytes_needed(
+            self.rows as u64,
+            self.cols as u64,
+            registers as u64,
+            bins as u64,
+            (g * g) as u64,
+        );
+        if need > MAX_ARRAY_BYTES {
+            return Err(format!(
+                "{} × {} pixels need {need} bytes: allowed at most {MAX_ARRAY_BYTES}",
+                self.rows, self.cols
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -270,16 +370,37 @@ pub fn resolve_array(
     }
     // The pixels: G × G SPADs each.
     let (prows, pcols) = (a.rows / g, a.cols / g);
-    let need = SensorArray::bytes_needed(prows.into(), pcols.into(), registers as u64, bins as u64);
+    let analysis_bins = match pixel.mode {
+        tofprobe_pixel::Mode::Fourier => bins as u64,
+        tofprobe_pixel::Mode::Haar => 0,
+    };
+    let spads = u64::from(g) * u64::from(g);
+    let need = SensorArray::bytes_needed(
+        prows.into(),
+        pcols.into(),
+        registers as u64,
+        analysis_bins,
+        spads,
+    );
     if need > MAX_ARRAY_BYTES {
-        let per_pixel = 8 * (registers as u64 + 2 * bins as u64 + 2);
-        let side = ((MAX_ARRAY_BYTES / per_pixel) as f64).sqrt().floor() as u64;
+        let per_pixel = SensorArray::bytes_per_pixel(registers as u64, analysis_bins, spads);
+        // The largest square of SPADs (a multiple of G) whose pixels fit.
+        let pixels = (MAX_ARRAY_BYTES - FIXED_BYTES) / per_pixel;
+        let side = ((pixels as f64).sqrt().floor() as u64) * u64::from(g);
         return Err(err(format!(
-            "array.rows × array.cols = {} × {} needs {:.1} GiB for its registers ({registers} \
-             per pixel), spectra and maps: allowed at most {} GiB; {side} × {side} pixels fit",
-            prows,
-            pcols,
+            "array.rows × array.cols = {} × {} needs {:.2} GiB at its peak ({per_pixel} bytes \
+             per pixel: {registers} registers, the detections, the rate maps and the {} maps, \
+             with {} MiB for the ROM and the program): allowed at most {} GiB; \
+             array.rows = array.cols = {side} fits",
+            a.rows,
+            a.cols,
             need as f64 / (1u64 << 30) as f64,
+            if analysis_bins > 0 {
+                "amplitude and phase"
+            } else {
+                "transition-time"
+            },
+            FIXED_BYTES >> 20,
             MAX_ARRAY_BYTES >> 30
         )));
     }
@@ -293,17 +414,21 @@ pub fn resolve_array(
             a.rows, a.cols,
         )));
     }
-    if !(a.pitch_um.is_finite() && a.pitch_um > 0.0 && a.pitch_um <= 1e4) {
+    let num = tofprobe_io::text::number;
+    if !(a.pitch_um.is_finite() && (MIN_PITCH_UM..=1e4).contains(&a.pitch_um)) {
         return Err(err(format!(
-            "array.pitch_um = {} is out of range: allowed 0 < pitch_um <= 10000 (e.g. 30)",
-            a.pitch_um
+            "array.pitch_um = {} is out of range: allowed {} <= pitch_um <= 10000 (e.g. 30)",
+            num(a.pitch_um),
+            num(MIN_PITCH_UM)
         )));
     }
     let mm_per_pixel = match (a.mm_per_pixel, a.field_of_view_deg, a.distance_mm) {
         (Some(s), None, None) => {
-            if !(s.is_finite() && s > 0.0 && s <= 1e4) {
+            if !(s.is_finite() && (MIN_MM_PER_PIXEL..=MAX_MM_PER_PIXEL).contains(&s)) {
                 return Err(err(format!(
-                    "array.mm_per_pixel = {s} is out of range: allowed 0 < mm_per_pixel <= 10000"
+                    "array.mm_per_pixel = {} is out of range: allowed {} <= mm_per_pixel <= 10000",
+                    num(s),
+                    num(MIN_MM_PER_PIXEL)
                 )));
             }
             s
@@ -311,15 +436,35 @@ pub fn resolve_array(
         (None, Some(fov), Some(d)) => {
             if !(fov.is_finite() && fov > 0.0 && fov < 180.0) {
                 return Err(err(format!(
-                    "array.field_of_view_deg = {fov} is out of range: allowed 0 < fov < 180"
+                    "array.field_of_view_deg = {} is out of range: allowed 0 < fov < 180",
+                    num(fov)
                 )));
             }
             if !(d.is_finite() && d > 0.0 && d <= 1e7) {
                 return Err(err(format!(
-                    "array.distance_mm = {d} is out of range: allowed 0 < distance_mm <= 1e7"
+                    "array.distance_mm = {} is out of range: allowed 0 < distance_mm <= 1e7",
+                    num(d)
                 )));
             }
-            2.0 * d * (fov.to_radians() / 2.0).tan() / f64::from(a.cols)
+            let s = 2.0 * d * (fov.to_radians() / 2.0).tan() / f64::from(a.cols);
+            // The mapping's result within the bounds `mm_per_pixel` has when written.
+            if !(s.is_finite() && (MIN_MM_PER_PIXEL..=MAX_MM_PER_PIXEL).contains(&s)) {
+                let want = if s.is_finite() && s > MAX_MM_PER_PIXEL {
+                    "a narrower field of view or a nearer plane"
+                } else {
+                    "a wider field of view or a farther plane"
+                };
+                return Err(err(format!(
+                    "array.field_of_view_deg = {} and array.distance_mm = {} over {} columns give \
+                     {} mm per pixel: allowed {} ..= 10000 (what array.mm_per_pixel allows); {want}",
+                    num(fov),
+                    num(d),
+                    a.cols,
+                    num(s),
+                    num(MIN_MM_PER_PIXEL)
+                )));
+            }
+            s
         }
         _ => {
             // Name the keys written (their dotted paths), not only the section.
@@ -422,12 +567,15 @@ fn rate_map(
         Some(RateMap::Image { path, scale }) => {
             if !(scale.is_finite() && *scale >= 0.0) {
                 return Err(format!(
-                    "{field}.scale = {scale} is out of range: allowed >= 0 (1: the image as it is)"
+                    "{field}.scale = {} is out of range: allowed >= 0 (1: the image as it is)",
+                    tofprobe_io::text::number(*scale)
                 ));
             }
             let p = base.join(path);
+            // A path is echoed at most 200 characters (a 4 kB path made a 4 kB message).
+            let shown = tofprobe_io::text::clip(path, 200);
             let img = crate::rate_image::read(&p, rows, cols)
-                .map_err(|m| format!("{field}.path = \"{path}\": {m}"))?;
+                .map_err(|m| format!("{field}.path = \"{shown}\": {m}"))?;
             img.into_iter().map(|v| v * scale).collect()
         }
     };
@@ -437,9 +585,10 @@ fn rate_map(
         .find(|(_, v)| !(v.is_finite() && (0.0..=max).contains(*v)))
     {
         return Err(format!(
-            "{field} gives pixel ({}, {}) the rate {v}: allowed 0..={max} (a {} rate per pulse)",
+            "{field} gives pixel ({}, {}) the rate {}: allowed 0..={max} (a {} rate per pulse)",
             i / cols,
             i % cols,
+            tofprobe_io::text::number(*v),
             if max == 1.0 {
                 "signal-photon probability; scale the map down"
             } else {

@@ -38,6 +38,10 @@ pub const FIRST_BEAT_LATENCY: u64 = 6;
 
 /// Widest output port (bits per beat) the generator renders.
 pub const MAX_READOUT_BITS: u32 = 63;
+/// Longest readout phase, in pixel-clock cycles: 2^40 (three hours at 100 MHz). A slower
+/// `readout_bits_per_s` is refused, so every count the RTL and the model keep of it fits
+/// 64 bits with room.
+pub const MAX_READOUT_CYCLES: u64 = 1 << 40;
 
 /// The `[array]` readout keys as written (all optional).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -130,15 +134,39 @@ impl Readout {
         }
         let clock_hz = c as f64 * laser_rate_hz;
         let port = f64::from(b) * clock_hz;
+        // The longest readout phase allowed bounds the cycles a beat may take: P·(R+1)·k·g
+        // + 1 cycles must stay within MAX_READOUT_CYCLES (a 5e-324 bits/s link once
+        // wrapped the count past 2^64 into the rendered RTL).
+        let beats = ((rows * cols) as u64)
+            .saturating_mul((pixel.registers() + 1) as u64)
+            .saturating_mul(u64::from(w.div_ceil(b)));
+        let g_max = (MAX_READOUT_CYCLES - 1) / beats.max(1);
         let beat_cycles = match keys.readout_bits_per_s {
             None => 1,
-            Some(rate) if rate.is_finite() && rate > 0.0 && rate <= port * (1.0 + 1e-12) => {
+            Some(rate)
+                if rate.is_finite()
+                    && rate > 0.0
+                    && rate <= port * (1.0 + 1e-12)
+                    && port / rate <= g_max as f64 =>
+            {
                 ((port / rate) * (1.0 - 1e-12)).ceil().max(1.0) as u64
+            }
+            Some(rate) if rate.is_finite() && rate > 0.0 && rate <= port * (1.0 + 1e-12) => {
+                return Err(format!(
+                    "array.readout_bits_per_s = {} is out of range: a frame's readout would take \
+                     more than 2^40 cycles ({} beats of {b} bits, each ≥ {} cycles); allowed \
+                     {:.6e} <= rate <= {port:.6e} bits/s",
+                    tofprobe_io::text::number(rate),
+                    beats,
+                    tofprobe_io::text::number((port / rate).ceil()),
+                    port / g_max.max(1) as f64
+                ));
             }
             Some(rate) => {
                 let need = (rate / clock_hz).ceil();
+                let given = tofprobe_io::text::number(rate);
                 return Err(format!(
-                    "array.readout_bits_per_s = {rate} is out of range: allowed 0 < rate <= \
+                    "array.readout_bits_per_s = {given} is out of range: allowed 0 < rate <= \
                      readout_bits × C × f_laser = {b} × {c} × {laser_rate_hz} = {port:.6e} bits/s \
                      (one beat per pixel-clock cycle){}",
                     if need.is_finite() && need <= f64::from(w) && rate > 0.0 {

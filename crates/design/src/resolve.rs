@@ -51,6 +51,14 @@ pub struct ResolvedDesign {
     pub array: Option<crate::array::SensorArray>,
 }
 
+/// A design received as JSON that does not hold.
+fn received_error(message: String) -> DesignError {
+    DesignError::Toml {
+        origin: "<serialised design>".to_string(),
+        message,
+    }
+}
+
 /// Reads `path` (or the embedded default) and resolves it.
 pub fn load(path: Option<&Path>) -> Result<ResolvedDesign, DesignError> {
     let (document, origin) = Document::read(path)?;
@@ -338,11 +346,40 @@ impl ResolvedDesign {
     }
 
     /// A design sent as [`Self::to_json`]; errors name what does not fit.
+    /// An `[array]` is checked as [`crate::array::SensorArray::check_received`] does: its
+    /// shape against its maps and the memory cap, before anything is sized from it.
     pub fn from_json(text: &str) -> Result<ResolvedDesign, DesignError> {
-        serde_json::from_str(text).map_err(|e| DesignError::Toml {
-            origin: "<serialised design>".to_string(),
-            message: e.to_string(),
-        })
+        Self::received(serde_json::from_str(text))
+    }
+
+    /// [`Self::from_json`] from a reader (a file streamed, never held whole as text).
+    pub fn from_json_reader(r: impl std::io::Read) -> Result<ResolvedDesign, DesignError> {
+        Self::received(serde_json::from_reader(std::io::BufReader::new(r)))
+    }
+
+    fn received(d: serde_json::Result<ResolvedDesign>) -> Result<ResolvedDesign, DesignError> {
+        let d = d.map_err(|e| received_error(e.to_string()))?;
+        d.check_received()?;
+        Ok(d)
+    }
+
+    /// The checks of a design received whole rather than resolved here: its `[array]`
+    /// ([`crate::array::SensorArray::check_received`]).
+    pub fn check_received(&self) -> Result<(), DesignError> {
+        if let Some(a) = &self.array {
+            a.check_received(self.pixel.registers(), self.analysis_bins())
+                .map_err(|m| received_error(format!("its [array]: {m}")))?;
+        }
+        Ok(())
+    }
+
+    /// The bins read from each pixel's registers: B in Fourier mode, 0 in Haar mode (the
+    /// memory accounting's `bins`, [`crate::array::SensorArray::bytes_per_pixel`]).
+    pub fn analysis_bins(&self) -> usize {
+        match self.pixel.mode {
+            tofprobe_pixel::Mode::Fourier => self.pixel.bins,
+            tofprobe_pixel::Mode::Haar => 0,
+        }
     }
 
     /// The sensor.

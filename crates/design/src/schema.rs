@@ -41,7 +41,18 @@ fn misfit(section: &str, key: &str, value: &Value, entry: Option<&Value>) -> Opt
 /// against the schema ([`misfit`]); a name-valued key whose names serde does not list (an
 /// untagged choice) is shown by its default value.
 fn describe(section: &str, key: &str, entry: Option<&Value>) -> String {
-    let fits = |v: Value| misfit(section, key, &v, entry).is_none();
+    describe_by(&|v| misfit(section, key, v, entry), || {
+        default_value(section, key, entry)
+    })
+}
+
+/// [`describe`] of a key judged by `try_value` (serde's message when a value does not
+/// fit), its default value from `default` for a name-valued key.
+fn describe_by(
+    try_value: &dyn Fn(&Value) -> Option<String>,
+    default: impl Fn() -> Option<Value>,
+) -> String {
+    let fits = |v: Value| try_value(&v).is_none();
     let mut kinds = Vec::new();
     if fits(Value::Float(1.5)) {
         kinds.push("a number".to_string());
@@ -62,7 +73,7 @@ fn describe(section: &str, key: &str, entry: Option<&Value>) -> String {
     if fits(odd.clone()) {
         kinds.push("a string".into());
     } else {
-        let names = misfit(section, key, &odd, entry)
+        let names = try_value(&odd)
             .and_then(|m| {
                 m.split_once(", expected ")
                     .map(|(_, n)| n.trim().to_string())
@@ -75,7 +86,7 @@ fn describe(section: &str, key: &str, entry: Option<&Value>) -> String {
                 format!("one of {n}")
             }),
             None => {
-                if let Some(Value::String(d)) = default_value(section, key, entry)
+                if let Some(Value::String(d)) = default()
                     && d != "auto"
                 {
                     kinds.push(format!("a name such as \"{d}\""));
@@ -185,6 +196,9 @@ pub fn wrong_type_in(doc: &Table) -> Option<String> {
                 continue;
             }
             if let Some(e) = misfit(section, key, v, None) {
+                if let Some(inner) = v.as_table().and_then(|t| nested_misfit(section, key, t)) {
+                    return Some(inner);
+                }
                 return Some(report(format!("{section}.{key}"), v, e, section, key, None));
             }
         }
@@ -269,6 +283,49 @@ pub fn unknown_key(doc: &Table) -> Option<String> {
     None
 }
 
+/// The key inside the table `t` of `section.key` (a tagged table such as
+/// `array.signal_map = { kind = "constant", value = "x" }`) whose value does not fit, each
+/// tried alone beside the table's `kind`, as "`section.key.inner` = value has the wrong
+/// type: expected …"; `None` when none does alone.
+fn nested_misfit(section: &str, key: &str, t: &Table) -> Option<String> {
+    let kind = t.get("kind");
+    let try_inner = |inner: &str, v: &Value| {
+        let mut sub = Table::new();
+        if let Some(k) = kind
+            && inner != "kind"
+        {
+            sub.insert("kind".into(), k.clone());
+        }
+        sub.insert(inner.to_string(), v.clone());
+        misfit(section, key, &Value::Table(sub), None)
+    };
+    let keys = t
+        .iter()
+        .filter(|(k, _)| *k == "kind")
+        .chain(t.iter().filter(|(k, _)| *k != "kind"));
+    for (inner, v) in keys {
+        let Some(m) = try_inner(inner, v) else {
+            continue;
+        };
+        let shown = tofprobe_io::text::clip(&v.to_string(), 60);
+        let path = format!("{section}.{key}.{inner}");
+        return Some(
+            if m.starts_with("invalid type") || m.starts_with("invalid value") {
+                format!(
+                    "`{path}` = {shown} has the wrong type: expected {}",
+                    describe_by(&|x| try_inner(inner, x), || None)
+                )
+            } else {
+                format!(
+                    "`{path}` = {shown} is not accepted: {}",
+                    tofprobe_io::text::clip(&m, 200)
+                )
+            },
+        );
+    }
+    None
+}
+
 /// The toml crate's message with every line cut to a readable length: a megabyte string in
 /// the document is not echoed back whole.
 pub fn clip_message(message: &str) -> String {
@@ -347,6 +404,18 @@ mod tests {
             (
                 "[array]\nrows = \"x\"\n",
                 "`array.rows` = \"x\" has the wrong type: expected an integer >= 0",
+            ),
+            (
+                "[array]\nsignal_map = { kind = \"constant\", value = \"x\" }\n",
+                "`array.signal_map.value` = \"x\" has the wrong type: expected a number",
+            ),
+            (
+                "[array]\nsignal_map = { kind = \"gradient\", from = 0.1, to = [1] }\n",
+                "`array.signal_map.to` = [1] has the wrong type: expected a number",
+            ),
+            (
+                "[array]\nbackground_map = { kind = \"image\", path = 3 }\n",
+                "`array.background_map.path` = 3 has the wrong type: expected a string",
             ),
             (
                 "[[scene.motion]]\nkind = 3\n",

@@ -299,10 +299,11 @@ pub fn check_equivalence(spec: &EquivSpec, work: &Path) -> Result<Equivalence> {
 }
 
 /// [`check_equivalence`] with the cache in `cache` (`None`: no cache). Only a proof is
-/// cached (a failure is re-run, so its report is fresh): `cache/<key>/equiv.log` and then
-/// `result.json`, each written atomically, the result last, so an entry is whole or absent;
-/// an entry that does not read back whole (unparsable, not all points proven, its log
-/// missing) is proven again and replaced.
+/// cached (a failure is re-run, so its report is fresh): the entry `cache/<key>/`
+/// (`equiv.log` and `result.json` naming it) is made by `tofprobe_io::cache::entry` — built
+/// in a private directory under the key's lock, sealed with its files' hashes, published
+/// by a rename and checked on every read — so two runs proving one pair at once run one
+/// proof, and an entry that does not read back whole is proven again and replaced.
 pub fn check_equivalence_cached(
     spec: &EquivSpec,
     work: &Path,
@@ -324,21 +325,34 @@ pub fn check_equivalence_cached(
         .map_err(|e| EdaError::io("reading", &spec.netlist, e))?;
     let models = crate::clock_gate::icg_models(&lib, &netlist);
     let recipe = Recipe::of(spec)?;
-    let entry = match cache {
-        Some(dir) => Some(dir.join(cache_key(spec, recipe, &yosys, models.as_deref())?)),
-        None => None,
+    let Some(root) = cache else {
+        return prove(spec, recipe, work, &yosys, models.as_deref());
     };
-    if let Some(hit) = entry.as_deref().and_then(read_entry) {
-        return Ok(hit);
+    let key = cache_key(spec, recipe, &yosys, models.as_deref())?;
+    let dir = root.join(&key);
+    let mut fresh = None;
+    tofprobe_io::cache::entry(
+        root,
+        &key,
+        |tmp| {
+            let proven = prove(spec, recipe, work, &yosys, models.as_deref())?;
+            store_entry(tmp, &dir, &proven)?;
+            fresh = Some(proven);
+            Ok(())
+        },
+        |p, e| EdaError::io("publishing the equivalence cache entry", p, e),
+    )?;
+    match fresh {
+        Some(proven) => Ok(proven),
+        // A whole entry that is not a proof (written by another version): prove again.
+        None => match read_entry(&dir) {
+            Some(hit) => Ok(hit),
+            None => prove(spec, recipe, work, &yosys, models.as_deref()),
+        },
     }
-    let proven = prove(spec, recipe, work, &yosys, models.as_deref())?;
-    if let Some(dir) = &entry {
-        store_entry(dir, &proven)?;
-    }
-    Ok(proven)
 }
 
-/// A whole cache entry, or `None` (absent, or not readable back whole).
+/// A whole cache entry's proof, or `None` (not a proof of every point).
 fn read_entry(dir: &Path) -> Option<Equivalence> {
     let text = std::fs::read_to_string(dir.join("result.json")).ok()?;
     let e: Equivalence = serde_json::from_str(&text).ok()?;
@@ -346,14 +360,13 @@ fn read_entry(dir: &Path) -> Option<Equivalence> {
         .then_some(Equivalence { cached: true, ..e })
 }
 
-/// Stores a proof: its log, then the result naming it (each atomically).
-fn store_entry(dir: &Path, proven: &Equivalence) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| EdaError::io("creating", dir, e))?;
-    let log = dir.join("equiv.log");
+/// Stores a proof into `tmp`, the entry published at `dir`: its log, then the result
+/// naming the log at `dir`.
+fn store_entry(tmp: &Path, dir: &Path, proven: &Equivalence) -> Result<()> {
     let text = std::fs::read(&proven.log).map_err(|e| EdaError::io("reading", &proven.log, e))?;
-    write_atomic(&log, &text)?;
+    write_atomic(&tmp.join("equiv.log"), &text)?;
     let entry = Equivalence {
-        log,
+        log: dir.join("equiv.log"),
         cached: false,
         ..proven.clone()
     };
@@ -361,7 +374,7 @@ fn store_entry(dir: &Path, proven: &Equivalence) -> Result<()> {
         what: dir.join("result.json").display().to_string(),
         source: e,
     })?;
-    write_atomic(&dir.join("result.json"), &json)
+    write_atomic(&tmp.join("result.json"), &json)
 }
 
 /// Runs yosys's proof of `spec` in `work`.

@@ -29,17 +29,19 @@ impl Fnv64 {
     }
 }
 
-/// The JSON value cached at `path`, or `compute`'s, then cached there atomically. A cache
-/// file that does not parse (an older crate version's layout) is recomputed, not an error.
+/// The JSON value cached at `path` (an OpenSTA timing, an area split), or `compute`'s,
+/// then cached there: sealed with its hash (`tofprobe_io::cache::sealed`) and written
+/// atomically, so a reader gets a value whole and checked or computes it again. A file
+/// that does not unseal or parse (cut short, changed, an older layout) is recomputed, not
+/// an error.
 pub fn cached_json<T, F>(path: &Path, compute: F) -> Result<T>
 where
     T: serde::Serialize + serde::de::DeserializeOwned,
     F: FnOnce() -> Result<T>,
 {
-    if let Some(v) = std::fs::read_to_string(path)
-        .ok()
-        .and_then(|t| serde_json::from_str::<T>(&t).ok())
-    {
+    if let Some(v) = std::fs::read(path).ok().and_then(|b| {
+        tofprobe_io::cache::unsealed(&b).and_then(|t| serde_json::from_slice::<T>(t).ok())
+    }) {
         return Ok(v);
     }
     let v = compute()?;
@@ -47,7 +49,7 @@ where
         what: path.display().to_string(),
         source: e,
     })?;
-    write_atomic(path, &json)?;
+    write_atomic(path, &tofprobe_io::cache::sealed(&json))?;
     Ok(v)
 }
 

@@ -221,17 +221,72 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
     let key = h.hex();
     let dir = cache_root.join(&key);
     let result_path = dir.join("synthesis.json");
-    if let Ok(text) = std::fs::read_to_string(&result_path)
-        && let Ok(cached) = serde_json::from_str::<Synthesis>(&text)
-        && cached.netlist_json.exists()
-        && cached.netlist_verilog.exists()
-    {
-        return Ok(cached);
+    // Built in a private directory and published whole under the key's lock, checked on
+    // every read (tofprobe_io::cache::entry): a concurrent run waits for this synthesis and
+    // reuses it, and never reads a netlist half written.
+    let (_, reused) = tofprobe_io::cache::entry(
+        cache_root,
+        &key,
+        |tmp| {
+            build_entry(
+                &BuildInputs {
+                    spec,
+                    lib: &lib,
+                    lib_text: &lib_text,
+                    yosys: &yosys,
+                    clock_gate_map: clock_gate_map.as_deref(),
+                    latch_map: latch_map.as_deref(),
+                    key: &key,
+                    cache_root,
+                },
+                tmp,
+                &dir,
+            )
+        },
+        |p, e| EdaError::io("publishing the synthesis cache entry", p, e),
+    )?;
+    let text = std::fs::read_to_string(&result_path)
+        .map_err(|e| EdaError::io("reading", &result_path, e))?;
+    let mut syn: Synthesis = serde_json::from_str(&text).map_err(|e| EdaError::Json {
+        what: result_path.display().to_string(),
+        source: e,
+    })?;
+    if reused {
+        syn.yosys_seconds = 0.0;
     }
-    std::fs::create_dir_all(&dir).map_err(|e| EdaError::io("creating", &dir, e))?;
+    Ok(syn)
+}
+
+/// What one synthesis entry is built from.
+struct BuildInputs<'a> {
+    spec: &'a SynthSpec,
+    lib: &'a Liberty,
+    lib_text: &'a [u8],
+    yosys: &'a Path,
+    clock_gate_map: Option<&'a str>,
+    latch_map: Option<&'a str>,
+    key: &'a str,
+    cache_root: &'a Path,
+}
+
+/// Runs yosys for `inputs` in the private directory `tmp`, leaving the netlists, the log
+/// and `synthesis.json` there; the result names the files at `dir`, where the entry is
+/// published.
+fn build_entry(inputs: &BuildInputs, tmp: &Path, dir: &Path) -> Result<()> {
+    let BuildInputs {
+        spec,
+        lib,
+        lib_text,
+        yosys,
+        clock_gate_map,
+        latch_map,
+        key,
+        cache_root,
+    } = *inputs;
+    let result_path = tmp.join("synthesis.json");
     // Map onto a copy with the cells synthesis must not use marked `dont_use` (ABC honours
     // it), when the liberty has such cells; the area and timing of the others are the same.
-    let text = String::from_utf8_lossy(&lib_text);
+    let text = String::from_utf8_lossy(lib_text);
     let marked = crate::liberty::mark_not_for_synthesis(&text);
     let map_spec = match &marked {
         Some(m) => {
@@ -252,43 +307,43 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
     };
     let mut constrained = false;
     if let Some(d) = spec.delay_target_ps {
-        write_atomic(&dir.join("abc.script"), abc_timing_script(d).as_bytes())?;
+        write_atomic(&tmp.join("abc.script"), abc_timing_script(d).as_bytes())?;
         // `drive_cell` already skips the cells the map copy marks: no second parse.
         if let Some(cell) = lib.drive_cell() {
-            write_atomic(&dir.join("abc.constr"), abc_constraints(cell).as_bytes())?;
+            write_atomic(&tmp.join("abc.constr"), abc_constraints(cell).as_bytes())?;
             constrained = true;
         }
     }
-    let latch_path = dir.join("latch_map.v");
-    if let Some(m) = &latch_map {
+    let latch_path = tmp.join("latch_map.v");
+    if let Some(m) = latch_map {
         write_atomic(&latch_path, m.as_bytes())?;
     }
-    let map_path = dir.join("clock_gate_map.v");
-    if let Some(m) = &clock_gate_map {
+    let map_path = tmp.join("clock_gate_map.v");
+    if let Some(m) = clock_gate_map {
         write_atomic(&map_path, m.as_bytes())?;
     }
-    let script_path = dir.join("synth.ys");
+    let script_path = tmp.join("synth.ys");
     write_atomic(
         &script_path,
         yosys_script(
             &map_spec,
-            &dir,
+            tmp,
             constrained,
-            clock_gate_map.as_ref().map(|_| map_path.as_path()),
-            latch_map.as_ref().map(|_| latch_path.as_path()),
+            clock_gate_map.map(|_| map_path.as_path()),
+            latch_map.map(|_| latch_path.as_path()),
         )
         .as_bytes(),
     )?;
     let start = std::time::Instant::now();
-    let out = Command::new(&yosys)
+    let out = Command::new(yosys)
         .arg("-q")
         .arg("-l")
-        .arg(dir.join("yosys.log"))
+        .arg(tmp.join("yosys.log"))
         .arg(&script_path)
         .output()
-        .map_err(|e| EdaError::io("running", &yosys, e))?;
+        .map_err(|e| EdaError::io("running", yosys, e))?;
     let seconds = start.elapsed().as_secs_f64();
-    let log = std::fs::read_to_string(dir.join("yosys.log")).unwrap_or_default();
+    let log = std::fs::read_to_string(tmp.join("yosys.log")).unwrap_or_default();
     if !out.status.success() {
         let mut text = log.clone();
         text += &String::from_utf8_lossy(&out.stderr);
@@ -333,7 +388,7 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
         });
     }
     let syn = Synthesis {
-        key,
+        key: key.to_string(),
         top: spec.top.clone(),
         total_area_um2,
         area_from_lef,
@@ -348,7 +403,7 @@ pub fn synthesise(spec: &SynthSpec, cache_root: &Path) -> Result<Synthesis> {
         source: e,
     })?;
     write_atomic(&result_path, &json)?;
-    Ok(syn)
+    Ok(())
 }
 
 /// Parses the LAST `stat -liberty` block of a yosys log: cells per type, the cell count

@@ -92,16 +92,28 @@ pub fn library_node_nm(library: &str) -> Option<f64> {
     }
 }
 
+/// Lowest placement utilisation `--utilisation` takes.
+pub const MIN_UTILISATION: f64 = 0.05;
+
 /// Checks what `tofprobe size` asks of an array before any synthesis: the utilisation
 /// (0 < u ≤ 1; `None`: [`DEFAULT_UTILISATION`]) and the array's readout (the chip resolves
 /// it: a frame rate the readout cannot reach is refused here, naming the bandwidth).
 pub fn check(design: &ResolvedDesign, utilisation: Option<f64>) -> Result<f64, FlowError> {
-    let u = utilisation.unwrap_or(DEFAULT_UTILISATION);
-    if !(u.is_finite() && u > 0.0 && u <= 1.0) {
+    if let (Some(u), None) = (utilisation, &design.array) {
         return Err(FlowError::option(
             "utilisation",
-            u,
-            "0 < utilisation ≤ 1 (0.7 is the usual placement density)",
+            tofprobe_io::text::number(u),
+            "an [array] configuration only (it turns the pixel's cell area into the array's \
+             pitch; a single pixel has none)",
+        ));
+    }
+    let u = utilisation.unwrap_or(DEFAULT_UTILISATION);
+    // Below 5 % a pitch is mostly empty rows (1e-300 once printed a 152-digit pitch).
+    if !(u.is_finite() && (MIN_UTILISATION..=1.0).contains(&u)) {
+        return Err(FlowError::option(
+            "utilisation",
+            tofprobe_io::text::number(u),
+            "0.05 ≤ utilisation ≤ 1 (0.7 is the usual placement density)",
         ));
     }
     if design.array.is_some() {

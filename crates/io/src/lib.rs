@@ -5,8 +5,9 @@
 //! ([`bounded`]: regular files only, so `/dev/zero` cannot exhaust memory), the sanitising of user text
 //! before it reaches a generated file ([`text`]) and the FNV-1a content hash ([`fnv1a64`],
 //! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries, and the one
-//! root of the caches ([`cache::root`]), and the [`watch::Watch`] a host stops a long
-//! computation with.
+//! root of the caches ([`cache::root`]), the writer lock of an output directory
+//! ([`lock`]) and the free space on its disk ([`disk`]), and the [`watch::Watch`] a host
+//! stops a long computation with.
 //!
 //! Errors are plain [`std::io::Error`]s: each crate maps them into its own error enum with
 //! the path it was writing.
@@ -14,7 +15,9 @@
 mod atomic;
 pub mod bounded;
 pub mod cache;
+pub mod disk;
 pub mod live;
+pub mod lock;
 pub mod marker;
 pub mod npy;
 mod set;
@@ -25,7 +28,7 @@ pub mod watch;
 pub use atomic::{write_atomic, write_svg_atomic};
 pub use bounded::{read_bounded, read_bounded_text};
 pub use marker::{SET_MARKER, SetStatus, check_set, inspect_set};
-pub use set::{OutputSet, STAGE_PREFIX, recover};
+pub use set::{OutputSet, STAGE_PREFIX, committed_sets, recover};
 
 /// FNV-1a 64-bit offset basis: the hash of no bytes.
 pub const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
@@ -65,6 +68,44 @@ impl Fnv1a64 {
     /// The hash of everything fed so far.
     pub fn finish(&self) -> u64 {
         self.0
+    }
+}
+
+/// A writer that hashes (FNV-1a-64) and counts the bytes it passes on to `inner`: a file
+/// streamed into an output set gets its marker's hash without being read back.
+#[derive(Debug)]
+pub struct HashingWriter<W: std::io::Write> {
+    inner: W,
+    hash: crate::Fnv1a64,
+    len: u64,
+}
+
+impl<W: std::io::Write> HashingWriter<W> {
+    /// Wraps `inner`, with nothing hashed yet.
+    pub fn new(inner: W) -> Self {
+        HashingWriter {
+            inner,
+            hash: crate::Fnv1a64::default(),
+            len: 0,
+        }
+    }
+
+    /// The inner writer, the hash and the length of what was written.
+    pub fn finish(self) -> (W, u64, u64) {
+        (self.inner, self.hash.finish(), self.len)
+    }
+}
+
+impl<W: std::io::Write> std::io::Write for HashingWriter<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.hash.write(&buf[..n]);
+        self.len += n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
     }
 }
 

@@ -102,6 +102,33 @@ fn incomplete(dir: &Path, kind: ErrorKind, what: String) -> Error {
     )
 }
 
+/// Why `dir` has no marker `marker`: a commit cut short (its stage names the files already
+/// moved in, which now sit beside the previous set's, and those not), or none found (not a
+/// tofprobe set, or one written before its kind carried a marker).
+fn missing_marker(dir: &Path, marker: &str) -> String {
+    let list = |v: &[String]| {
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            v.join(", ")
+        }
+    };
+    match crate::set::interrupted_commit(dir) {
+        Some((pid, moved, pending)) => format!(
+            "its completion marker {marker} is missing because the commit of process {pid} \
+             was cut short: moved in, beside what was there before: {}; still staged: {} \
+             (the next tofprobe run writing into it completes that commit)",
+            list(&moved),
+            list(&pending)
+        ),
+        None => format!(
+            "its completion marker {marker} is missing (no interrupted commit is there to \
+             complete: not a tofprobe output set, or one written before its kind carried a \
+             marker)"
+        ),
+    }
+}
+
 /// Reads the marker `marker` of the set in `dir` and checks that every file it lists is
 /// there; a missing marker or file is an error (kind `NotFound`; `InvalidData` for a
 /// marker that is not one or lists a path outside the set), a changed file is reported in
@@ -114,7 +141,7 @@ pub fn inspect_set(dir: &Path, marker: &str) -> std::io::Result<SetStatus> {
             return Err(incomplete(
                 dir,
                 ErrorKind::NotFound,
-                format!("its completion marker {marker} is missing"),
+                missing_marker(dir, marker),
             ));
         }
         Err(e) => {
@@ -179,6 +206,74 @@ pub fn check_set(dir: &Path, marker: &str) -> std::io::Result<Vec<String>> {
     Ok(s.files)
 }
 
+/// Refuses to replace a file the set in `dir` did not write: each of `names` present in
+/// `dir` must be listed by the completion marker `dir/marker` with the hash its bytes have
+/// now (a file of the previous set, unchanged since); `marker` itself may be replaced only
+/// if it is a marker. The error (kind `AlreadyExists`) names the first file that is not
+/// ours and why; nothing is written or removed by the check.
+pub fn check_replaceable(dir: &Path, marker: &str, names: &[String]) -> std::io::Result<()> {
+    let present: Vec<&String> = names.iter().filter(|n| dir.join(n).exists()).collect();
+    if present.is_empty() {
+        return Ok(());
+    }
+    let refuse = |name: &str, why: String| {
+        Error::new(
+            ErrorKind::AlreadyExists,
+            format!(
+                "{} is not a file of the tofprobe set in {} ({why}): it is not overwritten and \
+                 nothing was run or written; move it away, or write the set into another directory",
+                dir.join(name).display(),
+                dir.display()
+            ),
+        )
+    };
+    let mpath = dir.join(marker);
+    let listed = if mpath.exists() {
+        let text = crate::read_bounded_text(&mpath, MAX_MARKER_BYTES).map_err(|e| {
+            refuse(
+                marker,
+                format!("it cannot be read as a completion marker: {e}"),
+            )
+        })?;
+        Some(marker_files(&text).ok_or_else(|| {
+            refuse(
+                marker,
+                "it is not a completion marker: no [files] table of path = hash".into(),
+            )
+        })?)
+    } else {
+        None
+    };
+    for name in present {
+        if name == marker {
+            continue;
+        }
+        let Some(files) = &listed else {
+            return Err(refuse(
+                name,
+                format!("the directory has no completion marker {marker} listing it"),
+            ));
+        };
+        let Some(want) = files.get(name.as_str()) else {
+            return Err(refuse(name, format!("{marker} does not list it")));
+        };
+        let path = dir.join(name);
+        if !path.is_file() {
+            return Err(refuse(name, "it is not a regular file".into()));
+        }
+        let got = hash_file(&path)?;
+        if got != *want {
+            return Err(refuse(
+                name,
+                format!(
+                    "changed since tofprobe wrote it: hash {got:016x}, {marker} records {want:016x}"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -207,6 +302,54 @@ mod tests {
         let e = check_set(dir.path(), SET_MARKER).unwrap_err().to_string();
         assert!(
             e.contains("completion marker tofprobe-set.toml is missing"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn only_files_the_marker_lists_unchanged_may_be_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let names: Vec<String> = ["a.npy", "summary.json", SET_MARKER]
+            .map(String::from)
+            .to_vec();
+        // An empty directory, or one with other files only: nothing to refuse.
+        std::fs::write(d.join("notes.txt"), b"mine").unwrap();
+        check_replaceable(d, SET_MARKER, &names).unwrap();
+        // A user's own summary.json without a marker: refused, named.
+        std::fs::write(d.join("summary.json"), b"{}").unwrap();
+        let e = check_replaceable(d, SET_MARKER, &names).unwrap_err();
+        assert_eq!(e.kind(), ErrorKind::AlreadyExists);
+        assert!(
+            e.to_string()
+                .contains("summary.json is not a file of the tofprobe set"),
+            "{e}"
+        );
+        // Listed with its hash: ours to replace.
+        let mut files = BTreeMap::new();
+        files.insert("summary.json".to_string(), crate::fnv1a64(b"{}"));
+        std::fs::write(d.join(SET_MARKER), marker_text("", &files)).unwrap();
+        check_replaceable(d, SET_MARKER, &names).unwrap();
+        // Edited since: refused with both hashes.
+        std::fs::write(d.join("summary.json"), b"{ }").unwrap();
+        let e = check_replaceable(d, SET_MARKER, &names)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("changed since tofprobe wrote it"), "{e}");
+        // Present but not listed; a marker that is not one.
+        std::fs::write(d.join("summary.json"), b"{}").unwrap();
+        std::fs::write(d.join("a.npy"), b"x").unwrap();
+        let e = check_replaceable(d, SET_MARKER, &names)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a.npy") && e.contains("does not list it"), "{e}");
+        std::fs::remove_file(d.join("a.npy")).unwrap();
+        std::fs::write(d.join(SET_MARKER), b"my notes").unwrap();
+        let e = check_replaceable(d, SET_MARKER, &names)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(SET_MARKER) && e.contains("not a completion marker"),
             "{e}"
         );
     }

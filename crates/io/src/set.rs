@@ -18,7 +18,12 @@
 
 use std::path::{Path, PathBuf};
 
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::time::SystemTime;
+
 use crate::live::{self, Kind, Live};
+use crate::lock::DirLock;
 use crate::stale::{PID_MARK, pid_alive};
 
 /// Start of a stage directory's name; the pid and `.stage` follow.
@@ -26,7 +31,8 @@ pub const STAGE_PREFIX: &str = ".output-set";
 const STAGE_SUFFIX: &str = ".stage";
 const COMMIT: &str = "COMMIT";
 
-fn stage_pid(name: &str) -> Option<u32> {
+/// The pid in a stage directory's name, `.output-set.tofprobe-PID.stage`.
+pub(crate) fn stage_pid(name: &str) -> Option<u32> {
     let rest = name.strip_prefix(STAGE_PREFIX)?.strip_prefix(PID_MARK)?;
     rest.strip_suffix(STAGE_SUFFIX)?.parse().ok()
 }
@@ -43,14 +49,22 @@ pub struct OutputSet {
     hashes: std::collections::BTreeMap<String, u64>,
     created_target: bool,
     done: bool,
+    /// The directory's writer lock ([`crate::lock`]), held until the set is committed or
+    /// dropped.
+    _lock: Option<DirLock>,
+    /// Set by [`OutputSet::protect`]: the marker whose listed files alone may be replaced,
+    /// and what each protected name was at the check (length and time, `None`: absent), so
+    /// the commit checks again only what changed since.
+    protected: Option<(String, BTreeMap<String, Option<(u64, SystemTime)>>)>,
     /// The stage (and the target if this run made it) in the registry of live
     /// temporaries, removed by an interrupt ([`crate::live`]).
     live: Vec<Live>,
 }
 
 impl OutputSet {
-    /// Starts a set for directory `target` (created if missing): first [`recover`]s what
-    /// killed runs left there, then creates this run's stage directory.
+    /// Starts a set for directory `target` (created if missing): takes the directory's
+    /// writer lock (a second writer is refused, naming the first: [`crate::lock`]), then
+    /// [`recover`]s what killed runs left there, then creates this run's stage directory.
     pub fn begin(target: &Path) -> std::io::Result<OutputSet> {
         let created_target = !target.exists();
         let mut registered = Vec::new();
@@ -64,6 +78,15 @@ impl OutputSet {
         } else {
             std::fs::create_dir_all(target)?;
         }
+        let dir_lock = match crate::lock::lock_dir(target) {
+            Ok(l) => l,
+            Err(e) => {
+                if created_target {
+                    let _ = std::fs::remove_dir(target);
+                }
+                return Err(e);
+            }
+        };
         recover(target)?;
         let stage = target.join(format!(
             "{STAGE_PREFIX}{PID_MARK}{}{STAGE_SUFFIX}",
@@ -80,6 +103,8 @@ impl OutputSet {
             created_target,
             done: false,
             live: registered,
+            _lock: Some(dir_lock),
+            protected: None,
         };
         match live::create(
             Kind::Temporary,
@@ -101,9 +126,42 @@ impl OutputSet {
         &self.target
     }
 
+    /// Refuses to replace what this set does not own: each of `names` (the files the set
+    /// will write) already in the target must be listed, unchanged, by the target's
+    /// completion marker `marker` ([`crate::marker::check_replaceable`]); checked now,
+    /// before the caller's work, and again at the commit for any name that appeared or
+    /// changed meanwhile. For sets written into a directory the user names (`--out`).
+    pub fn protect(&mut self, marker: &str, names: &[String]) -> std::io::Result<()> {
+        let mut all = names.to_vec();
+        if !all.iter().any(|n| n == marker) {
+            all.push(marker.to_string());
+        }
+        crate::marker::check_replaceable(&self.target, marker, &all)?;
+        let seen = all
+            .into_iter()
+            .map(|n| {
+                let m = stamp(&self.target.join(&n));
+                (n, m)
+            })
+            .collect();
+        self.protected = Some((marker.to_string(), seen));
+        Ok(())
+    }
+
     /// Stages one file (a plain name, no directories).
     pub fn add(&mut self, name: &str, contents: &[u8]) -> std::io::Result<()> {
-        use std::io::Write;
+        self.add_streamed(name, |w| w.write_all(contents))
+            .map(|_| ())
+    }
+
+    /// Stages one file whose bytes `write` produces into a bounded buffer (64 KiB) that is
+    /// flushed to the stage as it fills, hashed on the way: a file is never held whole in
+    /// memory. Returns its length in bytes.
+    pub fn add_streamed(
+        &mut self,
+        name: &str,
+        write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    ) -> std::io::Result<u64> {
         if name.is_empty() || name.contains(['/', '\\']) || name.starts_with('.') {
             return Err(std::io::Error::new(
                 std::io::ErrorKind::InvalidInput,
@@ -112,14 +170,18 @@ impl OutputSet {
         }
         // Created with the interrupt handler held off: it never misses a file it must
         // remove with the stage.
-        let mut f = live::critical(|| std::fs::File::create(self.stage.join(name)))?;
-        f.write_all(contents)?;
-        f.sync_all()?;
+        let f = live::critical(|| std::fs::File::create(self.stage.join(name)))?;
+        let mut w = crate::HashingWriter::new(std::io::BufWriter::with_capacity(1 << 16, f));
+        write(&mut w)?;
+        let (buffered, hash, len) = w.finish();
+        buffered
+            .into_inner()
+            .map_err(std::io::IntoInnerError::into_error)?
+            .sync_all()?;
         self.names.retain(|n| n != name);
         self.names.push(name.to_string());
-        self.hashes
-            .insert(name.to_string(), crate::fnv1a64(contents));
-        Ok(())
+        self.hashes.insert(name.to_string(), hash);
+        Ok(len)
     }
 
     /// Stages the completion marker `marker` (`preamble`, then the `[files]` table of every
@@ -136,6 +198,19 @@ impl OutputSet {
     /// Moves the staged files into place, `last` (the set's completion file, e.g. its
     /// manifest; `None` for none) after all the others.
     pub fn commit(mut self, last: Option<&str>) -> std::io::Result<()> {
+        if let Some((marker, seen)) = &self.protected {
+            // Whatever appeared or changed in the target since `protect` is checked again.
+            let again: Vec<String> = self
+                .names
+                .iter()
+                .filter(|n| {
+                    let now = stamp(&self.target.join(n));
+                    now.is_some() && seen.get(n.as_str()).is_none_or(|was| *was != now)
+                })
+                .cloned()
+                .collect();
+            crate::marker::check_replaceable(&self.target, marker, &again)?;
+        }
         let mut order: Vec<String> = self
             .names
             .iter()
@@ -166,7 +241,11 @@ impl OutputSet {
             std::fs::File::open(&commit)?.sync_all()?;
             self.done = true;
             finish(&self.target, &self.stage, &list, kill_hook())
-        })
+        })?;
+        if let Ok(mut v) = COMMITTED.lock() {
+            v.push(self.target.clone());
+        }
+        Ok(())
     }
 
     fn remove_created_target(&self) {
@@ -184,6 +263,47 @@ impl Drop for OutputSet {
             self.remove_created_target();
         }
     }
+}
+
+/// A file's length and modification time (`None` when absent).
+fn stamp(path: &Path) -> Option<(u64, SystemTime)> {
+    let m = std::fs::symlink_metadata(path).ok()?;
+    Some((m.len(), m.modified().unwrap_or(SystemTime::UNIX_EPOCH)))
+}
+
+/// What an interrupted commit in `target` left (the stage of a process that is gone, with
+/// its `COMMIT` list): the pid, the files already moved into place, and those still staged
+/// (the completion marker among them). `None` when no commit was cut short there.
+pub(crate) fn interrupted_commit(target: &Path) -> Option<(u32, Vec<String>, Vec<String>)> {
+    for e in std::fs::read_dir(target).ok()?.flatten() {
+        let Some(pid) = stage_pid(&e.file_name().to_string_lossy()) else {
+            continue;
+        };
+        let stage = e.path();
+        let Ok(list) = crate::read_bounded_text(&stage.join(COMMIT), 1 << 20) else {
+            continue;
+        };
+        let (mut moved, mut pending) = (Vec::new(), Vec::new());
+        for name in list.lines().filter(|l| !l.starts_with(REMOVE)) {
+            if stage.join(name).exists() {
+                pending.push(name.to_string());
+            } else {
+                moved.push(name.to_string());
+            }
+        }
+        return Some((pid, moved, pending));
+    }
+    None
+}
+
+/// The target directories of the sets this process committed, in order.
+static COMMITTED: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// The directories of the sets this process committed so far (whole on disk), for a
+/// command that fails afterwards to say which sets it left written: a full standard
+/// output after the commit is an error (exit 2), the set stays whole.
+pub fn committed_sets() -> Vec<PathBuf> {
+    COMMITTED.lock().map(|v| v.clone()).unwrap_or_default()
 }
 
 /// Prefix of a `COMMIT` line naming a file of the old set to remove (a staged name never
@@ -342,6 +462,57 @@ mod tests {
             ["a.v", "mine.txt", "notes.md", crate::SET_MARKER]
         );
         assert_eq!(crate::check_set(&t, crate::SET_MARKER).unwrap(), ["a.v"]);
+    }
+
+    #[test]
+    fn a_protected_set_replaces_only_its_own_files_and_one_writer_at_a_time() {
+        let dir = tempfile::tempdir().unwrap();
+        let t = dir.path().join("out");
+        let names = ["a.npy".to_string(), "summary.json".to_string()];
+        let mut s = OutputSet::begin(&t).unwrap();
+        // A second writer into the same directory is refused while the first holds it.
+        let e = OutputSet::begin(&t).unwrap_err();
+        assert!(e.to_string().contains("is being written by"), "{e}");
+        s.protect(crate::SET_MARKER, &names).unwrap();
+        s.add_streamed("a.npy", |w| w.write_all(b"a1")).unwrap();
+        s.add("summary.json", b"s1").unwrap();
+        s.commit_marked(crate::SET_MARKER, "").unwrap();
+        assert_eq!(crate::check_set(&t, crate::SET_MARKER).unwrap(), names);
+        // Our own files are replaced; a user's file that appears during the run is not.
+        let mut s = OutputSet::begin(&t).unwrap();
+        s.protect(crate::SET_MARKER, &names).unwrap();
+        s.add("a.npy", b"a2").unwrap();
+        std::fs::write(t.join("summary.json"), b"the user's").unwrap();
+        s.add("summary.json", b"s2").unwrap();
+        let e = s.commit_marked(crate::SET_MARKER, "").unwrap_err();
+        assert!(e.to_string().contains("summary.json is not a file"), "{e}");
+        assert_eq!(
+            std::fs::read(t.join("summary.json")).unwrap(),
+            b"the user's"
+        );
+        assert_eq!(std::fs::read(t.join("a.npy")).unwrap(), b"a1");
+        assert!(listing(&t).iter().all(|n| !n.starts_with('.')));
+    }
+
+    #[test]
+    fn a_cut_commit_is_named_by_the_check() {
+        let dir = tempfile::tempdir().unwrap();
+        let t = dir.path();
+        std::fs::write(t.join("a.npy"), b"new").unwrap();
+        let dead = t.join(format!("{STAGE_PREFIX}{PID_MARK}4194304{STAGE_SUFFIX}"));
+        std::fs::create_dir(&dead).unwrap();
+        std::fs::write(dead.join(COMMIT), "a.npy\nb.npy\ntofprobe-set.toml\n").unwrap();
+        std::fs::write(dead.join("b.npy"), b"b").unwrap();
+        std::fs::write(dead.join(crate::SET_MARKER), b"m").unwrap();
+        let e = crate::check_set(t, crate::SET_MARKER)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("process 4194304 was cut short")
+                && e.contains("moved in, beside what was there before: a.npy;")
+                && e.contains("still staged: b.npy, tofprobe-set.toml"),
+            "{e}"
+        );
     }
 
     #[test]

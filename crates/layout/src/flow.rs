@@ -38,7 +38,7 @@ pub struct LayoutRequest {
 }
 
 /// A finished layout: the report and the files of its output set.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct LayoutRun {
     /// The report.
     pub report: LayoutReport,
@@ -46,6 +46,10 @@ pub struct LayoutRun {
     pub files: Vec<(String, PathBuf)>,
     /// The qflow project directory (logs of every tool).
     pub project: PathBuf,
+    /// The project's lock (`layout/TECH-KEY.lock`), held until the run is dropped: another
+    /// layout of the same netlist waits for it rather than wiping the project (and the
+    /// files above) from under this one while they are read.
+    _lock: std::fs::File,
 }
 
 /// Lays out `design`; `progress` hears each step's name as it starts.
@@ -123,10 +127,12 @@ pub fn run(
     }
 
     // 2. The qflow project: convert, then place and route, lower densities on failure.
-    let dir = req
-        .cache
-        .join("layout")
-        .join(format!("{}-{}", tech.tech.name(), syn.key));
+    let name = format!("{}-{}", tech.tech.name(), syn.key);
+    let dir = req.cache.join("layout").join(&name);
+    // One run per project at a time (across processes): a second layout of the same
+    // netlist waits here instead of removing this one's project as it is being built.
+    let lock = tofprobe_io::cache::lock_key(&req.cache.join("layout"), &name)
+        .map_err(|e| LayoutError::io("locking", &dir, e))?;
     let top = provider.top();
     let project = Project::create(&dir, &top, &tech, &syn.netlist_verilog)?;
     progress("netlist to qflow");
@@ -369,6 +375,7 @@ pub fn run(
         report,
         files,
         project: dir,
+        _lock: lock,
     })
 }
 

@@ -5,6 +5,7 @@ mod common;
 mod determinism;
 mod double_buffer;
 mod rtl;
+mod set_size;
 mod shard;
 mod superpixel;
 mod validation;

@@ -131,13 +131,13 @@ fn tile_sets_merge_into_the_single_runs_set_byte_for_byte() {
         "rows = 4\ncols = 3\npitch_um = 30.0\nmm_per_pixel = 20.0",
     );
     let whole = tmp.path().join("whole");
-    tofprobe_array::output::run_and_write(&d, &whole).unwrap();
+    tofprobe_array::output::run_and_write(&d, &whole, Default::default()).unwrap();
     let want = files(&whole);
     for n in [1u64, 2, 5, 12] {
         let mut dirs = sets(tmp.path(), &d, n);
         dirs.reverse(); // any order
         let out = tmp.path().join(format!("merged-{n}"));
-        let s = shard::merge_sets(&dirs, &out).unwrap();
+        let s = shard::merge_sets(&dirs, &out, Default::default()).unwrap();
         assert_eq!(s.rows * s.cols, 12);
         let got = files(&out);
         assert_eq!(got.len(), want.len());
@@ -145,6 +145,15 @@ fn tile_sets_merge_into_the_single_runs_set_byte_for_byte() {
             assert_eq!(gn, wn);
             if gn == "summary.json" {
                 assert_eq!(timeless(gb), timeless(wb), "n = {n}");
+            } else if gn == tofprobe_io::SET_MARKER {
+                // The same files with the same hashes, the summary's aside (its timing).
+                let listed = |b: &[u8]| {
+                    let mut f =
+                        tofprobe_io::marker::marker_files(std::str::from_utf8(b).unwrap()).unwrap();
+                    assert!(f.remove("summary.json").is_some());
+                    f
+                };
+                assert_eq!(listed(gb), listed(wb), "n = {n}");
             } else {
                 assert!(gb == wb, "{gn} differs after merging {n} tile sets");
             }
@@ -159,7 +168,11 @@ fn merge_refuses_sets_of_another_run_naming_them() {
     let d = design(&plate(1, 1), 40_000, arr);
     let dirs = sets(tmp.path(), &d, 2);
     let out = tmp.path().join("out");
-    let err = |dirs: &[PathBuf]| shard::merge_sets(dirs, &out).unwrap_err().to_string();
+    let err = |dirs: &[PathBuf]| {
+        shard::merge_sets(dirs, &out, Default::default())
+            .unwrap_err()
+            .to_string()
+    };
 
     // Another seed.
     let mut reseeded = d.clone();
@@ -177,7 +190,7 @@ fn merge_refuses_sets_of_another_run_naming_them() {
     shard::run_shard(&d2, Shard { index: 1, count: 2 }, &cfg).unwrap();
     let e = err(&[dirs[0].clone(), cfg]);
     assert!(
-        e.contains("otherconfig") && e.contains("different configuration"),
+        e.contains("otherconfig") && e.contains("different design"),
         "{e}"
     );
     // Overlap: the same tile twice, and a tile of another partition.
@@ -198,7 +211,10 @@ fn merge_refuses_sets_of_another_run_naming_them() {
     );
     // Not a (finished) tile set.
     let e = err(&[dirs[0].clone(), tmp.path().join("nothing")]);
-    assert!(e.contains("nothing") && e.contains("manifest.json"), "{e}");
+    assert!(
+        e.contains("nothing") && e.contains("not a directory"),
+        "{e}"
+    );
     // Nothing was written by any refusal.
     assert!(!out.exists());
     // A single-pixel design has no shards.

@@ -78,22 +78,7 @@ pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<super::Verdict, C
         SimulatorArg::Icarus => ArraySimulator::Icarus,
     };
     o.command = "tofprobe cosim".into();
-    if let Some(t) = &a.tile {
-        let v: Vec<usize> = t.split(',').filter_map(|x| x.trim().parse().ok()).collect();
-        let [row0, col0, rows, cols] = v[..] else {
-            return Err(CliError::option(
-                "tile",
-                t,
-                "ROW,COL,ROWS,COLS (e.g. 62,62,2,2)",
-            ));
-        };
-        o.tile = Some(tofprobe_design::readout::ArrayTile {
-            row0,
-            col0,
-            rows,
-            cols,
-        });
-    }
+    o.tile = super::tile_arg::tile_for(design, a.tile.as_deref())?;
     let r = cosim_array(design, &o)?;
     let ro = &r.readout;
     if a.json {

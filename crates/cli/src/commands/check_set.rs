@@ -1,9 +1,11 @@
 //! `tofprobe check-set DIR`: whether DIR holds a whole output set (`rtl`, `vectors`,
-//! `reproduce`, `flow`): its completion marker (`tofprobe-set.toml`, or a vector set's
+//! `reproduce`, `flow`, `layout`, an array's `simulate --out` or `merge` set, a tile set of
+//! `simulate --shard`): its completion marker (`tofprobe-set.toml`, or a vector set's
 //! `manifest.toml`) is there and every file it lists has the recorded FNV-1a-64 hash
 //! (`tofprobe_io::check_set`, the check `cosim --rtl` and `flow` make). For users of the
 //! FuseSoC core and scripts: exit 0 and one line when whole, exit 2 naming what is missing
-//! or changed when not (a set killed mid-commit has no marker).
+//! or changed when not (a set killed mid-commit has no marker: the message names the files
+//! the cut commit moved in beside the old set's and those still staged).
 
 use std::path::PathBuf;
 

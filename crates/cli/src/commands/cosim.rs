@@ -90,7 +90,7 @@ pub struct CosimArgs {
     pub shard: Option<String>,
     /// An `[array]` configuration too large to build whole: co-simulate the tile of ROWS ×
     /// COLS pixels from (ROW, COL), with the whole array's sequencer, broadcast and readout.
-    #[arg(long, value_name = "ROW,COL,ROWS,COLS")]
+    #[arg(long, value_name = "ROW,COL,ROWS,COLS", conflicts_with = "random")]
     pub tile: Option<String>,
     /// Also write a JUnit XML report: one test case per frame and configuration, the first
     /// mismatch as the failure message (written whole; an existing file is replaced only if
@@ -252,6 +252,8 @@ pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
     if design.array.is_some() {
         return super::array_rtl::cosim(a, &design);
     }
+    // A --tile on a single pixel is refused, not ignored.
+    super::tile_arg::tile_for(&design, a.tile.as_deref())?;
     let (design, _) = super::simulated_design_of(design, &overrides)?;
     // With --rtl, the chip `tofprobe rtl` renders for this configuration (the image in DIR
     // must be its ROM); else the chip the simulating commands replay.
@@ -262,6 +264,7 @@ pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
     };
     let chip = Chip::of(&design, &overrides, purpose)?;
     let p = chip.pixel;
+    super::check_stimulus(a.frames, p.frame_pulses, a.frame_pulses.is_some())?;
     let rom_note = if a.rtl.is_some() {
         format!(
             "ROM of --rtl checked against the configuration's: {}",

@@ -70,6 +70,11 @@ pub fn run(a: &LayoutArgs) -> Result<crate::commands::Verdict, CliError> {
         pitches: vec![(30.0, Some(6)), (40.0, Some(13))],
         route_cleanup,
     };
+    // The output set is opened (its directory made writable, locked, recovered) before
+    // minutes of synthesis, placement and routing: a read-only or busy --out is refused
+    // at once.
+    let io = |e: std::io::Error| CliError::output(a.out.clone(), e.to_string());
+    let mut set = tofprobe_io::OutputSet::begin(&a.out).map_err(io)?;
     let quiet = a.json;
     let run = tofprobe_layout::run(&design, &req, &mut |step| {
         if !quiet {
@@ -78,8 +83,6 @@ pub fn run(a: &LayoutArgs) -> Result<crate::commands::Verdict, CliError> {
     })?;
     let report = &run.report;
     let json = serde_json::to_vec_pretty(report)?;
-    let io = |e: std::io::Error| CliError::output(a.out.clone(), e.to_string());
-    let mut set = tofprobe_io::OutputSet::begin(&a.out).map_err(io)?;
     for (name, path) in &run.files {
         let bytes =
             std::fs::read(path).map_err(|e| CliError::output(path.clone(), e.to_string()))?;

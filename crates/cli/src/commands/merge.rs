@@ -2,8 +2,9 @@
 //! --out SET --shard i/n` wrote (one per task of a batch job array) into the array's output
 //! set, the one `simulate CONFIG --out DIR` writes in one run (the same files, byte for
 //! byte; `summary.json`'s timing sums the tiles'). Refuses, naming the set: a directory
-//! that is not a finished tile set, sets of different configurations or seeds, overlapping
-//! tiles, and pixels no set covers (`tofprobe_array::shard::merge_sets`).
+//! that is not a whole tile set (its completion marker, every file's hash, a manifest that
+//! agrees with the design it carries), sets of different designs (maps included) or seeds,
+//! overlapping tiles, and pixels no set covers (`tofprobe_array::shard::merge_sets`).
 
 use std::path::PathBuf;
 
@@ -23,10 +24,15 @@ pub struct MergeArgs {
     /// Print the summary as one JSON object.
     #[arg(long)]
     json: bool,
+    /// The largest output set to write, in GiB (default 16); checked, with the free disk
+    /// space, before any tile is read.
+    #[arg(long, value_name = "GIB")]
+    max_out_gib: Option<f64>,
 }
 
 /// Runs the command.
 pub fn run(args: &MergeArgs) -> Result<(), CliError> {
-    let summary = tofprobe_array::shard::merge_sets(&args.sets, &args.out)?;
+    let limits = super::simulate::set_limits(args.max_out_gib)?;
+    let summary = tofprobe_array::shard::merge_sets(&args.sets, &args.out, limits)?;
     super::simulate::print_array(&summary, Some(&args.out), args.json)
 }

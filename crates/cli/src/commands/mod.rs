@@ -14,6 +14,7 @@ pub mod reproduce;
 pub mod rtl;
 pub mod simulate;
 pub mod size;
+pub mod tile_arg;
 pub mod tradeoff;
 pub mod vectors;
 
@@ -53,7 +54,8 @@ pub enum Command {
     Layout(layout::LayoutArgs),
     /// The speed/accuracy trade: every fidelity level timed and scored per scene.
     Tradeoff(tradeoff::TradeoffArgs),
-    /// Check that a directory holds a whole output set (rtl, vectors, reproduce, flow).
+    /// Check that a directory holds a whole output set (rtl, vectors, reproduce, flow,
+    /// layout, an array's set, a tile set).
     CheckSet(check_set::CheckSetArgs),
 }
 
@@ -106,6 +108,37 @@ pub fn simulated_design_of(
     design.single_pixel("vectors and cosim")?;
     let p = tofprobe_design::rtl_params(&design, overrides)?;
     Ok((design, p))
+}
+
+/// Most pulses a single pixel's golden stimulus may hold (`vectors`, `cosim`: frames × N),
+/// each kept in memory (8 to 16 bytes a pulse): 2^26 pulses stay within 1 GiB. `--frame-pulses 2^32` once
+/// asked for 64 GiB and aborted; 2^63 overflowed the capacity and panicked.
+pub const MAX_STIMULUS_PULSES: u64 = 1 << 26;
+
+/// Refuses a stimulus of `frames` frames of `frame_pulses` pulses beyond
+/// [`MAX_STIMULUS_PULSES`], naming `--frame-pulses` (or the frame N of the configuration)
+/// and the largest N that fits.
+pub fn check_stimulus(frames: u64, frame_pulses: u64, overridden: bool) -> Result<(), CliError> {
+    let total = frames.checked_mul(frame_pulses);
+    if total.is_some_and(|t| t <= MAX_STIMULUS_PULSES) {
+        return Ok(());
+    }
+    let fits = MAX_STIMULUS_PULSES / frames.max(1);
+    let allowed = format!(
+        "--frames × N ≤ 2^26 = {MAX_STIMULUS_PULSES} pulses (the golden stimulus is held in \
+         memory, 8 to 16 bytes a pulse): N ≤ {fits} with --frames {frames}"
+    );
+    Err(if overridden {
+        CliError::option("frame-pulses", frame_pulses, allowed)
+    } else {
+        CliError::option(
+            "frames",
+            frames,
+            format!(
+                "{allowed} (N = {frame_pulses}, the configuration's frame; --frame-pulses sets a shorter one)"
+            ),
+        )
+    })
 }
 
 /// What a command that ran to its end concludes (README "Exit codes"): `Fail` is a

@@ -36,6 +36,28 @@ pub struct SimulateArgs {
     /// tile set (`tofprobe merge` joins the sets into the --out set of one run).
     #[arg(long, value_name = "I/N", requires = "out")]
     shard: Option<String>,
+    /// With --out: the largest output set to write, in GiB (default 16); the set's size is
+    /// estimated and checked, with the free disk space, before the model runs.
+    #[arg(long, value_name = "GIB", requires = "out")]
+    max_out_gib: Option<f64>,
+}
+
+/// `--max-out-gib` as the array's set limits: a finite number of GiB in (0, 2^20] (a
+/// pebibyte is past any disk), the default 16.
+pub fn set_limits(max_out_gib: Option<f64>) -> Result<tofprobe_array::output::SetLimits, CliError> {
+    let Some(gib) = max_out_gib else {
+        return Ok(tofprobe_array::output::SetLimits::default());
+    };
+    if !(gib.is_finite() && gib > 0.0 && gib <= (1u64 << 20) as f64) {
+        return Err(CliError::option(
+            "max-out-gib",
+            tofprobe_io::text::number(gib),
+            "0 < GiB <= 1048576 (default 16)",
+        ));
+    }
+    Ok(tofprobe_array::output::SetLimits {
+        max_set_bytes: (gib * (1u64 << 30) as f64) as u64,
+    })
 }
 
 /// Runs the command.
@@ -179,27 +201,29 @@ fn run_array(
                 "{}",
                 serde_json::json!({
                     "shard": shard.to_string(), "rows": m.rows, "cols": m.cols,
-                    "config_hash": m.config_hash, "seed": m.seed,
+                    "design_hash": m.design_hash, "seed": m.seed,
                     "model_seconds": m.model_seconds, "tile_set": dir,
                 })
             );
         } else {
             println!(
-                "tile set           {} (shard {shard}: rows {:?} × cols {:?} of {} × {}, seed {}, configuration {}; model {:.3} s)",
+                "tile set           {} (shard {shard}: rows {:?} × cols {:?} of {} × {}, seed {}, design {}; model {:.3} s)",
                 dir.display(),
                 m.rows,
                 m.cols,
                 m.array_rows,
                 m.array_cols,
                 m.seed,
-                m.config_hash,
+                m.design_hash,
                 m.model_seconds
             );
         }
         return Ok(());
     }
     let summary = match &args.out {
-        Some(dir) => tofprobe_array::output::run_and_write(design, dir)?,
+        Some(dir) => {
+            tofprobe_array::output::run_and_write(design, dir, set_limits(args.max_out_gib)?)?
+        }
         None => tofprobe_array::output::simulate(design)?.2,
     };
     print_array(&summary, args.out.as_deref(), args.json)

@@ -98,6 +98,7 @@ pub fn run(a: &VectorsArgs) -> Result<(), CliError> {
     let (design, _) = super::simulated_design_of(design, &overrides)?;
     let chip = Chip::of(&design, &overrides, RomPurpose::Replayed)?;
     let (p, rom, note) = (chip.pixel, chip.rom.words, chip.rom.note);
+    super::check_stimulus(a.frames, p.frame_pulses, a.frame_pulses.is_some())?;
     let stim = random_stimulus(&p, a.frames * p.frame_pulses, a.seed);
     let o = VectorOptions {
         frames: a.frames,

@@ -1,5 +1,6 @@
 //! `tofprobe simulate CONFIG --out DIR` on `[array]` configurations, as users run it: the
-//! set is written whole (summary.json last, listing every file), the NPY arrays have the
+//! set is written whole (summary.json listing every file, then the completion marker with
+//! their hashes), the NPY arrays have the
 //! documented shapes and read back, the UFF file holds its data sets, `--json` carries the
 //! figures; bad arrays are refused naming the field with exit 2 and nothing written;
 //! commands that run one pixel refuse an array, naming what runs it.
@@ -58,19 +59,24 @@ fn an_array_simulation_writes_its_whole_set() {
         .iter()
         .map(|f| f.as_str().unwrap())
         .collect();
-    assert_eq!(
-        files.last(),
-        Some(&"summary.json"),
-        "the completion file is last"
-    );
+    assert_eq!(files.last(), Some(&"summary.json"), "the summary is last");
     let mut listed: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
     listed.sort();
+    // The files, and the completion marker listing each with its hash (written last).
     let mut want: Vec<String> = files.iter().map(|s| s.to_string()).collect();
+    want.push("tofprobe-set.toml".into());
     want.sort();
-    assert_eq!(listed, want, "exactly the listed files");
+    assert_eq!(listed, want, "exactly the listed files and the marker");
+    let marked = tofprobe_io::check_set(&out, "tofprobe-set.toml").unwrap();
+    let mut files_sorted: Vec<String> = files.iter().map(|s| s.to_string()).collect();
+    files_sorted.sort();
+    assert_eq!(
+        marked, files_sorted,
+        "the marker lists every file of the summary"
+    );
     let regs = npy::from_bytes(&std::fs::read(out.join("registers.npy")).unwrap()).unwrap();
     assert_eq!(regs.shape, vec![3, 4, 8], "[R, C, 2B]");
     let amp = npy::from_bytes(&std::fs::read(out.join("amplitude_um.npy")).unwrap()).unwrap();

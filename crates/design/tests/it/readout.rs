@@ -110,11 +110,30 @@ fn bad_readouts_are_refused_naming_what_works() {
     // 8 bits × 160 MHz = 1.28 Gbit/s; 2 Gbit/s needs ceil(2e9 / 160e6) = 13 bits.
     let e = Readout::new(&keys(Some(8), Some(2e9), None), 2, 2, &pixel(64), LASER).unwrap_err();
     assert!(
-        e.contains("array.readout_bits_per_s = 2000000000") && e.contains("readout_bits = 13"),
+        e.contains("array.readout_bits_per_s = 2e9") && e.contains("readout_bits = 13"),
         "{e}"
     );
     // 64 × 64, N = 1000 (16,000 cycles): one word per cycle gives 151,169 cycles per
     // frame, 1058.4 Hz; 2000 Hz (80,000 cycles) cannot be met at any width.
+    // A link so slow a frame's readout would pass 2^40 cycles (5e-324 bits/s once wrapped
+    // the count past 2^64): refused with the slowest rate that fits.
+    let e = Readout::new(&keys(Some(8), Some(5e-324), None), 2, 2, &pixel(64), LASER).unwrap_err();
+    assert!(
+        e.contains("array.readout_bits_per_s = 5e-324") && e.contains("2^40 cycles"),
+        "{e}"
+    );
+    // 2 × 2 pixels of R + 1 words, each in ceil(39 / 8) = 5 beats of 8 bits at 1.28 Gbit/s.
+    let beats = 4 * (pixel(64).registers() as u64 + 1) * 5;
+    let slowest = 1.28e9 / ((((1u64 << 40) - 1) / beats) as f64);
+    let ok = Readout::new(
+        &keys(Some(8), Some(slowest * 1.001), None),
+        2,
+        2,
+        &pixel(64),
+        LASER,
+    )
+    .unwrap();
+    assert!(ok.readout_cycles() <= 1 << 40, "{}", ok.readout_cycles());
     let e = Readout::new(&keys(None, None, Some(2000.0)), 64, 64, &pixel(1000), LASER).unwrap_err();
     assert!(
         e.contains("array.frame_rate_hz = 2000")

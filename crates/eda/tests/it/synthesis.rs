@@ -177,3 +177,58 @@ fn a_latch_pixel_maps_onto_osu018_latches_counted_at_their_lef_area() {
     );
     assert!(syn.total_area_um2 >= 44.0 * 56.0);
 }
+
+/// Issue 45 item 13: the synthesis cache under concurrency. Three threads synthesise one
+/// spec into a fresh cache at once: one yosys run (the others wait on the key's lock and
+/// reuse it), every netlist whole. An entry whose netlist was cut short since (what a
+/// reader once met while another run still wrote it) is synthesised again, not read.
+#[test]
+fn the_synthesis_cache_builds_one_entry_per_key_and_checks_it_on_read() {
+    use tofprobe_eda::analysis::RtlProvider;
+    let root = cache("concurrent");
+    let _ = std::fs::remove_dir_all(&root);
+    let px = fixture();
+    let v = px.rtl(2, 8, &root.join("rtl")).unwrap();
+    let spec = SynthSpec {
+        sources: v.sources.clone(),
+        top: v.top.clone(),
+        params: v.params.clone(),
+        liberty: PathBuf::from(OSU018),
+        delay_target_ps: None,
+        keep: vec![],
+    };
+    let syn_root = root.join("syn");
+    let runs: Vec<_> = std::thread::scope(|s| {
+        let hs: Vec<_> = (0..3)
+            .map(|_| s.spawn(|| synthesise(&spec, &syn_root).unwrap()))
+            .collect();
+        hs.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    assert_eq!(
+        runs.iter().filter(|r| r.yosys_seconds > 0.0).count(),
+        1,
+        "one yosys run for one key"
+    );
+    assert!(
+        runs.windows(2)
+            .all(|w| w[0].key == w[1].key && w[0].cell_count == w[1].cell_count)
+    );
+    let netlist = runs[0].netlist_verilog.clone();
+    let whole = std::fs::read(&netlist).unwrap();
+    assert!(String::from_utf8_lossy(&whole).contains("endmodule"));
+    // Cut short in place: the entry fails its check and is built again.
+    std::fs::write(&netlist, &whole[..whole.len() / 2]).unwrap();
+    let again = synthesise(&spec, &syn_root).unwrap();
+    assert!(
+        again.yosys_seconds > 0.0,
+        "a torn entry was read instead of rebuilt"
+    );
+    assert_eq!(std::fs::read(&netlist).unwrap(), whole);
+    // Nothing temporary left beside the entries.
+    let hidden: Vec<_> = std::fs::read_dir(&syn_root)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
+}
