@@ -331,6 +331,17 @@ fn default_pixel_fits_its_clock_with_margin() {
             && text.contains(&format!("set `[pixel] adders = {a}`")),
         "{text}"
     );
+    // The advice is complete: the cycles per pulse the adders need (alone they keep C = 16
+    // and its 160 MHz), the clock that implies and the option's area against the
+    // configured pixel's.
+    let note = ss["note"].as_str().unwrap();
+    assert!(
+        note.contains(&format!("`[pixel] cycles_per_pulse = {c}`"))
+            && note.contains(&format!("{c} × 10 MHz = {:.1} MHz", c as f64 * 10.0))
+            && note.contains("against the configured")
+            && note.contains(" %, synthesis on sky130_fd_sc_hd__tt_025C_1v80)"),
+        "{note}"
+    );
     // `--corner-trials 0` reports the miss without the search (every synthesis cached).
     let mut quiet = args.to_vec();
     quiet.extend(["--corner-trials", "0", "--json"]);
