@@ -68,7 +68,7 @@ pub fn scene_detections(
 /// priming between). Deterministic: the same inputs give the same stimulus.
 pub fn exercise(inputs: &mut [Vec<Option<u32>>], cols: usize, g: usize) {
     let g2 = g * g;
-    if cols == 0 || g == 0 || inputs.len() % (cols * g2) != 0 {
+    if cols == 0 || g == 0 || !inputs.len().is_multiple_of(cols * g2) {
         return;
     }
     let scols = cols * g;

@@ -295,9 +295,8 @@ impl SensorArray {
                 ));
             }
         }
-        if !(self.mm_per_pixel.is_finite() && self.mm_per_pixel > 0.0)
-            || !(self.pitch_um.is_finite() && self.pitch_um > 0.0)
-        {
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        if !positive(self.mm_per_pixel) || !positive(self.pitch_um) {
             return Err(format!(
                 "pitch {} µm, {} mm per pixel: both must be finite and positive",
                 self.pitch_um, self.mm_per_pixel

@@ -26,6 +26,9 @@ use crate::live::{self, Kind, Live};
 use crate::lock::DirLock;
 use crate::stale::{PID_MARK, pid_alive};
 
+/// A protected file's length and modification time at the check (`None`: absent).
+type Stamp = Option<(u64, SystemTime)>;
+
 /// Start of a stage directory's name; the pid and `.stage` follow.
 pub const STAGE_PREFIX: &str = ".output-set";
 const STAGE_SUFFIX: &str = ".stage";
@@ -55,7 +58,7 @@ pub struct OutputSet {
     /// Set by [`OutputSet::protect`]: the marker whose listed files alone may be replaced,
     /// and what each protected name was at the check (length and time, `None`: absent), so
     /// the commit checks again only what changed since.
-    protected: Option<(String, BTreeMap<String, Option<(u64, SystemTime)>>)>,
+    protected: Option<(String, BTreeMap<String, Stamp>)>,
     /// The stage (and the target if this run made it) in the registry of live
     /// temporaries, removed by an interrupt ([`crate::live`]).
     live: Vec<Live>,
@@ -266,7 +269,7 @@ impl Drop for OutputSet {
 }
 
 /// A file's length and modification time (`None` when absent).
-fn stamp(path: &Path) -> Option<(u64, SystemTime)> {
+fn stamp(path: &Path) -> Stamp {
     let m = std::fs::symlink_metadata(path).ok()?;
     Some((m.len(), m.modified().unwrap_or(SystemTime::UNIX_EPOCH)))
 }

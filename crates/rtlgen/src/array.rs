@@ -172,6 +172,8 @@ struct ArrayT<'a> {
     tcols: usize,
     b: usize,
     g: u64,
+    /// N·C: the frame's accumulation cycles (the double buffer's hold is the walk beyond it).
+    acc: u64,
     /// The readout buffer's words: the registers and the status word.
     words: Vec<usize>,
     /// The row of a row fault (`row_late`, `row_stuck`).
@@ -425,6 +427,7 @@ pub fn render_array(
         tcols: tile.cols,
         b: a.bits as usize,
         g: a.beat_cycles,
+        acc,
         words: (0..=r).collect(),
         fault_row,
         neighbour,

@@ -60,6 +60,12 @@ module tofprobe_array #(
     localparam integer QW = (PIXELS + 1 > 2) ? $clog2(PIXELS + 1) : 1;
     localparam integer KW = (K > 2) ? $clog2(K) : 1;
     localparam integer GW = (BEAT_CYCLES > 2) ? $clog2(BEAT_CYCLES) : 1;
+    localparam integer SW = (SLOT > 2) ? $clog2(SLOT) : 1;
+    // The sequencer's hold (double-buffered): the walk beyond the frame's N·C + 1 cycles, in
+    // 64 bits; its counter's width QW + SW bounds it (WAIT < (PIXELS + 1)·SLOT).
+    localparam [63:0] WALK = 64'd0 + PIXELS * 64'd1 * SLOT + 64'd1;
+    localparam [63:0] ACC = 64'd64;
+    localparam [63:0] WAIT = (0 != 0 && WALK > ACC + 64'd1) ? WALK - ACC - 64'd1 : 64'd0;
     localparam integer K_LAST = K - 1;
     localparam integer G_LAST = BEAT_CYCLES - 1;
     localparam [IB - 1:0] LAST_WORD = R[IB - 1:0];
@@ -82,7 +88,13 @@ module tofprobe_array #(
         .PIXELS(PIXELS),
         .COLS(COLS),
         .SLOT(SLOT),
-        .DOUBLE_BUFFER(0)
+        .DOUBLE_BUFFER(0),
+        .QW(QW),
+        .RW(RW),
+        .CW(CW),
+        .SW(SW),
+        .HW(QW + SW),
+        .WAIT(WAIT)
     ) u_sequencer (
         .clk(clk),
         .rst(rst),

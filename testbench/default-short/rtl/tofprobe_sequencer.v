@@ -16,10 +16,18 @@ module tofprobe_sequencer #(
     parameter integer COLS = 1,
     parameter integer SLOT = 33,
     parameter integer DOUBLE_BUFFER = 0,
-    // Derived widths (not to be overridden).
-    parameter integer QW = (PIXELS + 1 > 2) ? $clog2(PIXELS + 1) : 1,
-    parameter integer RW = (PIXELS / COLS > 2) ? $clog2(PIXELS / COLS) : 1,
-    parameter integer CW = (COLS > 2) ? $clog2(COLS) : 1
+    // The counters' widths, set by the instantiating top: the walk's pixel index (its end
+    // value PIXELS included), row, column, slot cycle and hold (none is derived here: Icarus
+    // 11 crashes evaluating $clog2 parameters beside the gate-level cell models).
+    parameter integer QW = 1,
+    parameter integer RW = 1,
+    parameter integer CW = 1,
+    parameter integer SW = 6,
+    parameter integer HW = 1,
+    // Double-buffered: the cycles the pulses wait after a frame's last one beyond the swap
+    // cycle, max(PIXELS·SLOT + 1 − N·C − 1, 0) (64 bits: a large array's walk outlasts 2^32
+    // cycles).
+    parameter [63:0] WAIT = 64'd0
 ) (
     input  wire clk,
     input  wire rst,
@@ -31,18 +39,15 @@ module tofprobe_sequencer #(
     output wire [CW - 1:0] col,
     output wire [14:0] addr
 );
-    // Sized in 64 bits: a large array's readout outlasts 2^32 cycles.
-    localparam [63:0] WALK = 64'd0 + PIXELS * 64'd1 * SLOT + 64'd1;
-    localparam [63:0] ACC = 64'd1024;
-    localparam [63:0] WAIT = (DOUBLE_BUFFER != 0 && WALK > ACC + 64'd1) ? WALK - ACC - 64'd1 : 64'd0;
-    localparam integer SW = (SLOT > 2) ? $clog2(SLOT) : 1;
-    localparam integer HW = (WAIT + 64'd1 > 64'd2) ? $clog2(WAIT + 64'd1) : 1;
-    localparam [QW - 1:0] Q_END = PIXELS[QW - 1:0];
-    localparam integer SLOT_LAST = SLOT - 1;
-    localparam integer COL_LAST = COLS - 1;
-    localparam [SW - 1:0] SC_END = SLOT_LAST[SW - 1:0];
-    localparam [CW - 1:0] C_END = COL_LAST[CW - 1:0];
-    localparam [HW - 1:0] WT_START = WAIT[HW - 1:0];
+    // The counters' end values at their widths (the values fit: the widths are theirs).
+    // Constant wires, not localparams ranged by parameters: Icarus 11 crashes on those
+    // beside the gate-level cell models.
+    /* verilator lint_off WIDTH */
+    wire [QW - 1:0] q_end = PIXELS;
+    wire [SW - 1:0] sc_end = SLOT - 1;
+    wire [CW - 1:0] c_end = COLS - 1;
+    wire [HW - 1:0] wt_start = WAIT;
+    /* verilator lint_on WIDTH */
 
     reg ro_phase;
     reg hold;
@@ -58,7 +63,7 @@ module tofprobe_sequencer #(
     // Single-buffered the pulses wait for the walk; double-buffered for the hold only.
     wire waiting = (DOUBLE_BUFFER != 0) ? hold : ro_phase;
     assign pulse = !rst && !waiting && (ph == 4'd0);
-    assign readout = !rst && ro_phase && (sc == {SW{1'b0}}) && (qi != Q_END);
+    assign readout = !rst && ro_phase && (sc == {SW{1'b0}}) && (qi != q_end);
     assign swap = (DOUBLE_BUFFER != 0) && !rst && ro_phase && (qi == {QW{1'b0}}) && (sc == {SW{1'b0}});
     assign q = qi;
     assign row = qr;
@@ -81,12 +86,12 @@ module tofprobe_sequencer #(
             // The readout walk: a slot of SLOT cycles per pixel, row-major, then the
             // phase's last cycle.
             if (ro_phase) begin
-                if (qi == Q_END) begin
+                if (qi == q_end) begin
                     ro_phase <= 1'b0;
-                end else if (sc == SC_END) begin
+                end else if (sc == sc_end) begin
                     sc <= {SW{1'b0}};
                     qi <= qi + 1'b1;
-                    if (qc == C_END) begin
+                    if (qc == c_end) begin
                         qc <= {CW{1'b0}};
                         qr <= qr + 1'b1;
                     end else begin
@@ -114,7 +119,7 @@ module tofprobe_sequencer #(
             if (frame_end) begin
                 ro_phase <= 1'b1;
                 hold <= (DOUBLE_BUFFER != 0);
-                wt <= WT_START;
+                wt <= wt_start;
                 qi <= {QW{1'b0}};
                 sc <= {SW{1'b0}};
                 qr <= {RW{1'b0}};

@@ -295,7 +295,8 @@ fn merge_refuses_a_tampered_manifest_before_sizing_anything() {
         .collect();
     let bad = tmp.path().join("bad");
     let out = tmp.path().join("out");
-    let cases: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>, &[&str])> = vec![
+    type Tamper = Box<dyn Fn(&mut serde_json::Value)>;
+    let cases: Vec<(&str, Tamper, &[&str])> = vec![
         (
             "2^31 × 2^31",
             Box::new(|m| {

@@ -132,6 +132,7 @@ pub fn amplitude_row(r: &RowResult, quick: bool) -> Option<Row> {
 /// closed form's. The paper's values, 2.93–3.99 floors (3.29 on average), are what the
 /// largest of ≈ 2,000 bins gives (3.23 floors), not of the ≈ 19,000 bins of 1 Hz from 1
 /// to 20 kHz (3.65): its spectra were read on a coarser grid than their 1 Hz bins.
+#[allow(clippy::too_many_arguments)]
 pub fn largest_value_row(
     family: &'static str,
     r: &RowResult,
