@@ -48,5 +48,6 @@ mod self_contained;
 mod shard;
 mod signals;
 mod size;
+mod soak_arrays;
 mod tile_option;
 mod tradeoff;

@@ -128,10 +128,12 @@ fn a_killed_rtl_commit_is_refused_by_every_reader_or_whole() {
     let dir = tmp.join("rtl");
     let a = ["rtl", "--out", "rtl", "--frame-pulses", "64"];
     let b = ["rtl", "--out", "rtl", "--frame-pulses", "128"];
-    // 7 files and the marker: 8 renames; the marker's is the last.
-    let refused = kill_every_rename(&dir, &a, &b, 8);
+    // The set's files and the marker: one rename each; the marker's is the last.
+    let files = listing_after(&tmp, &a, &dir);
+    assert!(files >= 7, "{files} files");
+    let refused = kill_every_rename(&dir, &a, &b, files + 1);
     assert_eq!(
-        refused, 7,
+        refused, files,
         "refused before the marker's rename, whole after it"
     );
     // cosim --rtl refuses an interrupted set before anything else (no tool needed).
