@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # The users'-tools checks (issue 21): the FuseSoC core (lint, sim) and the cocotb
-# testbench on the committed default, in one cached Python venv (scripts/py-venv.sh).
+# testbench on the committed default, and an array set's verification kit (issue 42: its
+# core's sim and sim_verilator, the cocotb array test; scripts/array-kit-check.sh), in one
+# cached Python venv (scripts/py-venv.sh).
 # Prints one result line; skips (exit 0, saying so) only when python3 is missing outside CI.
 # (The PTU/SPC decoder's cross-check with ptufile runs as a cargo test:
 # crates/scene/tests/it/tttr_crosscheck.rs.)
@@ -17,4 +19,5 @@ fi
 start=$(date +%s)
 "$root/scripts/fusesoc-check.sh"
 "$root/scripts/cocotb-check.sh"
-echo "users-tools: ok (fusesoc lint+sim, cocotb) in $(( $(date +%s) - start )) s"
+"$root/scripts/array-kit-check.sh"
+echo "users-tools: ok (fusesoc lint+sim, cocotb, the array set's kit) in $(( $(date +%s) - start )) s"

@@ -7,9 +7,18 @@
 // preceded, for each of the first 10 mismatches, by
 //   TOFPROBE-MISMATCH cycle=<c> signal=<name> expected=<hex> actual=<hex>
 // Compile with -I VECDIR -DAR_VECTORS=\"VECDIR/\" (where array_params.vh, array_stim.hex and
-// array_expect.hex are) and run from the RTL directory (a deep probe ROM's $readmemh).
+// array_expect.hex are) and run from the RTL directory (a deep probe ROM's $readmemh); without
+// AR_VECTORS the vector files are read from the working directory (an array set's
+// verification kit, where `tofprobe rtl` writes this file beside the RTL and the vectors:
+// testbench/README.md "The array set's verification kit"). Verilog-2005: runs under Icarus
+// and under `verilator --binary` (its timing support drives the #1 steps).
 `timescale 1ns / 1ps
 `include "array_params.vh"
+`ifdef AR_VECTORS
+`define AR_FILE(name) {`AR_VECTORS, name}
+`else
+`define AR_FILE(name) name
+`endif
 // The inputs: the pixels, or with a superpixel (G > 1) their SPADs (AR_NS = AR_NP * G * G).
 `ifndef AR_NS
 `define AR_NS `AR_NP
@@ -47,8 +56,8 @@ module array_tb;
         end
     endtask
     initial begin
-        $readmemh({`AR_VECTORS, "array_stim.hex"}, stim);
-        $readmemh({`AR_VECTORS, "array_expect.hex"}, expect_mem);
+        $readmemh(`AR_FILE("array_stim.hex"), stim);
+        $readmemh(`AR_FILE("array_expect.hex"), expect_mem);
         clk = 1'b0;
         rst = 1'b1;
         valid = 0;

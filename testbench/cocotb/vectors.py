@@ -67,3 +67,77 @@ class Vectors:
             readout=read_hex(d / "readout.hex"),
             pins=[Pins.decode(v) for v in read_hex(d / "pins.hex")],
         )
+
+
+def read_defines(path):
+    """`\\`define AR_<KEY> value` lines of an array's array_params.vh, as {KEY: value}
+    (integers where they are, e.g. {"NP": 6, "TOP": "tofprobe_array"})."""
+    out = {}
+    for m in re.finditer(r"^`define\s+AR_(\w+)\s+(\S+)\s*$", Path(path).read_text(), re.M):
+        k, v = m.group(1), m.group(2)
+        out[k] = int(v) if v.isdigit() else v
+    return out
+
+
+def data_lines(path):
+    """The non-comment, non-empty lines of a vector file."""
+    for line in Path(path).read_text().splitlines():
+        s = line.strip()
+        if s and not s.startswith("//") and not s.startswith("#"):
+            yield s
+
+
+@dataclass(frozen=True)
+class ArrayPins:
+    """The array's ports the model expects in one cycle (array_expect.hex: one line each)."""
+
+    pulse_o: int
+    ready: int
+    ro_valid: int
+    ro_data: int
+
+
+@dataclass
+class ArrayVectors:
+    """An array's golden vectors (crates/array/src/rtl_vectors.rs): in an array set's
+    verification kit, beside the RTL, or in a `tofprobe vectors` directory."""
+
+    params: dict
+    stimulus: list  # per pulse: (valid bits, tdc bits) of every pixel (or SPAD)
+    expect: list  # ArrayPins per cycle
+    readout: list  # (frame, row, col, [words]) in stream order
+
+    @staticmethod
+    def load(vec_dir):
+        d = Path(vec_dir)
+        params = read_defines(d / "array_params.vh")
+        ns = params.get("NS", params["NP"])
+        stim = []
+        for s in data_lines(d / "array_stim.hex"):
+            v = int(s, 16)
+            stim.append((v & ((1 << ns) - 1), v >> ns))
+        expect = []
+        for s in data_lines(d / "array_expect.hex"):
+            p, r, v, data = s.split()
+            expect.append(ArrayPins(int(p, 16), int(r, 16), int(v, 16), int(data, 16)))
+        readout = []
+        for s in data_lines(d / "readout.txt"):
+            head, words = s.split(":")
+            f, r, c = (int(x) for x in head.split())
+            readout.append((f, r, c, [int(w, 16) for w in words.split()]))
+        return ArrayVectors(params=params, stimulus=stim, expect=expect, readout=readout)
+
+    def where(self, cycle):
+        """The readout beat on the port at `cycle` (or the next one): "frame F pixel (r, c)
+        word w", from the order of readout.txt and the beats of array_expect.hex."""
+        beats = [c for c, e in enumerate(self.expect) if e.ro_valid]
+        if not beats or not self.readout:
+            return "no readout"
+        per_pixel = len(beats) // len(self.readout)
+        words = len(self.readout[0][3])
+        idx = sum(1 for b in beats if b < cycle)
+        idx = min(idx, len(beats) - 1)
+        f, r, c, _ = self.readout[min(idx // max(per_pixel, 1), len(self.readout) - 1)]
+        w = (idx % max(per_pixel, 1)) * words // max(per_pixel, 1)
+        state = "beat of" if self.expect[cycle].ro_valid else "before the beat of"
+        return f"{state} frame {f} pixel ({r}, {c}) word {w}"

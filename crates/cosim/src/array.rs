@@ -25,14 +25,20 @@ pub const MAX_COSIM_PIXELS: usize = 64 * 64;
 /// The array harness, embedded so the binary works outside the source tree.
 pub const ARRAY_HARNESS_CPP: &str = include_str!("../../../testbench/array_harness.cpp");
 
-/// The array testbench for Icarus.
-pub const ARRAY_TB_V: &str = include_str!("../../../testbench/array_tb.v");
+/// The array testbench for Icarus (the one an array set's verification kit carries).
+pub use tofprobe_rtlgen::kit::ARRAY_TB_V;
 
+/// The RTL of an array set: its `.v` files but the verification kit's testbench
+/// (`tofprobe_rtlgen::kit::KIT_TESTBENCH`), which the simulators get from here.
 fn sources(rtl_dir: &Path) -> Result<Vec<std::path::PathBuf>, CosimError> {
     let mut v: Vec<_> = std::fs::read_dir(rtl_dir)
         .map_err(|e| CosimError::io(rtl_dir, e))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "v"))
+        .filter(|p| {
+            p.file_name()
+                .is_none_or(|n| n != tofprobe_rtlgen::kit::KIT_TESTBENCH)
+        })
         .collect();
     v.sort();
     Ok(v)

@@ -177,14 +177,17 @@ fn chip(design: &ResolvedDesign, o: &RtlOverrides, purpose: RomPurpose) -> Resul
     Ok(Chip::array_of(design, o, purpose)?)
 }
 
-/// Renders the array chip into `out` (the RTL and its FuseSoC core, one set); returns the
-/// chip and the file names.
+/// Renders the array chip into `out` (the RTL and its FuseSoC core, one set; with `kit`,
+/// the set's verification kit too: the vector files of [`array_vector_files`] for this chip
+/// beside the RTL, the testbench `tofprobe_rtlgen::kit` copies, and the core's simulation
+/// targets); returns the file names.
 pub fn render_array_to(
     chip: &Chip,
     out: &Path,
     command: String,
     fault: Option<ArrayFault>,
     tile: Option<ArrayTile>,
+    kit: Option<Vec<(String, String)>>,
 ) -> Result<Vec<String>, FlowError> {
     let spec = chip
         .array_spec(fault, tile)
@@ -201,23 +204,96 @@ pub fn render_array_to(
         &options,
         chip.rows,
         chip.cols,
+        kit.is_some(),
     )?;
     files.extend(core);
-    let pairs: Vec<(String, String)> = files.into_iter().map(|f| (f.name, f.contents)).collect();
+    if kit.is_some() {
+        files.push(tofprobe_rtlgen::kit::render_kit_testbench(
+            &chip.pixel,
+            &options,
+        ));
+    }
+    let mut pairs: Vec<(String, String)> =
+        files.into_iter().map(|f| (f.name, f.contents)).collect();
+    pairs.extend(kit.into_iter().flatten());
     write_generated(out, &pairs)?;
     Ok(pairs.into_iter().map(|(n, _)| n).collect())
 }
 
-/// `tofprobe rtl` on an array design: the chip ROM policy's ROM, N and L as overridden.
+/// What `tofprobe rtl` put in an array set besides the RTL: its verification kit's frames
+/// and cycles, or why it has none.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ArrayKit {
+    /// The testbench and `frames` frames of golden vectors, `cycles` cycles.
+    Written { frames: u64, cycles: u64 },
+    /// No kit (`--kit-frames 0`, or more cycles than [`tofprobe_rtlgen::kit::KIT_MAX_CYCLES`]):
+    /// the reason, naming the option that gives one.
+    Omitted(String),
+}
+
+/// `tofprobe rtl` on an array design: the chip ROM policy's ROM, N and L as overridden; with
+/// `kit_frames` > 0 the set carries its verification kit ([`render_array_to`]): the golden
+/// vectors of `tofprobe vectors` for `kit_frames` frames (the same code path,
+/// [`array_vector_files`], on the ROM rendered into the set, as `tofprobe cosim --rtl`
+/// replays), unless they would exceed `KIT_MAX_CYCLES` cycles.
 pub fn render_array_design(
     design: &ResolvedDesign,
     o: &RtlOverrides,
     out: &Path,
     command: String,
-) -> Result<(Chip, Vec<String>), FlowError> {
+    kit_frames: u64,
+) -> Result<(Chip, Vec<String>, ArrayKit), FlowError> {
+    let max = tofprobe_rtlgen::kit::KIT_MAX_CYCLES;
+    if kit_frames > 100 {
+        return Err(FlowError::option(
+            "kit-frames",
+            kit_frames,
+            "0..=100 (0: no verification kit)",
+        ));
+    }
     let chip = chip(design, o, RomPurpose::Rendered)?;
-    let files = render_array_to(&chip, out, command, None, None)?;
-    Ok((chip, files))
+    let ro = chip
+        .readout
+        .ok_or_else(|| FlowError::option("array", "none", "an [array] design"))?;
+    // The run's length, bounded before the model runs: every frame and one readout more.
+    let estimate = ro
+        .frame_cycles()
+        .saturating_mul(kit_frames)
+        .saturating_add(ro.readout_cycles());
+    let (kit, status) = if kit_frames == 0 {
+        (
+            None,
+            ArrayKit::Omitted("--kit-frames 0: no verification kit".into()),
+        )
+    } else if estimate > max {
+        (
+            None,
+            ArrayKit::Omitted(format!(
+                "no verification kit: {kit_frames} frame(s) of N = {} replay about {estimate} cycles,                  over the kit's {max} (render with a shorter --frame-pulses or fewer --kit-frames,                  or re-verify with `tofprobe cosim --rtl`)",
+                chip.pixel.frame_pulses
+            )),
+        )
+    } else {
+        let stimulus = ArrayStimulus {
+            frames: kit_frames,
+            detections: None,
+            tile: None,
+            lead_misses: 0,
+            exercise: false,
+            purpose: RomPurpose::Rendered,
+        };
+        let (v, files) = array_vector_files(design, chip.clone(), stimulus, &command)?;
+        let cycles = v.run.cycles();
+        (
+            Some(files),
+            ArrayKit::Written {
+                frames: kit_frames,
+                cycles,
+            },
+        )
+    };
+    let files = render_array_to(&chip, out, command, None, None, kit)?;
+    Ok((chip, files, status))
 }
 
 /// The array's golden vectors written (`tofprobe vectors` on an array design): the chip
@@ -272,18 +348,33 @@ fn write_vectors(
     vec_dir: &Path,
     command: &str,
 ) -> Result<ArrayVectors, FlowError> {
+    if stimulus.frames == 0 || stimulus.frames > 100 {
+        return Err(FlowError::option("frames", stimulus.frames, "1..=100"));
+    }
+    let chip = chip(design, o, stimulus.purpose)?;
+    let (v, files) = array_vector_files(design, chip, stimulus, command)?;
+    write_generated(vec_dir, &files)?;
+    Ok(v)
+}
+
+/// The array model of `chip` run on the stimulus, and the vector files
+/// (`tofprobe_array::rtl_vectors::vector_files`, headers naming `command`): what `tofprobe
+/// vectors` writes into its directory and `tofprobe rtl` into an array set's verification
+/// kit.
+fn array_vector_files(
+    design: &ResolvedDesign,
+    chip: Chip,
+    stimulus: ArrayStimulus,
+    command: &str,
+) -> Result<(ArrayVectors, Vec<(String, String)>), FlowError> {
     let ArrayStimulus {
         frames,
         detections,
         tile,
         lead_misses: v_lead,
         exercise: thin,
-        purpose,
+        purpose: _,
     } = stimulus;
-    if frames == 0 || frames > 100 {
-        return Err(FlowError::option("frames", frames, "1..=100"));
-    }
-    let chip = chip(design, o, purpose)?;
     let ro = chip
         .readout
         .ok_or_else(|| FlowError::option("array", "none", "an [array] design"))?;
@@ -320,14 +411,17 @@ fn write_vectors(
         frames,
         tofprobe_io::text::sanitize(command)
     );
-    write_generated(vec_dir, &vector_files(&r, &detections, p, &top, &header))?;
-    Ok(ArrayVectors {
-        chip,
-        readout: ro,
-        run: r,
-        detections,
-        model_seconds,
-    })
+    let files = vector_files(&r, &detections, p, &top, &header);
+    Ok((
+        ArrayVectors {
+            chip,
+            readout: ro,
+            run: r,
+            detections,
+            model_seconds,
+        },
+        files,
+    ))
 }
 
 /// Renders the array of `design`, runs the array model on its scene (or the given
@@ -372,7 +466,7 @@ pub fn cosim_array(
         }
         None => {
             let dir = a.out.join("rtl");
-            render_array_to(&v.chip, &dir, a.command.clone(), a.fault, a.tile)?;
+            render_array_to(&v.chip, &dir, a.command.clone(), a.fault, a.tile, None)?;
             dir
         }
     };

@@ -29,23 +29,28 @@ pub struct CoreSim {
 
 #[derive(Template)]
 #[template(path = "tofprobe.core", escape = "none")]
-struct CoreT<'a> {
+struct CoreT {
     header: String,
     vlnv_name: String,
     version: &'static str,
     description: String,
     rtl_files: Vec<String>,
     rom_hex: Option<String>,
-    sim: Option<SimT<'a>>,
+    sim: Option<SimT>,
     yosys_script: String,
     top: String,
 }
 
-struct SimT<'a> {
-    defines: String,
-    testbench: &'a str,
-    vectors_dir: &'a str,
-    vector_files: &'static [&'static str],
+/// The `tb` fileset and the simulation targets: Verilog sources (the pixel's macro file and
+/// testbench, or the array kit's testbench), the vectors' include, the vector data copied to
+/// the tool's work directory (path, name there), the testbench's top and whether a Verilator
+/// target (`sim_verilator`, `verilator --binary`) is rendered beside Icarus's `sim`.
+struct SimT {
+    sources: Vec<String>,
+    include: String,
+    data: Vec<(String, String)>,
+    toplevel: &'static str,
+    verilator: bool,
 }
 
 #[derive(Template)]
@@ -99,6 +104,16 @@ pub fn render_core(
     }
     let prefix = &o.module_prefix;
     let (_, _, top) = crate::naming::module_names(prefix);
+    let sim = sim.map(|s| SimT {
+        sources: vec![defines_name(prefix), s.testbench.clone()],
+        include: format!("{}/tb_params.vh", s.vectors_dir),
+        data: VECTOR_FILES
+            .iter()
+            .map(|v| (format!("{}/{v}", s.vectors_dir), v.to_string()))
+            .collect(),
+        toplevel: "tb",
+        verilator: false,
+    });
     core_files(
         p,
         rtl,
@@ -111,41 +126,60 @@ pub fn render_core(
 }
 
 /// The core of an array's rendered files (`crate::render_array`): its toplevel the
-/// `<prefix>_array` module of `rows` × `cols` pixels, targets `lint` and `synth` (the
-/// array is co-simulated by `tofprobe cosim`, not by the core's `sim`).
+/// `<prefix>_array` module of `rows` × `cols` pixels, targets `lint` and `synth`; with
+/// `kit` (the set carries its verification kit, [`crate::kit`]: the testbench and the
+/// vectors beside the RTL) also `sim` (Icarus) and `sim_verilator` (`verilator --binary`),
+/// both running the kit's testbench against the set's RTL.
 pub fn render_array_core(
     p: &PixelParams,
     rtl: &[RtlFile],
     o: &RenderOptions,
     rows: usize,
     cols: usize,
+    kit: bool,
 ) -> Result<Vec<RtlFile>, RtlError> {
     crate::naming::validate_identifier("module_prefix", &o.module_prefix)?;
     let prefix = &o.module_prefix;
     let top = crate::array::array_module_name(prefix);
+    let sim = kit.then(|| SimT {
+        sources: vec![crate::kit::KIT_TESTBENCH.to_string()],
+        include: crate::kit::KIT_PARAMS.to_string(),
+        data: crate::kit::KIT_DATA
+            .iter()
+            .map(|d| (d.to_string(), d.to_string()))
+            .collect(),
+        toplevel: crate::kit::KIT_TOP,
+        verilator: true,
+    });
     core_files(
         p,
         rtl,
         o,
-        None,
+        sim,
         top.clone(),
         top,
         format!("{rows} x {cols} array of the "),
     )
 }
 
+/// The pixel's macro file for testbench/tb.v (`TB_TOP`, `TB_VECTORS`).
+fn defines_name(prefix: &str) -> String {
+    format!("{prefix}_tb_defines.vh")
+}
+
 fn core_files(
     p: &PixelParams,
     rtl: &[RtlFile],
     o: &RenderOptions,
-    sim: Option<&CoreSim>,
+    sim: Option<SimT>,
     top: String,
     vlnv: String,
     what: String,
 ) -> Result<Vec<RtlFile>, RtlError> {
     let prefix = &o.module_prefix;
     let yosys_script = format!("{prefix}_yosys_synth.tcl");
-    let defines = format!("{prefix}_tb_defines.vh");
+    let defines = defines_name(prefix);
+    let pixel_sim = sim.as_ref().is_some_and(|s| s.sources.contains(&defines));
     let mut files = Vec::new();
     let core = CoreT {
         header: hash_header(p, "tofprobe.core", o),
@@ -172,12 +206,7 @@ fn core_files(
             .iter()
             .find(|f| f.name.ends_with(".hex"))
             .map(|f| f.name.clone()),
-        sim: sim.map(|s| SimT {
-            defines: defines.clone(),
-            testbench: &s.testbench,
-            vectors_dir: &s.vectors_dir,
-            vector_files: VECTOR_FILES,
-        }),
+        sim,
         yosys_script: yosys_script.clone(),
         top: top.clone(),
     };
@@ -194,7 +223,7 @@ fn core_files(
         template: "yosys_synth.tcl",
         contents: y.render().map_err(render_err("yosys_synth.tcl"))? + "\n",
     });
-    if sim.is_some() {
+    if pixel_sim {
         let d = DefinesT {
             header: header(p, "tb_defines.vh", o),
             top,

@@ -10,6 +10,7 @@ pub mod array;
 pub mod core;
 pub mod error;
 pub mod golden;
+pub mod kit;
 pub mod naming;
 pub mod render;
 pub mod stimulus;

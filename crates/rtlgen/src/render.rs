@@ -65,8 +65,19 @@ pub const ROM_TABLE_MAX_DEPTH: usize = 64;
 
 /// The header of every generated file (`//` comment lines, no final newline).
 pub(crate) fn header(p: &PixelParams, template: &str, o: &RenderOptions) -> String {
+    header_from(p, &format!("template templates/{template}"), template, o)
+}
+
+/// [`header`] of a file copied from `source` (e.g. `testbench/array_tb.v`) rather than
+/// rendered from a template; `template` still selects the template-specific lines.
+pub(crate) fn header_from(
+    p: &PixelParams,
+    source: &str,
+    template: &str,
+    o: &RenderOptions,
+) -> String {
     let mut h = format!(
-        "{HEADER_MARK} {} from template templates/{template}.\n\
+        "{HEADER_MARK} {} from {source}.\n\
          // DO NOT EDIT: regenerate with `{}`.\n\
          // Configuration hash: {} ({:?}, B={}, U={}, A={}, C={}, T={}, Z={}, S={}, F={}, W={}, N={}, L={}{}).\n",
         env!("CARGO_PKG_VERSION"),

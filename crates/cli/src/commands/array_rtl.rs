@@ -4,7 +4,9 @@
 //! calls `tofprobe_flow::array::run_array_flow` from its own file. Printing only.
 
 use tofprobe_design::{ResolvedDesign, RtlOverrides};
-use tofprobe_flow::array::{ArrayCosimOptions, ArraySimulator, cosim_array, render_array_design};
+use tofprobe_flow::array::{
+    ArrayCosimOptions, ArrayKit, ArraySimulator, cosim_array, render_array_design,
+};
 
 use crate::commands::cosim::{CosimArgs, SimulatorArg};
 use crate::commands::rtl::{RtlArgs, regen_command};
@@ -23,7 +25,10 @@ pub fn rtl(a: &RtlArgs, design: &ResolvedDesign) -> Result<(), CliError> {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
     };
-    let (chip, files) = render_array_design(design, &o, &a.out, regen_command(a))?;
+    let kit_frames = a
+        .kit_frames
+        .unwrap_or(tofprobe_rtlgen::kit::KIT_DEFAULT_FRAMES);
+    let (chip, files, kit) = render_array_design(design, &o, &a.out, regen_command(a), kit_frames)?;
     let p = &chip.pixel;
     let ro = chip.readout.as_ref();
     println!(
@@ -43,6 +48,14 @@ pub fn rtl(a: &RtlArgs, design: &ResolvedDesign) -> Result<(), CliError> {
         files.join(", "),
         chip.rom.note
     );
+    match kit {
+        ArrayKit::Written { frames, cycles } => println!(
+            "rtl: verification kit: {} with {frames} frame(s) of golden vectors ({cycles} cycles) in the set; \
+             run it with its core's `sim`/`sim_verilator` targets or testbench/README.md's commands",
+            tofprobe_rtlgen::kit::KIT_TESTBENCH
+        ),
+        ArrayKit::Omitted(why) => println!("rtl: {why}"),
+    }
     Ok(())
 }
 

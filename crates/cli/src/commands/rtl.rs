@@ -5,7 +5,8 @@
 //! `--rom-depth` renders the sign-of-cosine probe instead, and the command says which
 //! (`tofprobe_design::rom_policy`). Beside the RTL it writes the FuseSoC core
 //! (`<prefix>.core`: `lint`, `synth`, and `sim` with `--core-vectors`/`--core-testbench`)
-//! and the core's yosys script, in the same atomic set.
+//! and the core's yosys script, in the same atomic set; an array's set also carries its
+//! verification kit (`--kit-frames`, `tofprobe_rtlgen::kit`).
 
 use std::path::PathBuf;
 
@@ -38,6 +39,11 @@ pub struct RtlArgs {
     /// recorded relative to DIR.
     #[arg(long, value_name = "FILE", requires = "core_vectors")]
     pub core_testbench: Option<PathBuf>,
+    /// An `[array]` configuration's set carries its verification kit (the self-checking
+    /// testbench and the golden vectors of this many frames, beside the RTL; the core's
+    /// `sim` and `sim_verilator` targets run it): 0..=100, 0 for none (default 2).
+    #[arg(long, value_name = "K")]
+    pub kit_frames: Option<u64>,
 }
 
 /// The command line that regenerates `out` (recorded in every header): paths as the user
@@ -58,6 +64,9 @@ pub fn regen_command(a: &RtlArgs) -> String {
     if let Some(l) = a.rom_depth {
         s.push_str(&format!(" --rom-depth {l}"));
     }
+    if let Some(k) = a.kit_frames {
+        s.push_str(&format!(" --kit-frames {k}"));
+    }
     if let (Some(v), Some(t)) = (&a.core_vectors, &a.core_testbench) {
         s.push_str(&format!(
             " --core-vectors {} --core-testbench {}",
@@ -73,6 +82,14 @@ pub fn run(a: &RtlArgs) -> Result<(), CliError> {
     let design = crate::commands::load_for_hardware(a.config.as_deref())?;
     if design.array.is_some() {
         return super::array_rtl::rtl(a, &design);
+    }
+    if a.kit_frames.is_some() {
+        return Err(CliError::option(
+            "kit-frames",
+            "given",
+            "an [array] configuration only (the pixel's core replays vectors given by \
+             --core-vectors/--core-testbench)",
+        ));
     }
     let overrides = RtlOverrides {
         frame_pulses: a.frame_pulses,

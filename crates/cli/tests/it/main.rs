@@ -5,6 +5,7 @@
 mod adders_auto;
 mod array;
 mod array_edited;
+mod array_kit;
 mod array_memory;
 mod array_refusals;
 mod array_rtl;
