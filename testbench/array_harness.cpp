@@ -143,6 +143,12 @@ int main(int argc, char** argv) {
                         (unsigned long long)a);
         ++mism;
     };
+    // The clock starts high: Verilator's first eval settles the model without an edge, so
+    // cycle 0's rise is the first edge everywhere. Starting low, a hierarchically Verilated
+    // pixel (its own model, `cosim::array::build`) missed that first edge.
+    top->clk = 1;
+    top->rst = 1;
+    top->eval();
     for (uint64_t cycle = 0; cycle < cycles; ++cycle) {
         unsigned p = 0, r = 0, v = 0;
         unsigned long long d = 0;

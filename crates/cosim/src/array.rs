@@ -44,8 +44,58 @@ fn sources(rtl_dir: &Path) -> Result<Vec<std::path::PathBuf>, CosimError> {
     Ok(v)
 }
 
-/// Builds (or reuses) the Verilator harness of the array RTL in `rtl_dir` (top `top`).
-pub fn build(rtl_dir: &Path, top: &str, profile: BuildProfile) -> Result<HarnessBuild, CosimError> {
+/// From this many pixels on, the harness is Verilated hierarchically: the pixel module is a
+/// `hier_block`, Verilated and compiled once and instantiated R × C times, instead of
+/// inlined R × C times. Measured (`tofprobe bench cosim-array`, docs/performance.md "The
+/// array RTL at scale"): a 2 × 2 array of the tiny example pixel builds cheaper flat (9.9
+/// against 13 CPU-s), 4 × 4 of scenes/sensor-64x64.toml's pixel hierarchically (13.1
+/// against 23.6 CPU-s), and the flat build grows faster than R × C.
+pub const HIERARCHICAL_FROM_PIXELS: usize = 16;
+
+/// How the harness's Verilator build treats the pixel module.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layout {
+    /// Every pixel inlined into one model (small arrays).
+    Flat,
+    /// The pixel one `hier_block` model, compiled once.
+    Hierarchical,
+}
+
+impl Layout {
+    /// Its name in reports: `flat` or `hierarchical`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::Flat => "flat",
+            Layout::Hierarchical => "hierarchical",
+        }
+    }
+
+    /// The layout for an array of `pixels` pixels ([`HIERARCHICAL_FROM_PIXELS`]).
+    pub fn for_pixels(pixels: usize) -> Layout {
+        if pixels >= HIERARCHICAL_FROM_PIXELS {
+            Layout::Hierarchical
+        } else {
+            Layout::Flat
+        }
+    }
+}
+
+/// The pixel module of the array top `top` (`<prefix>_array` → `<prefix>_pixel`).
+fn pixel_module(top: &str) -> String {
+    let prefix = top.strip_suffix("_array").unwrap_or(top);
+    tofprobe_rtlgen::naming::module_names(prefix).0
+}
+
+/// Builds (or reuses) the Verilator harness of the array RTL in `rtl_dir` (top `top`), its
+/// pixel inlined or a hierarchical block as `layout` says, in the build cache (`cache`:
+/// another cache root, e.g. an empty one for a benchmark's cold build).
+pub fn build(
+    rtl_dir: &Path,
+    top: &str,
+    profile: BuildProfile,
+    layout: Layout,
+    cache: Option<&Path>,
+) -> Result<HarnessBuild, CosimError> {
     let verilator = require("verilator")?;
     let t0 = Instant::now();
     let srcs = sources(rtl_dir)?;
@@ -53,16 +103,31 @@ pub fn build(rtl_dir: &Path, top: &str, profile: BuildProfile) -> Result<Harness
         &verilator,
         "array ",
         ARRAY_HARNESS_CPP,
-        &format!("{top} {profile:?} {VERILATOR_FLAGS:?}"),
+        &format!("{top} {profile:?} {layout:?} {VERILATOR_FLAGS:?}"),
         &srcs,
     )?;
     let hash = format!("array-{:016x}", fnv1a64(&key));
-    let root = cache_root().join("verilator");
+    let root = cache
+        .map_or_else(cache_root, Path::to_path_buf)
+        .join("verilator");
     let (exe, reused) = cached_entry(&root, &hash, |tmp| {
         let cpp = tmp.join("array_harness.cpp");
         std::fs::write(&cpp, ARRAY_HARNESS_CPP).map_err(|e| CosimError::io(&cpp, e))?;
         let cflags = "-DTOP_HEADER='\"Vtop.h\"' -DTOP_CLASS=Vtop";
-        verilate(&verilator, tmp, top, profile, cflags, &[], &srcs, &cpp).map(|_| ())
+        let vlt = tmp.join("hier.vlt");
+        let extra: Vec<String> = match layout {
+            Layout::Flat => Vec::new(),
+            Layout::Hierarchical => {
+                let text = format!(
+                    "`verilator_config\nhier_block -module \"{}\"\n",
+                    pixel_module(top)
+                );
+                std::fs::write(&vlt, text).map_err(|e| CosimError::io(&vlt, e))?;
+                vec!["--hierarchical".into(), vlt.display().to_string()]
+            }
+        };
+        let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+        verilate(&verilator, tmp, top, profile, cflags, &extra, &srcs, &cpp).map(|_| ())
     })?;
     Ok(HarnessBuild {
         exe,

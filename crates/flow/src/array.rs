@@ -67,6 +67,11 @@ pub struct ArrayCosimOptions {
     /// count of valid SPADs, the hold and the priming are reached (default on; given
     /// `detections` are replayed as they are).
     pub exercise: bool,
+    /// How Verilator builds the pixel (`None`: by the pixel count,
+    /// `tofprobe_cosim::array::Layout::for_pixels`).
+    pub layout: Option<tofprobe_cosim::array::Layout>,
+    /// Another build cache root (`None`: the user's; an empty directory: a cold build).
+    pub cache: Option<PathBuf>,
 }
 
 impl ArrayCosimOptions {
@@ -87,6 +92,8 @@ impl ArrayCosimOptions {
             x_seeds: vec![1, 2, 3],
             lead_misses: 0,
             exercise: true,
+            layout: None,
+            cache: None,
         }
     }
 }
@@ -163,6 +170,8 @@ pub struct ArrayCosimReport {
     /// Harness build seconds (0 for Icarus) and whether the cached build was reused.
     pub build_seconds: f64,
     pub reused: bool,
+    /// How Verilator built the pixel (`None`: Icarus).
+    pub layout: Option<tofprobe_cosim::array::Layout>,
     /// Simulation and model seconds.
     pub sim_seconds: f64,
     pub model_seconds: f64,
@@ -474,7 +483,12 @@ pub fn cosim_array(
     let p = &v.chip.pixel;
     let rtl_abs = std::fs::canonicalize(&rtl_dir)
         .map_err(|e| FlowError::output(rtl_dir.clone(), e.to_string()))?;
-    let (outcome, build_seconds, reused, x_seed) = simulate(a, &rtl_abs, &vec_dir, &top)?;
+    // The pixels the RTL holds: the tile's, or the whole array's.
+    let pixels = a.tile.map_or(ro.pixels(), |t| t.rows * t.cols);
+    let layout = a
+        .layout
+        .unwrap_or_else(|| tofprobe_cosim::array::Layout::for_pixels(pixels));
+    let (outcome, build_seconds, reused, x_seed) = simulate(a, &rtl_abs, &vec_dir, &top, layout)?;
     let first = outcome.first.as_ref().map(|m| {
         format!(
             "{} expected {} actual {} at {}",
@@ -512,6 +526,7 @@ pub fn cosim_array(
         run: r,
         build_seconds,
         reused,
+        layout: (a.simulator == ArraySimulator::Verilator).then_some(layout),
         sim_seconds: outcome.seconds,
         model_seconds,
         detections: count,
@@ -526,10 +541,11 @@ fn simulate(
     rtl: &Path,
     vec_dir: &Path,
     top: &str,
+    layout: tofprobe_cosim::array::Layout,
 ) -> Result<(RunOutcome, f64, bool, Option<u64>), FlowError> {
     match a.simulator {
         ArraySimulator::Verilator => {
-            let b = tofprobe_cosim::array::build(rtl, top, a.profile)?;
+            let b = tofprobe_cosim::array::build(rtl, top, a.profile, layout, a.cache.as_deref())?;
             let mut last = None;
             for &seed in &a.x_seeds {
                 let o = tofprobe_cosim::array::run_verilator(&b.exe, rtl, vec_dir, seed)?;

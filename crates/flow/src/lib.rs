@@ -7,6 +7,7 @@
 
 pub mod adders;
 pub mod array;
+pub mod array_cosim_bench;
 pub mod array_options;
 pub mod array_report;
 pub mod array_size;

@@ -111,13 +111,14 @@ pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<super::Verdict, C
             "edited_rtl": a.rtl.is_some(),
             "build_seconds": r.build_seconds,
             "build_reused": r.reused,
+            "verilator_layout": r.layout.map(|l| l.name()),
             "simulator_seconds": r.sim_seconds,
             "model_seconds": r.model_seconds,
         });
         println!("{j}");
     } else {
         println!(
-            "cosim {}: {} x {} array, N = {}, {} frame(s), {} cycles, {} mismatches; {} beats of {} bits per frame in {} readout cycles; build {:.1} s{}, simulator {:.2} s, model {:.2} s{}",
+            "cosim {}: {} x {} array, N = {}, {} frame(s), {} cycles, {} mismatches; {} beats of {} bits per frame in {} readout cycles; build {:.1} s{}{}, simulator {:.2} s, model {:.2} s{}",
             if r.pass { "PASS" } else { "FAIL" },
             ro.rows,
             ro.cols,
@@ -130,6 +131,9 @@ pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<super::Verdict, C
             ro.readout_cycles(),
             r.build_seconds,
             if r.reused { " (cached)" } else { "" },
+            r.layout
+                .map(|l| format!(", {}", l.name()))
+                .unwrap_or_default(),
             r.sim_seconds,
             r.model_seconds,
             r.first

@@ -135,11 +135,23 @@ fn tamper(rng: &mut Rng, dir: &Path) -> String {
             let path = *rng.pick(FIELDS);
             let lit = *rng.pick(EDGES);
             let p = dir.join("manifest.json");
-            let mut m: serde_json::Value =
-                serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+            // An earlier tampering of this case may have cut or removed the manifest.
+            let Some(mut m) = std::fs::read(&p)
+                .ok()
+                .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+            else {
+                return "manifest.json no longer JSON".into();
+            };
             let mut at = &mut m;
             for k in &path[..path.len() - 1] {
+                // serde_json's index panics on a scalar (an earlier tampering's).
+                if !(at.is_object() || at.is_null()) {
+                    return format!("manifest {path:?} under a scalar");
+                }
                 at = &mut at[*k];
+            }
+            if !(at.is_object() || at.is_null()) {
+                return format!("manifest {path:?} under a scalar");
             }
             at[*path.last().unwrap()] = serde_json::from_str(lit).unwrap();
             std::fs::write(&p, serde_json::to_vec(&m).unwrap()).unwrap();

@@ -2,6 +2,7 @@
 //! target, add a variant to [`BenchTarget`] and a line to [`run`].
 
 pub mod array;
+pub mod cosim_array;
 pub mod dsp;
 pub mod fullband;
 pub mod pixel;
@@ -25,6 +26,9 @@ pub enum BenchTarget {
     /// The array model: pixel-pulses/s of a 64 × 64 array at N = 10^6 and 10^7 on all
     /// cores beside the single-pixel Monte Carlo alone, and peak memory.
     Array(array::ArrayBenchArgs),
+    /// The whole array co-simulated under Verilator: each layout (every pixel inlined, the
+    /// pixel one hierarchical block) built cold, build and run times side by side.
+    CosimArray(cosim_array::CosimArrayBenchArgs),
     /// Photon/TDC Monte Carlo throughput (pulses/s, one thread) at (ρ_s, ρ_b) = (1, 0) and
     /// (0.3, 0.3).
     Scene(scene::SceneBenchArgs),
@@ -46,6 +50,7 @@ pub enum BenchTarget {
 pub fn run(args: BenchArgs) -> Result<(), CliError> {
     match args.target {
         BenchTarget::Array(a) => array::run(&a),
+        BenchTarget::CosimArray(a) => cosim_array::run(&a),
         BenchTarget::Scene(a) => scene::run(&a),
         BenchTarget::Dsp(a) => dsp::run(&a),
         BenchTarget::Pixel(a) => pixel::run(&a),
