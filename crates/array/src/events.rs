@@ -1,17 +1,18 @@
-//! Haar arrays: each pixel's transition time, and the velocity of an edge across the
-//! sensor. A pixel's registers, as its scalogram (`Scalogram::from_registers`), give the
-//! mean depth (relative to the frame's) of each of the 2^(U+1) finest half-wavelets through
-//! the one inverse transform, `Scalogram::cell_means_mm`. For one transition from level a (first segment) to b (last
-//! segment) at time τ, segment j's mean is a·f_j + b·(1 − f_j), f_j its fraction before
-//! τ, so τ = Σ_j (m_j − b)/(a − b) · (its duration): exact for a noiseless step wherever it
-//! falls, the "area" estimator. A pixel whose |a − b| is below 8 σ of a segment mean has no
-//! transition (its time is −1 in the map). The edge's velocity comes from the
-//! least-squares plane t = t0 + g·(x, y) over the pixels with a transition: speed 1/|g|,
-//! direction atan2(g_y, g_x).
+//! Haar arrays: each pixel's transition time with its uncertainty, and the velocity of an
+//! edge across the sensor. A pixel's registers, as its scalogram
+//! (`Scalogram::from_registers`), go through the pixel's own least-squares step/ramp fit,
+//! `tofprobe_dsp::haar::fit_transition` (one implementation for the pixel and the array):
+//! the fitted centre of the transition and its Cramér–Rao sd under the closed-form noise
+//! of the scene's static depth. A pixel whose fitted |height| is below 8 σ of a segment
+//! mean has no transition (its time is −1 in the map). The edge's velocity comes from the
+//! weighted least-squares plane t = t0 + g·(x, y) over the pixels with a transition,
+//! weights 1/sd²: speed 1/|g|, direction atan2(g_y, g_x).
 
 use serde::Serialize;
 use tofprobe_design::ResolvedDesign;
 use tofprobe_dsp::haar::analysis::Scalogram;
+use tofprobe_dsp::haar::paper::FAMILY_RATE;
+use tofprobe_dsp::haar::{HaarNoise, Thresholds, fit_transition};
 
 use crate::model::ArrayFrame;
 
@@ -20,6 +21,8 @@ use crate::model::ArrayFrame;
 pub struct EventMap {
     /// [R, C] transition time (ms from the frame start); −1 where there is none.
     pub time_ms: Vec<f64>,
+    /// [R, C] the fit's sd of each time (ms); −1 where there is none.
+    pub time_sd_ms: Vec<f64>,
     /// Pixels with a transition.
     pub pixels: usize,
     /// The fitted edge: speed (mm/s on the scene plane) and direction (degrees from +x
@@ -28,42 +31,41 @@ pub struct EventMap {
     pub direction_deg: Option<f64>,
 }
 
-/// The transition time (s) of one pixel's cell means `m`, or `None` below `min_step`.
-pub fn transition_time_s(m: &[f64], segment_s: f64, min_step: f64) -> Option<f64> {
-    let (a, b) = (*m.first()?, *m.last()?);
-    if (a - b).abs() < min_step {
-        return None;
-    }
-    let t: f64 = m.iter().map(|&x| (x - b) / (a - b) * segment_s).sum();
-    Some(t.clamp(0.0, segment_s * m.len() as f64))
-}
-
 /// The map and fit of a Haar frame.
 pub fn event_map(design: &ResolvedDesign, frame: &ArrayFrame) -> EventMap {
     let u = design.pixel.haar_scales;
     let n = design.pixel.frame_pulses;
     let s = design.sensor();
     let segments = 1usize << (u + 1);
-    let segment_s = n as f64 / segments as f64 / s.laser_rate_hz;
     // σ of a segment mean in codes (the depth noise over its pulses), from eq. 12's σ_s.
     let sigma_codes =
         tofprobe_dsp::closed_form::sigma_total_mm(s.jitter_mm(), s.tdc_lsb_mm()) / s.tdc_lsb_mm();
     let min_step = 8.0 * sigma_codes / (n as f64 / segments as f64).sqrt();
     let mm = design.array.as_ref().map_or(1.0, |a| a.mm_per_pixel);
+    // The per-coefficient sd of the noise model (the resolution validated U and N).
+    let sd_mm = HaarNoise::for_static_scene(s, design.document.scene.depth_mm)
+        .and_then(|noise| Thresholds::new(&noise, n as usize, u, FAMILY_RATE))
+        .map(|t| t.sd_mm)
+        .unwrap_or_default();
     let mut time_ms = vec![-1.0; frame.rows * frame.cols];
+    let mut time_sd_ms = vec![-1.0; frame.rows * frame.cols];
     let mut points = Vec::new();
-    for (p, t) in time_ms.iter_mut().enumerate() {
+    for (p, (t, sd)) in time_ms.iter_mut().zip(&mut time_sd_ms).enumerate() {
         let (r, c) = (p / frame.cols, p % frame.cols);
-        // The resolution validated U and N, and the frame holds 2^(U+1) − 1 words per pixel.
+        // The frame holds 2^(U+1) − 1 words per pixel.
         let Ok(scalogram) =
             Scalogram::from_registers(frame.pixel(r, c), n, u, s.tdc_lsb_mm(), s.laser_rate_hz)
         else {
             continue;
         };
-        let m = scalogram.cell_means_mm();
-        if let Some(ts) = transition_time_s(&m, segment_s, min_step) {
-            *t = ts * 1e3;
-            points.push(((c as f64 + 0.5) * mm, (r as f64 + 0.5) * mm, ts));
+        match fit_transition(&scalogram, &sd_mm) {
+            Some(f) if f.height_mm.abs() >= min_step && f.time_sd_s.is_finite() => {
+                *t = f.time_s * 1e3;
+                *sd = f.time_sd_s * 1e3;
+                let w = 1.0 / f.time_sd_s.powi(2).max(f64::MIN_POSITIVE);
+                points.push(((c as f64 + 0.5) * mm, (r as f64 + 0.5) * mm, f.time_s, w));
+            }
+            _ => {}
         }
     }
     let (velocity, direction) = match fit_plane(&points) {
@@ -74,31 +76,36 @@ pub fn event_map(design: &ResolvedDesign, frame: &ArrayFrame) -> EventMap {
     };
     EventMap {
         time_ms,
+        time_sd_ms,
         pixels: points.len(),
         velocity_mm_per_s: velocity.filter(|v| v.is_finite()),
         direction_deg: direction.filter(|d| d.is_finite()),
     }
 }
 
-/// Least squares t = t0 + gx·x + gy·y: (gx, gy) in s/mm, or `None` when the positions do
-/// not span a plane's worth of directions (fewer than 3, or collinear, fitted along their
-/// line instead).
-fn fit_plane(p: &[(f64, f64, f64)]) -> Option<(f64, f64)> {
+/// Weighted least squares t = t0 + gx·x + gy·y over points (x, y, t, weight): (gx, gy)
+/// in s/mm, or `None` when the positions do not span a plane's worth of directions (fewer
+/// than 3, or collinear, fitted along their line instead).
+pub fn fit_plane(p: &[(f64, f64, f64, f64)]) -> Option<(f64, f64)> {
     if p.len() < 3 {
         return None;
     }
-    let k = p.len() as f64;
+    let k: f64 = p.iter().map(|q| q.3).sum();
     let (mx, my, mt) = p.iter().fold((0.0, 0.0, 0.0), |a, q| {
-        (a.0 + q.0 / k, a.1 + q.1 / k, a.2 + q.2 / k)
+        (
+            a.0 + q.3 * q.0 / k,
+            a.1 + q.3 * q.1 / k,
+            a.2 + q.3 * q.2 / k,
+        )
     });
     let (mut sxx, mut syy, mut sxy, mut sxt, mut syt) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for &(x, y, t) in p {
+    for &(x, y, t, w) in p {
         let (dx, dy, dt) = (x - mx, y - my, t - mt);
-        sxx += dx * dx;
-        syy += dy * dy;
-        sxy += dx * dy;
-        sxt += dx * dt;
-        syt += dy * dt;
+        sxx += w * dx * dx;
+        syy += w * dy * dy;
+        sxy += w * dx * dy;
+        sxt += w * dx * dt;
+        syt += w * dy * dt;
     }
     let det = sxx * syy - sxy * sxy;
     if det.abs() > 1e-12 * (sxx * syy).max(f64::MIN_POSITIVE) {
@@ -116,25 +123,69 @@ fn fit_plane(p: &[(f64, f64, f64)]) -> Option<(f64, f64)> {
 mod tests {
     use super::*;
 
-    /// A noiseless step of 10 codes at pulse 300 of 1024 (U = 3: 16 segments of 64): the
-    /// detail sums of the record, as a scalogram of 1 mm codes and inverted, put the step at
-    /// 300 pulses exactly.
+    /// A noiseless step of 10 codes at pulse 300 of 1024 (U = 3: 16 cells of 64): the
+    /// least-squares fit of the registers puts it at 300 pulses (to the golden section's
+    /// 1e-6 pulse) with height −10 mm.
     #[test]
-    fn the_area_estimator_is_exact_on_a_step() {
+    fn the_fit_is_exact_on_a_step() {
         let x: Vec<i64> = (0..1024).map(|n| if n < 300 { 40 } else { 30 }).collect();
         let words = tofprobe_dsp::haar::haar_sums(&x, 3).unwrap();
-        let m = Scalogram::from_registers(&words, 1024, 3, 1.0, 1.0)
-            .unwrap()
-            .cell_means_mm();
-        assert_eq!(m.len(), 16);
-        // Segment 0 is 10 mm above segment 15 (relative levels).
-        assert!((m[0] - m[15] - 10.0).abs() < 1e-12);
-        let t = transition_time_s(&m, 64.0, 1.0).unwrap();
-        assert!((t - 300.0).abs() < 1e-9, "{t}");
+        let s = Scalogram::from_registers(&words, 1024, 3, 1.0, 1.0).unwrap();
+        let f = fit_transition(&s, &[0.01; 15]).unwrap();
+        assert!((f.time_s - 300.0).abs() < 1e-6, "{f:?}");
         assert!(
-            transition_time_s(&m, 64.0, 11.0).is_none(),
-            "below the threshold"
+            (f.height_mm + 10.0).abs() < 1e-9 && f.duration_s == 0.0,
+            "{f:?}"
         );
+    }
+
+    /// Weighting by 1/sd²: points on a 10 × 10 grid whose times carry noise of sd 1 µs
+    /// (even columns) or 20 µs (odd), 400 draws. The weighted slope's error has the sd
+    /// of weighted least squares, σ_g² = 1/Σ w (x − x̄_w)²; the unweighted fit's is
+    /// larger (≈ 14 µs/√(Σ(x − x̄)²) here, 7× larger): its error sd must exceed twice the
+    /// weighted prediction, and the weighted one lies within 20 % of it (400 draws: the
+    /// sample sd is within ±3.5 % at 1 sd).
+    #[test]
+    fn the_weighted_plane_fit_has_its_predicted_spread() {
+        let mut state = 0x853c_49e6_748f_ea9b_u64;
+        let mut normal = || {
+            let mut u = || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+            };
+            let (a, b) = (u(), u());
+            (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+        };
+        let grid: Vec<(f64, f64, f64)> = (0..100)
+            .map(|i| {
+                let (x, y) = ((i % 10) as f64, (i / 10) as f64);
+                (x, y, if i % 2 == 0 { 1e-6 } else { 20e-6 })
+            })
+            .collect();
+        let w: f64 = grid.iter().map(|g| g.2.powi(-2)).sum();
+        let xw: f64 = grid.iter().map(|g| g.0 * g.2.powi(-2)).sum::<f64>() / w;
+        let predicted = 1.0
+            / grid
+                .iter()
+                .map(|g| (g.0 - xw).powi(2) / g.2.powi(2))
+                .sum::<f64>()
+                .sqrt();
+        let (mut ew, mut eu) = (0.0, 0.0);
+        let draws = 400;
+        for _ in 0..draws {
+            let pts: Vec<_> = grid
+                .iter()
+                .map(|&(x, y, sd)| (x, y, 1e-3 + x / 500.0 + sd * normal(), sd.powi(-2)))
+                .collect();
+            ew += (fit_plane(&pts).unwrap().0 - 1.0 / 500.0).powi(2);
+            let flat: Vec<_> = pts.iter().map(|p| (p.0, p.1, p.2, 1.0)).collect();
+            eu += (fit_plane(&flat).unwrap().0 - 1.0 / 500.0).powi(2);
+        }
+        let (sw, su) = ((ew / draws as f64).sqrt(), (eu / draws as f64).sqrt());
+        assert!((sw / predicted - 1.0).abs() < 0.2, "{sw} vs {predicted}");
+        assert!(su > 2.0 * predicted, "unweighted {su} vs {predicted}");
     }
 
     #[test]
@@ -144,7 +195,7 @@ mod tests {
         let p: Vec<_> = (0..20)
             .map(|i| {
                 let (x, y) = ((i % 5) as f64, (i / 5) as f64);
-                (x, y, 0.1 + (x * c + y * s) / 500.0)
+                (x, y, 0.1 + (x * c + y * s) / 500.0, 1.0)
             })
             .collect();
         let (gx, gy) = fit_plane(&p).unwrap();

@@ -6,23 +6,37 @@
 //! 1. A coefficient is *significant* when |w| > z·sd(w) ([`super::Thresholds`]).
 //! 2. A significant coefficient with no significant descendant (a finer wavelet inside its
 //!    support) is a *leaf*: the transient's finest significant localisation. Leaves never
-//!    overlap.
-//! 3. Leaves whose supports touch, or lie less than two finest wavelets apart, form one
-//!    event, whatever their signs (a brief impulse is a rise and a fall in neighbouring
-//!    wavelets). Two finest wavelets of steady depth between two transitions is the
-//!    resolution at which they are told apart.
-//! 4. Consecutive groups further apart are one event when the depth moves across the gap
-//!    between them: the mean depth of the gap's second half minus its first, from the
-//!    coefficients across scales (the inverse transform, [`super::profile`]), exceeds the
-//!    same z·sd. A slow ramp whose finest coefficients sit near the threshold leaves gaps
-//!    in its leaves, but its depth keeps moving through them (the coarser coefficients
-//!    carry it); two transitions with steady depth between them stay two.
+//!    overlap. A significant coarser coefficient whose middle lies more than one finest
+//!    wavelet from every leaf, where the depth steps (one finest wavelet after its middle
+//!    against one before, by z sd), is a leaf over the finest wavelet around its middle: a
+//!    step on a finest wavelet's border shows only in the coarser wavelet centred on it.
+//! 3. Leaves whose supports touch or lie one finest wavelet apart form one group.
+//! 4. Groups further apart are one group unless the cells between them are a *plateau*;
+//!    a group is split at its strongest plateau of three cells (with at least one cell and
+//!    one leaf each side), again until none is left. Cells [a, b) are a plateau between
+//!    a transition on each side when their least-squares slope is within z sd of 0 while
+//!    the slope from the level before the transition (up to one finest wavelet of cells)
+//!    to their mean, and from it to the level after, each differ from theirs by more than
+//!    z sd ([`super::profile`]). A ramp's depth keeps moving at its own slope, so a slow
+//!    ramp whose finest coefficients sit near the threshold stays one event through the
+//!    gaps in its leaves; two steps, or an impulse's rise and fall, with steady depth
+//!    between them are two.
+//!
+//! # The resolution limit
+//! Two transitions at least two finest wavelets (2·T_U, four cells) apart have at least
+//! three whole cells of steady depth between them, a plateau: they are two events. Closer
+//! transitions cannot be told from one ramp: two steps δ apart spread like a ramp of
+//! √3·δ, so an event whose measured duration is not above 2√3·T_U (by 2 sd) is
+//! *unresolved* (`Shape::Unresolved`): its height is measured, with no duration and no
+//! single-ramp rate. Shown by crates/experiments/tests/it/transients.rs
+//! (`transitions_two_finest_wavelets_apart_are_two_events`,
+//! `transitions_closer_than_the_limit_are_one_unresolved_event`).
 //! 5. A significant non-leaf coefficient joins the event of the leaves below it when they
 //!    all belong to one event (the same transient seen at a coarser scale); when the
 //!    leaves below it belong to several events it is listed as *spanning* (a coarse view of
 //!    several transients) and joins none.
 //!
-//! An event's time is the span of its leaves and gaps ([start, end), centre the midpoint);
+//! An event's time is the span of its group and its leaves ([start, end), centre the midpoint);
 //! its *peak* is its largest |w|, whose sign gives the direction: w > 0 is a depth
 //! *decrease* (the paper's convention, the first half deeper than the second).
 //!
@@ -46,7 +60,7 @@ use std::fmt::Write as _;
 
 use super::analysis::{Coefficient, Scalogram};
 use super::noise::Thresholds;
-use super::profile::{Profile, Shape};
+use super::profile::{PLATEAU_CELLS, Profile, Shape};
 use super::{register_count, register_index};
 use crate::error::DspError;
 
@@ -104,6 +118,9 @@ pub struct Event {
     /// A step's |dδ/dt| is above this: |height| / the duration's bound (m/s; `shape` =
     /// step).
     pub abs_rate_lower_bound_m_per_s: Option<f64>,
+    /// The finest wavelet's duration T/2^U (s): transitions two of these apart are told
+    /// apart (module doc).
+    pub finest_wavelet_s: f64,
     /// Finest and coarsest scale among the event's coefficients.
     pub finest_scale: u32,
     pub coarsest_scale: u32,
@@ -138,6 +155,14 @@ impl Event {
                 self.height_sd_mm.unwrap_or(f64::NAN),
             ),
             Shape::Edge => "at the frame's edge: height, duration and rate not measured".into(),
+            Shape::Unresolved => format!(
+                "unresolved: height {:+.3} ± {:.3} mm over {:.3}–{:.3} ms, one ramp or several transitions closer than two finest wavelets ({:.3} ms), no single-ramp rate",
+                self.height_mm.unwrap_or(f64::NAN),
+                self.height_sd_mm.unwrap_or(f64::NAN),
+                self.start_s * 1e3,
+                self.end_s * 1e3,
+                2.0 * self.finest_wavelet_s * 1e3,
+            ),
         };
         format!(
             "{:.3} ms ({:.3}–{:.3} ms): depth {}; {measured}; peak w({},{}) = {:+.4} mm ({:.1} sd) at scale {} ({:.3} ms wavelets, scales {}..{}), paper's estimator −4w/T_u = {:+.3} m/s{}",
@@ -203,6 +228,54 @@ impl EventReport {
     }
 }
 
+/// A group of leaves: first cell, end cell, registers.
+type Group = (usize, usize, Vec<usize>);
+
+/// Splits each group at its best plateau (rule 4), again until none is left: a run of
+/// [`PLATEAU_CELLS`] cells inside the group with at least one cell on each side and a leaf
+/// (by its centre) on each side.
+fn split_at_plateaus(
+    profile: &Profile,
+    mut groups: Vec<Group>,
+    span: &dyn Fn(usize) -> (usize, usize),
+    z: f64,
+) -> Vec<Group> {
+    let mut i = 0;
+    while i < groups.len() {
+        let (gs, ge) = (groups[i].0, groups[i].1);
+        let free = (
+            if i == 0 { 0 } else { groups[i - 1].1 },
+            groups.get(i + 1).map_or(profile.len(), |g| g.0),
+        );
+        let centre = |r: usize| {
+            let (a, b) = span(r);
+            a + b
+        };
+        let best = (gs + 1..(ge + 1).saturating_sub(PLATEAU_CELLS + 1))
+            .filter(|&a| {
+                let cut = 2 * a + PLATEAU_CELLS;
+                let left = groups[i].2.iter().filter(|&&r| centre(r) < cut).count();
+                left > 0 && left < groups[i].2.len()
+            })
+            .filter_map(|a| {
+                let run = (a, a + PLATEAU_CELLS);
+                profile.plateau(free, gs, run, ge, z).map(|q| (a, q))
+            })
+            .max_by(|x, y| x.1.total_cmp(&y.1));
+        match best {
+            Some((a, _)) => {
+                let cut = 2 * a + PLATEAU_CELLS;
+                let (l, r): (Vec<usize>, Vec<usize>) =
+                    groups[i].2.iter().partition(|&&r| centre(r) < cut);
+                groups[i] = (gs, a, l);
+                groups.insert(i + 1, (a + PLATEAU_CELLS, ge, r));
+            }
+            None => i += 1,
+        }
+    }
+    groups
+}
+
 /// Finds the events of a scalogram under per-coefficient thresholds (module doc's rule).
 pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspError> {
     let k = register_count(s.scales);
@@ -234,28 +307,70 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
     }
     let profile = Profile::new(s, &t.sd_mm, n);
     // Supports in profile cells (half finest wavelets).
-    let span = |r: usize| {
+    let support = |r: usize| {
         let c = &s.coefficients[r];
         profile.cells_of(c.u, c.v)
     };
     let mut leaves: Vec<usize> = (0..k).filter(|&r| sig[r] && !below[r]).collect();
+    // Rule 2b: a significant coarser coefficient whose middle lies away from every leaf,
+    // where the depth steps, is a leaf of the finest wavelet around its middle.
+    let near_leaf = |m: usize| {
+        leaves.iter().any(|&l| {
+            let (a, b) = support(l);
+            a <= m + 2 && m <= b + 2
+        })
+    };
+    let middles: Vec<usize> = (0..k)
+        .filter(|&r| sig[r] && below[r])
+        .filter(|&r| {
+            let (a, b) = support(r);
+            let m = (a + b) / 2;
+            !near_leaf(m) && profile.steps_at(m, (a, b), t.z)
+        })
+        .collect();
+    leaves.extend(&middles);
+    let span = |r: usize| {
+        let (a, b) = support(r);
+        if middles.contains(&r) {
+            ((a + b) / 2 - 1, (a + b) / 2 + 1)
+        } else {
+            (a, b)
+        }
+    };
     leaves.sort_by_key(|&r| span(r).0);
     // Groups of leaves (first cell, end cell, registers): touching leaves (rule 3), and
     // groups whose gap the depth moves across (rule 4).
-    let mut groups: Vec<(usize, usize, Vec<usize>)> = Vec::new();
+    let mut groups: Vec<Group> = Vec::new();
     for &r in &leaves {
         let (st, e) = span(r);
+        let prev_end = groups.len().checked_sub(2).map_or(0, |i| groups[i].1);
         match groups.last_mut() {
-            Some(g) if st <= g.1 + 2 || profile.moves_across(g.1, st, t.z) => {
+            Some(g)
+                if st <= g.1 + 2
+                    || profile
+                        .plateau((prev_end, profile.len()), g.0, (g.1, st), e, t.z)
+                        .is_none() =>
+            {
                 g.1 = g.1.max(e);
                 g.2.push(r);
             }
             _ => groups.push((st, e, vec![r])),
         }
     }
+    let mut groups = split_at_plateaus(&profile, groups, &span, t.z);
+    // The cells an event is shown over: its group's and its leaves' (a transition split
+    // off at a plateau may end inside the plateau's first or last cell).
+    let shown: Vec<(usize, usize)> = groups
+        .iter()
+        .map(|g| {
+            g.2.iter()
+                .map(|&r| span(r))
+                .fold((g.0, g.1), |(a, b), (c, d)| (a.min(c), b.max(d)))
+        })
+        .collect();
     let mut spanning = Vec::new();
-    for r in (0..k).filter(|&r| sig[r] && below[r]) {
-        let (st, e) = span(r);
+    for r in (0..k).filter(|&r| sig[r] && below[r] && !middles.contains(&r)) {
+        let (st, e) = support(r);
         // Groups with a leaf inside [st, e).
         let hits: Vec<usize> = groups
             .iter()
@@ -298,12 +413,14 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
                 Shape::Ramp => m.duration_s.is_some_and(|x| d > x),
                 // Not resolved by the finest wavelets: every wavelet is longer.
                 Shape::Step => true,
-                Shape::Excursion | Shape::Edge => d > profile.time_s(e) - profile.time_s(st),
+                Shape::Excursion | Shape::Edge | Shape::Unresolved => {
+                    d > profile.time_s(e) - profile.time_s(st)
+                }
             };
             Event {
-                start_s: profile.time_s(st),
-                end_s: profile.time_s(e),
-                centre_s: 0.5 * (profile.time_s(st) + profile.time_s(e)),
+                start_s: profile.time_s(shown[i].0),
+                end_s: profile.time_s(shown[i].1),
+                centre_s: 0.5 * (profile.time_s(shown[i].0) + profile.time_s(shown[i].1)),
                 peak,
                 peak_z: peak.value_mm.abs() / t.sd_mm[peak_r],
                 wavelet_duration_s: d,
@@ -323,6 +440,7 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
                 mean_rate_sd_m_per_s: m.mean_rate_sd_m_per_s,
                 duration_upper_bound_s: m.duration_upper_bound_s,
                 abs_rate_lower_bound_m_per_s: m.abs_rate_lower_bound_m_per_s,
+                finest_wavelet_s: s.wavelet_duration_s(s.scales),
                 finest_scale: regs.iter().map(|&r| s.coefficients[r].u).max().unwrap_or(0),
                 coarsest_scale: regs.iter().map(|&r| s.coefficients[r].u).min().unwrap_or(0),
                 coefficients: regs

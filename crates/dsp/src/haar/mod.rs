@@ -26,6 +26,7 @@
 pub mod analysis;
 pub mod checks;
 pub mod events;
+pub mod fit;
 pub mod montecarlo;
 pub mod noise;
 pub mod paper;
@@ -33,6 +34,7 @@ pub mod profile;
 
 pub use analysis::{Coefficient, Scalogram, held_codes};
 pub use events::{Event, EventReport, detect_events};
+pub use fit::{TransitionFit, fit_transition};
 pub use noise::{HaarNoise, Thresholds, inverse_normal_cdf};
 pub use profile::Shape;
 

@@ -41,6 +41,14 @@ const GUARD: usize = 2;
 /// bound is √max(T_U², D̂² + this · sd).
 const RESOLVED_Z: f64 = 2.0;
 
+/// Two equal steps δ apart spread like a ramp of D = √3·δ (variance δ²/4 = D²/12): steps
+/// under two finest wavelets apart look like a ramp of up to 2√3 finest wavelets.
+const PAIR_SPREAD: f64 = 3.464_101_615_137_754_4;
+
+/// Cells of steady depth that separate two transitions: three, the fewest whole cells
+/// between two transitions two finest wavelets (four cells) apart.
+pub(crate) const PLATEAU_CELLS: usize = 3;
+
 /// The cell profile of one scalogram with its noise model.
 pub(crate) struct Profile<'a> {
     sd_mm: &'a [f64],
@@ -65,6 +73,10 @@ pub enum Shape {
     Excursion,
     /// The event touches the frame's edge: no level on one side, no height.
     Edge,
+    /// A transition spread over less than 2√3 finest wavelets: one ramp, or several
+    /// transitions closer than two finest wavelets (module doc), which the registers cannot
+    /// tell apart: the height is measured, no duration and no single-ramp rate.
+    Unresolved,
 }
 
 /// The measured transition of one event (module doc).
@@ -168,24 +180,69 @@ impl<'a> Profile<'a> {
         w
     }
 
-    /// Whether the depth moves across the gap of cells [a, b): the mean of its second half
-    /// minus that of its first exceeds z sd. `false` for gaps under 4 cells (two finest
-    /// wavelets), where the gap's only statistic is a coefficient already found not
-    /// significant.
-    pub(crate) fn moves_across(&self, a: usize, b: usize, z: f64) -> bool {
-        if b < a + 4 {
+    /// Whether the depth steps at cell boundary `m` inside `within`: the mean of up to one
+    /// finest wavelet after it minus that before it exceeds z sd.
+    pub(crate) fn steps_at(&self, m: usize, within: (usize, usize), z: f64) -> bool {
+        let (a, b) = (
+            within.0.max(m.saturating_sub(GUARD)),
+            within.1.min(m + GUARD),
+        );
+        if a >= m || b <= m {
             return false;
         }
-        let h = (b - a) / 2;
-        let mut w = vec![0.0; self.len()];
-        for x in &mut w[a..a + h] {
-            *x = -1.0 / h as f64;
+        let (before, after) = (self.window(a, m), self.window(m, b));
+        let d: Vec<f64> = after.iter().zip(&before).map(|(x, y)| x - y).collect();
+        let (v, sd) = self.linear(&d);
+        v.abs() > z * sd
+    }
+
+    /// Whether cells `run` = [a, b) are a plateau between a transition over [gs, a) and
+    /// one over [b, ge) (module doc, "Telling transitions apart"), with level windows of
+    /// up to one finest wavelet outside [gs, ge) within `free`: the run's least-squares
+    /// slope is within z sd of 0, and the slopes from the level before to the run's mean
+    /// and from it to the level after each differ from the run's by more than z sd. The
+    /// score is the smaller of those two |differences|/sd.
+    pub(crate) fn plateau(
+        &self,
+        free: (usize, usize),
+        gs: usize,
+        (a, b): (usize, usize),
+        ge: usize,
+        z: f64,
+    ) -> Option<f64> {
+        if b < a + PLATEAU_CELLS || gs >= a || ge <= b {
+            return None;
         }
-        for x in &mut w[b - h..b] {
-            *x = 1.0 / h as f64;
+        let before = (free.0.max(gs.saturating_sub(GUARD)), gs);
+        let after = (ge, free.1.min(ge + GUARD));
+        if before.0 >= before.1 || after.0 >= after.1 {
+            return None;
         }
-        let (d, sd) = self.linear(&w);
-        d.abs() > z * sd
+        // Centres in cell units (cell c spans [c, c + 1)).
+        let mid = |(a, b): (usize, usize)| (a + b) as f64 / 2.0;
+        let n = self.len();
+        let cbar = mid((a, b)) - 0.5;
+        let sxx: f64 = (a..b).map(|c| (c as f64 - cbar).powi(2)).sum();
+        let mut slope = vec![0.0; n];
+        for (c, x) in slope.iter_mut().enumerate().take(b).skip(a) {
+            *x = (c as f64 - cbar) / sxx;
+        }
+        let (sp, sd_sp) = self.linear(&slope);
+        if sp.abs() > z * sd_sp {
+            return None;
+        }
+        let run = self.window(a, b);
+        let side = |w: (usize, usize), sign: f64| {
+            let level = self.window(w.0, w.1);
+            let dist = (mid((a, b)) - mid(w)).abs();
+            let g: Vec<f64> = (0..n)
+                .map(|c| sign * (run[c] - level[c]) / dist - slope[c])
+                .collect();
+            let (v, sd) = self.linear(&g);
+            v.abs() / sd.max(f64::MIN_POSITIVE)
+        };
+        let score = side(before, 1.0).min(side(after, -1.0));
+        (score > z).then_some(score)
     }
 
     /// The transition of the event over cells [s, e), with free cells back to `prev_end`
@@ -253,7 +310,12 @@ impl<'a> Profile<'a> {
             x[c] = self.cells[c];
         }
         let sd2 = self.linear(&g2).1;
-        if d2 - RESOLVED_Z * sd2 >= finest * finest {
+        if d2 - RESOLVED_Z * sd2 >= finest * finest
+            && d2 - RESOLVED_Z * sd2 < (PAIR_SPREAD * finest).powi(2)
+        {
+            // A spread a pair of steps under two finest wavelets apart could give.
+            m.shape = Shape::Unresolved;
+        } else if d2 - RESOLVED_Z * sd2 >= finest * finest {
             m.shape = Shape::Ramp;
             m.duration_s = Some(d);
             m.duration_sd_s = Some(sd2 / (2.0 * d));
@@ -301,9 +363,21 @@ mod tests {
         assert!((m.height_mm.unwrap() - 3.0).abs() < 1e-9);
         assert!((m.duration_s.unwrap() / 1024.0 - 1.0).abs() < 0.01, "{m:?}");
         assert!((m.mean_rate_m_per_s.unwrap() / (3.0 / 1024.0 * 1e-3) - 1.0).abs() < 0.01);
-        assert!(p.moves_across(20, 28, 3.0) && !p.moves_across(40, 48, 3.0));
-        // A gap under two finest wavelets is never judged here.
-        assert!(!p.moves_across(20, 22, 3.0));
+        assert!(p.steps_at(24, (16, 32), 3.0) && !p.steps_at(44, (40, 48), 3.0));
+        // Inside the ramp no run of 3 cells is a plateau: its slope is the ramp's.
+        assert!((17..28).all(|a| p.plateau((0, 64), 16, (a, a + 3), 32, 3.0).is_none()));
+        // Two steps of +1.5 mm at samples 1300 and 1600 (cells 20 and 25, 4.7 cells
+        // apart): the three cells 21..24 between them are a plateau; with the second step
+        // moved to 1400 (cell 21, 1.6 cells apart) no run is.
+        let two = |second: usize| {
+            profile_of(move |i| 1.5 * (u8::from(i >= 1300) + u8::from(i >= second)) as f64)
+        };
+        let (s, _) = two(1600);
+        let p = Profile::new(&s, &sd, 4096);
+        assert!(p.plateau((0, 64), 20, (21, 24), 26, 3.0).is_some());
+        let (s, _) = two(1400);
+        let p = Profile::new(&s, &sd, 4096);
+        assert!((19..24).all(|a| p.plateau((0, 64), 18, (a, a + 3), 28, 3.0).is_none()));
 
         // A step with (almost) no noise: the bound is one finest wavelet.
         let (s, _) = profile_of(|i| if i >= 1000 { -2.0 } else { 0.0 });
