@@ -29,7 +29,7 @@ else
     -e 's/^cycles_per_pulse = 16/cycles_per_pulse = 4/' "$root/scenes/default.toml" >"$work/array.toml"
   printf '\n[array]\nrows = %s\ncols = %s\npitch_um = 30.0\nmm_per_pixel = 1.0\n' "$rows" "$cols" >>"$work/array.toml"
 fi
-"$bin" rtl "$work/array.toml" --out "$work/rtl" --frame-pulses 16 --rom-depth 16 >/dev/null
+"$bin" rtl "$work/array.toml" --out "$work/rtl" --frame-pulses 16 --rom-depth 16 --kit-frames 0 >/dev/null
 cd "$work/rtl"
 echo "array-lint: ${rows} x ${cols}: tofprobe_array.v is $(wc -c <tofprobe_array.v) bytes"
 measure() {
