@@ -37,7 +37,9 @@ pub const SIGNAL_MAP: &str = "signal_rate.npy";
 pub const BACKGROUND_MAP: &str = "background_rate.npy";
 /// The `kind` a manifest carries, and the version of the tile set's layout.
 pub(crate) const KIND: &str = "tofprobe array tile set";
-pub(crate) const VERSION: u32 = 2;
+pub(crate) const VERSION: u32 = 3;
+/// The data files a manifest carries the hashes of.
+pub(crate) const DATA_FILES: [&str; 4] = [REGISTERS, DETECTIONS, SIGNAL_MAP, BACKGROUND_MAP];
 
 /// Share `index` of `count` (0-based: a job array's task `0 .. count − 1`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -121,6 +123,9 @@ pub struct TileManifest {
     pub rows: Range<usize>,
     pub cols: Range<usize>,
     pub registers_per_pixel: usize,
+    /// FNV-1a-64 (hex) of each data file as the shard wrote it: a file changed and the
+    /// marker re-sealed to match still differs from the manifest (version 3).
+    pub files: std::collections::BTreeMap<String, String>,
     /// Wall time of the tile's model, s.
     pub model_seconds: f64,
     /// The resolved design with its rate maps empty (they are in the set's `.npy` maps,
@@ -198,7 +203,7 @@ pub fn run_shard(
         b.signal_rate = Vec::new();
         b.background_rate = Vec::new();
     }
-    let manifest = TileManifest {
+    let mut manifest = TileManifest {
         kind: KIND.into(),
         version: VERSION,
         design_hash: design_hash(design)?,
@@ -209,6 +214,7 @@ pub fn run_shard(
         rows: rows.clone(),
         cols: cols.clone(),
         registers_per_pixel: tile.registers_per_pixel,
+        files: Default::default(),
         model_seconds: t0.elapsed().as_secs_f64(),
         design: bare,
     };
@@ -233,6 +239,10 @@ pub fn run_shard(
         let part = map_part(map, a.spad_cols(), spads.0.clone(), spads.1.clone());
         set.add_streamed(name, |w| npy::write(w, &[rt * g, ct * g], &part))
             .map_err(out)?;
+    }
+    for name in DATA_FILES {
+        let h = set.staged_hash(name).unwrap_or_default();
+        manifest.files.insert(name.to_string(), format!("{h:016x}"));
     }
     set.add_streamed(MANIFEST, |w| {
         serde_json::to_writer_pretty(&mut *w, &manifest).map_err(std::io::Error::other)

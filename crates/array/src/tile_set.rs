@@ -120,6 +120,42 @@ fn npy_shapes(rt: usize, ct: usize, k: usize, g: usize) -> [(&'static str, Vec<u
     ]
 }
 
+/// Each data file's hash in the (checked) marker against the one the manifest carries: a
+/// file changed after the shard wrote it, with the marker re-sealed to match, is named.
+fn check_data_hashes(dir: &Path, m: &TileManifest) -> Result<(), ArrayError> {
+    // The marker was just checked whole by check_set (each listed file has its hash), and it
+    // is a small text (its files are the tile set's five).
+    let text = std::fs::read_to_string(dir.join(MARKER))
+        .map_err(|e| refuse(dir, format!("{MARKER}: {e}")))?;
+    let marked = tofprobe_io::marker::marker_files(&text)
+        .ok_or_else(|| refuse(dir, format!("{MARKER} has no [files] table")))?;
+    for name in crate::shard::DATA_FILES {
+        let file = marked.get(name).map(|h| format!("{h:016x}"));
+        let wrote = m.files.get(name);
+        if file.as_ref() != wrote {
+            return Err(refuse(
+                dir,
+                format!(
+                    "{name} is not the file its shard wrote (hash {} in {MANIFEST}, {} now): changed since; run its shard again",
+                    wrote.map_or("none", String::as_str),
+                    file.as_deref().unwrap_or("none")
+                ),
+            ));
+        }
+    }
+    if m.files.len() != crate::shard::DATA_FILES.len() {
+        return Err(refuse(
+            dir,
+            format!(
+                "{MANIFEST} lists the hashes of {} file(s), not of the tile set's {}",
+                m.files.len(),
+                crate::shard::DATA_FILES.join(", ")
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Reads and checks the manifest of the tile set in `dir` (steps 1–4 of the module
 /// header): a set whole and unchanged, whose manifest agrees with the design it carries
 /// and whose files have the lengths their shapes give. Every refusal names the set.
@@ -183,6 +219,7 @@ pub fn read_manifest(dir: &Path) -> Result<TileManifest, ArrayError> {
             ),
         ));
     }
+    check_data_hashes(dir, &m)?;
     Ok(m)
 }
 

@@ -187,6 +187,11 @@ impl OutputSet {
         Ok(len)
     }
 
+    /// FNV-1a-64 of the staged file `name` (the hash its marker will list), if staged.
+    pub fn staged_hash(&self, name: &str) -> Option<u64> {
+        self.hashes.get(name).copied()
+    }
+
     /// Stages the completion marker `marker` (`preamble`, then the `[files]` table of every
     /// file staged so far with its hash, [`crate::marker::marker_text`]) and commits with
     /// it last: readers check the set with [`crate::check_set`]`(dir, marker)`.

@@ -417,8 +417,35 @@ fn merge_refuses_sets_of_another_design_or_with_edited_files() {
         tofprobe_io::fnv1a64(&b)
     );
     std::fs::write(t.join("tofprobe-set.toml"), marker.replace(&old, &new)).unwrap();
+    // The manifest carries each data file's hash as the shard wrote it.
     fails(
         &["merge", s(&s0), s(&t), "--out", s(&tmp.path().join("o3"))],
+        &[
+            "tile set",
+            "signal_rate.npy is not the file its shard wrote",
+            "run its shard again",
+        ],
+    );
+    // The manifest's hash rewritten too (and the marker re-sealed over it): the joined maps
+    // no longer give the design hash the manifests name.
+    let mpath = t.join("manifest.json");
+    let mut m: serde_json::Value = serde_json::from_slice(&std::fs::read(&mpath).unwrap()).unwrap();
+    m["files"]["signal_rate.npy"] = format!("{:016x}", tofprobe_io::fnv1a64(&b)).into();
+    let mtext = serde_json::to_vec_pretty(&m).unwrap();
+    std::fs::write(&mpath, &mtext).unwrap();
+    let marker = std::fs::read_to_string(t.join("tofprobe-set.toml")).unwrap();
+    let old = marker
+        .lines()
+        .find(|l| l.starts_with("\"manifest.json\""))
+        .unwrap()
+        .to_string();
+    let new = format!(
+        "\"manifest.json\" = \"{:016x}\"",
+        tofprobe_io::fnv1a64(&mtext)
+    );
+    std::fs::write(t.join("tofprobe-set.toml"), marker.replace(&old, &new)).unwrap();
+    fails(
+        &["merge", s(&s0), s(&t), "--out", s(&tmp.path().join("o4"))],
         &[
             "tile set",
             "join into a design of hash",
