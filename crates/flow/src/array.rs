@@ -9,7 +9,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use tofprobe_array::rtl::{ArrayModel, ArrayRun, run};
+use tofprobe_array::rtl::{ArrayModel, ArrayRun, mid_frame_reset, run_with_reset};
 use tofprobe_array::rtl_vectors::{exercise, scene_detections, vector_files};
 use tofprobe_cosim::RunOutcome;
 use tofprobe_design::readout::{ArrayTile, Readout};
@@ -67,6 +67,14 @@ pub struct ArrayCosimOptions {
     /// count of valid SPADs, the hold and the priming are reached (default on; given
     /// `detections` are replayed as they are).
     pub exercise: bool,
+    /// A test option: one cycle of `rst` in the middle of the first frame, while the
+    /// pixels accumulate a pulse (`tofprobe_array::rtl::mid_frame_reset`); model and RTL
+    /// restart and the frames follow it (default off).
+    pub mid_frame_reset: bool,
+    /// A test option: registers W bits wide, narrower than the configuration's sizing
+    /// (which `[pixel] width` refuses), so the words reach their sign bit and the top
+    /// bit of W and a frame overflows and wraps (`None`: the design's W).
+    pub width: Option<u32>,
 }
 
 impl ArrayCosimOptions {
@@ -87,6 +95,8 @@ impl ArrayCosimOptions {
             x_seeds: vec![1, 2, 3],
             lead_misses: 0,
             exercise: true,
+            mid_frame_reset: false,
+            width: None,
         }
     }
 }
@@ -280,6 +290,7 @@ pub fn render_array_design(
             tile: None,
             lead_misses: 0,
             exercise: false,
+            mid_frame_reset: false,
             purpose: RomPurpose::Rendered,
         };
         let (v, files) = array_vector_files(design, chip.clone(), stimulus, &command)?;
@@ -324,6 +335,7 @@ pub fn write_array_vectors(
         tile,
         lead_misses: 0,
         exercise: false,
+        mid_frame_reset: false,
         purpose: RomPurpose::Replayed,
     };
     write_vectors(design, o, stimulus, vec_dir, command)
@@ -338,6 +350,8 @@ struct ArrayStimulus {
     lead_misses: u64,
     /// Thin the scene's detections (`rtl_vectors::exercise`).
     exercise: bool,
+    /// One cycle of `rst` in the middle of the first frame (`rtl::mid_frame_reset`).
+    mid_frame_reset: bool,
     purpose: RomPurpose,
 }
 
@@ -373,6 +387,7 @@ fn array_vector_files(
         tile,
         lead_misses: v_lead,
         exercise: thin,
+        mid_frame_reset: reset,
         purpose: _,
     } = stimulus;
     let ro = chip
@@ -382,7 +397,9 @@ fn array_vector_files(
     let mut detections = match detections {
         Some(d) => d,
         None => {
-            let mut d = scene_detections(design, p.frame_pulses, frames, tile)?;
+            // The pulses before a mid-frame reset take the first detections: one frame more.
+            let drawn = frames + u64::from(reset);
+            let mut d = scene_detections(design, p.frame_pulses, drawn, tile)?;
             if thin {
                 let cols = tile.map_or(ro.cols, |t| t.cols);
                 exercise(&mut d, cols, chip.superpixel);
@@ -398,7 +415,8 @@ fn array_vector_files(
     let t0 = std::time::Instant::now();
     let mut model = ArrayModel::tile(&ro, p, &chip.rom.words, None, tile)?
         .with_superpixel(chip.superpixel, p)?;
-    let r = run(&mut model, &detections, frames)?;
+    let reset_at = reset.then(|| mid_frame_reset(&ro));
+    let r = run_with_reset(&mut model, &detections, frames, reset_at)?;
     let model_seconds = t0.elapsed().as_secs_f64();
     let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
     let header = format!(
@@ -430,6 +448,8 @@ pub fn cosim_array(
     design: &ResolvedDesign,
     a: &ArrayCosimOptions,
 ) -> Result<ArrayCosimReport, FlowError> {
+    let narrowed = narrow_width(design, a)?;
+    let design = narrowed.as_ref().unwrap_or(design);
     let o = RtlOverrides {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
@@ -454,6 +474,7 @@ pub fn cosim_array(
         tile: a.tile,
         lead_misses: a.lead_misses,
         exercise: a.exercise,
+        mid_frame_reset: a.mid_frame_reset,
         purpose,
     };
     let v = write_vectors(design, &o, stimulus, &vec_dir, &a.command)?;
@@ -516,6 +537,30 @@ pub fn cosim_array(
         model_seconds,
         detections: count,
     })
+}
+
+/// The design with the test option [`ArrayCosimOptions::width`] applied: W narrower than
+/// its sizing, at least the operand's bits and at most the design's W; refused with an
+/// existing set (`--rtl`: its width is the set's).
+fn narrow_width(
+    design: &ResolvedDesign,
+    a: &ArrayCosimOptions,
+) -> Result<Option<ResolvedDesign>, FlowError> {
+    let Some(w) = a.width else {
+        return Ok(None);
+    };
+    let p = &design.pixel;
+    let lo = p.operand_bits().max(2);
+    if a.rtl.is_some() || !(lo..=p.width).contains(&w) {
+        let allowed = match a.rtl {
+            Some(_) => "none with an existing set (--rtl: the set's width)".to_string(),
+            None => format!("{lo}..={} (the operand's bits to the design's W)", p.width),
+        };
+        return Err(FlowError::option("width", w, &allowed));
+    }
+    let mut d = design.clone();
+    d.pixel.width = w;
+    Ok(Some(d))
 }
 
 /// Replays the vectors under the simulator: Verilator once per power-up seed (the first
