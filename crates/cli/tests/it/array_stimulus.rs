@@ -19,15 +19,37 @@ use tofprobe_rtlgen::ArrayFault;
 
 use crate::common::have_tools;
 
-fn example() -> ResolvedDesign {
+fn example_text() -> String {
     let path =
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../testbench/array-2x2/array-2x2.toml");
-    let text = std::fs::read_to_string(&path).unwrap();
-    resolve(
-        Document::from_toml_str(&text, "array-2x2.toml").unwrap(),
-        "array-2x2.toml",
-    )
-    .unwrap()
+    std::fs::read_to_string(&path).unwrap()
+}
+
+fn resolved(text: &str, name: &str) -> ResolvedDesign {
+    resolve(Document::from_toml_str(text, name).unwrap(), name).unwrap()
+}
+
+fn example() -> ResolvedDesign {
+    resolved(&example_text(), "array-2x2.toml")
+}
+
+/// The example as a Haar array (U = 2: 7 registers over one adder, 16,384 pulses) on a
+/// 4-bit port.
+fn haar_example() -> ResolvedDesign {
+    let mut text = example_text();
+    for (from, to) in [
+        ("pulses = 20000 ", "pulses = 16384 "),
+        ("mode = \"fourier\" ", "mode = \"haar\"\nhaar_scales = 2 "),
+        ("adders = 2 ", "adders = 1 "),
+        ("shift = 5 ", "# "),
+        ("frac_bits = 8 ", "# "),
+        // Narrow registers need a narrower port: W = T + 1 = 8 bits in two beats.
+        ("readout_bits = 16 ", "readout_bits = 4 "),
+    ] {
+        assert!(text.contains(from), "{from}");
+        text = text.replacen(from, to, 1);
+    }
+    resolved(&text, "haar-2x2.toml")
 }
 
 /// One frame of N = 16 (L = 16), Verilator under `seeds` or Icarus (`seeds` empty).
@@ -104,6 +126,44 @@ fn a_mid_frame_reset_restarts_the_array_and_catches_the_reset_escapes() {
             eprintln!("{fault:?} {seeds:?}: reset at cycle {reset}, caught: {first}");
         }
     }
+}
+
+/// The Haar array's words (sums of the held codes, W sized for its frame) reach the top
+/// bits only past the sizing: at W = T + 1 the scaling register wraps within a frame of
+/// 16 pulses (4 frames, 4 pixels: its jittered sums land on both sides), and an
+/// accumulate that holds instead is caught (Icarus).
+#[test]
+fn haar_words_wrap_at_a_narrow_width_and_catch_hold_on_overflow() {
+    if !have_tools(&["iverilog", "vvp"]) {
+        return;
+    }
+    let d = haar_example();
+    let dir = tempfile::tempdir().unwrap();
+    let w = d.pixel.operand_bits();
+    let frame = |name: &str, fault: Option<Fault>| {
+        let mut o = ArrayCosimOptions::new(&dir.path().join(name));
+        (o.frame_pulses, o.frames, o.width) = (Some(16), 4, Some(w));
+        (o.fault, o.simulator) = (fault.map(ArrayFault::Pixel), ArraySimulator::Icarus);
+        o.mid_frame_reset = true;
+        cosim_array(&d, &o).unwrap()
+    };
+    let clean = frame("clean", None);
+    assert!(clean.pass, "Haar, W = {w}: {:?}", clean.first);
+    let (neg, pos) = top_bits(&clean);
+    eprintln!(
+        "Haar W = {w} (sized {}): {neg} words ≤ −2^(W−2), {pos} ≥ 2^(W−2)",
+        d.pixel.width
+    );
+    assert!(
+        neg > 0 && pos > 0,
+        "Haar, W = {w}: the words miss the top bits"
+    );
+    let r = frame("hold", Some(Fault::HoldOnOverflow));
+    assert!(!r.pass, "Haar hold_on_overflow not caught at W = {w}");
+    eprintln!(
+        "Haar HoldOnOverflow: caught: {}",
+        r.first.unwrap_or_default()
+    );
 }
 
 /// Register words with the sign bit set and the next clear (≤ −2^(W−2)), and the other way.
