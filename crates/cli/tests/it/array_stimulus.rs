@@ -6,8 +6,9 @@
 //! `ArrayCosimOptions::width`, on frames of half the ROM's period) overflow and wrap, their words reach the sign bit and the top
 //! bit of W, and an accumulate that holds instead of wrapping is caught.
 //!
-//! Cold cost: three Verilator builds of the 2 × 2 array (clean, two mutants: ≈ 20 s each on
-//! two cores) and six Icarus runs (< 1 s each).
+//! Cold cost: three Verilator builds of the 2 × 2 array (clean, two mutants) and eleven
+//! Icarus runs; the four tests took 43 s with an empty `TOFPROBE_CACHE` on the shared
+//! two-core machine at a load of ≈ 7 (2 s with the builds cached).
 
 use std::path::PathBuf;
 
