@@ -180,6 +180,10 @@ module {{ name }} (
     end
 {%- if mutation == "sign_flip" %}
     wire [{{ w - 1 }}:0] sum_{{ ad.a }} = add_{{ ad.a }} ? (yin_{{ ad.a }} - opx) : (yin_{{ ad.a }} + opx);
+{%- else if mutation == "hold_on_overflow" %}
+    // FAULT: an accumulate that leaves W bits holds the register instead of wrapping.
+    wire [{{ w }}:0] sx_{{ ad.a }} = add_{{ ad.a }} ? ({yin_{{ ad.a }}[{{ w - 1 }}], yin_{{ ad.a }}} + {opx[{{ w - 1 }}], opx}) : ({yin_{{ ad.a }}[{{ w - 1 }}], yin_{{ ad.a }}} - {opx[{{ w - 1 }}], opx});
+    wire [{{ w - 1 }}:0] sum_{{ ad.a }} = (sx_{{ ad.a }}[{{ w }}] != sx_{{ ad.a }}[{{ w - 1 }}]) ? yin_{{ ad.a }} : sx_{{ ad.a }}[{{ w - 1 }}:0];
 {%- else %}
     wire [{{ w - 1 }}:0] sum_{{ ad.a }} = add_{{ ad.a }} ? (yin_{{ ad.a }} + opx) : (yin_{{ ad.a }} - opx);
 {%- endif %}
@@ -290,7 +294,12 @@ module {{ name }} (
 {%- endfor %}
 {%- else %}
     always @(posedge clk) begin
+{%- if mutation == "reset_when_idle" %}
+        // FAULT: reset clears the register file only when no pulse is in flight.
+        if (rst && !active) begin
+{%- else %}
         if (rst) begin
+{%- endif %}
 {%- for g in regs %}
             y[{{ g.r }}] <= {{ w }}'d0;
 {%- endfor %}

@@ -1,9 +1,9 @@
 {{ header }}{% if directed %}
 // Top: the pixel{% if fourier %}, the probe ROM{% endif %} and the contract's directed sequencer ("The
 // directed sequencer", crates/pixel/src/directed.rs): after rst, the {{ steps.len() }} steps of the
-// table below in a loop; a step presents its strobe (pulse and/or readout) at the first of
-// every `every` cycles, `count` times. It drives the refusal paths the reference sequencer
-// never takes. `pulse_o` tells the TDC (and a testbench) that this cycle samples `valid`/`tdc`.{% else %}
+// table below in a loop; a step presents its strobe (pulse and/or readout, or a reset of the
+// pixel) at the first of every `every` cycles, `count` times. It drives the refusal paths
+// and the reset in the middle of a frame that the reference sequencer never takes. `pulse_o` tells the TDC (and a testbench) that this cycle samples `valid`/`tdc`.{% else %}
 // Top: the pixel{% if fourier %}, the probe ROM{% endif %} and the chip's one sequencer (`{{ seq_name }}`, the
 // contract's "The reference sequencer" walking one pixel): after rst, {{ n }} pulses one every {{ c }} cycles, then a
 // readout cycle and {{ r + 1 }} idle cycles, frame after frame. `pulse_o` tells the TDC
@@ -25,6 +25,7 @@ module {{ name }} (
     reg [{{ cw - 1 }}:0] cnt;
     reg s_pulse;
     reg s_readout;
+    reg s_reset;
     reg [{{ ew - 1 }}:0] s_every;
     reg [{{ cw - 1 }}:0] s_count;
     always @* begin
@@ -34,6 +35,7 @@ module {{ name }} (
             {{ stw }}'d{{ s.i }}: begin
                 s_pulse = 1'b{{ s.pulse }};
                 s_readout = 1'b{{ s.readout }};
+                s_reset = 1'b{{ s.reset }};
                 s_every = {{ ew }}'d{{ s.every }};
                 s_count = {{ cw }}'d{{ s.count }};
             end
@@ -41,6 +43,7 @@ module {{ name }} (
             default: begin
                 s_pulse = 1'b0;
                 s_readout = 1'b0;
+                s_reset = 1'b0;
                 s_every = {{ ew }}'d0;
                 s_count = {{ cw }}'d0;
             end
@@ -49,6 +52,8 @@ module {{ name }} (
     wire strobe = !rst && (ph == {{ ew }}'d0);
     wire pulse = strobe && s_pulse;
     wire readout = strobe && s_readout;
+    // The pixel's reset: the pin, or a reset step's strobe (the sequencer itself runs on).
+    wire px_rst /*verilator public_flat_rd*/ = rst || (strobe && s_reset);
     assign pulse_o = pulse;
 {%- if fourier %}
     // ROM address: pulse strobes since the last readout strobe, mod {{ l }}.
@@ -78,7 +83,7 @@ module {{ name }} (
                 ph <= ph + {{ ew }}'d1;
             end
 {%- if fourier %}
-            if (readout) begin
+            if (readout || px_rst) begin
                 addr <= {{ aw }}'d0;
             end else if (pulse) begin
                 addr <= (addr == {{ aw }}'d{{ l - 1 }}) ? {{ aw }}'d0 : addr + {{ aw }}'d1;
@@ -128,7 +133,7 @@ module {{ name }} (
 {% endif %}
     {{ pixel_name }} u_pixel (
         .clk(clk),
-        .rst(rst),
+        .rst({% if directed %}px_rst{% else %}rst{% endif %}),
         .pulse(pulse),
         .valid(valid),
         .tdc(tdc),

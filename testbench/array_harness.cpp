@@ -119,6 +119,10 @@ int main(int argc, char** argv) {
     const size_t t = std::stoul(defs["AR_T"]);
     const size_t b = std::stoul(defs["AR_B"]);
     const uint64_t cycles = std::stoull(defs["AR_CYCLES"]);
+    // A reset in the middle of the first frame (AR_RESET_AT, when the vectors have one):
+    // one cycle of rst beside power-up's two.
+    const bool has_reset = defs.count("AR_RESET_AT") != 0;
+    const uint64_t reset_at = has_reset ? std::stoull(defs["AR_RESET_AT"]) : 0;
     auto stim = read_lines(dir + "/array_stim.hex");
     auto expect = read_lines(dir + "/array_expect.hex");
     if (expect.size() != cycles) {
@@ -156,7 +160,7 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "harness: bad expected line %llu\n", (unsigned long long)cycle);
             return 2;
         }
-        top->rst = cycle < 2;
+        top->rst = cycle < 2 || (has_reset && cycle == reset_at);
         if (p && pidx < stim.size()) {
             auto w = hex_words(stim[pidx++]);
             put(top->valid, slice(w, 0, np));

@@ -6,7 +6,8 @@
 //   TOFPROBE-COSIM-DONE cycles=<n> mismatches=<n>
 // preceded, for each of the first 10 mismatches, by
 //   TOFPROBE-MISMATCH cycle=<c> signal=<name> expected=<hex> actual=<hex>
-// Compile with -I VECDIR -DAR_VECTORS=\"VECDIR/\" (where array_params.vh, array_stim.hex and
+// With AR_RESET_AT defined (array_params.vh) rst is high in that cycle too: a reset in
+// the middle of the first frame. Compile with -I VECDIR -DAR_VECTORS=\"VECDIR/\" (where array_params.vh, array_stim.hex and
 // array_expect.hex are) and run from the RTL directory (a deep probe ROM's $readmemh); without
 // AR_VECTORS the vector files are read from the working directory (an array set's
 // verification kit, where `tofprobe rtl` writes this file beside the RTL and the vectors:
@@ -65,7 +66,13 @@ module array_tb;
         pidx = 0;
         mism = 0;
         for (cycle = 0; cycle < `AR_CYCLES; cycle = cycle + 1) begin
+`ifdef AR_RESET_AT
+            // A reset in the middle of the first frame: one cycle of rst (the vectors'
+            // AR_RESET_AT), the array restarts.
+            rst = (cycle < 2) || (cycle == `AR_RESET_AT);
+`else
             rst = (cycle < 2);
+`endif
             if (expect_mem[4 * cycle][0]) begin
                 {tdc, valid} = stim[pidx];
                 pidx = pidx + 1;

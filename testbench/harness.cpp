@@ -13,7 +13,9 @@
 // and/or
 //   TOFPROBE-DIGEST-MISMATCH window=<w> first_pulse=<p> cycle_from=<a> cycle_to=<b>
 // Compile-time settings (-D): PIX_WE, PIX_Y (expressions reaching the pixel's `we` and `y`
-// from `top->rootp`), TOP_HEADER, TOP_CLASS, optional TOFPROBE_TRACE (VCD support).
+// from `top->rootp`), optional PIX_RST (the pixel's reset, when the top resets it in the
+// middle of a frame: the directed top's `px_rst`; default the `rst` pin), TOP_HEADER,
+// TOP_CLASS, optional TOFPROBE_TRACE (VCD support).
 #include <chrono>
 #include <ctime>
 #include <cstdint>
@@ -32,6 +34,9 @@
 #include TOP_ROOT_HEADER
 #ifdef TOFPROBE_TRACE
 #include "verilated_vcd_c.h"
+#endif
+#ifndef PIX_RST
+#define PIX_RST (top->rst)
 #endif
 
 namespace {
@@ -319,9 +324,10 @@ int main(int argc, char** argv) {
         Pins now{c, top->ready != 0, top->rd_valid != 0, static_cast<uint32_t>(top->rd_index),
                  static_cast<uint64_t>(top->rd_data)};
         const bool pulse = top->pulse_o;
-        // rst wins: a write enable during reset writes nothing (the state it comes from is
-        // random until the reset edge, under +verilator+rand+reset+2).
-        const uint64_t we = top->rst ? 0 : static_cast<uint64_t>(PIX_WE);
+        // rst wins (the pixel's, PIX_RST): a write enable during reset writes nothing (the
+        // state it comes from is random until the reset edge, under +verilator+rand+reset+2).
+        const bool rst_now = (PIX_RST) != 0;
+        const uint64_t we = rst_now ? 0 : static_cast<uint64_t>(PIX_WE);
         top->clk = 1;
         top->eval();
 #ifdef TOFPROBE_TRACE
@@ -371,7 +377,7 @@ int main(int argc, char** argv) {
         }
         pend_c = c;
         pend_we = we;
-        pend_rst = top->rst != 0;
+        pend_rst = rst_now;
         pend_full = full;
         pending = true;
     }

@@ -40,7 +40,7 @@ module tb;
     // observed (at the next falling edge) with its enables and reset.
     integer rep_c, cw;
     reg [63:0] we_w;
-    reg rst_w, pending;
+    reg rst_w, rst_s, pending;
     reg [19:0] s;
     reg p_s, ready_s, rd_valid_s;
     reg [TB_RD_INDEX_BITS-1:0] rd_index_s;
@@ -132,8 +132,10 @@ module tb;
             rd_valid_s = rd_valid;
             rd_index_s = rd_index;
             rd_data_s = rd_data;
-            // rst wins; any X on the write enables (a register reset forgot) is a mismatch.
-            we = rst ? 64'd0 : dut.u_pixel.we;
+            // rst wins (the pixel's: the directed top also resets it in the middle of a
+            // frame); any X on the write enables (a register reset forgot) is a mismatch.
+            rst_s = dut.u_pixel.rst;
+            we = rst_s ? 64'd0 : dut.u_pixel.we;
             if (c >= 1 && ^we === 1'bx) mismatch("we", -1, 64'd0, we);
             clk = 1;
             #1;
@@ -162,7 +164,7 @@ module tb;
             end
             cw = c;
             we_w = we;
-            rst_w = rst;
+            rst_w = rst_s;
             pending = 1;
             clk = 0;
         end

@@ -475,4 +475,4 @@ impl ArrayModel {
     }
 }
 
-pub use crate::rtl_run::{ArrayRun, run};
+pub use crate::rtl_run::{ArrayRun, mid_frame_reset, run, run_with_reset};

@@ -5,7 +5,8 @@
 //!
 //! - `array_params.vh`: `AR_TOP`, `AR_NP` (pixels present: all, or a tile's), `AR_T`,
 //!   `AR_B`, `AR_CYCLES`, `AR_PULSES`, and with `[array] superpixel = G > 1` `AR_NS` (the
-//!   SPAD inputs, AR_NP·G²);
+//!   SPAD inputs, AR_NP·G²), and with a mid-frame reset (`rtl::run_with_reset`)
+//!   `AR_RESET_AT` (its cycle: `rst` is high then, and in power-up's two cycles);
 //! - `array_stim.hex`: one line per pulse the pixels sample, the P·(T+1)-bit value
 //!   {tdc[P·T−1:0], valid[P−1:0]} over the P inputs (pixel i = r·cols + c; with G > 1 the
 //!   SPADs, i = sr·(cols·G) + sc over the SPAD grid);
@@ -135,6 +136,11 @@ pub fn vector_files(
         ("AR_TOP", top.to_string()),
     ] {
         params.push_str(&format!("`define {k} {v}\n"));
+    }
+    if let Some(c) = run.reset_at {
+        // One cycle of `rst` in the middle of the first frame (the testbenches' second
+        // reset; absent, power-up's alone).
+        params.push_str(&format!("`define AR_RESET_AT {c}\n"));
     }
     let mut stim = format!("{header}\n");
     for n in 0..run.pulse_cycles.len().max(1) {

@@ -9,7 +9,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use tofprobe_array::rtl::{ArrayModel, ArrayRun, run};
+use tofprobe_array::rtl::{ArrayModel, ArrayRun, mid_frame_reset, run_with_reset};
 use tofprobe_array::rtl_vectors::{exercise, scene_detections, vector_files};
 use tofprobe_cosim::RunOutcome;
 use tofprobe_design::readout::{ArrayTile, Readout};
@@ -72,6 +72,14 @@ pub struct ArrayCosimOptions {
     pub layout: Option<tofprobe_cosim::array::Layout>,
     /// Another build cache root (`None`: the user's; an empty directory: a cold build).
     pub cache: Option<PathBuf>,
+    /// A test option: one cycle of `rst` in the middle of the first frame, while the
+    /// pixels accumulate a pulse (`tofprobe_array::rtl::mid_frame_reset`); model and RTL
+    /// restart and the frames follow it (default off).
+    pub mid_frame_reset: bool,
+    /// A test option: registers W bits wide, narrower than the configuration's sizing
+    /// (which `[pixel] width` refuses), so the words reach their sign bit and the top
+    /// bit of W and a frame overflows and wraps (`None`: the design's W).
+    pub width: Option<u32>,
 }
 
 impl ArrayCosimOptions {
@@ -94,6 +102,8 @@ impl ArrayCosimOptions {
             exercise: true,
             layout: None,
             cache: None,
+            mid_frame_reset: false,
+            width: None,
         }
     }
 }
@@ -289,6 +299,7 @@ pub fn render_array_design(
             tile: None,
             lead_misses: 0,
             exercise: false,
+            mid_frame_reset: false,
             purpose: RomPurpose::Rendered,
         };
         let (v, files) = array_vector_files(design, chip.clone(), stimulus, &command)?;
@@ -333,6 +344,7 @@ pub fn write_array_vectors(
         tile,
         lead_misses: 0,
         exercise: false,
+        mid_frame_reset: false,
         purpose: RomPurpose::Replayed,
     };
     write_vectors(design, o, stimulus, vec_dir, command)
@@ -347,6 +359,8 @@ struct ArrayStimulus {
     lead_misses: u64,
     /// Thin the scene's detections (`rtl_vectors::exercise`).
     exercise: bool,
+    /// One cycle of `rst` in the middle of the first frame (`rtl::mid_frame_reset`).
+    mid_frame_reset: bool,
     purpose: RomPurpose,
 }
 
@@ -382,6 +396,7 @@ fn array_vector_files(
         tile,
         lead_misses: v_lead,
         exercise: thin,
+        mid_frame_reset: reset,
         purpose: _,
     } = stimulus;
     let ro = chip
@@ -391,7 +406,9 @@ fn array_vector_files(
     let mut detections = match detections {
         Some(d) => d,
         None => {
-            let mut d = scene_detections(design, p.frame_pulses, frames, tile)?;
+            // The pulses before a mid-frame reset take the first detections: one frame more.
+            let drawn = frames + u64::from(reset);
+            let mut d = scene_detections(design, p.frame_pulses, drawn, tile)?;
             if thin {
                 let cols = tile.map_or(ro.cols, |t| t.cols);
                 exercise(&mut d, cols, chip.superpixel);
@@ -407,7 +424,8 @@ fn array_vector_files(
     let t0 = std::time::Instant::now();
     let mut model = ArrayModel::tile(&ro, p, &chip.rom.words, None, tile)?
         .with_superpixel(chip.superpixel, p)?;
-    let r = run(&mut model, &detections, frames)?;
+    let reset_at = reset.then(|| mid_frame_reset(&ro));
+    let r = run_with_reset(&mut model, &detections, frames, reset_at)?;
     let model_seconds = t0.elapsed().as_secs_f64();
     let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
     let header = format!(
@@ -439,6 +457,8 @@ pub fn cosim_array(
     design: &ResolvedDesign,
     a: &ArrayCosimOptions,
 ) -> Result<ArrayCosimReport, FlowError> {
+    let narrowed = narrow_width(design, a)?;
+    let design = narrowed.as_ref().unwrap_or(design);
     let o = RtlOverrides {
         frame_pulses: a.frame_pulses,
         rom_depth: a.rom_depth,
@@ -463,6 +483,7 @@ pub fn cosim_array(
         tile: a.tile,
         lead_misses: a.lead_misses,
         exercise: a.exercise,
+        mid_frame_reset: a.mid_frame_reset,
         purpose,
     };
     let v = write_vectors(design, &o, stimulus, &vec_dir, &a.command)?;
@@ -531,6 +552,30 @@ pub fn cosim_array(
         model_seconds,
         detections: count,
     })
+}
+
+/// The design with the test option [`ArrayCosimOptions::width`] applied: W narrower than
+/// its sizing, at least the operand's bits and at most the design's W; refused with an
+/// existing set (`--rtl`: its width is the set's).
+fn narrow_width(
+    design: &ResolvedDesign,
+    a: &ArrayCosimOptions,
+) -> Result<Option<ResolvedDesign>, FlowError> {
+    let Some(w) = a.width else {
+        return Ok(None);
+    };
+    let p = &design.pixel;
+    let lo = p.operand_bits().max(2);
+    if a.rtl.is_some() || !(lo..=p.width).contains(&w) {
+        let allowed = match a.rtl {
+            Some(_) => "none with an existing set (--rtl: the set's width)".to_string(),
+            None => format!("{lo}..={} (the operand's bits to the design's W)", p.width),
+        };
+        return Err(FlowError::option("width", w, &allowed));
+    }
+    let mut d = design.clone();
+    d.pixel.width = w;
+    Ok(Some(d))
 }
 
 /// Replays the vectors under the simulator: Verilator once per power-up seed (the first

@@ -2,8 +2,9 @@
 //! path of the contract the reference sequencer never takes (docs/pixel-contract.md, "The
 //! directed sequencer"): pulses into a busy pipeline, during a readout, at the status edge
 //! and after a full Haar frame (all refused), the refused counter to saturation, a readout
-//! and a pulse in the same cycle, readout strobes while busy or reading (ignored), and a
-//! frame longer than the width was sized for (wrap-around against saturation).
+//! and a pulse in the same cycle, readout strobes while busy or reading (ignored), a reset
+//! in the middle of a frame with a pulse in flight, and a frame longer than the width was
+//! sized for (wrap-around against saturation).
 //!
 //! The schedule is a [`Program`] of [`Step`]s, defined here once: the model's
 //! [`crate::Sequencer::directed`] walks it, and tofprobe-rtlgen renders the same steps as the
@@ -28,6 +29,9 @@ pub struct Step {
     pub pulse: bool,
     /// The strobe presents a readout.
     pub readout: bool,
+    /// The strobe resets the pixel (`rst` for that one cycle, never with a pulse or a
+    /// readout): a reset in the middle of a frame. The ROM address restarts.
+    pub reset: bool,
     /// Cycles per strobe period (≥ 1).
     pub every: u64,
     /// Strobe periods (≥ 1).
@@ -71,6 +75,8 @@ pub struct At {
     pub pulse: bool,
     /// A readout is presented.
     pub readout: bool,
+    /// The pixel is reset (one cycle of `rst`).
+    pub reset: bool,
     /// With `pulse`: pulse strobes of the loop before this one.
     pub pulse_in_loop: u64,
     /// With `pulse`: the ROM address, unreduced (pulse strobes since the last readout
@@ -94,9 +100,9 @@ pub struct Program {
 }
 
 impl Program {
-    /// A program of `steps`. Fails unless every step has `every, count ≥ 1` and the loop
-    /// ends with a readout strobe followed by no pulse strobe (the ROM address restarts
-    /// with every loop).
+    /// A program of `steps`. Fails unless every step has `every, count ≥ 1`, a reset
+    /// step presents nothing else and the loop ends with a readout strobe followed by no
+    /// pulse strobe (the ROM address restarts with every loop).
     pub fn new(steps: Vec<Step>, lead_misses: u64) -> Result<Self, PixelError> {
         if let Some(s) = steps.iter().find(|s| s.every == 0 || s.count == 0) {
             return Err(PixelError::invalid(
@@ -104,6 +110,14 @@ impl Program {
                 format!("every = {}, count = {}", s.every, s.count),
                 "a step needs every ≥ 1 and count ≥ 1",
                 "every = 1, count = 1",
+            ));
+        }
+        if let Some(s) = steps.iter().find(|s| s.reset && (s.pulse || s.readout)) {
+            return Err(PixelError::invalid(
+                "directed step",
+                format!("reset with pulse = {}, readout = {}", s.pulse, s.readout),
+                "a reset step presents no pulse and no readout",
+                "reset alone",
             ));
         }
         let last_readout = steps.iter().rposition(|s| s.readout);
@@ -129,7 +143,7 @@ impl Program {
             if s.pulse {
                 pulses += s.count;
             }
-            address = match (s.pulse, s.readout) {
+            address = match (s.pulse, s.readout || s.reset) {
                 (_, true) => 0,
                 (true, false) => address + s.count,
                 (false, false) => address,
@@ -183,6 +197,7 @@ impl Program {
             step: i,
             pulse,
             readout: strobe && s.readout,
+            reset: strobe && s.reset,
             pulse_in_loop: self.pulses_before[i] + if s.pulse { j } else { 0 },
             address,
             in_frame: address,
@@ -208,7 +223,8 @@ impl Program {
 }
 
 /// The contract's directed schedule for `p` (docs/pixel-contract.md, "The directed
-/// sequencer"). Three frames per loop:
+/// sequencer"). First half a frame and a reset while its last pulse is in flight (the
+/// frame restarts: [`mid_frame_reset`]), then three frames per loop:
 ///
 /// 0. N pulses one every C cycles; a readout with a pulse in the same cycle (readout taken,
 ///    pulse refused); pulses at every cycle of the readout (refused, the one at the status
@@ -242,11 +258,13 @@ pub fn directed_program(p: &PixelParams, o: &DirectedOptions) -> Result<Program,
     let step = |pulse, readout, every, count, purpose| Step {
         pulse,
         readout,
+        reset: false,
         every,
         count,
         purpose,
     };
-    let steps = vec![
+    let mut steps = mid_frame_reset(n, c);
+    steps.extend([
         step(true, false, c, n, "frame 0: N pulses, one every C cycles"),
         step(
             true,
@@ -302,8 +320,47 @@ pub fn directed_program(p: &PixelParams, o: &DirectedOptions) -> Result<Program,
         ),
         step(false, true, 1, k + 1, "readout strobes: ignored while busy"),
         step(false, false, 1, r + 2, "the words come out"),
-    ];
+    ]);
     Program::new(steps, o.lead_misses)
+}
+
+/// The loop's first steps: half a frame of pulses one every C cycles, the last of them
+/// followed at the next cycle by one cycle of reset, while its slots are in flight
+/// (`active`, the register file being written), then the rest of that pulse's period.
+/// Model and RTL both restart: every register, the pipeline, the priming, the refused
+/// counter, the Haar pulse count and the ROM address.
+fn mid_frame_reset(n: u64, c: u64) -> Vec<Step> {
+    let before = (n / 2).max(1);
+    let pulses = |every, count, purpose| Step {
+        pulse: true,
+        readout: false,
+        reset: false,
+        every,
+        count,
+        purpose,
+    };
+    let mut steps = Vec::new();
+    if before > 1 {
+        steps.push(pulses(
+            c,
+            before - 1,
+            "half a frame: pulses one every C cycles",
+        ));
+    }
+    steps.push(pulses(
+        1,
+        1,
+        "its last pulse, whose slots the reset interrupts",
+    ));
+    steps.push(Step {
+        pulse: false,
+        readout: false,
+        reset: true,
+        every: c.saturating_sub(1).max(1),
+        count: 1,
+        purpose: "reset in the middle of the frame, the pulse's slots in flight",
+    });
+    steps
 }
 
 #[cfg(test)]
@@ -333,7 +390,7 @@ mod tests {
                         pulses += 1;
                         address += 1;
                     }
-                    if a.readout {
+                    if a.readout || a.reset {
                         address = 0;
                     }
                     let _ = j;
@@ -350,6 +407,7 @@ mod tests {
         let s = |pulse, readout| Step {
             pulse,
             readout,
+            reset: false,
             every: 1,
             count: 1,
             purpose: "",

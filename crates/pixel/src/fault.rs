@@ -34,6 +34,14 @@ pub enum Fault {
     /// The read-ahead stage reads the register file before this edge's writes (no forward
     /// of the sum being written): a read-after-write hazard, visible only when K = 1.
     MissingForward,
+    /// Reset clears the register file only when the pixel is idle (no pulse in flight):
+    /// a reset while a pulse's slots are being written keeps the registers (and lets the
+    /// slot write). Power-up's two reset cycles hide it; a reset in the middle of a frame
+    /// (the directed sequencer) shows it. Rendered into the flop register file.
+    ResetWhenIdle,
+    /// An accumulate that overflows W bits holds the register instead of wrapping it.
+    /// Frames whose registers stay inside W hide it; a long frame or a narrow W shows it.
+    HoldOnOverflow,
 }
 
 impl Fault {
@@ -60,12 +68,19 @@ impl Fault {
     /// Faults the cycle model has no hook for: the co-simulation must catch them, but the
     /// cycle where they first show is not predicted (the mutation tests check that they are
     /// caught, with the first mismatch reported).
-    pub const UNMODELLED: [Fault; 4] = [
+    pub const UNMODELLED: [Fault; 6] = [
         Fault::ResetPrimed,
         Fault::PrimeOnMiss,
         Fault::ReadoutClear,
         Fault::EnableDecode,
+        Fault::ResetWhenIdle,
+        Fault::HoldOnOverflow,
     ];
+
+    /// The unmodelled faults only the directed stimulus shows: a reset in the middle of a
+    /// frame (`ResetWhenIdle`) and registers that leave W bits (`HoldOnOverflow`, in a
+    /// pixel whose W is sized for its frame). The reference sequencer's frames pass them.
+    pub const STIMULUS: [Fault; 2] = [Fault::ResetWhenIdle, Fault::HoldOnOverflow];
 
     /// The name used by templates and reports.
     pub fn name(self) -> &'static str {
@@ -83,6 +98,8 @@ impl Fault {
             Fault::RefusedCounter => "refused_counter",
             Fault::HaarFrameLimit => "haar_frame_limit",
             Fault::MissingForward => "missing_forward",
+            Fault::ResetWhenIdle => "reset_when_idle",
+            Fault::HoldOnOverflow => "hold_on_overflow",
         }
     }
 }

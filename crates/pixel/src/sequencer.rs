@@ -181,7 +181,8 @@ impl<'a> Sequencer<'a> {
     }
 
     /// What cycle `cycle` of the sequence does (directed: `frame` counts loops, `pulse`
-    /// the pulse strobes of the loop; a cycle with both strobes is a `Pulse`).
+    /// the pulse strobes of the loop; a cycle with both strobes is a `Pulse`, a reset
+    /// strobe in the middle of a frame a `Reset`).
     pub fn phase(&self, cycle: u64) -> Phase {
         if cycle < RESET_CYCLES {
             return Phase::Reset;
@@ -196,6 +197,7 @@ impl<'a> Sequencer<'a> {
                     pulse: a.pulse_in_loop,
                 },
                 (false, true) => Phase::Readout { frame },
+                (false, false) if a.reset => Phase::Reset,
                 (false, false) => Phase::Idle,
             };
         }
@@ -224,6 +226,7 @@ impl<'a> Sequencer<'a> {
             let a = prog.at(t % prog.loop_cycles());
             if !a.pulse {
                 return PinsIn {
+                    rst: a.reset,
                     readout: a.readout,
                     ..PinsIn::default()
                 };

@@ -5,7 +5,7 @@
 //! this module only renders them. [`ArrayFault`] are the array-level mutants.
 
 use askama::Template;
-use tofprobe_pixel::{Mode, PixelParams};
+use tofprobe_pixel::{Fault, Mode, PixelParams};
 
 use crate::error::RtlError;
 use crate::naming::clog2;
@@ -48,6 +48,9 @@ pub enum ArrayFault {
     /// small (2^k − 1: a lone SPAD's code comes out one less). With every SPAD valid on
     /// every pulse it never shows.
     ReciprocalEntry,
+    /// The pixel's own fault ([`Fault`], rendered into `templates/pixel.v`) in every pixel
+    /// of the array: the pixel's mutants under the array's stimulus.
+    Pixel(Fault),
 }
 
 impl ArrayFault {
@@ -62,6 +65,15 @@ impl ArrayFault {
             ArrayFault::SuperpixelAnd => "superpixel_and",
             ArrayFault::SpadSwap => "spad_swap",
             ArrayFault::ReciprocalEntry => "reciprocal_entry",
+            ArrayFault::Pixel(f) => f.name(),
+        }
+    }
+
+    /// The pixel's fault, when this is one ([`ArrayFault::Pixel`]).
+    pub fn pixel(self) -> Option<Fault> {
+        match self {
+            ArrayFault::Pixel(f) => Some(f),
+            _ => None,
         }
     }
 
@@ -344,7 +356,13 @@ pub fn render_array(
         ));
     }
     // The pixel and the ROM exactly as the single pixel's set has them (the pixel with its
-    // shadow registers when double-buffered).
+    // shadow registers when double-buffered; with a pixel fault, in every pixel).
+    let pixel_fault = a.fault.and_then(ArrayFault::pixel);
+    let with_fault = RenderOptions {
+        mutation: pixel_fault.or(o.mutation),
+        ..o.clone()
+    };
+    let o = &with_fault;
     let mut files: Vec<RtlFile> = render_set(p, rom, o, a.double_buffer)?
         .into_iter()
         .filter(|f| f.template != "top.v")
@@ -409,7 +427,7 @@ pub fn render_array(
         fourier: p.mode == Mode::Fourier,
         mutation: a
             .fault
-            .filter(|f| !f.in_superpixel())
+            .filter(|f| !f.in_superpixel() && f.pixel().is_none())
             .map(ArrayFault::name)
             .unwrap_or(""),
         t: p.tdc_bits as usize,

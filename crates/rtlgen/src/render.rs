@@ -304,6 +304,7 @@ struct StepRow {
     i: usize,
     pulse: u8,
     readout: u8,
+    reset: u8,
     /// `every` − 1.
     every: u64,
     /// `count` − 1.
@@ -541,6 +542,7 @@ pub(crate) fn render_set(
             i,
             pulse: u8::from(s.pulse),
             readout: u8::from(s.readout),
+            reset: u8::from(s.reset),
             every: s.every - 1,
             count: s.count - 1,
             purpose: s.purpose,

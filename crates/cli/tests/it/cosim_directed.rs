@@ -29,7 +29,8 @@ fn json(o: &std::process::Output) -> serde_json::Value {
 /// program's table summed by hand.
 fn loop_cycles(m: u64) -> u64 {
     let (n, c, k, r) = (16, 16, 16, 32);
-    n * c + 1 + (r + 2) // frame 0, readout with a pulse, pulses during the readout
+    (n / 2 - 1) * c + 1 + (c - 1) // half a frame, its last pulse, the mid-frame reset
+        + n * c + 1 + (r + 2) // frame 0, readout with a pulse, pulses during the readout
         + 2 * k + n * c + 2 * 4096 + k + (k + 1) + (r + 2) // frame 1
         + (m * n - 1) * c + 1 + (k + 1) + (r + 2) // frame 2
 }

@@ -132,6 +132,10 @@ fn long_frame_wraps_while_the_refused_counter_saturates() {
     let mut twin_readouts = Vec::new();
     for c in 0..seq.total_cycles() {
         let pins = seq.pins(c);
+        if pins.rst {
+            // The reset in the middle of frame 0 restarts the twin too.
+            twin = TransactionModel::new(&wide).unwrap();
+        }
         let out = model.step(&pins);
         if out.rd_valid && out.rd_index as usize == p.registers() {
             twin_readouts.push(twin.readout().words);

@@ -12,3 +12,4 @@ mod exact;
 mod icarus_default;
 mod mutations;
 mod sd_rom;
+mod stimulus;

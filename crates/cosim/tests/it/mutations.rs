@@ -234,7 +234,8 @@ fn refusal_faults_are_caught_at_their_first_cycle_by_the_directed_schedule() {
 /// every state element reset forgets is an X there), in both modes, with a directed
 /// stimulus whose frames start with missed pulses (the priming rule): each is caught, with
 /// its first mismatch reported (the refusal path's faults are modelled: see
-/// `refusal_faults_are_caught_at_their_first_cycle_by_the_directed_schedule`).
+/// `refusal_faults_are_caught_at_their_first_cycle_by_the_directed_schedule`; the
+/// stimulus faults, `Fault::STIMULUS`, are caught in stimulus.rs).
 #[test]
 fn unmodelled_faults_are_caught_under_icarus() {
     if !tools_or_skip(
@@ -266,7 +267,12 @@ fn unmodelled_faults_are_caught_under_icarus() {
         let clean = run(None);
         assert!(clean.pass, "{mode:?} clean: {:?}", clean.first);
         assert_eq!(clean.stimulus[..3], [None, None, None]);
-        for fault in Fault::UNMODELLED {
+        // The stimulus faults need the directed sequencer's mid-frame reset and words that
+        // leave W bits: crates/cosim/tests/it/stimulus.rs.
+        for fault in Fault::UNMODELLED
+            .into_iter()
+            .filter(|f| !Fault::STIMULUS.contains(f))
+        {
             total += 1;
             let r = run(Some(fault));
             assert!(!r.pass, "{mode:?} {fault:?} was not caught");
