@@ -6,7 +6,8 @@
 //! map of amplitude and of phase per bin, each pixel's strongest bin, the animated
 //! deflection shape at the dominant bin and the Universal File Format file `vibration.uff`;
 //! for a Haar frame each pixel's transition time (`event_time_ms.npy`, −1 where none, and
-//! its heat map) and the edge velocity fitted from them; the summary with its figures,
+//! its heat map), the fit's sd of that time (`event_time_sd_ms.npy`, −1 where none) and
+//! the edge velocity fitted from them; the summary with its figures,
 //! units and file names. Every file is streamed into the set as it is made (bounded
 //! buffers), and the set's size, directory and disk are checked before the model runs
 //! ([`crate::set_plan`]).
@@ -197,6 +198,9 @@ fn stream_files(
     if let Some(e) = events {
         add(set, "event_time_ms.npy", &mut |w| {
             npy::write(w, &[r, c], &e.time_ms)
+        })?;
+        add(set, "event_time_sd_ms.npy", &mut |w| {
+            npy::write(w, &[r, c], &e.time_sd_ms)
         })?;
         add(set, "event_time.svg", &mut |w| {
             // Pixels without a transition (−1) drawn as 0 ms.

@@ -77,6 +77,7 @@ fn array_set_of(design: &ResolvedDesign, r: usize, c: usize) -> Vec<SetFile> {
     match design.pixel.mode {
         tofprobe_pixel::Mode::Haar => {
             out.push(file("event_time_ms.npy", npy::file_bytes(&[r, c])));
+            out.push(file("event_time_sd_ms.npy", npy::file_bytes(&[r, c])));
             out.push(file("event_time.svg", heat));
         }
         tofprobe_pixel::Mode::Fourier => {

@@ -239,7 +239,11 @@ fn a_new_array_set_drops_the_files_of_the_one_it_replaces() {
     let edge = include_str!("../../../../scenes/edge-sweep.toml")
         .replacen("rows = 32", "rows = 4", 1)
         .replacen("cols = 32", "cols = 3", 1)
-        .replacen("pulses = 65536", "pulses = 4096", 1);
+        // 16384 pulses: 512 per cell, so a pixel's transition threshold (8 σ of a cell
+        // mean, 8 × 10 codes/√512 ≈ 2.7 mm) is under the edge's 4 mm (at 4096 it is 5.3 mm
+        // and no pixel would have a time); the edge crosses columns 0–2 at 0.15–0.35 ms of
+        // the 1.6 ms frame.
+        .replacen("pulses = 65536", "pulses = 16384", 1);
     let haar = tmp.path().join("edge.toml");
     std::fs::write(&haar, edge).unwrap();
     ok(&["simulate", s(&haar), "--out", s(&out)]);
@@ -249,6 +253,7 @@ fn a_new_array_set_drops_the_files_of_the_one_it_replaces() {
             "detections.npy",
             "event_time.svg",
             "event_time_ms.npy",
+            "event_time_sd_ms.npy",
             "notes.txt",
             "registers.npy",
             "summary.json",
@@ -256,6 +261,26 @@ fn a_new_array_set_drops_the_files_of_the_one_it_replaces() {
         ]
     );
     ok(&["check-set", s(&out)]);
+    // Each pixel's sd beside its time: the same [R, C], −1 exactly where the time is −1,
+    // positive and finite elsewhere.
+    let read =
+        |n: &str| tofprobe_io::npy::from_bytes(&std::fs::read(out.join(n)).unwrap()).unwrap();
+    let (t, sd) = (read("event_time_ms.npy"), read("event_time_sd_ms.npy"));
+    assert_eq!(
+        (t.shape.clone(), sd.shape.clone()),
+        (vec![4, 3], vec![4, 3])
+    );
+    for (t, sd) in t.data.iter().zip(&sd.data) {
+        assert!(
+            if *t < 0.0 {
+                *sd == -1.0
+            } else {
+                sd.is_finite() && *sd > 0.0
+            },
+            "time {t} ms, sd {sd} ms"
+        );
+    }
+    assert!(t.data.iter().any(|&t| t >= 0.0), "{:?}", t.data);
 }
 
 /// Rewrites `dir/manifest.json` through `edit`.

@@ -47,6 +47,12 @@
 //! upper bound on its duration and a lower bound on |rate| instead. One convention:
 //! every rate is dδ/dt, positive when the depth increases (the target recedes).
 //!
+//! An excursion (no significant net height: an impulse) reports its rise and fall with
+//! their heights ([`super::profile`], "Excursions"). A step's, ramp's or unresolved
+//! event's time is also fitted: the least-squares step/ramp of the cells between its
+//! neighbours, with its Cramér–Rao sd (`fitted_time_s`, [`super::fit`], the same fit as an
+//! array pixel's).
+//!
 //! # The paper's ramp rate (Suppl. S5)
 //! A linear ramp δ(t) = r·t across a whole wavelet gives w = −r·T_u/4, so the paper
 //! estimates the rate as r̂ = −4·w_{u′,v′}/T_u′ at the peak (`paper_rate_m_per_s`, the
@@ -118,6 +124,25 @@ pub struct Event {
     /// A step's |dδ/dt| is above this: |height| / the duration's bound (m/s; `shape` =
     /// step).
     pub abs_rate_lower_bound_m_per_s: Option<f64>,
+    /// The transition's time from the least-squares step/ramp fit of the cells between
+    /// the event's neighbours ([`super::fit_transition`]'s implementation; `shape` = step,
+    /// ramp or unresolved, where it is the centre of the one ramp fitted) (s from the
+    /// frame start).
+    pub fitted_time_s: Option<f64>,
+    /// Its Cramér–Rao sd under the noise model (s).
+    pub fitted_time_sd_s: Option<f64>,
+    /// An excursion's rise: its cell's mean depth minus the level before (mm; `shape` =
+    /// excursion; negative for a dip). Below a cell's duration it is the excursion's area
+    /// over the cell: height × width / τ ([`super::profile`], "Excursions").
+    pub rise_mm: Option<f64>,
+    /// Its sd under the noise model (mm).
+    pub rise_sd_mm: Option<f64>,
+    /// An excursion's fall: the level after minus its cell's mean depth (mm).
+    pub fall_mm: Option<f64>,
+    /// Its sd under the noise model (mm).
+    pub fall_sd_mm: Option<f64>,
+    /// The cell the rise and fall are measured at, [start, end) (s).
+    pub excursion_cell_s: Option<(f64, f64)>,
     /// The finest wavelet's duration T/2^U (s): transitions two of these apart are told
     /// apart (module doc).
     pub finest_wavelet_s: f64,
@@ -149,11 +174,20 @@ impl Event {
                 self.duration_upper_bound_s.unwrap_or(f64::NAN) * 1e3,
                 self.abs_rate_lower_bound_m_per_s.unwrap_or(f64::NAN),
             ),
-            Shape::Excursion => format!(
-                "excursion: no significant net height ({:+.3} ± {:.3} mm), no rate",
-                self.height_mm.unwrap_or(f64::NAN),
-                self.height_sd_mm.unwrap_or(f64::NAN),
-            ),
+            Shape::Excursion => {
+                let (a, b) = self.excursion_cell_s.unwrap_or((f64::NAN, f64::NAN));
+                format!(
+                    "excursion: rise {:+.3} ± {:.3} mm then fall {:+.3} ± {:.3} mm at the cell {:.3}–{:.3} ms (its mean: one shorter than the cell is higher by cell/width), no significant net height ({:+.3} ± {:.3} mm), no rate",
+                    self.rise_mm.unwrap_or(f64::NAN),
+                    self.rise_sd_mm.unwrap_or(f64::NAN),
+                    self.fall_mm.unwrap_or(f64::NAN),
+                    self.fall_sd_mm.unwrap_or(f64::NAN),
+                    a * 1e3,
+                    b * 1e3,
+                    self.height_mm.unwrap_or(f64::NAN),
+                    self.height_sd_mm.unwrap_or(f64::NAN),
+                )
+            }
             Shape::Edge => "at the frame's edge: height, duration and rate not measured".into(),
             Shape::Unresolved => format!(
                 "unresolved: height {:+.3} ± {:.3} mm over {:.3}–{:.3} ms, one ramp or several transitions closer than two finest wavelets ({:.3} ms), no single-ramp rate",
@@ -164,8 +198,12 @@ impl Event {
                 2.0 * self.finest_wavelet_s * 1e3,
             ),
         };
+        let fitted = match (self.fitted_time_s, self.fitted_time_sd_s) {
+            (Some(t), Some(sd)) => format!("; fitted time {:.4} ± {:.4} ms", t * 1e3, sd * 1e3),
+            _ => String::new(),
+        };
         format!(
-            "{:.3} ms ({:.3}–{:.3} ms): depth {}; {measured}; peak w({},{}) = {:+.4} mm ({:.1} sd) at scale {} ({:.3} ms wavelets, scales {}..{}), paper's estimator −4w/T_u = {:+.3} m/s{}",
+            "{:.3} ms ({:.3}–{:.3} ms): depth {}; {measured}{fitted}; peak w({},{}) = {:+.4} mm ({:.1} sd) at scale {} ({:.3} ms wavelets, scales {}..{}), paper's estimator −4w/T_u = {:+.3} m/s{}",
             self.centre_s * 1e3,
             self.start_s * 1e3,
             self.end_s * 1e3,
@@ -409,6 +447,11 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
             let peak = s.coefficients[peak_r];
             let d = peak.duration_s();
             let m = profile.measure(st, e, prev_end, next_start, t.z);
+            // One transition's fit over the cells between the neighbours.
+            let fit = matches!(m.shape, Shape::Step | Shape::Ramp | Shape::Unresolved)
+                .then(|| profile.fit(prev_end, next_start))
+                .flatten()
+                .filter(|f| f.time_sd_s.is_finite());
             let longer = match m.shape {
                 Shape::Ramp => m.duration_s.is_some_and(|x| d > x),
                 // Not resolved by the finest wavelets: every wavelet is longer.
@@ -440,6 +483,13 @@ pub fn detect_events(s: &Scalogram, t: &Thresholds) -> Result<EventReport, DspEr
                 mean_rate_sd_m_per_s: m.mean_rate_sd_m_per_s,
                 duration_upper_bound_s: m.duration_upper_bound_s,
                 abs_rate_lower_bound_m_per_s: m.abs_rate_lower_bound_m_per_s,
+                fitted_time_s: fit.map(|f| f.time_s),
+                fitted_time_sd_s: fit.map(|f| f.time_sd_s),
+                rise_mm: m.rise_mm,
+                rise_sd_mm: m.rise_sd_mm,
+                fall_mm: m.fall_mm,
+                fall_sd_mm: m.fall_sd_mm,
+                excursion_cell_s: m.excursion_cell_s,
                 finest_wavelet_s: s.wavelet_duration_s(s.scales),
                 finest_scale: regs.iter().map(|&r| s.coefficients[r].u).max().unwrap_or(0),
                 coarsest_scale: regs.iter().map(|&r| s.coefficients[r].u).min().unwrap_or(0),
@@ -487,10 +537,40 @@ mod tests {
         assert_eq!((e.coarsest_scale, e.finest_scale), (0, 5));
         assert_eq!(e.coefficients.len(), 6);
         assert!(r.spanning.is_empty());
+        // The fitted time is the step's, to the golden section's 1e-6 pulse (the span's
+        // centre, 304 samples, would miss by 4 pulses), and the line shows it.
+        let ft = e.fitted_time_s.unwrap();
+        assert!((ft - 300e-7).abs() < 1e-13, "{}", e.text_line());
+        assert!(
+            e.text_line().contains("fitted time 0.0300 ±"),
+            "{}",
+            e.text_line()
+        );
         // The line names the event; a broken threshold (huge sd) finds nothing.
         assert!(r.text().contains("event 1: 0.030 ms"), "{}", r.text());
         let t_big = Thresholds::new(&HaarNoise::new(100.0, 1.0).unwrap(), n, 5, 0.01).unwrap();
         assert!(detect_events(&s, &t_big).unwrap().events.is_empty());
+    }
+
+    /// A noiseless impulse of +2 mm over samples 300..304, inside cell 18 (288..304 of
+    /// 16-sample cells at U = 5): one excursion whose rise is the cell mean's +2·4/16 =
+    /// +0.5 mm and fall −0.5 mm (exact: the levels are 0), at that cell, with no fitted
+    /// time; one "excursion" height (≈ 0) or the impulse's 2 mm would fail.
+    #[test]
+    fn an_impulse_reports_its_rise_and_fall() {
+        let n = 1024;
+        let s = frame(|i| if (300..304).contains(&i) { 2.0 } else { 0.0 }, n, 5);
+        let t = Thresholds::new(&HaarNoise::new(0.05, 1.0).unwrap(), n, 5, 0.01).unwrap();
+        let r = detect_events(&s, &t).unwrap();
+        assert_eq!(r.events.len(), 1, "{}", r.text());
+        let e = &r.events[0];
+        assert_eq!(e.shape, Shape::Excursion, "{}", r.text());
+        assert!((e.rise_mm.unwrap() - 0.5).abs() < 1e-9, "{}", r.text());
+        assert!((e.fall_mm.unwrap() + 0.5).abs() < 1e-9, "{}", r.text());
+        assert!(e.rise_sd_mm.unwrap() > 0.0 && e.fall_sd_mm.unwrap() > 0.0);
+        assert_eq!(e.excursion_cell_s, Some((288e-7, 304e-7)));
+        assert!(e.fitted_time_s.is_none());
+        assert!(r.text().contains("rise +0.500"), "{}", r.text());
     }
 
     /// Two steps far apart (down at 100, up at 900 of 1024) are two events; the

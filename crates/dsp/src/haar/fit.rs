@@ -128,31 +128,46 @@ fn variance_of_first(cols: &[Vec<f64>], sigma: f64) -> f64 {
     sigma * sigma * y[0] / m[0][0]
 }
 
+/// The sd of one cell mean under the noise model: a cell mean is Σ ±w over one
+/// coefficient per scale, so its variance is Σ_u sd_u² (`sd_mm` in register order).
+pub(crate) fn cell_sigma(sd_mm: &[f64], scales: u32) -> f64 {
+    (0..=scales)
+        .map(|u| sd_mm[super::register_index(u, 0)].powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
 /// The least-squares transition of a scalogram (module doc), `sd_mm` the noise model's
 /// sd per coefficient (register order, [`super::Thresholds::sd_mm`]); `None` for a frame
 /// with fewer than 4 cells or mismatched `sd_mm`.
 pub fn fit_transition(s: &Scalogram, sd_mm: &[f64]) -> Option<TransitionFit> {
-    let x = s.cell_means_mm();
-    let k = x.len();
-    if k < 4 || sd_mm.len() != s.coefficients.len() {
+    if sd_mm.len() != s.coefficients.len() {
         return None;
     }
-    let tau = s.duration_s() / k as f64;
-    // A cell mean is Σ ±w over one coefficient per scale: its variance is Σ_u sd_u².
-    let sigma = (0..=s.scales)
-        .map(|u| sd_mm[super::register_index(u, 0)].powi(2))
-        .sum::<f64>()
-        .sqrt();
+    let x = s.cell_means_mm();
+    let tau = s.duration_s() / x.len().max(1) as f64;
+    fit_cells(&x, tau, cell_sigma(sd_mm, s.scales))
+}
+
+/// The fit of cell means `x` (cells of duration `tau`, noise sd `sigma` each), times from
+/// the start of `x[0]`: the one implementation behind [`fit_transition`] (a whole frame)
+/// and the single pixel's events (the cells between an event's neighbours,
+/// [`super::events`]). `None` with fewer than 4 cells.
+pub(crate) fn fit_cells(x: &[f64], tau: f64, sigma: f64) -> Option<TransitionFit> {
+    let k = x.len();
+    if k < 4 {
+        return None;
+    }
     let mut fit = (0.0, 0.0, f64::INFINITY);
     for d in [0.0, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0].map(|m| m * tau) {
-        let (t, ssr) = best_time(&x, tau, d);
+        let (t, ssr) = best_time(x, tau, d);
         if ssr < fit.2 {
             fit = (t, d, ssr);
         }
     }
     let (t, d, _) = fit;
     let f = shape(k, tau, t, d);
-    let (_, h, _) = levels(&x, &f);
+    let (_, h, _) = levels(x, &f);
     let eps = 1e-4 * tau;
     let deriv = |g: &dyn Fn(f64) -> Vec<f64>| -> Vec<f64> {
         let (p, m) = (g(eps), g(-eps));

@@ -28,6 +28,16 @@
 //! *step-like*: its duration is below the bound √max(T_U², D̂² + 2 sd) and |rate| above
 //! |h| over that bound, and only those bounds are given. The sd of D̂² and of h/D̂ are the
 //! delta method's (their gradients over the cells, through the same linear noise).
+//!
+//! # Excursions
+//! An event whose net height is not significant (|h| ≤ z sd) is an excursion: the depth
+//! leaves and returns, an impulse's rise and fall. Both are reported with their heights at
+//! the cell of the event's span furthest from the mean of L0 and L1 (cell p): the rise is
+//! x_p − L0 and the fall L1 − x_p. The registers hold cell means, so an excursion shorter
+//! than a cell (τ) inside cell p shows its area: an impulse of height H and width w < τ
+//! gives a rise of H·w/τ and a fall of −H·w/τ (the true height is H = rise·τ/w, at least
+//! the rise's); crates/experiments/tests/it/transients.rs
+//! (`a_step_and_an_impulse_are_one_event_each_for_every_seed`) checks that on the model.
 
 use serde::{Deserialize, Serialize};
 
@@ -91,6 +101,13 @@ pub(crate) struct Measured {
     pub mean_rate_sd_m_per_s: Option<f64>,
     pub duration_upper_bound_s: Option<f64>,
     pub abs_rate_lower_bound_m_per_s: Option<f64>,
+    /// An excursion's rise and fall (mm) with their sd (module doc, "Excursions").
+    pub rise_mm: Option<f64>,
+    pub rise_sd_mm: Option<f64>,
+    pub fall_mm: Option<f64>,
+    pub fall_sd_mm: Option<f64>,
+    /// The cell the excursion's rise and fall are measured at: [start, end) (s).
+    pub excursion_cell_s: Option<(f64, f64)>,
 }
 
 impl<'a> Profile<'a> {
@@ -168,6 +185,17 @@ impl<'a> Profile<'a> {
         let var: f64 = mass.iter().map(|(t, p)| (t - mean).powi(2) * p).sum();
         let tau = (self.time_s(e) - self.time_s(s)) / (e - s) as f64;
         12.0 * var - tau * tau
+    }
+
+    /// The least-squares transition of cells [a, b) ([`super::fit::fit_cells`], the one
+    /// implementation), its time from the frame start; `None` under 4 cells.
+    pub(crate) fn fit(&self, a: usize, b: usize) -> Option<super::fit::TransitionFit> {
+        let tau = (self.time_s(b) - self.time_s(a)) / b.saturating_sub(a).max(1) as f64;
+        let sigma = super::fit::cell_sigma(self.sd_mm, self.scales);
+        super::fit::fit_cells(&self.cells[a..b], tau, sigma).map(|mut f| {
+            f.time_s += self.time_s(a);
+            f
+        })
     }
 
     /// Mean of cells [a, b) as weights.
@@ -265,7 +293,13 @@ impl<'a> Profile<'a> {
             mean_rate_sd_m_per_s: None,
             duration_upper_bound_s: None,
             abs_rate_lower_bound_m_per_s: None,
+            rise_mm: None,
+            rise_sd_mm: None,
+            fall_mm: None,
+            fall_sd_mm: None,
+            excursion_cell_s: None,
         };
+        let (s0, e0) = (s, e);
         // A guard of one finest wavelet each side: a transition's faint ends (a ramp's end
         // inside a finest wavelet) may fall short of the threshold, outside the leaves.
         let s = s.saturating_sub(GUARD).max(prev_end);
@@ -284,6 +318,24 @@ impl<'a> Profile<'a> {
         m.height_sd_mm = Some(sd_h);
         if h.abs() <= z * sd_h {
             m.shape = Shape::Excursion;
+            // The cell of the event's own span furthest from the mean of the two levels.
+            let base = 0.5 * (self.linear(&after).0 + self.linear(&before).0);
+            let p = (s0..e0)
+                .max_by(|&a, &b| {
+                    (self.cells[a] - base)
+                        .abs()
+                        .total_cmp(&(self.cells[b] - base).abs())
+                })
+                .unwrap_or(s0);
+            let unit = self.window(p, p + 1);
+            let rise: Vec<f64> = unit.iter().zip(&before).map(|(a, b)| a - b).collect();
+            let fall: Vec<f64> = after.iter().zip(&unit).map(|(a, b)| a - b).collect();
+            let ((r, sd_r), (f, sd_f)) = (self.linear(&rise), self.linear(&fall));
+            m.rise_mm = Some(r);
+            m.rise_sd_mm = Some(sd_r);
+            m.fall_mm = Some(f);
+            m.fall_sd_mm = Some(sd_f);
+            m.excursion_cell_s = Some((self.time_s(p), self.time_s(p + 1)));
             return m;
         }
         let d2 = self.duration_squared(&self.cells, s, e, (b0, a1));

@@ -83,10 +83,27 @@ fn a_slow_ramp_is_one_event_with_its_rate_for_every_seed() {
 /// step-like (no duration resolved): its duration is bounded by one finest wavelet (or a little more when the
 /// noise allows: below two), its
 /// |rate| from below by |h|/T_6, its height is +10 mm within 5 sd, and the paper's
-/// estimator is flagged as averaged over a longer wavelet. The impulse has no net height.
+/// estimator is flagged as averaged over a longer wavelet.
+///
+/// The step's fitted time (the least-squares fit, `fitted_time_s`) lies within 4 of its
+/// stated sd of 23.3 ms (+0.1 µs, one pulse: the model steps at a pulse), the stated sd
+/// is that of a 10 mm step inside a cell of τ = 0.41 ms whose mean has sd σ_c = 3.01 mm
+/// (20 ps jitter, 0.75 mm LSB)/√4096 = 0.047 mm: σ_c·τ/h = 1.93 µs, the fitted levels
+/// adding a little, more when the fit takes a short ramp and its duration is a fourth
+/// parameter (2.7 µs in seed 3): between 1.7 and 4 µs, and the rms error over the 10 seeds
+/// is the stated sd within [0.4, 2] (χ²₁₀ puts 99.8 % of the ratio inside). The wavelet
+/// span's centre, 0.2 ms away at most, would miss by ≫ 4 sd.
+///
+/// The 100 µs impulse has no net height; it reports its rise and fall at the cell that
+/// holds it (29.9008–30.3104 ms, τ = 0.4096 ms): its mean rises by H·w/τ =
+/// 3 × 0.1/0.4096 = 0.7324 mm and falls back by as much, within 4 of their stated sd
+/// (+0.01 mm for the model's bias, 0.5 % of a 10 mm step above); one excursion height
+/// (≈ 0 mm, 5.6 sd off) or the impulse's 3 mm would fail.
 #[test]
 fn a_step_and_an_impulse_are_one_event_each_for_every_seed() {
     let impulse = "[[scene.motion]]\nkind = \"impulse\"\nstart_s = 30.1e-3\nwidth_s = 1.0e-4\nheight_mm = 3.0\n";
+    let (mut sq, mut stated) = (0.0, 0.0);
+    let expected = 3.0 * 1e-4 / (T6 / 2.0);
     for seed in SEEDS {
         let (ev, text) = events(&step(23.3e-3, 10.0), seed);
         assert_eq!(ev.len(), 1, "seed {seed}:\n{text}");
@@ -100,6 +117,15 @@ fn a_step_and_an_impulse_are_one_event_each_for_every_seed() {
         let lb = e.abs_rate_lower_bound_m_per_s.unwrap();
         assert!((lb - h / ub * 1e-3).abs() < 1e-12, "{text}");
         assert!(e.duration_s.is_none() && e.mean_rate_m_per_s.is_none());
+        let (ft, fsd) = (e.fitted_time_s.unwrap(), e.fitted_time_sd_s.unwrap());
+        assert!(
+            (ft - 23.3e-3).abs() < 4.0 * fsd + 1e-7,
+            "seed {seed}:\n{text}"
+        );
+        assert!((1.7e-6..4e-6).contains(&fsd), "seed {seed}:\n{text}");
+        assert!(text.contains("fitted time"), "{text}");
+        sq += (ft - 23.3e-3).powi(2);
+        stated += fsd;
         assert!(e.peak_wavelet_longer_than_event, "{text}");
         assert!(
             text.contains("step-like") && text.contains("not its rate"),
@@ -108,9 +134,29 @@ fn a_step_and_an_impulse_are_one_event_each_for_every_seed() {
 
         let (ev, text) = events(impulse, seed);
         assert_eq!(ev.len(), 1, "seed {seed}:\n{text}");
-        assert_eq!(ev[0].shape, Shape::Excursion, "seed {seed}:\n{text}");
-        assert!(ev[0].mean_rate_m_per_s.is_none(), "{text}");
+        let e = &ev[0];
+        assert_eq!(e.shape, Shape::Excursion, "seed {seed}:\n{text}");
+        assert!(e.mean_rate_m_per_s.is_none(), "{text}");
+        let (a, b) = e.excursion_cell_s.unwrap();
+        assert!((a - 29.9008e-3).abs() < 1e-12 && (b - 30.3104e-3).abs() < 1e-12);
+        let (r, sd) = (e.rise_mm.unwrap(), e.rise_sd_mm.unwrap());
+        assert!(
+            (r - expected).abs() < 4.0 * sd + 0.01,
+            "seed {seed}:\n{text}"
+        );
+        let (f, sd) = (e.fall_mm.unwrap(), e.fall_sd_mm.unwrap());
+        assert!(
+            (f + expected).abs() < 4.0 * sd + 0.01,
+            "seed {seed}:\n{text}"
+        );
+        assert!(
+            text.contains("rise +0.") && text.contains("fall -0."),
+            "{text}"
+        );
     }
+    let n = SEEDS.count() as f64;
+    let ratio = (sq / n).sqrt() / (stated / n);
+    assert!((0.4..2.0).contains(&ratio), "rms error / stated sd {ratio}");
 }
 
 /// Two steps 4.6 ms apart (steady depth between them) stay two events for every seed,
@@ -127,6 +173,9 @@ fn two_steps_a_few_ms_apart_stay_two_for_every_seed() {
                 assert_eq!(e.shape, Shape::Step, "{text}");
                 let (hm, sd) = (e.height_mm.unwrap(), e.height_sd_mm.unwrap());
                 assert!((hm - h).abs() < 5.0 * sd + 0.05, "{text}");
+                // Each step's own fitted time (4 sd + one pulse, as above).
+                let (ft, fsd) = (e.fitted_time_s.unwrap(), e.fitted_time_sd_s.unwrap());
+                assert!((ft - at).abs() < 4.0 * fsd + 1e-7, "{text}");
             }
         }
     }
