@@ -65,10 +65,11 @@ module {{ name }} #(
     localparam integer GW = (BEAT_CYCLES > 2) ? $clog2(BEAT_CYCLES) : 1;
     localparam integer SW = (SLOT > 2) ? $clog2(SLOT) : 1;
     // The sequencer's hold (double-buffered): the walk beyond the frame's N·C + 1 cycles, in
-    // 64 bits; its counter's width QW + SW bounds it (WAIT < (PIXELS + 1)·SLOT).
+    // 64 bits, and the width of its counter (the least that holds WAIT).
     localparam [63:0] WALK = 64'd0 + PIXELS * 64'd1 * SLOT + 64'd1;
     localparam [63:0] ACC = 64'd{{ acc }};
     localparam [63:0] WAIT = ({% if dbuf %}1{% else %}0{% endif %} != 0 && WALK > ACC + 64'd1) ? WALK - ACC - 64'd1 : 64'd0;
+    localparam integer HW = (WAIT + 64'd1 > 64'd2) ? $clog2(WAIT + 64'd1) : 1;
     localparam integer K_LAST = K - 1;
     localparam integer G_LAST = BEAT_CYCLES - 1;
     localparam [IB - 1:0] LAST_WORD = R[IB - 1:0];
@@ -98,7 +99,7 @@ module {{ name }} #(
         .RW(RW),
         .CW(CW),
         .SW(SW),
-        .HW(QW + SW),
+        .HW(HW),
         .WAIT(WAIT)
     ) u_sequencer (
         .clk(clk),
