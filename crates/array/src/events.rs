@@ -5,8 +5,10 @@
 //! the fitted centre of the transition and its Cramér–Rao sd under the closed-form noise
 //! of the scene's static depth. A pixel whose fitted |height| is below 8 σ of a segment
 //! mean has no transition (its time is −1 in the map). The edge's velocity comes from the
-//! weighted least-squares plane t = t0 + g·(x, y) over the pixels with a transition,
-//! weights 1/sd²: speed 1/|g|, direction atan2(g_y, g_x).
+//! weighted least-squares plane t = t0 + g·(x, y) over the pixels with a transition at
+//! least 3 sd inside the frame's first and last segments (nearer, the fit sees less than a
+//! segment of level on one side and its time is censored), weights 1/sd²: speed 1/|g|,
+//! direction atan2(g_y, g_x).
 
 use serde::Serialize;
 use tofprobe_design::ResolvedDesign;
@@ -47,9 +49,15 @@ pub fn event_map(design: &ResolvedDesign, frame: &ArrayFrame) -> EventMap {
         .and_then(|noise| Thresholds::new(&noise, n as usize, u, FAMILY_RATE))
         .map(|t| t.sd_mm)
         .unwrap_or_default();
+    // A time within 3 sd of a segment from the frame's start or end is censored: the fit
+    // has less than a segment of level on that side, and its times there bias the plane.
+    let frame_s = n as f64 / s.laser_rate_hz;
+    let segment_s = frame_s / segments as f64;
+    let inside = |t: f64, sd: f64| t - 3.0 * sd > segment_s && t + 3.0 * sd < frame_s - segment_s;
     let mut time_ms = vec![-1.0; frame.rows * frame.cols];
     let mut time_sd_ms = vec![-1.0; frame.rows * frame.cols];
     let mut points = Vec::new();
+    let mut events = 0;
     for (p, (t, sd)) in time_ms.iter_mut().zip(&mut time_sd_ms).enumerate() {
         let (r, c) = (p / frame.cols, p % frame.cols);
         // The frame holds 2^(U+1) − 1 words per pixel.
@@ -63,7 +71,11 @@ pub fn event_map(design: &ResolvedDesign, frame: &ArrayFrame) -> EventMap {
                 *t = f.time_s * 1e3;
                 *sd = f.time_sd_s * 1e3;
                 let w = 1.0 / f.time_sd_s.powi(2).max(f64::MIN_POSITIVE);
-                points.push(((c as f64 + 0.5) * mm, (r as f64 + 0.5) * mm, f.time_s, w));
+                let at = ((c as f64 + 0.5) * mm, (r as f64 + 0.5) * mm, f.time_s, w);
+                events += 1;
+                if inside(f.time_s, f.time_sd_s) {
+                    points.push(at);
+                }
             }
             _ => {}
         }
@@ -77,7 +89,7 @@ pub fn event_map(design: &ResolvedDesign, frame: &ArrayFrame) -> EventMap {
     EventMap {
         time_ms,
         time_sd_ms,
-        pixels: points.len(),
+        pixels: events,
         velocity_mm_per_s: velocity.filter(|v| v.is_finite()),
         direction_deg: direction.filter(|d| d.is_finite()),
     }
