@@ -239,7 +239,8 @@ module {{ name }} #(
             wire [R - 1:0] next_word = b_word;
 {%- endif %}
 {%- endif %}
-            always @(posedge clk) begin
+            // `keep` on the block too: yosys merges equal flops whose wires alone are kept.
+            (* keep *) always @(posedge clk) begin
                 if (rst) begin
                     pulse_q <= 1'b0;
                     ro_q <= 1'b0;

@@ -162,7 +162,8 @@ module tofprobe_array #(
             assign r_word[lr * R +: R] = word_q;
             wire next_pulse = b_pulse;
             wire [R - 1:0] next_word = b_word;
-            always @(posedge clk) begin
+            // `keep` on the block too: yosys merges equal flops whose wires alone are kept.
+            (* keep *) always @(posedge clk) begin
                 if (rst) begin
                     pulse_q <= 1'b0;
                     ro_q <= 1'b0;
