@@ -35,13 +35,7 @@ module tofprobe_top (
         .PIXELS(1),
         .COLS(1),
         .SLOT(33),
-        .DOUBLE_BUFFER(0),
-        .QW(1),
-        .RW(1),
-        .CW(1),
-        .SW(6),
-        .HW(1),
-        .WAIT(64'd0)
+        .DOUBLE_BUFFER(0)
     ) u_sequencer (
         .clk(clk),
         .rst(rst),

@@ -112,13 +112,7 @@ module {{ name }} (
         .PIXELS(1),
         .COLS(1),
         .SLOT({{ r + 1 }}),
-        .DOUBLE_BUFFER(0),
-        .QW(1),
-        .RW(1),
-        .CW(1),
-        .SW({{ sw1 }}),
-        .HW(1),
-        .WAIT(64'd0)
+        .DOUBLE_BUFFER(0)
     ) u_sequencer (
         .clk(clk),
         .rst(rst),

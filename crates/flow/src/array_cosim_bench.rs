@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 use tofprobe_cosim::array::Layout;
 use tofprobe_design::{ResolvedDesign, resolve};
+use tofprobe_io::cpu::children_cpu_seconds;
 
 use crate::array::{ArrayCosimOptions, cosim_array};
 use crate::error::FlowError;
@@ -42,17 +43,6 @@ pub struct CosimBenchReport {
     /// Flat over hierarchical tools' CPU seconds (both measured): above 1, the hierarchical
     /// build is the cheaper.
     pub flat_over_hierarchical_build_cpu: Option<f64>,
-}
-
-/// CPU seconds (user + system) of this process's waited-for children (Linux /proc: fields
-/// cutime and cstime, 100 ticks/s). `None` elsewhere.
-pub fn children_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = stat.rsplit_once(')')?.1;
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let cutime: f64 = f.get(13)?.parse().ok()?;
-    let cstime: f64 = f.get(14)?.parse().ok()?;
-    Some((cutime + cstime) / 100.0)
 }
 
 /// `base` (which must have an `[array]` table) at `rows` × `cols` pixels.

@@ -15,6 +15,7 @@
 mod atomic;
 pub mod bounded;
 pub mod cache;
+pub mod cpu;
 pub mod disk;
 pub mod live;
 pub mod lock;

@@ -279,8 +279,6 @@ struct TopT<'a> {
     pixel_name: &'a str,
     rom_name: &'a str,
     seq_name: &'a str,
-    /// The sequencer's slot counter width walking one pixel (SLOT = R + 1).
-    sw1: u32,
     fourier: bool,
     t: u32,
     w: u32,
@@ -561,7 +559,6 @@ pub(crate) fn render_set(
         pixel_name: &pixel_name,
         rom_name: &rom_name,
         seq_name: &seq_name,
-        sw1: clog2(r as u64 + 1),
         fourier,
         t: p.tdc_bits,
         w: p.width,

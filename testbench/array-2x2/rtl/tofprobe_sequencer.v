@@ -16,9 +16,10 @@ module tofprobe_sequencer #(
     parameter integer COLS = 1,
     parameter integer SLOT = 5,
     parameter integer DOUBLE_BUFFER = 0,
-    // The counters' widths, set by the instantiating top: the walk's pixel index (its end
-    // value PIXELS included), row, column, slot cycle and hold (none is derived here: Icarus
-    // 11 crashes evaluating $clog2 parameters beside the gate-level cell models).
+    // The counters' widths: the walk's pixel index (its end value PIXELS included), row,
+    // column, slot cycle and hold. The defaults are the single pixel's walk; the array's
+    // top sets them (none is derived here: Icarus 11 crashes evaluating $clog2 parameters
+    // beside the gate-level cell models).
     parameter integer QW = 1,
     parameter integer RW = 1,
     parameter integer CW = 1,
