@@ -10,6 +10,7 @@
 //! segment of level on one side and its time is censored), weights 1/sd²: speed 1/|g|,
 //! direction atan2(g_y, g_x).
 
+use rayon::prelude::*;
 use serde::Serialize;
 use tofprobe_design::ResolvedDesign;
 use tofprobe_dsp::haar::analysis::Scalogram;
@@ -54,30 +55,36 @@ pub fn event_map(design: &ResolvedDesign, frame: &ArrayFrame) -> EventMap {
     let frame_s = n as f64 / s.laser_rate_hz;
     let segment_s = frame_s / segments as f64;
     let inside = |t: f64, sd: f64| t - 3.0 * sd > segment_s && t + 3.0 * sd < frame_s - segment_s;
+    // The fits are independent: in parallel on the caller's pool, collected in pixel order
+    // and accumulated serially, so the map and the plane are the same on any thread count.
+    let fits: Vec<Option<(f64, f64)>> = (0..frame.rows * frame.cols)
+        .into_par_iter()
+        .map(|p| {
+            let (r, c) = (p / frame.cols, p % frame.cols);
+            // The frame holds 2^(U+1) − 1 words per pixel.
+            let scalogram =
+                Scalogram::from_registers(frame.pixel(r, c), n, u, s.tdc_lsb_mm(), s.laser_rate_hz)
+                    .ok()?;
+            fit_transition(&scalogram, &sd_mm)
+                .filter(|f| f.height_mm.abs() >= min_step && f.time_sd_s.is_finite())
+                .map(|f| (f.time_s, f.time_sd_s))
+        })
+        .collect();
     let mut time_ms = vec![-1.0; frame.rows * frame.cols];
     let mut time_sd_ms = vec![-1.0; frame.rows * frame.cols];
     let mut points = Vec::new();
     let mut events = 0;
-    for (p, (t, sd)) in time_ms.iter_mut().zip(&mut time_sd_ms).enumerate() {
-        let (r, c) = (p / frame.cols, p % frame.cols);
-        // The frame holds 2^(U+1) − 1 words per pixel.
-        let Ok(scalogram) =
-            Scalogram::from_registers(frame.pixel(r, c), n, u, s.tdc_lsb_mm(), s.laser_rate_hz)
-        else {
+    for (p, fit) in fits.into_iter().enumerate() {
+        let Some((time_s, time_sd_s)) = fit else {
             continue;
         };
-        match fit_transition(&scalogram, &sd_mm) {
-            Some(f) if f.height_mm.abs() >= min_step && f.time_sd_s.is_finite() => {
-                *t = f.time_s * 1e3;
-                *sd = f.time_sd_s * 1e3;
-                let w = 1.0 / f.time_sd_s.powi(2).max(f64::MIN_POSITIVE);
-                let at = ((c as f64 + 0.5) * mm, (r as f64 + 0.5) * mm, f.time_s, w);
-                events += 1;
-                if inside(f.time_s, f.time_sd_s) {
-                    points.push(at);
-                }
-            }
-            _ => {}
+        let (r, c) = (p / frame.cols, p % frame.cols);
+        time_ms[p] = time_s * 1e3;
+        time_sd_ms[p] = time_sd_s * 1e3;
+        let w = 1.0 / time_sd_s.powi(2).max(f64::MIN_POSITIVE);
+        events += 1;
+        if inside(time_s, time_sd_s) {
+            points.push(((c as f64 + 0.5) * mm, (r as f64 + 0.5) * mm, time_s, w));
         }
     }
     let (velocity, direction) = match fit_plane(&points) {
