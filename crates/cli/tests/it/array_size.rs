@@ -4,6 +4,8 @@
 //! readout timing of the whole array (3 × 5 ≤ 64 pixels); a readout that does not fit the
 //! frame rate refused with the bandwidth that would.
 
+use crate::common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -66,7 +68,7 @@ fn a_three_by_five_array_is_sized_against_the_readout_contract() {
             "--sweep-bins",
             "1",
         ],
-        &dir.join("cache"),
+        common::shared_synth_cache(),
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
@@ -185,7 +187,7 @@ fn a_superpixel_array_reports_memory_and_area_per_spad() {
             "--sweep-bins",
             "1",
         ],
-        &dir.join("cache"),
+        common::shared_synth_cache(),
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
@@ -240,7 +242,7 @@ fn a_frame_rate_the_readout_cannot_reach_is_refused_with_the_bandwidth_that_woul
     );
     let out = size(
         &[cfg.to_str().unwrap(), "--no-sky130", "--json"],
-        &dir.join("cache"),
+        common::shared_synth_cache(),
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
@@ -252,7 +254,7 @@ fn a_frame_rate_the_readout_cannot_reach_is_refused_with_the_bandwidth_that_woul
     let ok = config(&dir, 2, 2, "");
     let out = size(
         &[ok.to_str().unwrap(), "--no-sky130", "--utilisation", "1.5"],
-        &dir.join("cache"),
+        common::shared_synth_cache(),
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");

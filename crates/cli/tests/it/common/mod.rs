@@ -157,3 +157,31 @@ pub fn run_limited(
     }
     Ok((status.code(), err, t0.elapsed().as_secs_f64()))
 }
+
+/// One synthesis cache for the tests that only read what a synthesis reports (its keys are
+/// the design's and the liberty's content, and it serves concurrent runs:
+/// `concurrency::the_synthesis_cache_rebuilds_a_half_written_netlist_and_serves_concurrent_runs`),
+/// so a pixel several tests size is synthesised once per liberty in a run, not once per
+/// test (the tiny pixel of size.rs and array_size.rs: 17 syntheses of 4 designs). A test
+/// about the cache itself, a missing tool before synthesis, or the files a synthesis
+/// writes keeps its own. Fresh for each run of the test binary (a stale cache could hide
+/// a synthesis regression between runs); the directories of finished runs are removed.
+pub fn shared_synth_cache() -> &'static Path {
+    static DIR: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        let root = Path::new(env!("CARGO_TARGET_TMPDIR"));
+        let prefix = "synth-cache-";
+        for e in std::fs::read_dir(root).into_iter().flatten().flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if let Some(pid) = name.strip_prefix(prefix)
+                && !Path::new("/proc").join(pid).exists()
+            {
+                let _ = std::fs::remove_dir_all(e.path());
+            }
+        }
+        let dir = root.join(format!("{prefix}{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("the shared synthesis cache");
+        dir
+    })
+}
