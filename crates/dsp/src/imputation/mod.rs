@@ -139,11 +139,14 @@ impl AlphaBeta {
         } else {
             f64::INFINITY
         };
-        Ok(AlphaBeta {
+        let g = AlphaBeta {
             alpha,
             beta,
             gate_mm,
-        })
+        };
+        // σ_a = 0 gives α = 0: a filter that never moves (refused, naming α).
+        g.check()?;
+        Ok(g)
     }
 
     /// Detections before the gate applies: ⌈1/α⌉, the depth's settling time in
@@ -275,7 +278,7 @@ impl Imputer {
         self.accepted += 1;
     }
 
-    /// The Kalman gain the next detection would see after a prediction (tests).
+    /// The state [d, v] and covariance (P_dd, P_dv, P_vv) after the last pulse (tests).
     #[cfg(test)]
     pub(crate) fn state(&self) -> ([f64; 2], [f64; 3]) {
         (self.x, self.p)

@@ -282,6 +282,12 @@ fn bad_parameters_rejected() {
             .contains("alpha")
     );
     assert!(AlphaBeta::from_kalman(&k, 0.0).is_err());
+    let still = KalmanParams {
+        process_noise: 0.0,
+        ..k
+    };
+    let e = AlphaBeta::from_kalman(&still, 0.1).unwrap_err();
+    assert!(e.to_string().contains("alpha"), "{e}");
     // The physics defaults give power-of-two gains and a finite gate.
     assert_eq!(g.alpha.log2().fract(), 0.0);
     assert_eq!(g.beta.log2().fract(), 0.0);
