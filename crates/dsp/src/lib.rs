@@ -9,6 +9,7 @@ pub mod closed_form;
 pub mod dft;
 pub mod error;
 pub mod haar;
+pub mod imputation;
 pub mod preprocess;
 pub mod rom;
 pub mod sd;

@@ -2,7 +2,10 @@
 //! time-window zoom, 1NN missing-pulse hold with priming, and the first-order prefilter.
 //!
 //! Per pulse n with detection d[n] (depth minus the zoom offset, or none):
-//! - **hold**: held[n] = d[n] if detected, else held[n−1];
+//! - **hold**: held[n] = d[n] if detected, else held[n−1] (the pixel's imputation; beyond
+//!   the paper, [`FrontEnd::with_imputation`] puts a constant-velocity Kalman filter or
+//!   its fixed-gain α-β form in its place, [`crate::imputation`]: held[n] is then the
+//!   filter's depth after pulse n, and everything below is unchanged);
 //! - **priming**: pulses before the first detection contribute nothing (output 0, which
 //!   adds nothing to any linear accumulator, exactly as the pixel's `acc_en = 0`);
 //! - **raw output** (the DFT/Haar reference, no prefilter): y[n] = held[n] once primed,
@@ -23,6 +26,7 @@ use std::f64::consts::PI;
 use rustfft::num_complex::Complex64;
 
 use crate::error::DspError;
+use crate::imputation::{Imputation, Imputer};
 
 /// Which signal the front end outputs.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,6 +42,7 @@ pub enum FrontEndOutput {
 pub struct FrontEnd {
     zoom: f64,
     output: FrontEndOutput,
+    imputer: Imputer,
     primed: bool,
     held: f64,
     x: f64,
@@ -60,11 +65,25 @@ impl FrontEnd {
         Ok(Self::unchecked(zoom, output))
     }
 
+    /// [`FrontEnd::new`] with `imputation` in place of the 1NN hold (its parameters
+    /// checked, [`Imputation::check`]).
+    pub fn with_imputation(
+        zoom: f64,
+        output: FrontEndOutput,
+        imputation: Imputation,
+    ) -> Result<Self, DspError> {
+        imputation.check()?;
+        let mut fe = Self::new(zoom, output)?;
+        fe.imputer = Imputer::new(imputation);
+        Ok(fe)
+    }
+
     /// The front end without the argument checks (callers whose α is the pixel's 2^−S).
     pub(crate) fn unchecked(zoom: f64, output: FrontEndOutput) -> Self {
         FrontEnd {
             zoom,
             output,
+            imputer: Imputer::new(Imputation::Hold),
             primed: false,
             held: 0.0,
             x: 0.0,
@@ -76,10 +95,10 @@ impl FrontEnd {
     #[inline]
     pub fn step(&mut self, detection: Option<f64>) -> f64 {
         self.pulses += 1;
-        let d = detection.map(|v| v - self.zoom);
+        let imputed = self.imputer.step(detection.map(|v| v - self.zoom));
         match self.output {
             FrontEndOutput::Held => {
-                if let Some(d) = d {
+                if let Some(d) = imputed {
                     self.held = d;
                     self.primed = true;
                 }
@@ -92,7 +111,7 @@ impl FrontEnd {
                 } else {
                     0.0
                 };
-                if let Some(d) = d {
+                if let Some(d) = imputed {
                     if !self.primed {
                         self.primed = true;
                         self.x = d;
@@ -123,7 +142,7 @@ impl FrontEnd {
     pub fn primed(&self) -> bool {
         self.primed
     }
-    /// The held depth (after zoom).
+    /// The held (imputed) depth (after zoom).
     pub fn held(&self) -> f64 {
         self.held
     }

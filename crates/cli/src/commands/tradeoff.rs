@@ -1,11 +1,15 @@
-//! `tofprobe tradeoff [CONFIG...] [--json] [--out DIR] [--verilator] [--knobs] [--skips]`:
+//! `tofprobe tradeoff [CONFIG...] [--json] [--out DIR] [--verilator] [--knobs] [--skips]
+//! [--imputation]`:
 //! every fidelity level on each configuration (the embedded default without one), timed
 //! per simulated second and scored against the float DFT and the scene's truth (a Haar
 //! pixel: float Haar, bit-true, cycle-accurate, Verilator, scored by the coefficient error
 //! against the float Haar and the event time error, `tradeoff::haar`); with
 //! `--knobs` the bit-true knob sweep ([`tofprobe_experiments::tradeoff::knobs::DEFAULT_SWEEP`]) and with
 //! `--skips` the skipped-stage speedups, both on a frame of at most `--sweep-pulses` and
-//! timed as the median of `--reps` runs. Markdown tables on stdout (or one JSON object),
+//! timed as the median of `--reps` runs; with `--imputation` the motion-model imputation
+//! (Kalman, α-β) against the 1NN hold on Table 2's scenes and its pixel cost
+//! ([`tofprobe_experiments::tradeoff::imputation`], once, not per configuration; JSON key
+//! `imputation`). Markdown tables on stdout (or one JSON object),
 //! and with `--out` the tables (`tradeoff.md`) and the Pareto plot (`pareto.svg`),
 //! written atomically.
 
@@ -15,6 +19,8 @@ use clap::Args;
 use serde::Serialize;
 
 use tofprobe_experiments::tradeoff::haar::{self, HaarSceneResult, measure_haar};
+use tofprobe_experiments::tradeoff::imputation::{self, ImputationReport};
+use tofprobe_experiments::tradeoff::imputation_cost::CellAreas;
 use tofprobe_experiments::tradeoff::knobs::{self, DEFAULT_SWEEP, KnobSweep};
 use tofprobe_experiments::tradeoff::skips::{self, SkipReport, measure_skips};
 use tofprobe_experiments::tradeoff::{SceneResult, markdown, measure, plot::pareto_svg_text};
@@ -52,6 +58,17 @@ pub struct TradeoffArgs {
     /// Timing runs per knob setting and per skip measurement (the median is reported).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..=100))]
     reps: u64,
+    /// Also compare the motion-model imputation (Kalman filter, its α-β form) with the
+    /// 1NN hold on Table 2's scenes at ρ_s 0.03–0.3, with its pixel cost (sky130 cells).
+    #[arg(long)]
+    imputation: bool,
+    /// Pulses per record of `--imputation` (Table 2's 10^7 by default; ≈ 2 s of CPU per
+    /// record and method).
+    #[arg(long, default_value_t = 10_000_000, value_parser = clap::value_parser!(u64).range(1_048_576..))]
+    imputation_pulses: u64,
+    /// Seeds per scene of `--imputation`.
+    #[arg(long, default_value_t = imputation::DEFAULT_SEEDS as u64, value_parser = clap::value_parser!(u64).range(2..=64))]
+    imputation_seeds: u64,
     /// Write tradeoff.md and pareto.svg into this directory.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -66,6 +83,8 @@ struct JsonOut<'a> {
     knobs: &'a [KnobSweep],
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     skips: &'a [SkipReport],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    imputation: Option<&'a ImputationReport>,
 }
 
 /// Runs the command.
@@ -120,6 +139,15 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
             skip_reports.push(sk);
         }
     }
+    let imputation_report = if args.imputation {
+        let cells = CellAreas::sky130()?;
+        let seeds = usize::try_from(args.imputation_seeds).unwrap_or(2);
+        let r = imputation::measure(args.imputation_pulses, seeds, cells.as_ref())?;
+        tables.push(imputation::markdown(&r));
+        Some(r)
+    } else {
+        None
+    };
     let table = tables.join("\n");
     if let Some(dir) = &args.out {
         // One set, whole or absent (tofprobe_io::OutputSet), the table last.
@@ -144,6 +172,7 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
                 haar_scenes: &haar_scenes,
                 knobs: &sweeps,
                 skips: &skip_reports,
+                imputation: imputation_report.as_ref(),
             })?
         );
     } else {

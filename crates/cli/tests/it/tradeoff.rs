@@ -300,3 +300,50 @@ fn closed_form_level_models_background_pile_up() {
         "closed-form noise {cf_noise} µm vs DFT {noise} µm"
     );
 }
+
+/// `--imputation` on short records: every Table 2 scene at ρ_s 0.03–0.3 has the three
+/// methods with finite figures under unit-named keys, and the pixel cost its rows from
+/// the vendored sky130 cells (the α-β form needs no multiplier, the Kalman filter does).
+#[test]
+fn tradeoff_imputation_section() {
+    let dir = std::env::temp_dir().join(format!("tofprobe-imputation-{}", std::process::id()));
+    let cfg = tiny_config(&dir, 1 << 12);
+    let res = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .args(["tradeoff", cfg.to_str().unwrap(), "--json", "--imputation"])
+        .args(["--imputation-pulses", "1048576", "--imputation-seeds", "2"])
+        .output()
+        .expect("run");
+    assert!(
+        res.status.success(),
+        "{}",
+        String::from_utf8_lossy(&res.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&res.stdout).expect("one JSON object");
+    let imp = &v["imputation"];
+    assert_eq!(imp["pulses"].as_u64(), Some(1 << 20));
+    let scenes = imp["scenes"].as_array().expect("scenes");
+    // Table 2: ρ_s 0.1 and 0.03 without background, 0.3 at six rates and without.
+    assert_eq!(scenes.len(), 9);
+    for sc in scenes {
+        let methods = sc["methods"].as_array().expect("methods");
+        assert_eq!(methods.len(), 3);
+        for m in methods {
+            for key in ["noise_floor_um", "amplitude_um", "noise_at_tone_um"] {
+                let x = m[key]["mean"].as_f64().unwrap_or(f64::NAN);
+                assert!(x.is_finite() && x > 0.0, "{key} of {m}");
+            }
+        }
+    }
+    let cost = imp["pixel_cost"].as_array().expect("pixel cost");
+    let form = |name: &str| {
+        cost.iter()
+            .find(|r| r["form"].as_str().is_some_and(|f| f.starts_with(name)))
+            .unwrap_or_else(|| panic!("form {name}"))
+    };
+    assert_eq!(form("alpha-beta")["multipliers"].as_u64(), Some(0));
+    assert!(form("Kalman")["multipliers"].as_u64() > Some(0));
+    let area = |name: &str| form(name)["area_um2"].as_f64().expect("area");
+    assert!(area("1NN hold") > 0.0 && area("1NN hold") < area("alpha-beta"));
+    assert!(area("alpha-beta") < area("Kalman"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

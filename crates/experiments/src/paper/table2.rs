@@ -31,8 +31,9 @@ mod probe_runs;
 mod rows;
 mod spec;
 pub use closed_form::{
-    band_bins, closed_form_amp_um, closed_form_noise_on_bins_um, closed_form_noise_um,
-    largest_bin_um, peak_band_bins, snr_closed_db,
+    band_bins, closed_form_amp_for, closed_form_amp_um, closed_form_noise_on_bins_for,
+    closed_form_noise_on_bins_um, closed_form_noise_um, largest_bin_um, peak_band_bins,
+    snr_closed_db,
 };
 pub use probe_runs::{ProbeRecord, ProbeRun};
 pub use rows::{
@@ -147,7 +148,7 @@ pub const COLUMNS: &[Column] = &[
 ];
 
 /// Bin of the tone in an N-point record.
-fn tone_bin(n: usize) -> usize {
+pub fn tone_bin(n: usize) -> usize {
     (F0_HZ * n as f64 / FS_HZ).round() as usize
 }
 

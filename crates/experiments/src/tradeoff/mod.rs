@@ -6,6 +6,8 @@
 //! float full DFT and against the scene's true amplitude.
 
 pub mod haar;
+pub mod imputation;
+pub mod imputation_cost;
 pub mod knobs;
 pub mod overrides;
 pub mod plot;

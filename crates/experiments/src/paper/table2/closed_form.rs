@@ -46,6 +46,18 @@ pub fn closed_form_noise_on_bins_um(
     n: usize,
     bins: &[u64],
 ) -> Result<f64, ExperimentError> {
+    closed_form_noise_on_bins_for(spec, n, bins, &|rho, w| Ok(hold_noise_factor(rho, w)))
+}
+
+/// [`closed_form_noise_on_bins_um`] for any imputation whose held noise, in units of the
+/// detections' variance, is `factor(ρ_v, ω)` (the hold's F(ρ, ω); the α-β form's
+/// `tofprobe_dsp::imputation::response::noise_factor`).
+pub fn closed_form_noise_on_bins_for(
+    spec: &Spec,
+    n: usize,
+    bins: &[u64],
+    factor: &dyn Fn(f64, f64) -> Result<f64, tofprobe_dsp::DspError>,
+) -> Result<f64, ExperimentError> {
     let setup = spec.setup();
     let fa = first_arrival(&MixtureParams {
         signal_rate: spec.rho_s,
@@ -55,14 +67,12 @@ pub fn closed_form_noise_on_bins_um(
         window_mm: setup.window_mm,
     })?;
     let sigma = (fa.variance_mm2 + LSB_MM * LSB_MM / 12.0).sqrt();
-    let mean_sqrt_f = bins
-        .iter()
-        .map(|&k| {
-            let w = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
-            hold_noise_factor(fa.valid_rate.min(1.0), w).sqrt()
-        })
-        .sum::<f64>()
-        / bins.len().max(1) as f64;
+    let mut sum_sqrt_f = 0.0;
+    for &k in bins {
+        let w = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
+        sum_sqrt_f += factor(fa.valid_rate.min(1.0), w)?.sqrt();
+    }
+    let mean_sqrt_f = sum_sqrt_f / bins.len().max(1) as f64;
     let n_eff = n as f64 * WINDOW.effective_length_factor();
     Ok(noise_floor_mm(sigma, n_eff) * mean_sqrt_f * 1e3)
 }
@@ -83,6 +93,15 @@ pub fn snr_closed_db(a_eff: f64, floor: f64, floor_rel_sd: f64) -> f64 {
 /// The expected tone amplitude (µm): the mixture's mean follows the signal with gain
 /// g = ∂μ/∂t_s, and the hold's mean response at f0 is |H(ρ_v, ω0)|.
 pub fn closed_form_amp_um(spec: &Spec) -> Result<Option<f64>, ExperimentError> {
+    closed_form_amp_for(spec, &|rho, w| Ok(hold_response_sq(rho, w)))
+}
+
+/// [`closed_form_amp_um`] for any imputation whose mean response is `response_sq(ρ_v, ω)`
+/// (|H|²; the hold's, or the α-β form's `response::mean_response` squared).
+pub fn closed_form_amp_for(
+    spec: &Spec,
+    response_sq: &dyn Fn(f64, f64) -> Result<f64, tofprobe_dsp::DspError>,
+) -> Result<Option<f64>, ExperimentError> {
     let Some(a) = spec.amp_um else {
         return Ok(None);
     };
@@ -97,7 +116,7 @@ pub fn closed_form_amp_um(spec: &Spec) -> Result<Option<f64>, ExperimentError> {
     let g = mixture_gain(&p)?;
     let rho_v = first_arrival(&p)?.valid_rate.min(1.0);
     let w0 = 2.0 * std::f64::consts::PI * F0_HZ / FS_HZ;
-    Ok(Some(a * g * hold_response_sq(rho_v, w0).sqrt()))
+    Ok(Some(a * g * response_sq(rho_v, w0)?.sqrt()))
 }
 
 /// The number of DFT bins "A meas." of a row without a tone is the largest of (those of
