@@ -8,6 +8,7 @@
 //! A dev-dependency only: no library crate of the workspace depends on it.
 
 pub mod data;
+pub mod imports;
 pub mod mutants;
 pub mod params;
 pub mod tools;
