@@ -8,7 +8,7 @@
 use serde::Deserialize;
 use toml::{Table, Value};
 
-use crate::document::Document;
+use crate::Document;
 
 /// Whether `value` fits key `key` of section `section` (`scene.motion` entries: `entry`
 /// holds the entry's `kind`): the document's own serde types are asked, with a document
