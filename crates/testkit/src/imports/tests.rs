@@ -92,22 +92,10 @@ fn shared_types_in_the_parent_leave_no_circle() {
     );
 }
 
-/// The circles not yet broken, each as "crate: file, file, …" (issue 43): the check
-/// fails when a circle appears that is not here, and when one here is gone (then remove
-/// its line). The list only shrinks.
-const NOT_YET_BROKEN: &[&str] = &[
-    "cli: commands/array_rtl.rs, commands/cosim.rs, commands/rtl.rs",
-    "dsp: sd/isa.rs, sd/pairs.rs, sd/pairs_kernel.rs",
-    "dsp: sd/lanes.rs, sd/modulator.rs",
-    "layout: qflow.rs, repair/mod.rs, report.rs, verdict.rs",
-];
-
-/// Every crate of the workspace: no file of a crate's `src` is in an import circle (but
-/// those of [`NOT_YET_BROKEN`]).
+/// Every crate of the workspace: no file of a crate's `src` is in an import circle.
 #[test]
 fn no_crate_of_the_workspace_has_an_import_circle() {
     let crates = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let mut found = Vec::new();
     let mut dirs: Vec<_> = std::fs::read_dir(&crates)
         .unwrap()
         .map(|e| e.unwrap().path().join("src"))
@@ -115,30 +103,19 @@ fn no_crate_of_the_workspace_has_an_import_circle() {
         .collect();
     dirs.sort();
     assert!(dirs.len() > 10, "the workspace's crates under {crates:?}");
+    let mut found = Vec::new();
     for src in dirs {
         let name = src.parent().unwrap().file_name().unwrap();
         let name = name.to_string_lossy().to_string();
         for c in circles(&read_sources(&src).unwrap()) {
-            found.push((format!("{name}: {}", c.files.join(", ")), c));
+            found.push(format!("crates/{name}/src: {c}"));
         }
     }
-    let new: Vec<String> = found
-        .iter()
-        .filter(|(key, _)| !NOT_YET_BROKEN.contains(&key.as_str()))
-        .map(|(key, c)| format!("crates/{key}\n{c}"))
-        .collect();
     assert!(
-        new.is_empty(),
-        "{} import circles between the files of a crate:\n{}",
-        new.len(),
-        new.join("")
-    );
-    let gone: Vec<&&str> = NOT_YET_BROKEN
-        .iter()
-        .filter(|k| !found.iter().any(|(key, _)| key == *k))
-        .collect();
-    assert!(
-        gone.is_empty(),
-        "broken, remove from NOT_YET_BROKEN: {gone:?}"
+        found.is_empty(),
+        "{} import circles between the files of a crate (move what both files use to a module \
+         both may use, e.g. their parent):\n{}",
+        found.len(),
+        found.join("")
     );
 }
