@@ -16,6 +16,7 @@ use tofprobe_scene::{AcquisitionConfig, PhotonSource, Scene, SceneConfig, Sensor
 use crate::error::DesignError;
 use crate::{DEFAULT_ORIGIN, DEFAULT_TOML};
 
+pub mod keys;
 pub mod schema;
 
 /// Jitter σ on each side of the scene's depth range that `width = "auto"` sizes for (the
