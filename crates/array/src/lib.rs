@@ -26,3 +26,13 @@ pub mod uff;
 
 pub use error::ArrayError;
 pub use model::{ArrayFrame, Tile, run_array, run_tile, run_tile_watched};
+
+/// The configuration's name in the set: its file name (`plate.toml`), or the embedded
+/// default's name; never the path as typed, so the set's bytes do not depend on where the
+/// configuration lies or how its path was spelled.
+pub fn configuration_name(design: &tofprobe_design::ResolvedDesign) -> String {
+    std::path::Path::new(&design.origin)
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| design.origin.clone())
+}

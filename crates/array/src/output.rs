@@ -21,6 +21,7 @@ use tofprobe_design::ResolvedDesign;
 use tofprobe_dsp::sd::ProbeRom;
 use tofprobe_io::{OutputSet, npy};
 
+use crate::configuration_name;
 use crate::error::ArrayError;
 use crate::events::{EventMap, event_map};
 use crate::maps::{VibrationMaps, fourier_maps};
@@ -152,16 +153,6 @@ pub fn finish(
         files: Vec::new(),
     };
     Ok((frame, maps, events, summary))
-}
-
-/// The configuration's name in the set: its file name (`plate.toml`), or the embedded
-/// default's name; never the path as typed, so the set's bytes do not depend on where the
-/// configuration lies or how its path was spelled.
-pub fn configuration_name(design: &ResolvedDesign) -> String {
-    std::path::Path::new(&design.origin)
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| design.origin.clone())
 }
 
 /// Streams the files of the set (all but the summary) into `set`, each written as it is

@@ -21,6 +21,15 @@ use crate::plot::{CELL_BYTES, DEFLECTION_CELL_BYTES, DEFLECTION_HEAD_BYTES, FRAM
 pub const MARKER: &str = tofprobe_io::SET_MARKER;
 /// The array set's summary.
 pub const SUMMARY: &str = "summary.json";
+/// A tile set's manifest (`crate::shard`).
+pub const MANIFEST: &str = "manifest.json";
+/// The tile's registers, int64 [rows, cols, K].
+pub const REGISTERS: &str = "registers.npy";
+/// The tile's detections, int64 [rows, cols].
+pub const DETECTIONS: &str = "detections.npy";
+/// The tile's SPADs' ρ_s and ρ_b, float64 [rows·G, cols·G].
+pub const SIGNAL_MAP: &str = "signal_rate.npy";
+pub const BACKGROUND_MAP: &str = "background_rate.npy";
 /// Largest set written unless `--max-out-gib` allows more: 16 GiB (a 2048 × 2048 Fourier
 /// array with 4 bins is ≈ 9 GB: its UFF file alone 4 kB a pixel).
 pub const DEFAULT_MAX_SET_BYTES: u64 = 16 << 30;
@@ -110,12 +119,9 @@ pub fn tile_set(design: &ResolvedDesign, rows: usize, cols: usize) -> Vec<SetFil
         (a.spad_rows() as u64).saturating_mul(a.spad_cols() as u64)
     });
     vec![
-        file(crate::shard::REGISTERS, npy::file_bytes(&[rows, cols, k])),
-        file(crate::shard::DETECTIONS, npy::file_bytes(&[rows, cols])),
-        file(
-            crate::shard::MANIFEST,
-            spads.saturating_mul(64).saturating_add(64 << 10),
-        ),
+        file(REGISTERS, npy::file_bytes(&[rows, cols, k])),
+        file(DETECTIONS, npy::file_bytes(&[rows, cols])),
+        file(MANIFEST, spads.saturating_mul(64).saturating_add(64 << 10)),
     ]
 }
 

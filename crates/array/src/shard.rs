@@ -24,17 +24,9 @@ use tofprobe_io::npy;
 use crate::error::ArrayError;
 use crate::model::run_tile;
 
+pub use crate::set_plan::{BACKGROUND_MAP, DETECTIONS, MANIFEST, REGISTERS, SIGNAL_MAP};
 pub use crate::tile_set::{merge_sets, read_manifest};
 
-/// The tile set's manifest.
-pub const MANIFEST: &str = "manifest.json";
-/// The tile's registers, int64 [rows, cols, K].
-pub const REGISTERS: &str = "registers.npy";
-/// The tile's detections, int64 [rows, cols].
-pub const DETECTIONS: &str = "detections.npy";
-/// The tile's SPADs' ρ_s and ρ_b, float64 [rows·G, cols·G].
-pub const SIGNAL_MAP: &str = "signal_rate.npy";
-pub const BACKGROUND_MAP: &str = "background_rate.npy";
 /// The `kind` a manifest carries, and the version of the tile set's layout.
 pub(crate) const KIND: &str = "tofprobe array tile set";
 pub(crate) const VERSION: u32 = 3;

@@ -24,14 +24,12 @@ use std::path::{Path, PathBuf};
 use tofprobe_design::ResolvedDesign;
 use tofprobe_io::npy;
 
+use crate::configuration_name;
 use crate::error::ArrayError;
 use crate::model::ArrayFrame;
-use crate::output::{ArraySummary, SetLimits, configuration_name, open_set, write_set};
-use crate::set_plan::MARKER;
-use crate::shard::{
-    BACKGROUND_MAP, DETECTIONS, KIND, MANIFEST, REGISTERS, SIGNAL_MAP, TileManifest, VERSION,
-    design_hash, tiles,
-};
+use crate::output::{ArraySummary, SetLimits, open_set, write_set};
+use crate::set_plan::{BACKGROUND_MAP, DETECTIONS, MANIFEST, MARKER, REGISTERS, SIGNAL_MAP};
+use crate::shard::{KIND, TileManifest, VERSION, design_hash, tiles};
 
 /// Largest manifest read: the design without its maps is a few kB (its configuration
 /// document at most the 16 MiB a configuration may have).

@@ -236,7 +236,7 @@ pub fn write(design: &ResolvedDesign, m: &VibrationMaps) -> String {
     let mut out = Vec::new();
     let mm = design.array.as_ref().map_or(1.0, |a| a.mm_per_pixel);
     // Writing into memory cannot fail.
-    let _ = write_to(&mut out, &crate::output::configuration_name(design), mm, m);
+    let _ = write_to(&mut out, &crate::configuration_name(design), mm, m);
     String::from_utf8_lossy(&out).into_owned()
 }
 

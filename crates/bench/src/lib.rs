@@ -19,6 +19,5 @@ pub mod lane_rates;
 pub mod pixel;
 pub mod scene;
 pub mod sd;
-mod sd_svg;
 
 pub use error::BenchError;

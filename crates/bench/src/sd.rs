@@ -18,6 +18,8 @@ use crate::BenchError;
 use crate::cpu::process_cpu_seconds;
 use crate::lane_rates::fullband_rates;
 
+mod svg;
+
 pub const FS_HZ: f64 = 10e6;
 pub const N_ROM: u64 = 10_000_000;
 pub const ROM_TARGET_S: f64 = 1.0;
@@ -195,7 +197,7 @@ pub fn measure(svg: Option<&Path>, rom_dir: Option<&Path>) -> Result<SdReport, B
 
     let svg = match svg {
         Some(p) => {
-            crate::sd_svg::write(m, p)?;
+            svg::write(m, p)?;
             Some(p.display().to_string())
         }
         None => None,

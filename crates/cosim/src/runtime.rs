@@ -26,6 +26,14 @@ use std::process::Command;
 use tofprobe_io::fnv1a64;
 use tofprobe_io::stale::pid_tagged;
 
+/// A per-process counter: two threads of one process (parallel tests) building the same
+/// RTL must not share a temporary directory (the first to finish publishes, the other's
+/// copy is dropped).
+pub(crate) fn next_build_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
 /// The manifest of an entry: one `NAME SIZE FNV` line per object.
 const MANIFEST: &str = "objects.fnv";
 
@@ -122,7 +130,7 @@ fn entry_key(
     }
     let compiler = commands.split_whitespace().next()?.to_string();
     let compiler_version = Command::new(&compiler).arg("--version").output().ok()?;
-    let verilator_version = crate::verilator::version(verilator).ok()?;
+    let verilator_version = crate::tools::version(verilator).ok()?;
     let mut key = b"tofprobe-verilator-runtime-v1\n".to_vec();
     key.extend_from_slice(&verilator_version);
     key.extend_from_slice(&compiler_version.stdout);
@@ -170,7 +178,7 @@ impl Seeded {
         let (Some(root), Some(name)) = (self.entry.parent(), self.entry.file_name()) else {
             return;
         };
-        let id = crate::verilator::next_build_id().to_string();
+        let id = next_build_id().to_string();
         let tmp = root.join(pid_tagged(&name.to_string_lossy(), &id));
         let copied = (|| -> std::io::Result<()> {
             std::fs::create_dir_all(&tmp)?;

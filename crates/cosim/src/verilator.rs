@@ -9,7 +9,8 @@
 //! entry whose executable is missing or does not match is removed and built again.
 
 use crate::error::CosimError;
-use crate::tools::require;
+use crate::runtime::next_build_id;
+use crate::tools::{require, version};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -74,14 +75,6 @@ fn pixel_reset(top: &str, sources: &[PathBuf]) -> Result<String, CosimError> {
         }
     }
     Ok(String::new())
-}
-
-/// A per-process counter: two threads of one process (parallel tests) building the same
-/// RTL must not share a temporary directory (the first to finish publishes, the other's
-/// copy is dropped).
-pub(crate) fn next_build_id() -> u64 {
-    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 /// Builds (or reuses) the harness for the RTL in `rtl_dir` whose top module is `top`.
@@ -198,29 +191,6 @@ pub fn build_with(
         reused,
         seconds: t0.elapsed().as_secs_f64(),
     })
-}
-
-/// `verilator --version`'s output, run once per executable path in a process (every
-/// build's key and its run-time library's key hold it).
-pub(crate) fn version(verilator: &Path) -> Result<Vec<u8>, CosimError> {
-    type Seen = std::sync::Mutex<Vec<(PathBuf, Vec<u8>)>>;
-    static SEEN: std::sync::OnceLock<Seen> = std::sync::OnceLock::new();
-    let seen = SEEN.get_or_init(Default::default);
-    if let Some((_, v)) = seen
-        .lock()
-        .ok()
-        .and_then(|s| s.iter().find(|(p, _)| p == verilator).cloned())
-    {
-        return Ok(v);
-    }
-    let out = Command::new(verilator)
-        .arg("--version")
-        .output()
-        .map_err(|e| CosimError::io(verilator, e))?;
-    if let Ok(mut s) = seen.lock() {
-        s.push((verilator.to_path_buf(), out.stdout.clone()));
-    }
-    Ok(out.stdout)
 }
 
 /// The cache key of a harness build: the Verilator version, a `tag`, the harness source,

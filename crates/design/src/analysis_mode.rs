@@ -72,8 +72,10 @@ pub fn ignored_probe_warning(d: &Document, mode: Mode) -> Option<String> {
 fn frame_field(d: &Document) -> &'static str {
     if d.pixel.frame_pulses.is_some() {
         "pixel.frame_pulses"
-    } else {
+    } else if d.acquisition.pulses.is_some() {
         "acquisition.pulses (pixel.frame_pulses not set)"
+    } else {
+        "acquisition.duration_s × sensor.laser_rate_hz (pixel.frame_pulses not set)"
     }
 }
 

@@ -583,6 +583,12 @@ fn rate_map(
         .enumerate()
         .find(|(_, v)| !(v.is_finite() && (0.0..=max).contains(*v)))
     {
+        // No map: every pixel has the sensor's rate, and the sensor's key is the one to name.
+        let field = match map {
+            None if max == 1.0 => format!("sensor.signal_rate (every pixel's without {field})"),
+            None => format!("sensor.background_rate (every pixel's without {field})"),
+            Some(_) => field.to_string(),
+        };
         return Err(format!(
             "{field} gives pixel ({}, {}) the rate {}: allowed 0..={max} (a {} rate per pulse)",
             i / cols,

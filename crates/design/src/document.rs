@@ -14,13 +14,10 @@ use tofprobe_pixel::PixelContext;
 use tofprobe_scene::{AcquisitionConfig, PhotonSource, Scene, SceneConfig, SensorConfig};
 
 use crate::error::DesignError;
+use crate::{DEFAULT_ORIGIN, DEFAULT_TOML};
 
-/// The embedded default configuration text (paper Fig. 8: 0.1 mm at 4.5 kHz on 30 mm,
-/// σ_I = 50 ps, ρ_s = 1, ρ_b = 0, 1 s at 10 MHz).
-pub const DEFAULT_TOML: &str = include_str!("../../../scenes/default.toml");
-
-/// Name used in messages for the embedded default.
-pub const DEFAULT_ORIGIN: &str = "<embedded default>";
+pub mod keys;
+pub mod schema;
 
 /// Jitter σ on each side of the scene's depth range that `width = "auto"` sizes for (the
 /// pixel crate's one sizing rule, also used by `tofprobe size`).
@@ -51,12 +48,12 @@ impl Document {
     /// Parses TOML text; `origin` names the source in error messages.
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Document, DesignError> {
         toml::from_str(text).map_err(|e| {
-            let parser = crate::schema::clip_message(e.to_string().trim_end());
+            let parser = schema::clip_message(e.to_string().trim_end());
             // The key the walk names, with where the parser stopped and (unless the walk
             // already quotes it) what it said.
-            let message = match crate::schema::wrong_type(text) {
+            let message = match schema::wrong_type(text) {
                 Some(m) => {
-                    let said = crate::schema::clip_message(e.message().trim());
+                    let said = schema::clip_message(e.message().trim());
                     let at = e.span().map(|r| {
                         let before = &text[..r.start.min(text.len())];
                         let line = before.matches('\n').count() + 1;

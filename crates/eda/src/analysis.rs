@@ -10,6 +10,25 @@ use crate::synth::{SynthSpec, Synthesis, synthesise};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
+/// The pixel a size report (`crate::size_report`) and its corner options are about.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Design {
+    /// Bins B (Fourier) — the sweep axis.
+    pub bins: u64,
+    /// Register width W (bits).
+    pub width: u32,
+    /// Registers R.
+    pub registers: u64,
+    /// Operations per pulse P.
+    pub ops_per_pulse: u64,
+    /// Adders A.
+    pub adders: u64,
+    /// Clock cycles per laser pulse C.
+    pub cycles_per_pulse: u64,
+    /// Laser pulse rate (Hz).
+    pub laser_rate_hz: f64,
+}
+
 /// The Verilog of one pixel variant.
 #[derive(Debug, Clone)]
 pub struct RtlVariant {

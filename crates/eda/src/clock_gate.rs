@@ -7,8 +7,9 @@
 //! cells before flattening, so ABC never sees (nor restructures, nor duplicates) the gated
 //! clock: the gates are fixed instances, the flops behind them plain flops.
 
+use crate::cells::{inputs, outputs, smallest, smallest_inverter};
 use crate::error::{EdaError, Result};
-use crate::liberty::{LibCell, Liberty, NOT_FOR_SYNTHESIS};
+use crate::liberty::Liberty;
 
 /// The cells that implement one clock gate, with their pin names.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -39,35 +40,6 @@ pub const INSTANCES: [&str; 4] = ["icg", "clk_inv", "enable_latch", "clk_and"];
 /// The prefix of the pixel's clock-gate instances (`cg_<r>`), see templates/pixel.v.
 pub const INSTANCE_PREFIX: &str = "cg_";
 
-fn usable((name, c): &(&String, &LibCell)) -> bool {
-    !c.dont_use && !NOT_FOR_SYNTHESIS.iter().any(|p| name.contains(p))
-}
-
-/// The function without parentheses and blanks.
-fn bare(function: &str) -> String {
-    function
-        .chars()
-        .filter(|c| !c.is_whitespace() && *c != '(' && *c != ')')
-        .collect()
-}
-
-fn inputs(c: &LibCell) -> Vec<&str> {
-    c.pins
-        .iter()
-        .filter(|p| p.direction == "input")
-        .map(|p| p.name.as_str())
-        .collect()
-}
-
-/// Output pins with their functions (`bare` for the AND test's raw text, see [`is_and`]).
-fn outputs(c: &LibCell) -> Vec<(&str, String)> {
-    c.pins
-        .iter()
-        .filter(|p| p.direction == "output")
-        .map(|p| (p.name.as_str(), p.function.clone()))
-        .collect()
-}
-
 /// `function` is the AND of pins `a` and `b`: `A&B`, `A*B` or liberty's juxtaposition
 /// `A B` (osu018), in either order, with any parentheses.
 fn is_and(function: &str, a: &str, b: &str) -> bool {
@@ -83,19 +55,6 @@ fn is_and(function: &str, a: &str, b: &str) -> bool {
     let mut want = [a, b];
     want.sort_unstable();
     terms == want
-}
-
-fn smallest<'a, T>(
-    lib: &'a Liberty,
-    pick: impl Fn(&'a String, &'a LibCell) -> Option<T>,
-) -> Option<T> {
-    lib.cells
-        .iter()
-        .filter(usable)
-        .filter_map(|(n, c)| pick(n, c).map(|t| (c.area, t)))
-        // The first by name among equals (BTreeMap order; `min_by` keeps the first).
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .map(|(_, t)| t)
 }
 
 impl ClockGateCells {
@@ -227,21 +186,6 @@ impl ClockGateCells {
         s += "endmodule\n";
         s
     }
-}
-
-/// The liberty's smallest inverter: (cell, input pin, output pin).
-pub fn smallest_inverter(lib: &Liberty) -> Option<(String, String, String)> {
-    smallest(lib, |n, c| {
-        let ins = inputs(c);
-        let outs = outputs(c);
-        if c.sequential || ins.len() != 1 || outs.len() != 1 {
-            return None;
-        }
-        let a = ins[0];
-        [format!("!{a}"), format!("{a}'")]
-            .contains(&bare(&outs[0].1))
-            .then(|| (n.clone(), a.to_string(), outs[0].0.to_string()))
-    })
 }
 
 /// Behavioural Verilog of the `latch_posedge` integrated clock gates of `lib` that

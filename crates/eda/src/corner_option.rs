@@ -13,11 +13,10 @@
 //! `max_trials` candidates are synthesised. A corner whose f_max is below
 //! f_laser / (1 − margin) cannot be met by any A: the report says the laser rate it allows.
 
-use crate::analysis::{RtlProvider, analyse_point};
+use crate::analysis::{Design, RtlProvider, analyse_point};
 use crate::corners::{CornerTiming, MARGIN_PERCENT, time_cached};
 use crate::error::Result;
 use crate::liberty::Liberty;
-use crate::size_report::Design;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

@@ -7,8 +7,9 @@
 //! naming the option. The LEF area of a latch whose liberty gives none lives in
 //! [`crate::liberty::Liberty::load`] (osu018's `LATCH` has `area : 0`).
 
+use crate::cells::{bare, smallest_inverter, usable};
 use crate::error::{EdaError, Result};
-use crate::liberty::{LibCell, Liberty, NOT_FOR_SYNTHESIS};
+use crate::liberty::{LibCell, Liberty};
 
 /// The marker the pixel template writes in a latch register file's comment (templates/pixel.v).
 pub const MARKER: &str = "pixel.register_file = \"latch\"";
@@ -26,18 +27,6 @@ pub struct DLatch {
     pub q: String,
     /// Transparent while the enable is low (`enable : "!G"`).
     pub transparent_low: bool,
-}
-
-fn usable(name: &str, c: &LibCell) -> bool {
-    !c.dont_use && !NOT_FOR_SYNTHESIS.iter().any(|p| name.contains(p))
-}
-
-/// The function without parentheses and blanks.
-fn bare(function: &str) -> String {
-    function
-        .chars()
-        .filter(|c| !c.is_whitespace() && *c != '(' && *c != ')')
-        .collect()
 }
 
 /// `c` read as a plain D latch, if it is one.
@@ -120,7 +109,7 @@ impl LatchCells {
             });
         }
         let latch = smallest(all).ok_or_else(|| missing("D latch (`latch` group)"))?;
-        let inverter = crate::clock_gate::smallest_inverter(lib)
+        let inverter = smallest_inverter(lib)
             .ok_or_else(|| missing("inverter for its transparent-low latch"))?;
         Ok(LatchCells {
             latch,

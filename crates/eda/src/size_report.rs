@@ -2,6 +2,7 @@
 //! the stable JSON schema documented in docs/size-report-schema.md), and the build that
 //! runs synthesis, timing, the sky130 mapping and the sweeps.
 
+pub use crate::analysis::Design;
 use crate::analysis::{PointResult, RtlProvider, analyse_points};
 use crate::corner_option::CornerOption;
 use crate::corners::{CornerTiming, sky130_corners};
@@ -21,25 +22,6 @@ use std::path::PathBuf;
 
 /// The JSON schema identifier; bumped on any incompatible change.
 pub const SCHEMA: &str = "tofprobe-size-report/1";
-
-/// The pixel the report is about.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-pub struct Design {
-    /// Bins B (Fourier) — the sweep axis.
-    pub bins: u64,
-    /// Register width W (bits).
-    pub width: u32,
-    /// Registers R.
-    pub registers: u64,
-    /// Operations per pulse P.
-    pub ops_per_pulse: u64,
-    /// Adders A.
-    pub adders: u64,
-    /// Clock cycles per laser pulse C.
-    pub cycles_per_pulse: u64,
-    /// Laser pulse rate (Hz).
-    pub laser_rate_hz: f64,
-}
 
 /// What to build a report from.
 pub struct SizeRequest<'a> {

@@ -2,7 +2,7 @@
 //! detection), at the design's probe bins, composed from the one implementation of each:
 //! the depth of a code (`PhotonSource::code_to_depth_mm`), the float front end's hold
 //! ([`crate::records::held_record`]), the selected-bin DFT (`dsp::bins::SelectedBins`) at
-//! the ROM's bins as N-point DFT indices ([`crate::tradeoff::dft_bins`]) with the ROM's
+//! the ROM's bins as N-point DFT indices ([`dft_bins`]) with the ROM's
 //! window, float ΣΔ probing (`dsp::sd::probe_detections` + `normalise`, α = 2^−S: the
 //! pixel's float twin), and the closed-form noise floor (eq. 12 with the 1NN-hold and
 //! first-arrival extensions, `dsp::closed_form`). The Python package's `Design.dft`,
@@ -16,11 +16,19 @@ use tofprobe_dsp::sd::{ProbeRom, normalise, probe_detections};
 
 use crate::error::ExperimentError;
 use crate::records::held_record;
-use crate::tradeoff::dft_bins;
 
 /// One reading per probe bin, in ROM order: the phasor (mm; A·e^{jφ} for a tone
 /// A·cos(ω_k n + φ)).
 pub type Phasors = Vec<Complex64>;
+
+/// The ROM's bins k·f_s/L as indices of the N-point DFT (equal in windowed mode, the
+/// nearest bin in periodic mode when L does not divide N).
+pub fn dft_bins(rom_bins: &[u64], n: u64, rom_depth: usize) -> Vec<usize> {
+    rom_bins
+        .iter()
+        .map(|&k| (k as f64 * n as f64 / rom_depth as f64).round() as usize)
+        .collect()
+}
 
 fn dsp_err(design: &ResolvedDesign) -> impl Fn(tofprobe_dsp::DspError) -> ExperimentError + '_ {
     move |source| ExperimentError::from(DesignError::probe(&design.origin, source))

@@ -22,6 +22,7 @@ pub mod lock;
 pub mod marker;
 pub mod npy;
 mod set;
+mod stage;
 pub mod stale;
 pub mod text;
 pub mod watch;
@@ -29,7 +30,8 @@ pub mod watch;
 pub use atomic::{write_atomic, write_svg_atomic};
 pub use bounded::{read_bounded, read_bounded_text};
 pub use marker::{SET_MARKER, SetStatus, check_set, inspect_set};
-pub use set::{OutputSet, STAGE_PREFIX, committed_sets, recover};
+pub use set::{OutputSet, committed_sets, recover};
+pub use stage::STAGE_PREFIX;
 
 /// FNV-1a 64-bit offset basis: the hash of no bytes.
 pub const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;

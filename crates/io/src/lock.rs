@@ -24,7 +24,7 @@ fn holder(dir: &Path) -> Option<u32> {
     std::fs::read_dir(dir)
         .ok()?
         .flatten()
-        .filter_map(|e| crate::set::stage_pid(&e.file_name().to_string_lossy()))
+        .filter_map(|e| crate::stage::stage_pid(&e.file_name().to_string_lossy()))
         .find(|&pid| pid != me && crate::stale::pid_alive(pid))
 }
 

@@ -113,7 +113,7 @@ fn missing_marker(dir: &Path, marker: &str) -> String {
             v.join(", ")
         }
     };
-    match crate::set::interrupted_commit(dir) {
+    match crate::stage::interrupted_commit(dir) {
         Some((pid, moved, pending)) => format!(
             "its completion marker {marker} is missing because the commit of process {pid} \
              was cut short: moved in, beside what was there before: {}; still staged: {} \

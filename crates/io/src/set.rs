@@ -24,21 +24,11 @@ use std::time::SystemTime;
 
 use crate::live::{self, Kind, Live};
 use crate::lock::DirLock;
+use crate::stage::{COMMIT, REMOVE, STAGE_PREFIX, STAGE_SUFFIX, stage_pid};
 use crate::stale::{PID_MARK, pid_alive};
 
 /// A protected file's length and modification time at the check (`None`: absent).
 type Stamp = Option<(u64, SystemTime)>;
-
-/// Start of a stage directory's name; the pid and `.stage` follow.
-pub const STAGE_PREFIX: &str = ".output-set";
-const STAGE_SUFFIX: &str = ".stage";
-const COMMIT: &str = "COMMIT";
-
-/// The pid in a stage directory's name, `.output-set.tofprobe-PID.stage`.
-pub(crate) fn stage_pid(name: &str) -> Option<u32> {
-    let rest = name.strip_prefix(STAGE_PREFIX)?.strip_prefix(PID_MARK)?;
-    rest.strip_suffix(STAGE_SUFFIX)?.parse().ok()
-}
 
 /// Files staged for one directory, moved into place together by [`OutputSet::commit`];
 /// dropped uncommitted, it removes its stage (and the target directory if it created it
@@ -279,31 +269,6 @@ fn stamp(path: &Path) -> Stamp {
     Some((m.len(), m.modified().unwrap_or(SystemTime::UNIX_EPOCH)))
 }
 
-/// What an interrupted commit in `target` left (the stage of a process that is gone, with
-/// its `COMMIT` list): the pid, the files already moved into place, and those still staged
-/// (the completion marker among them). `None` when no commit was cut short there.
-pub(crate) fn interrupted_commit(target: &Path) -> Option<(u32, Vec<String>, Vec<String>)> {
-    for e in std::fs::read_dir(target).ok()?.flatten() {
-        let Some(pid) = stage_pid(&e.file_name().to_string_lossy()) else {
-            continue;
-        };
-        let stage = e.path();
-        let Ok(list) = crate::read_bounded_text(&stage.join(COMMIT), 1 << 20) else {
-            continue;
-        };
-        let (mut moved, mut pending) = (Vec::new(), Vec::new());
-        for name in list.lines().filter(|l| !l.starts_with(REMOVE)) {
-            if stage.join(name).exists() {
-                pending.push(name.to_string());
-            } else {
-                moved.push(name.to_string());
-            }
-        }
-        return Some((pid, moved, pending));
-    }
-    None
-}
-
 /// The target directories of the sets this process committed, in order.
 static COMMITTED: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
 
@@ -313,10 +278,6 @@ static COMMITTED: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::ne
 pub fn committed_sets() -> Vec<PathBuf> {
     COMMITTED.lock().map(|v| v.clone()).unwrap_or_default()
 }
-
-/// Prefix of a `COMMIT` line naming a file of the old set to remove (a staged name never
-/// holds `/`, so no name reads as one).
-const REMOVE: &str = "remove/";
 
 /// The files of the set completed by `target/marker` that are not in `keep`, still as the
 /// marker lists them (plain names whose bytes have the listed hash).

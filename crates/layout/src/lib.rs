@@ -28,9 +28,18 @@ pub mod spef;
 pub mod sta;
 pub mod tech;
 pub mod tools;
-pub mod verdict;
 
 pub use error::{LayoutError, Result};
 pub use flow::{LayoutRequest, LayoutRun, run};
-pub use report::LayoutReport;
+pub use report::{LayoutReport, verdict};
 pub use tech::Tech;
+
+/// A step of the layout flow and its wall time (the report lists them; the flow and the
+/// repair time theirs).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct Step {
+    /// The step.
+    pub step: String,
+    /// Wall time (s).
+    pub seconds: f64,
+}

@@ -8,6 +8,7 @@
 use crate::error::{LayoutError, Result};
 use crate::tech::TechFiles;
 use crate::tools::{Tool, tail};
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -158,7 +159,7 @@ impl Project {
     /// magic's reasons for the DRC errors of the routed macro: each rule broken and how
     /// many boxes break it, and every error box (`drc listall why` on the layout database
     /// the DRC stage checked; the boxes are what the ECO re-route maps to nets).
-    pub fn drc_reasons(&self) -> Result<(Vec<DrcRule>, Vec<crate::repair::DrcBox>)> {
+    pub fn drc_reasons(&self) -> Result<(Vec<DrcRule>, Vec<DrcBox>)> {
         let magic = Tool::Magic.locate()?;
         let script = self
             .dir
@@ -184,10 +185,7 @@ impl Project {
         let text = String::from_utf8_lossy(&out.stdout);
         // Kept beside qflow's DRC log: the boxes the ECO re-route worked from.
         write(&self.dir.join("log").join("drc_why.log"), &text)?;
-        Ok((
-            parse_drc_reasons(&text),
-            crate::repair::parse_drc_boxes(&text),
-        ))
+        Ok((parse_drc_reasons(&text), parse_drc_boxes(&text)))
     }
 
     /// The checks of the routed DEF (`layout/TOP.def`, its section counts set to its
@@ -234,7 +232,7 @@ impl Project {
             lvs_match,
             lvs_result,
             lvs_errors: lvs_counts(&lvs_log),
-            lvs_total: crate::repair::lvs_total(&lvs_log).unwrap_or(u64::from(!lvs_match)),
+            lvs_total: lvs_total(&lvs_log).unwrap_or(u64::from(!lvs_match)),
             drc_seconds,
             lvs_seconds,
         })
@@ -324,7 +322,7 @@ pub struct Checks {
     /// The rules broken (empty when clean).
     pub drc_rules: Vec<DrcRule>,
     /// The error boxes (empty when clean).
-    pub drc_boxes: Vec<crate::repair::DrcBox>,
+    pub drc_boxes: Vec<DrcBox>,
     /// netgen's verdict.
     pub lvs_match: bool,
     /// netgen's result line.
@@ -353,6 +351,59 @@ pub struct DrcRule {
     pub rule: String,
     /// Error boxes.
     pub boxes: u64,
+}
+
+/// netgen's total error count in qflow's LVS log (`Total errors = N`).
+pub fn lvs_total(log: &str) -> Option<u64> {
+    log.lines()
+        .rev()
+        .find_map(|l| l.trim().strip_prefix("Total errors = "))
+        .and_then(|n| n.trim().parse().ok())
+}
+
+/// A DRC error box (µm) and the rule it breaks.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DrcBox {
+    /// magic's text of the rule.
+    pub rule: String,
+    /// Lower left x (µm).
+    pub x0: f64,
+    /// Lower left y (µm).
+    pub y0: f64,
+    /// Upper right x (µm).
+    pub x1: f64,
+    /// Upper right y (µm).
+    pub y1: f64,
+}
+
+/// The error boxes printed by the DRC script of [`Project::drc_reasons`]:
+/// `TOFPROBE-SCALE S` (µm per magic unit, `cif scale out`) and one
+/// `TOFPROBE-BOX X0 Y0 X1 Y1 RULE` per box in magic units.
+pub fn parse_drc_boxes(text: &str) -> Vec<DrcBox> {
+    let scale = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("TOFPROBE-SCALE "))
+        .and_then(|s| s.trim().parse::<f64>().ok());
+    let Some(s) = scale else {
+        return vec![];
+    };
+    text.lines()
+        .filter_map(|l| l.trim().strip_prefix("TOFPROBE-BOX "))
+        .filter_map(|l| {
+            let mut it = l.splitn(5, ' ');
+            let mut c = [0.0; 4];
+            for v in &mut c {
+                *v = it.next()?.parse::<f64>().ok()? * s;
+            }
+            Some(DrcBox {
+                rule: it.next()?.trim().to_string(),
+                x0: c[0],
+                y0: c[1],
+                x1: c[2],
+                y1: c[3],
+            })
+        })
+        .collect()
 }
 
 /// The `TOFPROBE-DRC N RULE` lines of [`Project::drc_reasons`]'s magic script.

@@ -5,9 +5,12 @@
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
+pub use crate::Step;
 use crate::bins::BinsPerPitch;
 use crate::def::DefFigures;
 use crate::sta::PostRoute;
+
+pub mod verdict;
 
 pub use crate::readers::{PostRouteTable, read_post_route, read_routed_factor};
 
@@ -54,15 +57,6 @@ pub struct CornerRow {
     pub synthesis_slack_ns: f64,
     /// Post-route timing at this corner (the same routed wires).
     pub post_route: PostRoute,
-}
-
-/// A step and its wall time.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-pub struct Step {
-    /// The step.
-    pub step: String,
-    /// Wall time (s).
-    pub seconds: f64,
 }
 
 /// The report of `tofprobe layout`.
@@ -226,8 +220,8 @@ impl LayoutReport {
         );
         // The verdict first, after the title; the checks' details after the macro table.
         let at = s.find("## Macro").unwrap_or(s.len());
-        s.insert_str(at, &crate::verdict::verdict_markdown(self));
-        s += &crate::verdict::checks_markdown(self);
+        s.insert_str(at, &verdict::verdict_markdown(self));
+        s += &verdict::checks_markdown(self);
         if !self.drc_rules.is_empty() {
             s += "DRC errors by rule (magic's `drc listall why`):\n\n| rule | error boxes |\n|---|---:|\n";
             for r in &self.drc_rules {
@@ -306,7 +300,7 @@ impl LayoutReport {
             p.hold_path.1,
             p.spef_nets,
         );
-        s += &crate::verdict::timing_note(p);
+        s += &verdict::timing_note(p);
         s += "## Corners\n\n";
         s += &corners_markdown(&self.corners);
         s += "\n";

@@ -20,6 +20,7 @@
 //! - [`sequencer`]: the reference pin sequence the testbench and vectors drive;
 //! - [`directed`]: the directed schedule beside it (refusals, saturation, wrap-around);
 //! - [`sizing`]: register widths, readout bytes and compression from a scene;
+//! - [`random`]: the one generator of random valid parameters (the tests', `cosim --random`'s);
 //! - [`spectrum`]: the bit-true spectrum of a scene for `tofprobe simulate`;
 //! - [`superpixel`]: the averaging of G × G SPADs in front of the datapath ([`Superpixel`]).
 
@@ -38,6 +39,7 @@ pub mod fixed;
 pub mod fold;
 pub mod lanes;
 pub mod params;
+pub mod random;
 pub mod readout;
 pub mod schedule;
 pub mod segments;

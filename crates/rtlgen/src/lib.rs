@@ -7,6 +7,7 @@
 //! FuseSoC core that packages the RTL for users' tools.
 
 pub mod array;
+pub mod array_fault;
 pub mod core;
 pub mod error;
 pub mod golden;

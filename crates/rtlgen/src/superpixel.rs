@@ -9,7 +9,7 @@
 use askama::Template;
 use tofprobe_pixel::{PixelParams, Superpixel};
 
-use crate::array::ArrayFault;
+use crate::array_fault::ArrayFault;
 use crate::error::RtlError;
 use crate::render::{RenderOptions, RtlFile, header};
 

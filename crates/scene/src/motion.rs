@@ -228,7 +228,7 @@ impl MotionConfig {
             }
             MotionConfig::PlateMode { .. }
             | MotionConfig::Rotor { .. }
-            | MotionConfig::Edge { .. } => crate::spatial::validate(self, index)?,
+            | MotionConfig::Edge { .. } => validate_spatial(self, index)?,
         }
         Ok(())
     }
@@ -266,4 +266,107 @@ impl MotionConfig {
             _ => None,
         }
     }
+}
+
+/// Largest coordinate or length on the scene plane (mm): 100 m.
+pub const MAX_PLANE_MM: f64 = 1e5;
+/// Largest mode index: beyond it the mode's wavelength is below any pixel.
+pub const MAX_MODE: u32 = 1000;
+/// Most blades of a rotor.
+pub const MAX_BLADES: u32 = 64;
+/// Sectors per blade period of the rotor's depth table (the blade fraction is rounded to
+/// 1/32 of a period).
+pub(crate) const SECTORS_PER_BLADE: usize = 32;
+
+/// Checks a spatial motion's fields (the kinds [`crate::spatial`] reduces to a point's) (`index`: its place in `[[scene.motion]]`).
+fn validate_spatial(m: &MotionConfig, index: usize) -> Result<(), SceneError> {
+    let f = |name: &str| format!("scene.motion[{index}].{name}");
+    match m {
+        MotionConfig::PlateMode {
+            m,
+            n,
+            length_x_mm,
+            length_y_mm,
+            amplitude_mm,
+            frequency_hz,
+            phase_deg,
+            x0_mm,
+            y0_mm,
+        } => {
+            for (name, v) in [("m", m), ("n", n)] {
+                if !(1..=MAX_MODE).contains(v) {
+                    return Err(SceneError::out_of_range(
+                        f(name),
+                        v,
+                        format!("1 <= {name} <= {MAX_MODE} (1 is the first mode: one half-wave)"),
+                    ));
+                }
+            }
+            check_positive(&f("length_x_mm"), *length_x_mm, MAX_PLANE_MM)?;
+            check_positive(&f("length_y_mm"), *length_y_mm, MAX_PLANE_MM)?;
+            check_range(&f("amplitude_mm"), *amplitude_mm, 0.0, MAX_MM)?;
+            check_positive(&f("frequency_hz"), *frequency_hz, MAX_HZ)?;
+            check_range(&f("phase_deg"), *phase_deg, -1e6, 1e6)?;
+            check_range(&f("x0_mm"), *x0_mm, -MAX_PLANE_MM, MAX_PLANE_MM)?;
+            check_range(&f("y0_mm"), *y0_mm, -MAX_PLANE_MM, MAX_PLANE_MM)?;
+        }
+        MotionConfig::Rotor {
+            blades,
+            rpm,
+            centre_x_mm,
+            centre_y_mm,
+            radius_mm,
+            hub_radius_mm,
+            blade_mm,
+            blade_fraction,
+            phase_deg,
+        } => {
+            if !(1..=MAX_BLADES).contains(blades) {
+                return Err(SceneError::out_of_range(
+                    f("blades"),
+                    blades,
+                    format!("1 <= blades <= {MAX_BLADES}"),
+                ));
+            }
+            check_positive(&f("rpm"), *rpm, MAX_HZ * 60.0)?;
+            check_range(&f("centre_x_mm"), *centre_x_mm, -MAX_PLANE_MM, MAX_PLANE_MM)?;
+            check_range(&f("centre_y_mm"), *centre_y_mm, -MAX_PLANE_MM, MAX_PLANE_MM)?;
+            check_positive(&f("radius_mm"), *radius_mm, MAX_PLANE_MM)?;
+            if !(hub_radius_mm.is_finite() && *hub_radius_mm >= 0.0 && hub_radius_mm < radius_mm) {
+                return Err(SceneError::out_of_range(
+                    f("hub_radius_mm"),
+                    hub_radius_mm,
+                    format!("0 <= hub_radius_mm < radius_mm = {radius_mm}"),
+                ));
+            }
+            check_range(&f("blade_mm"), *blade_mm, -MAX_MM, MAX_MM)?;
+            let k = (blade_fraction * SECTORS_PER_BLADE as f64).round();
+            if !(blade_fraction.is_finite() && k >= 1.0 && k < SECTORS_PER_BLADE as f64) {
+                return Err(SceneError::out_of_range(
+                    f("blade_fraction"),
+                    blade_fraction,
+                    format!(
+                        "1/{SECTORS_PER_BLADE} <= blade_fraction <= {}/{SECTORS_PER_BLADE} (0.5: blades as wide as the gaps)",
+                        SECTORS_PER_BLADE - 1
+                    ),
+                ));
+            }
+            check_range(&f("phase_deg"), *phase_deg, -1e6, 1e6)?;
+        }
+        MotionConfig::Edge {
+            height_mm,
+            velocity_mm_per_s,
+            direction_deg,
+            start_mm,
+            width_mm,
+        } => {
+            check_range(&f("height_mm"), *height_mm, -MAX_MM, MAX_MM)?;
+            check_positive(&f("velocity_mm_per_s"), *velocity_mm_per_s, 1e9)?;
+            check_range(&f("direction_deg"), *direction_deg, -360.0, 360.0)?;
+            check_range(&f("start_mm"), *start_mm, -MAX_PLANE_MM, MAX_PLANE_MM)?;
+            check_range(&f("width_mm"), *width_mm, 0.0, MAX_PLANE_MM)?;
+        }
+        _ => {}
+    }
+    Ok(())
 }

@@ -31,6 +31,22 @@ impl SplitMix64 {
         self.0 = self.0.wrapping_add(GAMMA);
         out
     }
+
+    /// Uniform in 0..n (n ≥ 1; the modulo's bias, below 2^-40 for the small n drawn, is
+    /// irrelevant to stimuli and parameters).
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next_u64() % n
+    }
+
+    /// True with probability `percent` %.
+    pub fn chance(&mut self, percent: u64) -> bool {
+        self.below(100) < percent
+    }
+
+    /// The state: `SplitMix64::new(g.state())` continues `g`'s stream.
+    pub fn state(&self) -> u64 {
+        self.0
+    }
 }
 
 #[cfg(test)]

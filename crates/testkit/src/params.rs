@@ -1,37 +1,41 @@
-//! Random valid pixel parameters for the tests, every knob of `PixelParams` drawn here once:
-//! both modes, A > 1, K < C, odd and tight widths (so the registers wrap often), any zoom,
-//! short frames, registers keeping G ≤ F fraction bits, either rounding, every register
-//! file. A tiny deterministic generator ([`Rng`]) makes a case reproducible from its seed;
-//! [`strategy`] wraps it for proptest.
+//! Random valid pixel parameters for the tests: `tofprobe_pixel::random`'s one generator
+//! with the tests' ranges (every knob of `PixelParams` is drawn there, once), on the
+//! workspace's one SplitMix64 (`tofprobe_scene`). [`Rng`] holds the generator's state, so a
+//! case is reproducible from its seed (`Rng(seed)`); [`strategy`] wraps it for proptest.
 
 use proptest::prelude::*;
 use tofprobe_dsp::RomImage;
-use tofprobe_pixel::{Mode, PixelParams, RegisterFile, Rounding};
+use tofprobe_pixel::PixelParams;
+use tofprobe_pixel::random::Ranges;
+use tofprobe_scene::SplitMix64;
 
-/// splitmix64: small, fast, good enough for stimuli.
+/// The tests' generator: `tofprobe_scene::SplitMix64` seeded with (and holding) `.0`.
 #[derive(Debug, Clone)]
 pub struct Rng(pub u64);
 
 impl Rng {
+    /// Runs `f` on the SplitMix64 at this state, keeping where it stopped.
+    fn with<T>(&mut self, f: impl FnOnce(&mut SplitMix64) -> T) -> T {
+        let mut g = SplitMix64::new(self.0);
+        let out = f(&mut g);
+        self.0 = g.state();
+        out
+    }
     /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.with(SplitMix64::next_u64)
     }
     /// Uniform in 0..n (n ≥ 1).
     pub fn below(&mut self, n: u64) -> u64 {
-        self.next_u64() % n
+        self.with(|g| g.below(n))
     }
     /// True with probability `percent` %.
     pub fn chance(&mut self, percent: u64) -> bool {
-        self.below(100) < percent
+        self.with(|g| g.chance(percent))
     }
     /// Uniform index in 0..n (0 when n is 0).
     pub fn index(&mut self, n: usize) -> usize {
-        (self.next_u64() % n.max(1) as u64) as usize
+        self.below(n.max(1) as u64) as usize
     }
     /// A uniformly chosen element of a non-empty slice.
     pub fn pick<'a, T>(&mut self, v: &'a [T]) -> &'a T {
@@ -39,63 +43,9 @@ impl Rng {
     }
 }
 
-/// Random valid parameters (see the module documentation). The draws before the latest
-/// knobs are unchanged, so a seed keeps its case when a knob is added (draw new knobs last).
+/// Random valid parameters ([`Ranges::TESTS`]; see `tofprobe_pixel::random`).
 pub fn random_params(rng: &mut Rng) -> PixelParams {
-    let haar = rng.chance(35);
-    let tdc_bits = 1 + rng.below(8) as u32;
-    let zoom = rng.below(1 << tdc_bits) as u32;
-    let (mode, bins, haar_scales, frame_pulses) = if haar {
-        let l = 1 + rng.below(4) as u32;
-        (Mode::Haar, 1, rng.below(u64::from(l)) as u32, 1u64 << l)
-    } else {
-        (
-            Mode::Fourier,
-            1 + rng.below(5) as usize,
-            0,
-            1 + rng.below(12),
-        )
-    };
-    let mut p = PixelParams {
-        mode,
-        bins,
-        haar_scales,
-        adders: 1,
-        cycles_per_pulse: 1,
-        tdc_bits,
-        zoom,
-        shift: rng.below(7) as u32,
-        frac_bits: rng.below(7) as u32,
-        width: 1,
-        frame_pulses,
-        rom_depth: 1 + rng.below(7) as usize,
-        prefilter_rounding: Rounding::Floor,
-        register_frac_bits: None,
-        register_file: RegisterFile::default(),
-    };
-    let ops = p.ops_per_pulse() as u64;
-    p.adders = 1 + rng.below(ops) as usize;
-    p.cycles_per_pulse = p.slots() + rng.below(3) as usize;
-    // Registers keeping G ≤ F fraction bits (G = F half the time), before the width so
-    // the tight widths are tight for the narrower operand too.
-    if mode == Mode::Fourier && rng.chance(50) {
-        p.register_frac_bits = Some(rng.below(u64::from(p.frac_bits) + 1) as u32);
-    }
-    p.width = p.operand_bits() + rng.below(10) as u32;
-    // Knobs added later, drawn last.
-    if mode == Mode::Fourier && rng.chance(30) {
-        p.prefilter_rounding = Rounding::Nearest;
-    }
-    if rng.chance(30) {
-        p.register_file = RegisterFile::ClockGated;
-    }
-    // Latches after that, only over flops: a case's other fields stay what they were.
-    if rng.chance(30) && p.register_file == RegisterFile::Flops {
-        p.register_file = RegisterFile::Latch;
-    }
-    p.validate()
-        .expect("random parameters are valid by construction");
-    p
+    rng.with(|g| tofprobe_pixel::random::random_params(g, &Ranges::TESTS))
 }
 
 /// A ROM of random bits for `p` (Fourier; Haar gets an unused one-entry ROM).
@@ -121,22 +71,18 @@ pub fn strategy() -> impl Strategy<Value = PixelParams> {
 mod tests {
     use super::*;
 
-    /// The generator covers every knob's values within a few hundred draws.
+    /// `Rng` is SplitMix64's stream: the published first outputs for seed 0
+    /// (prng.di.unimi.it/splitmix64.c), and a seed's parameters are those of the one
+    /// generator on that stream.
     #[test]
-    fn every_knob_is_drawn() {
-        let mut rng = Rng(7);
-        let ps: Vec<PixelParams> = (0..400).map(|_| random_params(&mut rng)).collect();
-        assert!(ps.iter().any(|p| p.mode == Mode::Haar));
-        assert!(ps.iter().any(|p| p.prefilter_rounding == Rounding::Nearest));
-        assert!(
-            ps.iter()
-                .any(|p| p.register_file == RegisterFile::ClockGated)
-        );
-        assert!(ps.iter().any(|p| p.register_file == RegisterFile::Latch));
-        assert!(ps.iter().any(|p| p.register_frac_bits.is_some()));
-        assert!(
-            ps.iter()
-                .any(|p| p.adders > 1 && p.cycles_per_pulse > p.slots())
-        );
+    fn the_stream_is_splitmix64s_and_the_parameters_the_one_generators() {
+        let mut r = Rng(0);
+        assert_eq!(r.next_u64(), 0xE220_A839_7B1D_CDAF);
+        assert_eq!(r.next_u64(), 0x6E78_9E6A_A1B9_65F4);
+        let mut g = SplitMix64::new(99);
+        let want = tofprobe_pixel::random::random_params(&mut g, &Ranges::TESTS);
+        let mut r = Rng(99);
+        assert_eq!(random_params(&mut r), want);
+        assert_eq!(r.0, g.state());
     }
 }

@@ -14,6 +14,8 @@ use tofprobe_pixel::{DirectedOptions, PixelParams};
 
 use crate::error::CliError;
 
+mod array;
+
 /// Runs longer than this many cycles compare digests of this many pulses instead of every
 /// pulse's (a 10^7-pulse frame then has ~10^4 digest lines).
 pub(crate) const LONG_RUN_CYCLES: u64 = 2_000_000;
@@ -250,7 +252,7 @@ pub fn run(a: &CosimArgs) -> Result<super::Verdict, CliError> {
     }
     let design = super::load_for_hardware(a.config.as_deref())?;
     if design.array.is_some() {
-        return super::array_rtl::cosim(a, &design);
+        return array::cosim(a, &design);
     }
     // A --tile on a single pixel is refused, not ignored.
     super::tile_arg::tile_for(&design, a.tile.as_deref())?;

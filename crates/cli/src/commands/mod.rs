@@ -1,7 +1,6 @@
 //! The subcommands: one file each. To add one, add a variant to [`Command`] and a line to
 //! [`run`].
 
-pub mod array_rtl;
 pub mod bench;
 pub mod check_set;
 pub mod config;

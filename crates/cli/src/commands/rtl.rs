@@ -11,7 +11,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tofprobe_design::RtlOverrides;
+use tofprobe_design::{ResolvedDesign, RtlOverrides};
+use tofprobe_flow::array::{ArrayKit, render_array_design};
 use tofprobe_flow::rtl::{CoreSimPaths, render_design};
 
 use crate::error::CliError;
@@ -81,7 +82,7 @@ pub fn regen_command(a: &RtlArgs) -> String {
 pub fn run(a: &RtlArgs) -> Result<(), CliError> {
     let design = crate::commands::load_for_hardware(a.config.as_deref())?;
     if design.array.is_some() {
-        return super::array_rtl::rtl(a, &design);
+        return rtl_array(a, &design);
     }
     if a.kit_frames.is_some() {
         return Err(CliError::option(
@@ -118,5 +119,52 @@ pub fn run(a: &RtlArgs) -> Result<(), CliError> {
         r.files.join(", "),
         r.rom_note
     );
+    Ok(())
+}
+
+/// `tofprobe rtl` on an array design.
+fn rtl_array(a: &RtlArgs, design: &ResolvedDesign) -> Result<(), CliError> {
+    if a.core_vectors.is_some() {
+        return Err(CliError::option(
+            "core-vectors",
+            "given",
+            "the pixel's top only (an array is co-simulated by `tofprobe cosim`)",
+        ));
+    }
+    let o = RtlOverrides {
+        frame_pulses: a.frame_pulses,
+        rom_depth: a.rom_depth,
+    };
+    let kit_frames = a
+        .kit_frames
+        .unwrap_or(tofprobe_rtlgen::kit::KIT_DEFAULT_FRAMES);
+    let (chip, files, kit) = render_array_design(design, &o, &a.out, regen_command(a), kit_frames)?;
+    let p = &chip.pixel;
+    let ro = chip.readout.as_ref();
+    println!(
+        "rtl: {} x {} array of {:?} pixels ({} registers x {} bits), N = {}, L = {}; readout {} bits x {} beat(s) per word, slot {} cycles, {} cycles per readout -> {} ({}); {}",
+        chip.rows,
+        chip.cols,
+        p.mode,
+        p.registers(),
+        p.width,
+        p.frame_pulses,
+        p.rom_depth,
+        ro.map(|r| r.bits).unwrap_or(0),
+        ro.map(|r| r.beats_per_word).unwrap_or(0),
+        ro.map(|r| r.slot_cycles()).unwrap_or(0),
+        ro.map(|r| r.readout_cycles()).unwrap_or(0),
+        a.out.display(),
+        files.join(", "),
+        chip.rom.note
+    );
+    match kit {
+        ArrayKit::Written { frames, cycles } => println!(
+            "rtl: verification kit: {} with {frames} frame(s) of golden vectors ({cycles} cycles) in the set; \
+             run it with its core's `sim`/`sim_verilator` targets or testbench/README.md's commands",
+            tofprobe_rtlgen::kit::KIT_TESTBENCH
+        ),
+        ArrayKit::Omitted(why) => println!("rtl: {why}"),
+    }
     Ok(())
 }

@@ -4,8 +4,9 @@
 //! run exits 0 or 2 within a time limit, prints no panic, and a refusal names a key of the
 //! document together with the value given (or, for a cross-field refusal, another key of
 //! the document by its dotted path). Deterministic: a fixed seed walks the same cases.
-//! `TOFPROBE_BINARY_MUTATIONS=N` runs N cases. Half the mutations draw the newer keys with
-//! their real types ([`TYPED`]: strings, `"auto"`, paths, lists, `[array]`).
+//! `TOFPROBE_BINARY_MUTATIONS=N` runs N cases. Half the mutations draw values of the key's
+//! own type, from the schema (`tofprobe_design::document::keys`): every key, `[array]`'s
+//! included, with no list here to keep.
 
 use crate::common;
 
@@ -15,56 +16,23 @@ use std::time::Duration;
 
 use common::{default_text, edit};
 
+use tofprobe_design::document::keys::{Key, keys};
 use tofprobe_testkit::params::Rng;
 
-/// The keys mutated, by table (`motion` = `scene.motion[0]`).
-const KEYS: &[(&str, &[&str])] = &[
-    (
-        "sensor",
-        &[
-            "laser_rate_hz",
-            "jitter_ps",
-            "tdc_lsb_ps",
-            "window_start_ps",
-            "window_length_ps",
-            "signal_rate",
-            "background_rate",
-        ],
-    ),
-    ("scene", &["depth_mm"]),
-    ("acquisition", &["duration_s", "pulses", "seed"]),
-    (
-        "pixel",
-        &[
-            "mode",
-            "bins",
-            "adders",
-            "cycles_per_pulse",
-            "shift",
-            "frac_bits",
-            "tdc_bits",
-            "width",
-            "frame_pulses",
-            "rom_depth",
-        ],
-    ),
-    (
-        "probe",
-        &[
-            "order",
-            "osr",
-            "h_inf",
-            "window",
-            "amplitude",
-            "rom_mode",
-            "rom_depth",
-        ],
-    ),
-    (
-        "motion",
-        &["kind", "amplitude_mm", "frequency_hz", "phase_deg"],
-    ),
-];
+/// The keys mutated: every key a document can hold, derived from the schema
+/// (`tofprobe_design::document::keys`: a new key is fuzzed with its type, no list to edit),
+/// a motion's those of the default's motion kind (`scene.motion[0]`).
+fn fuzzed_keys() -> Vec<Key> {
+    let doc: toml::Table = toml::from_str(tofprobe_design::DEFAULT_TOML).unwrap();
+    let kind = doc["scene"]["motion"][0]["kind"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    keys()
+        .into_iter()
+        .filter(|k| k.kind.as_ref().is_none_or(|x| *x == kind))
+        .collect()
+}
 
 /// TOML literals a mutation writes: zero, signs, extremes, non-finite values, wrong types.
 const VALUES: &[&str] = &[
@@ -100,65 +68,12 @@ const VALUES: &[&str] = &[
     "\"periodic\"",
 ];
 
-/// The newer keys with values of their real types (strings, `"auto"`, paths, lists) beside
-/// wrong ones: half of the mutations draw from here, so a key whose type the error table
-/// forgets, or a string key blamed for another key's fault, shows up (issue 31).
-const TYPED: &[(&str, &str, &[&str])] = &[
-    ("pixel", "adders", &["\"auto\"", "\"AUTO\"", "1", "4"]),
-    (
-        "pixel",
-        "register_file",
-        &["\"flops\"", "\"clock_gated\"", "\"latch\"", "\"sram\"", "1"],
-    ),
-    (
-        "pixel",
-        "prefilter_rounding",
-        &["\"floor\"", "\"nearest\"", "\"up\"", "0"],
-    ),
-    (
-        "pixel",
-        "timing_liberty",
-        &[
-            "\"osu018\"",
-            "\"sky130\"",
-            "\"/dev/zero\"",
-            "\"/nonexistent/x.lib\"",
-            "\"\"",
-            "130",
-        ],
-    ),
-    (
-        "pixel",
-        "register_frac_bits",
-        &["0", "4", "8", "64", "\"auto\""],
-    ),
-    ("pixel", "haar_scales", &["0", "4", "6", "31", "\"auto\""]),
-    (
-        "pixel",
-        "frequencies_hz",
-        &["[4500.0]", "[0.0]", "[-1.0]", "[4500.0, 4500.0]", "[\"x\"]"],
-    ),
-    (
-        "pixel",
-        "mode",
-        &["\"auto\"", "\"haar\"", "\"fourier\"", "\"x\""],
-    ),
-    ("array", "rows", &["1", "2", "0", "4097", "-1", "\"2\""]),
-    ("array", "cols", &["1", "3", "0", "4097", "1.5"]),
-    (
-        "array",
-        "pitch_um",
-        &["30.0", "0.0", "-1.0", "nan", "\"x\""],
-    ),
-    ("array", "mm_per_pixel", &["1.0", "0.0", "1e300", "inf"]),
-    ("array", "field_of_view_deg", &["30.0", "0.0", "180.0"]),
-    ("array", "distance_mm", &["1000.0", "0.0", "-5.0"]),
-];
-
 /// The short windowed frame (N = 4096, B = 4; fast through `simulate`) with one to three
-/// keys set from [`VALUES`] or [`TYPED`]; the text and the mutations (key, literal). A
+/// keys set from [`VALUES`] or to values of the key's own type (strings, `"auto"`, names,
+/// lists, `[array]`: a key whose type the error table forgets, or a string key blamed for
+/// another key's fault, shows up, issue 31); the text and the mutations (key, literal). A
 /// mutation of `[array]` starts from a valid 2 × 2 array.
-fn mutate(rng: &mut Rng) -> (String, Vec<(String, String)>) {
+fn mutate(rng: &mut Rng, keys: &[Key]) -> (String, Vec<(String, String)>) {
     let base = edit(
         default_text(),
         &[
@@ -171,16 +86,12 @@ fn mutate(rng: &mut Rng) -> (String, Vec<(String, String)>) {
     let mut doc: toml::Table = toml::from_str(&base).unwrap();
     let mut muts = Vec::new();
     for _ in 0..1 + rng.next_u64() % 3 {
-        let (table, key, lit) = if rng.next_u64().is_multiple_of(2) {
-            let (table, keys) = rng.pick(KEYS);
-            (
-                *table,
-                rng.pick(keys).to_string(),
-                rng.pick(VALUES).to_string(),
-            )
+        let k = rng.pick(keys);
+        let (table, key) = (k.section.as_str(), k.key.clone());
+        let lit = if rng.next_u64().is_multiple_of(2) || k.values.is_empty() {
+            rng.pick(VALUES).to_string()
         } else {
-            let (table, key, values) = rng.pick(TYPED);
-            (*table, key.to_string(), rng.pick(values).to_string())
+            rng.pick(&k.values).to_string()
         };
         if table == "array" && !doc.contains_key("array") {
             let array: toml::Table =
@@ -191,7 +102,7 @@ fn mutate(rng: &mut Rng) -> (String, Vec<(String, String)>) {
             .unwrap()
             .remove("v")
             .unwrap();
-        let target = if table == "motion" {
+        let target = if table == "scene.motion" {
             let scene = doc.get_mut("scene").unwrap().as_table_mut().unwrap();
             scene.get_mut("motion").unwrap().as_array_mut().unwrap()[0]
                 .as_table_mut()
@@ -261,10 +172,11 @@ fn mutated_configurations_through_the_binary_exit_0_or_2_and_name_their_field() 
         .unwrap_or(40);
     let tmp = tempfile::tempdir().unwrap();
     let mut rng = Rng(0x0b1a_2026_1119);
+    let keys = fuzzed_keys();
     let (mut runs, mut accepted, mut refused) = (0, 0, 0);
     let mut failures = Vec::new();
     for case in 0..cases {
-        let (text, muts) = mutate(&mut rng);
+        let (text, muts) = mutate(&mut rng, &keys);
         let cfg = tmp.path().join(format!("m{case}.toml"));
         std::fs::write(&cfg, &text).unwrap();
         let doc: toml::Table = toml::from_str(&text).unwrap();

@@ -18,8 +18,10 @@ fn eight_random_configurations_pass_in_verilator() {
     ) {
         return;
     }
-    let cases: Vec<_> = (0..8).map(|i| random_case(0x0070_70be, i)).collect();
-    // The CI's eight cover both modes and every way of choosing the width.
+    // The CI's eight (a seed whose eight cover every knob's values below: 0x0070_70be's did
+    // until the draws became the one generator's, `tofprobe_pixel::random`) cover both modes
+    // and every way of choosing the width.
+    let cases: Vec<_> = (0..8).map(|i| random_case(0x0070_70c2, i)).collect();
     for mode in [Mode::Fourier, Mode::Haar] {
         assert!(
             cases.iter().any(|c| c.params.mode == mode),

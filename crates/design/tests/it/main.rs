@@ -5,4 +5,5 @@
 mod mutations;
 mod readout;
 mod resolve;
+mod schema_keys;
 mod serde_roundtrip;

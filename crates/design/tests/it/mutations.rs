@@ -7,63 +7,28 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+use tofprobe_design::document::keys::{Key, keys};
 use tofprobe_design::{DEFAULT_TOML, Document, ProbeCache, RtlOverrides, resolve_with, rtl_params};
 
 use tofprobe_testkit::params::Rng;
 
-/// Every key a document can hold (those the default leaves out included), by table.
-const KEYS: &[(&str, &[&str])] = &[
-    (
-        "sensor",
-        &[
-            "laser_rate_hz",
-            "jitter_ps",
-            "tdc_lsb_ps",
-            "window_start_ps",
-            "window_length_ps",
-            "signal_rate",
-            "background_rate",
-        ],
-    ),
-    ("scene", &["depth_mm"]),
-    ("acquisition", &["duration_s", "pulses", "seed"]),
-    (
-        "pixel",
-        &[
-            "mode",
-            "bins",
-            "adders",
-            "cycles_per_pulse",
-            "shift",
-            "frac_bits",
-            "tdc_bits",
-            "width",
-            "frame_pulses",
-            "rom_depth",
-            "zoom",
-            "haar_scales",
-            "frequencies_hz",
-        ],
-    ),
-    (
-        "probe",
-        &[
-            "order",
-            "osr",
-            "h_inf",
-            "optimised_zeros",
-            "window",
-            "amplitude",
-            "rom_mode",
-            "rom_depth",
-            "convention",
-        ],
-    ),
-    (
-        "motion",
-        &["kind", "amplitude_mm", "frequency_hz", "phase_deg"],
-    ),
-];
+/// The keys mutated: every key a document can hold, derived from the schema
+/// (`tofprobe_design::document::keys`: a new key is fuzzed with its type, no list to edit),
+/// a motion's those of the default's motion kind.
+fn fuzzed_keys() -> Vec<Key> {
+    let doc: toml::Table = toml::from_str(DEFAULT_TOML).unwrap();
+    let kind = doc["scene"]["motion"][0]["kind"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    keys()
+        .into_iter()
+        .filter(|k| k.kind.as_ref().is_none_or(|x| *x == kind))
+        .collect()
+}
+
+/// A valid `[array]` for mutations of its keys (the default document has none).
+const BASE_ARRAY: &str = "rows = 2\ncols = 2\npitch_um = 30.0\nmm_per_pixel = 1.0";
 
 /// Values a mutation writes (TOML literals): zero, signs, extremes of f64 and u64,
 /// subnormals, non-finite values, wrong types, a long string.
@@ -122,20 +87,30 @@ fn values() -> Vec<String> {
     v
 }
 
-/// The default document with one to three keys set to `values()`; returns the text and the
-/// mutations (table, key, literal).
-fn mutate(rng: &mut Rng, vals: &[String]) -> (String, Vec<(String, String, String)>) {
+/// The default document with one to three keys set, half of them to `values()`, half to
+/// values of the key's own type; returns the text and the mutations (table, key, literal).
+fn mutate(rng: &mut Rng, keys: &[Key], vals: &[String]) -> (String, Vec<(String, String, String)>) {
     let mut doc: toml::Table = toml::from_str(DEFAULT_TOML).unwrap();
     let mut muts = Vec::new();
     for _ in 0..1 + rng.next_u64() % 3 {
-        let (table, keys) = rng.pick(KEYS);
-        let key = rng.pick(keys).to_string();
-        let lit = rng.pick(vals).clone();
-        let value: toml::Value = toml::from_str::<toml::Table>(&format!("v = {lit}"))
-            .unwrap()
-            .remove("v")
-            .unwrap();
-        let target = if *table == "motion" {
+        let k = rng.pick(keys);
+        let (table, key) = (k.section.as_str(), k.key.clone());
+        let (lit, value) = if rng.next_u64().is_multiple_of(2) && !k.values.is_empty() {
+            let v = rng.pick(&k.values).clone();
+            (v.to_string(), v)
+        } else {
+            let lit = rng.pick(vals).clone();
+            let value = toml::from_str::<toml::Table>(&format!("v = {lit}"))
+                .unwrap()
+                .remove("v")
+                .unwrap();
+            (lit, value)
+        };
+        if table == "array" && !doc.contains_key("array") {
+            let array: toml::Table = toml::from_str(BASE_ARRAY).unwrap();
+            doc.insert("array".into(), toml::Value::Table(array));
+        }
+        let target = if table == "scene.motion" {
             let scene = doc.get_mut("scene").unwrap().as_table_mut().unwrap();
             let m = scene.get_mut("motion").unwrap().as_array_mut().unwrap();
             m[0].as_table_mut().unwrap()
@@ -197,12 +172,13 @@ fn mutated_configurations_resolve_or_name_their_field() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(600);
     let vals = values();
+    let keys = fuzzed_keys();
     let mut rng = Rng(0x7f4a_7c15_2024);
     let mut cache = ProbeCache::default();
     let (mut ok, mut refused, mut panics) = (0, 0, 0);
     let mut failures: Vec<String> = Vec::new();
     for case in 0..cases {
-        let (text, muts) = mutate(&mut rng, &vals);
+        let (text, muts) = mutate(&mut rng, &keys, &vals);
         let run = catch_unwind(AssertUnwindSafe(|| {
             let doc = Document::from_toml_str(&text, "mutated.toml").map_err(Box::new)?;
             let d = resolve_with(doc, "mutated.toml", &mut cache).map_err(Box::new)?;

@@ -14,7 +14,7 @@
 //! stay within a group at every width. So all paths give the same bits and sums on every
 //! machine (crates/dsp/tests/it/fullband_isa.rs proves it for each path the CPU runs).
 
-use super::pairs::LanePrecision;
+use super::lane::LanePrecision;
 use crate::error::DspError;
 
 /// The instruction path of the full-band lane kernel.
@@ -111,10 +111,10 @@ impl KernelPath {
     pub fn lanes(self, precision: LanePrecision) -> usize {
         match (self, precision) {
             (KernelPath::Baseline, p) => p.lanes(),
-            (KernelPath::Avx2, LanePrecision::F64) => super::pairs::LANES_F64_AVX2,
-            (KernelPath::Avx2, LanePrecision::F32) => super::pairs::LANES_F32_AVX2,
-            (KernelPath::Avx512, LanePrecision::F64) => super::pairs::LANES_F64_AVX512,
-            (KernelPath::Avx512, LanePrecision::F32) => super::pairs::LANES_F32_AVX512,
+            (KernelPath::Avx2, LanePrecision::F64) => super::lane::LANES_F64_AVX2,
+            (KernelPath::Avx2, LanePrecision::F32) => super::lane::LANES_F32_AVX2,
+            (KernelPath::Avx512, LanePrecision::F64) => super::lane::LANES_F64_AVX512,
+            (KernelPath::Avx512, LanePrecision::F32) => super::lane::LANES_F32_AVX512,
         }
     }
 

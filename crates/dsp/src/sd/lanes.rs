@@ -15,8 +15,8 @@
 //! ([`Window::symmetric_value`]); still an exact function of n mod L, at the cost of a
 //! sin or cos per sample and lane (≈ 20 ns: seconds for a windowed ROM of 10^7 pulses).
 
+use super::STATE_BOUND;
 use super::config::ProbeConvention;
-use super::modulator::STATE_BOUND;
 use super::realize::StateSpace;
 use crate::error::DspError;
 use crate::window::Window;

@@ -5,6 +5,7 @@ pub mod fullband;
 pub mod fullband_check;
 pub mod fullband_spectrum;
 pub mod isa;
+mod lane;
 pub mod lanes;
 pub mod modulator;
 pub mod ntf;
@@ -28,3 +29,7 @@ pub use probing::{
 };
 pub use realize::{Cifb, StateSpace, realize_cifb};
 pub use wrap::WrapMetric;
+
+/// |state| above which the modulator is declared unstable (the scalar [`Modulator`] and
+/// the lanes of [`lanes`] and [`pairs`] alike).
+pub const STATE_BOUND: f64 = 100.0;

@@ -14,8 +14,7 @@ use crate::error::DspError;
 use crate::window::Window;
 use std::f64::consts::PI;
 
-/// |state| above which the modulator is declared unstable.
-pub const STATE_BOUND: f64 = 100.0;
+pub use super::STATE_BOUND;
 
 /// Samples of each fixed-length sine run of the stability sweep. For the default design
 /// 2^16 samples still miss slow run-aways (1 kHz reads 0.785); from 2^18 on the limit

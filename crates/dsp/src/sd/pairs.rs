@@ -13,7 +13,7 @@
 //! multiple of [`ANCHOR`] samples, so rounding never accumulates beyond one anchor span and
 //! the input at sample n depends on n alone, whatever the chunking.
 //!
-//! Two precisions, chosen explicitly by the caller ([`LanePrecision`]):
+//! Two precisions, chosen explicitly by the caller ([`LanePrecision`], [`super::lane`]):
 //! - `F64`: bit-exact with the scalar reference [`super::Modulator::run`] fed the same
 //!   input. Same operations in the same order; the only rewrites are exact ones: products
 //!   with the CIFB's unit coefficients dropped (1·x = x), ±b₂ and ±x formed by flipping the
@@ -32,141 +32,20 @@
 // plain index form is what the vectoriser and the reader both follow best.
 #![allow(clippy::needless_range_loop)]
 
+use super::STATE_BOUND;
 use super::isa::KernelPath;
-use super::modulator::STATE_BOUND;
+pub(crate) use super::lane::Lane;
+pub use super::lane::{
+    LANES_F32, LANES_F32_AVX2, LANES_F32_AVX512, LANES_F64, LANES_F64_AVX2, LANES_F64_AVX512,
+    LanePrecision,
+};
 use super::pairs_kernel::{Consts, Span, step_on};
 use super::realize::StateSpace;
 use crate::error::DspError;
 use std::f64::consts::PI;
-use std::fmt::Debug;
-use std::ops::{Add, BitAnd, BitXor, Mul};
 
 /// Samples between exact re-anchorings of the rotators (and f32 accumulator flushes).
 pub const ANCHOR: u64 = 1024;
-/// Lanes (streams) per f64 group: two SSE2 registers. More lanes spill (measured: 4 lanes
-/// 7.1·10⁸ steps per CPU-second, 8 lanes 6.0·10⁸).
-pub const LANES_F64: usize = 4;
-/// Lanes per f32 group: four SSE2 registers (8 lanes 1.1·10⁹, 16 lanes 1.3·10⁹, 32 spill).
-pub const LANES_F32: usize = 16;
-/// Lanes per f64 group on the AVX2 path ([`KernelPath::Avx2`]): two 256-bit registers,
-/// the register footprint of the baseline's four lanes (measured in one session, 401 bins
-/// of N = 2·10⁶: 8 lanes 1.0–1.09·10⁹ steps per CPU-second, 12 lanes 0.93–1.0·10⁹, the
-/// baseline's 4 lanes 0.59–0.65·10⁹).
-pub const LANES_F64_AVX2: usize = 8;
-/// Lanes per f32 group on the AVX2 path: four 256-bit registers (same run: 32 lanes
-/// 2.2–2.4·10⁹, 16 lanes 0.94–1.0·10⁹, the baseline's 16 lanes 0.73–0.77·10⁹).
-pub const LANES_F32_AVX2: usize = 32;
-/// Lanes per f64 group on the AVX-512 path ([`KernelPath::Avx512`]): two 512-bit
-/// registers, the I and the Q halves (measured in one session, 801 bins of N = 2·10⁶,
-/// steps per CPU-second: 16 lanes 2.5–2.8·10⁹, 8 lanes 1.2–2.1·10⁹, 32 lanes 1.1–1.4·10⁹).
-pub const LANES_F64_AVX512: usize = 16;
-/// Lanes per f32 group on the AVX-512 path: f32 lanes run the AVX2 copy there (its 32
-/// lanes measured 2.4–3.7·10⁹ steps per CPU-second against the AVX-512 copy's 1.6·10⁹ at
-/// 32 lanes and 2.0·10⁹ at 64, 4000 bins, one thread, same session).
-pub const LANES_F32_AVX512: usize = LANES_F32_AVX2;
-
-/// Arithmetic of the modulator lanes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum LanePrecision {
-    /// f64, bit-exact with the scalar reference modulator.
-    #[default]
-    F64,
-    /// f32 lanes (f64 across anchor spans): faster, different but equally valid bits.
-    F32,
-}
-
-impl LanePrecision {
-    /// Name as printed and parsed ("f64", "f32").
-    pub fn name(self) -> &'static str {
-        match self {
-            LanePrecision::F64 => "f64",
-            LanePrecision::F32 => "f32",
-        }
-    }
-
-    /// Lanes per interleaved group on the baseline path ([`KernelPath::lanes`] for any).
-    pub fn lanes(self) -> usize {
-        match self {
-            LanePrecision::F64 => LANES_F64,
-            LanePrecision::F32 => LANES_F32,
-        }
-    }
-}
-
-/// A float the lanes compute in: arithmetic plus its sign bit.
-pub(crate) trait Lane:
-    Copy + Default + Debug + Send + Sync + Add<Output = Self> + Mul<Output = Self>
-{
-    type Bits: Copy + Default + BitAnd<Output = Self::Bits> + BitXor<Output = Self::Bits> + Eq;
-    const SIGN: Self::Bits;
-    /// Whether the accumulator is flushed into an f64 total at every anchor (f32), or is
-    /// itself the f64 sequential sum (f64: bit-exact with sample-by-sample accumulation).
-    const FLUSH: bool;
-    /// Whether the AVX-512 copy of the kernel runs these lanes (f64); f32 lanes on the
-    /// AVX-512 path run the AVX2 copy, faster for them ([`LANES_F32_AVX512`]).
-    const AVX512: bool;
-    fn bits(self) -> Self::Bits;
-    fn from_bits(b: Self::Bits) -> Self;
-    fn of(v: f64) -> Self;
-    fn wide(self) -> f64;
-    /// self·a + b rounded once (used only with self = ±1, where it equals ±a + b).
-    fn mul_add(self, a: Self, b: Self) -> Self;
-}
-
-impl Lane for f64 {
-    type Bits = u64;
-    const SIGN: u64 = 1 << 63;
-    const FLUSH: bool = false;
-    const AVX512: bool = true;
-    #[inline(always)]
-    fn bits(self) -> u64 {
-        self.to_bits()
-    }
-    #[inline(always)]
-    fn from_bits(b: u64) -> Self {
-        f64::from_bits(b)
-    }
-    #[inline(always)]
-    fn of(v: f64) -> Self {
-        v
-    }
-    #[inline(always)]
-    fn wide(self) -> f64 {
-        self
-    }
-    #[inline(always)]
-    fn mul_add(self, a: f64, b: f64) -> f64 {
-        f64::mul_add(self, a, b)
-    }
-}
-
-impl Lane for f32 {
-    type Bits = u32;
-    const SIGN: u32 = 1 << 31;
-    const FLUSH: bool = true;
-    const AVX512: bool = false;
-    #[inline(always)]
-    fn bits(self) -> u32 {
-        self.to_bits()
-    }
-    #[inline(always)]
-    fn from_bits(b: u32) -> Self {
-        f32::from_bits(b)
-    }
-    #[inline(always)]
-    fn of(v: f64) -> Self {
-        v as f32
-    }
-    #[inline(always)]
-    fn wide(self) -> f64 {
-        f64::from(self)
-    }
-    #[inline(always)]
-    fn mul_add(self, a: f32, b: f32) -> f32 {
-        f32::mul_add(self, a, b)
-    }
-}
-
 /// The CIFB state update the kernel needs, checked once: unit diagonal and sub-diagonal,
 /// optional resonator entries above the diagonal, the quantiser reading the last state
 /// with unit weight and the input with unit weight (what `StateSpace::from_cifb` builds).

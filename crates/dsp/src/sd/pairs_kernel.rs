@@ -23,7 +23,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::isa::KernelPath;
-use super::pairs::Lane;
+use super::lane::Lane;
 
 /// The loop state a span reads and leaves: states, rotators and accumulators.
 pub(crate) struct Span<'a, T: Lane, const L: usize, const N: usize> {

@@ -9,6 +9,10 @@ use crate::ExperimentError;
 pub const FS_HZ: f64 = 10e6;
 /// TDC LSB of the Table 2 experiments (mm).
 pub const LSB_MM: f64 = 1.0;
+/// The noise band of Table 2 (Hz).
+pub const BAND: (f64, f64) = (1_000.0, 10_000.0);
+/// The tone frequency of Table 2's amplitude rows.
+pub const F0_HZ: f64 = 4_500.0;
 /// The timing window where background matters (mm).
 pub const BG_WINDOW_MM: f64 = 60.0;
 

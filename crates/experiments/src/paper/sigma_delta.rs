@@ -21,8 +21,7 @@ use tofprobe_pixel::sizing::{
 };
 use tofprobe_pixel::{PixelParams, TransactionModel};
 
-use super::setup::FS_HZ;
-use super::table2::{BAND, F0_HZ};
+use super::setup::{BAND, F0_HZ, FS_HZ};
 use crate::ExperimentError;
 
 mod rows;

@@ -20,6 +20,7 @@ use tofprobe_dsp::stats::{NoiseBand, interpolate_peak, noise_floor};
 use tofprobe_scene::PhotonSource;
 
 use super::chart::Curve;
+pub use super::setup::{BAND, F0_HZ};
 use super::setup::{FS_HZ, LSB_MM};
 use super::sigma_delta::{self, Phasor, ProbeSetup};
 use super::stats;
@@ -41,14 +42,24 @@ pub use rows::{
     snr_row,
 };
 pub use spec::{
-    AMP_BIAS_UM, AMP_MIN_SNR, FULL_N, MAX_SEEDS, NOISE_BIAS, PROBE_EPS2_MAX, ROWS, SeedSet, Spec,
+    AMP_BIAS_UM, AMP_MIN_SNR, FULL_N, MAX_SEEDS, NOISE_BIAS, PROBE_EPS2_MAX, ROWS, SeedSet,
     probe_noise_seeds, seeds_for, seeds_for_set,
 };
 
+/// One row of Table 2: its configuration and what the paper prints for it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spec {
+    pub sigma_s_mm: f64,
+    pub rho_s: f64,
+    pub rho_b: f64,
+    /// Tone amplitude (µm) at [`F0_HZ`], or none.
+    pub amp_um: Option<f64>,
+    /// The paper's values (`data/paper/table2.tsv`).
+    pub printed: printed::Printed,
+}
+
 /// The analysis window of Table 2.
 pub const WINDOW: Window = Window::Blackman;
-/// The noise band (Hz).
-pub const BAND: (f64, f64) = (1_000.0, 10_000.0);
 /// Where a row without a tone reads its "A meas." (the spectrum's largest value, Hz): the
 /// paper truncates its spectra at 20 kHz; from the noise band's lower edge, where a static
 /// depth's leakage through the Blackman sidelobes is gone.
@@ -56,8 +67,6 @@ pub const PEAK_BAND: (f64, f64) = (BAND.0, 20_000.0);
 /// The spectrum's largest bins a row without a tone hands to the probe columns (largest
 /// first): the probe reads them and their neighbours to find its own largest value.
 pub const TOP_BINS: usize = 16;
-/// The tone frequency of the amplitude rows.
-pub const F0_HZ: f64 = 4_500.0;
 /// The seeds of a row not in [`ROWS`] (tests' own specs), and the count every row has at
 /// least: noise floor and amplitude are means over a row's seeds ([`seeds_for`]).
 pub const SEEDS: &[u64] = stats::SEEDS;

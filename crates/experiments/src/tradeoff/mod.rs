@@ -33,6 +33,7 @@ use tofprobe_scene::PhotonSource;
 use crate::error::ExperimentError;
 use crate::level::Level;
 use crate::records::{detection_record, held_record};
+use crate::references::dft_bins;
 use crate::spectrum::{BitTrueSetup, setup};
 
 /// Pulses of the shortened frame the cycle-accurate model is timed on.
@@ -453,15 +454,6 @@ impl<'a> Ladder<'a> {
         let per_pulse = secs / rep.pulses.max(1) as f64;
         Ok(per_pulse * self.n as f64)
     }
-}
-
-/// The ROM's bins k·f_s/L as indices of the N-point DFT (equal in windowed mode, the
-/// nearest bin in periodic mode when L does not divide N).
-pub fn dft_bins(rom_bins: &[u64], n: u64, rom_depth: usize) -> Vec<usize> {
-    rom_bins
-        .iter()
-        .map(|&k| (k as f64 * n as f64 / rom_depth as f64).round() as usize)
-        .collect()
 }
 
 /// The Markdown table of one scene.

@@ -15,9 +15,9 @@ use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
 
-use super::dft_bins;
 use super::overrides::{shortened, with_overrides};
 use super::timing::median_seconds;
+use crate::references::dft_bins;
 use tofprobe_design::{DesignError, ProbeCache, ResolvedDesign};
 
 use crate::error::ExperimentError;

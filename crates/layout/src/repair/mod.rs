@@ -68,14 +68,6 @@ impl Repair {
     }
 }
 
-/// netgen's total error count in qflow's LVS log (`Total errors = N`).
-pub fn lvs_total(log: &str) -> Option<u64> {
-    log.lines()
-        .rev()
-        .find_map(|l| l.trim().strip_prefix("Total errors = "))
-        .and_then(|n| n.trim().parse().ok())
-}
-
 /// An error for an ECO round's output that qrouter did not write.
 pub fn missing(path: &std::path::Path) -> LayoutError {
     LayoutError::Parse {
@@ -172,7 +164,7 @@ fn errors(c: &Checks) -> u64 {
 pub fn repair(
     project: &crate::qflow::Project,
     first: Checks,
-    steps: &mut Vec<crate::report::Step>,
+    steps: &mut Vec<crate::Step>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<(Repair, Checks)> {
     let layout = project.dir.join("layout");
@@ -211,7 +203,7 @@ pub fn repair(
             targets.len()
         ));
         let eco = eco_round(project, &targets, round)?;
-        steps.push(crate::report::Step {
+        steps.push(crate::Step {
             step: format!(
                 "ECO re-route round {round} (qrouter, {} nets)",
                 eco.changed.len()
@@ -237,7 +229,7 @@ pub fn repair(
         progress(&format!("DRC and LVS after round {round}"));
         checks = project.checks()?;
         let seconds = checks.drc_seconds + checks.lvs_seconds;
-        steps.push(crate::report::Step {
+        steps.push(crate::Step {
             step: format!("DRC, extraction, LVS after round {round} (magic, netgen)"),
             seconds,
         });
@@ -258,7 +250,7 @@ pub fn repair(
             copy(&best_def, &def)?;
             copy(&best_rc, &rc)?;
             checks = project.checks()?;
-            steps.push(crate::report::Step {
+            steps.push(crate::Step {
                 step: "DRC, extraction, LVS of the best route again (magic, netgen)".into(),
                 seconds: checks.drc_seconds + checks.lvs_seconds,
             });

@@ -1,8 +1,8 @@
-//! What the checks and the routed DEF say about the nets: magic's DRC error boxes,
-//! the DEF's wires, vias and pins, the nets at each box and netgen's unmatched nets.
+//! What the checks and the routed DEF say about the nets: the nets at magic's DRC error
+//! boxes ([`crate::qflow::DrcBox`]), the DEF's wires, vias and pins, the nets at each box and netgen's unmatched nets.
 
 use crate::def::{RouteItem, route_items};
-use serde::{Deserialize, Serialize};
+use crate::qflow::DrcBox;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// How near (µm) a wire's centre line must come to a DRC error box for its net to be
@@ -13,51 +13,6 @@ pub const NEAR_UM: f64 = 0.45;
 
 /// The fallback distance for a box with no net within [`NEAR_UM`].
 pub const FAR_UM: f64 = 1.0;
-
-/// A DRC error box (µm) and the rule it breaks.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct DrcBox {
-    /// magic's text of the rule.
-    pub rule: String,
-    /// Lower left x (µm).
-    pub x0: f64,
-    /// Lower left y (µm).
-    pub y0: f64,
-    /// Upper right x (µm).
-    pub x1: f64,
-    /// Upper right y (µm).
-    pub y1: f64,
-}
-
-/// The error boxes printed by the DRC script of [`crate::qflow::Project::drc_reasons`]:
-/// `TOFPROBE-SCALE S` (µm per magic unit, `cif scale out`) and one
-/// `TOFPROBE-BOX X0 Y0 X1 Y1 RULE` per box in magic units.
-pub fn parse_drc_boxes(text: &str) -> Vec<DrcBox> {
-    let scale = text
-        .lines()
-        .find_map(|l| l.trim().strip_prefix("TOFPROBE-SCALE "))
-        .and_then(|s| s.trim().parse::<f64>().ok());
-    let Some(s) = scale else {
-        return vec![];
-    };
-    text.lines()
-        .filter_map(|l| l.trim().strip_prefix("TOFPROBE-BOX "))
-        .filter_map(|l| {
-            let mut it = l.splitn(5, ' ');
-            let mut c = [0.0; 4];
-            for v in &mut c {
-                *v = it.next()?.parse::<f64>().ok()? * s;
-            }
-            Some(DrcBox {
-                rule: it.next()?.trim().to_string(),
-                x0: c[0],
-                y0: c[1],
-                x1: c[2],
-                y1: c[3],
-            })
-        })
-        .collect()
-}
 
 /// One piece of a net's routing in the DEF: a wire between two points (its centre line's
 /// bounding box, µm) on `layer`, or a via at a point (`layer` is then the via's name).

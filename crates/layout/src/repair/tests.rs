@@ -2,6 +2,7 @@
 //! pixel's logs.
 
 use super::*;
+use crate::qflow::{DrcBox, lvs_total, parse_drc_boxes};
 
 /// The default pixel's routed DEF around its two DRC spots and its open net
 /// (2026-11-28, density 0.5, stage 3 skipped), cut to three nets; `far` is a net

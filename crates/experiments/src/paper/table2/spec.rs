@@ -8,8 +8,8 @@ use std::sync::LazyLock;
 use super::super::setup::{LSB_MM, Setup};
 use super::super::sigma_delta::probe_bins;
 use super::super::stats::{K, SEEDS};
-use super::printed::{Printed, TSV, parse};
-use super::{F0_HZ, closed_form_amp_um, closed_form_noise_on_bins_um, closed_form_noise_um};
+use super::printed::{TSV, parse};
+use super::{F0_HZ, Spec, closed_form_amp_um, closed_form_noise_on_bins_um, closed_form_noise_um};
 use crate::ExperimentError;
 
 /// The amplitude bias a full-length tested amplitude row must catch (µm): its seed count
@@ -25,18 +25,6 @@ pub const MAX_SEEDS: usize = 64;
 pub const FULL_N: u64 = 10_000_000;
 /// Amplitude rows are tested only where the tone stands this many floors above the noise.
 pub const AMP_MIN_SNR: f64 = 3.0;
-
-/// One row of Table 2: its configuration and what the paper prints for it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Spec {
-    pub sigma_s_mm: f64,
-    pub rho_s: f64,
-    pub rho_b: f64,
-    /// Tone amplitude (µm) at [`F0_HZ`], or none.
-    pub amp_um: Option<f64>,
-    /// The paper's values (`data/paper/table2.tsv`).
-    pub printed: Printed,
-}
 
 /// Every row of Table 2, in the paper's order, from the compiled-in table file (its parse
 /// is checked by `printed`'s tests, so it cannot fail at run time).

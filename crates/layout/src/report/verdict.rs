@@ -239,7 +239,7 @@ mod tests {
 
     /// The report of the 2-bin pixel on osu018 (`tofprobe layout two.toml --route-cleanup
     /// off`): every check passed.
-    const CLEAN: &str = include_str!("../testdata/layout-report-2bin-osu018.json");
+    const CLEAN: &str = include_str!("../../testdata/layout-report-2bin-osu018.json");
 
     fn clean() -> LayoutReport {
         serde_json::from_str(CLEAN).unwrap()
@@ -264,7 +264,7 @@ mod tests {
     fn each_failed_check_is_named_with_its_figure() {
         // The 4-bin latch pixel's timing (the recorded OpenSTA log of crate::sta's tests):
         // hold between registers −1.6524 ns.
-        let log = include_str!("../testdata/sta-latch4-osu018.log");
+        let log = include_str!("../../testdata/sta-latch4-osu018.log");
         let mut r = clean();
         r.post_route = crate::sta::parse(log, 6.25, 0, Path::new("l")).unwrap();
         let f = failures(&r);

@@ -1,66 +1,16 @@
-//! The RTL commands on an `[array]` design (docs/pixel-contract.md "Array"): `tofprobe rtl`
-//! renders the array (`tofprobe_flow::array::render_array_design`), `tofprobe cosim`
-//! co-simulates it at its ports (`tofprobe_flow::array::cosim_array`); `tofprobe flow`
-//! calls `tofprobe_flow::array::run_array_flow` from its own file. Printing only.
+//! `tofprobe cosim` on an `[array]` design (docs/pixel-contract.md "Array"): co-simulated
+//! at its ports (`tofprobe_flow::array::cosim_array`). `tofprobe rtl` renders the array in
+//! `rtl.rs`; `tofprobe flow` calls `tofprobe_flow::array::run_array_flow` from its own
+//! file. Printing only.
 
-use tofprobe_design::{ResolvedDesign, RtlOverrides};
-use tofprobe_flow::array::{
-    ArrayCosimOptions, ArrayKit, ArraySimulator, cosim_array, render_array_design,
-};
+use tofprobe_design::ResolvedDesign;
+use tofprobe_flow::array::{ArrayCosimOptions, ArraySimulator, cosim_array};
 
-use crate::commands::cosim::{CosimArgs, SimulatorArg};
-use crate::commands::rtl::{RtlArgs, regen_command};
+use super::{CosimArgs, SimulatorArg};
 use crate::error::CliError;
 
-/// `tofprobe rtl` on an array design.
-pub fn rtl(a: &RtlArgs, design: &ResolvedDesign) -> Result<(), CliError> {
-    if a.core_vectors.is_some() {
-        return Err(CliError::option(
-            "core-vectors",
-            "given",
-            "the pixel's top only (an array is co-simulated by `tofprobe cosim`)",
-        ));
-    }
-    let o = RtlOverrides {
-        frame_pulses: a.frame_pulses,
-        rom_depth: a.rom_depth,
-    };
-    let kit_frames = a
-        .kit_frames
-        .unwrap_or(tofprobe_rtlgen::kit::KIT_DEFAULT_FRAMES);
-    let (chip, files, kit) = render_array_design(design, &o, &a.out, regen_command(a), kit_frames)?;
-    let p = &chip.pixel;
-    let ro = chip.readout.as_ref();
-    println!(
-        "rtl: {} x {} array of {:?} pixels ({} registers x {} bits), N = {}, L = {}; readout {} bits x {} beat(s) per word, slot {} cycles, {} cycles per readout -> {} ({}); {}",
-        chip.rows,
-        chip.cols,
-        p.mode,
-        p.registers(),
-        p.width,
-        p.frame_pulses,
-        p.rom_depth,
-        ro.map(|r| r.bits).unwrap_or(0),
-        ro.map(|r| r.beats_per_word).unwrap_or(0),
-        ro.map(|r| r.slot_cycles()).unwrap_or(0),
-        ro.map(|r| r.readout_cycles()).unwrap_or(0),
-        a.out.display(),
-        files.join(", "),
-        chip.rom.note
-    );
-    match kit {
-        ArrayKit::Written { frames, cycles } => println!(
-            "rtl: verification kit: {} with {frames} frame(s) of golden vectors ({cycles} cycles) in the set; \
-             run it with its core's `sim`/`sim_verilator` targets or testbench/README.md's commands",
-            tofprobe_rtlgen::kit::KIT_TESTBENCH
-        ),
-        ArrayKit::Omitted(why) => println!("rtl: {why}"),
-    }
-    Ok(())
-}
-
 /// `tofprobe cosim` on an array design.
-pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<super::Verdict, CliError> {
+pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<crate::commands::Verdict, CliError> {
     // Every option either works on an array or is refused by name: none is ignored.
     let pixel_only = [
         ("directed", a.directed, "the pixel's directed sequencer"),
@@ -91,7 +41,7 @@ pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<super::Verdict, C
         SimulatorArg::Icarus => ArraySimulator::Icarus,
     };
     o.command = "tofprobe cosim".into();
-    o.tile = super::tile_arg::tile_for(design, a.tile.as_deref())?;
+    o.tile = crate::commands::tile_arg::tile_for(design, a.tile.as_deref())?;
     let r = cosim_array(design, &o)?;
     let ro = &r.readout;
     if a.json {
@@ -167,12 +117,12 @@ pub fn cosim(a: &CosimArgs, design: &ResolvedDesign) -> Result<super::Verdict, C
         }
     };
     let suite = tofprobe_cosim::junit::frames_suite(
-        &super::cosim::junit_name(a),
+        &super::junit_name(a),
         &tofprobe_rtlgen::config_hash(&r.pixel),
         r.build_seconds + r.sim_seconds + r.model_seconds,
         a.frames,
         failure,
     );
-    super::cosim::write_junit(a, &[suite])?;
-    Ok(super::Verdict::of(r.pass))
+    super::write_junit(a, &[suite])?;
+    Ok(crate::commands::Verdict::of(r.pass))
 }

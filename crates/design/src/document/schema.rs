@@ -5,10 +5,10 @@
 //! listed here: each key is tried alone against the document's own serde types
 //! ([`Document`]), so every key — a new one included — is judged by the one schema.
 
-use serde::Deserialize;
+use serde::de::DeserializeOwned;
 use toml::{Table, Value};
 
-use crate::document::Document;
+use crate::Document;
 
 /// Whether `value` fits key `key` of section `section` (`scene.motion` entries: `entry`
 /// holds the entry's `kind`): the document's own serde types are asked, with a document
@@ -16,6 +16,16 @@ use crate::document::Document;
 /// notices the keys that are missing, so "missing field" means the key fits; an unknown key
 /// is the parser's to report (with its line). `Some(serde's message)` when it does not fit.
 fn misfit(section: &str, key: &str, value: &Value, entry: Option<&Value>) -> Option<String> {
+    misfit_of::<Document>(section, key, value, entry)
+}
+
+/// [`misfit`] against the serde types of `D` (the document, or a test's own).
+pub(crate) fn misfit_of<D: DeserializeOwned>(
+    section: &str,
+    key: &str,
+    value: &Value,
+    entry: Option<&Value>,
+) -> Option<String> {
     let mut body = Table::new();
     body.insert(key.to_string(), value.clone());
     let body = match entry {
@@ -31,7 +41,7 @@ fn misfit(section: &str, key: &str, value: &Value, entry: Option<&Value>) -> Opt
     };
     let mut doc = Table::new();
     doc.insert(section.to_string(), Value::Table(body));
-    let e = Document::deserialize(Value::Table(doc)).err()?;
+    let e = D::deserialize(Value::Table(doc)).err()?;
     let m = e.message().trim();
     (!(m.starts_with("missing field") || m.starts_with("unknown field"))).then(|| m.to_string())
 }
@@ -111,7 +121,7 @@ fn describe_by(
 
 /// The embedded default's value of a key (absent keys at their serde defaults), for
 /// [`describe`]; motions only for the default's kind.
-fn default_value(section: &str, key: &str, entry: Option<&Value>) -> Option<Value> {
+pub(crate) fn default_value(section: &str, key: &str, entry: Option<&Value>) -> Option<Value> {
     let doc = Document::from_toml_str(crate::DEFAULT_TOML, crate::DEFAULT_ORIGIN).ok()?;
     let v = Value::try_from(doc).ok()?;
     let sec = v.get(section)?;
@@ -210,6 +220,15 @@ pub fn wrong_type_in(doc: &Table) -> Option<String> {
 /// when it is not a key there: "unknown field `x`, expected one of …"; `None` when the
 /// schema knows the key (whatever its value).
 fn unknown(section: &str, key: Option<&str>, entry: Option<&Value>) -> Option<String> {
+    unknown_of::<Document>(section, key, entry)
+}
+
+/// [`unknown`] against the serde types of `D`.
+pub(crate) fn unknown_of<D: DeserializeOwned>(
+    section: &str,
+    key: Option<&str>,
+    entry: Option<&Value>,
+) -> Option<String> {
     let mut body = Table::new();
     if let Some(k) = key {
         // A value that fits no key's type: the key's own name is what serde judges first.
@@ -228,7 +247,7 @@ fn unknown(section: &str, key: Option<&str>, entry: Option<&Value>) -> Option<St
     };
     let mut doc = Table::new();
     doc.insert(section.to_string(), Value::Table(body));
-    let e = Document::deserialize(Value::Table(doc)).err()?;
+    let e = D::deserialize(Value::Table(doc)).err()?;
     let m = e.message().trim();
     m.starts_with("unknown field").then(|| m.to_string())
 }

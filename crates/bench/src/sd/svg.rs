@@ -7,8 +7,8 @@ use plotters::prelude::*;
 use tofprobe_dsp::sd::Modulator;
 use tofprobe_dsp::sd::quality::ToneSpectrum;
 
+use super::{FS_HZ, err};
 use crate::BenchError;
-use crate::sd::{FS_HZ, err};
 
 /// The output spectrum of a 50 kHz, amplitude-0.5 probe (2^16 samples, Hann), dB vs
 /// log frequency, with the band edge f_s/(2·OSR) marked.
