@@ -6,8 +6,10 @@
 # elaborated; synthesis of a slice is `tofprobe size`'s). Prints each tool's wall time,
 # CPU time and peak memory. The array RTL is written with generate loops, so the file is
 # the same size at any R x C; what grows is the tools' elaboration (R x C pixel
-# instances): minutes and gigabytes at 256 x 256, which is why this is a script and not
-# a test (the tests lint 1 x 1 to 16 x 16 and a 64 x 64 tile).
+# instances, linear: Verilator about 380 kB per instance of the default small pixel,
+# 1.56 GB at 64 x 64, about 25 GB at 256 x 256), which is why this is a script and not a
+# test (the tests lint 1 x 1 to 7 x 1, a 64 x 64 tile, and a whole 64 x 64 array whose pixel
+# is a stub; docs/performance.md "Whole-array lint by size" has the figures).
 #
 # Usage: scripts/array-lint.sh ROWS COLS [CONFIG]
 set -euo pipefail

@@ -52,6 +52,12 @@ fn sources(rtl_dir: &Path) -> Result<Vec<std::path::PathBuf>, CosimError> {
 /// against 23.6 CPU-s), and the flat build grows faster than R × C.
 pub const HIERARCHICAL_FROM_PIXELS: usize = 16;
 
+/// The hierarchical build's C++ in pieces: the array top's model (R × C pixel instances'
+/// calls) is otherwise one file of a few giant functions, which one compiler process takes
+/// alone (at 64 × 64: 5.9 GB and most of the build); split into files of functions of at
+/// most this many Verilator statements, `make -j 2` compiles them side by side.
+pub const SPLIT_FLAGS: &[&str] = &["--output-split", "10000", "--output-split-cfuncs", "10000"];
+
 /// How the harness's Verilator build treats the pixel module.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Layout {
@@ -103,7 +109,7 @@ pub fn build(
         &verilator,
         "array ",
         ARRAY_HARNESS_CPP,
-        &format!("{top} {profile:?} {layout:?} {VERILATOR_FLAGS:?}"),
+        &format!("{top} {profile:?} {layout:?} {VERILATOR_FLAGS:?} {SPLIT_FLAGS:?}"),
         &srcs,
     )?;
     let hash = format!("array-{:016x}", fnv1a64(&key));
@@ -123,7 +129,9 @@ pub fn build(
                     pixel_module(top)
                 );
                 std::fs::write(&vlt, text).map_err(|e| CosimError::io(&vlt, e))?;
-                vec!["--hierarchical".into(), vlt.display().to_string()]
+                let mut v: Vec<String> = vec!["--hierarchical".into(), vlt.display().to_string()];
+                v.extend(SPLIT_FLAGS.iter().map(|f| f.to_string()));
+                v
             }
         };
         let extra: Vec<&str> = extra.iter().map(String::as_str).collect();

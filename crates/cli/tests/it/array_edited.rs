@@ -145,7 +145,10 @@ fn an_edited_array_set_is_reverified_and_its_edits_are_caught() {
     let renamed = dir.path().join("port-renamed");
     edited(&set, &renamed, "tofprobe_array.v", |v| {
         v.replace("output wire ready,", "output wire all_ready,")
-            .replace("assign ready = &p_ready;", "assign all_ready = &p_ready;")
+            .replace(
+                "assign ready = &row_ready;",
+                "assign all_ready = &row_ready;",
+            )
     });
     let (_, t) = cosim_rtl(cfg, &renamed, &dir.path().join("w3"), &[]);
     assert!(t.contains("port `ready` is missing"), "{t}");

@@ -4,6 +4,7 @@
 
 mod accepted_render;
 mod array_gates;
+mod array_scale;
 mod gates;
 mod render;
 mod superpixel;
