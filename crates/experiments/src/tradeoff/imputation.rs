@@ -337,7 +337,17 @@ pub fn measure(
         .map(|s| measure_scene(s, n, seeds))
         .collect::<Result<Vec<_>, _>>()?;
     let pixel_cost = match cells {
-        Some(c) => super::imputation_cost::costs(&scenes, c),
+        Some(c) => {
+            let gains: Vec<_> = scenes
+                .iter()
+                .map(|sc| super::imputation_cost::Gains {
+                    rho_s: sc.rho_s,
+                    alpha: sc.alpha,
+                    beta_per_pulse: sc.beta_per_pulse,
+                })
+                .collect();
+            super::imputation_cost::costs(&gains, c)
+        }
         None => Vec::new(),
     };
     Ok(ImputationReport {

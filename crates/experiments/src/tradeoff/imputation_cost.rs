@@ -22,7 +22,6 @@
 use serde::Serialize;
 use tofprobe_eda::liberty::Liberty;
 
-use super::imputation::SceneImputation;
 use crate::ExperimentError;
 use crate::paper::setup::{BG_WINDOW_MM, LSB_MM};
 
@@ -102,8 +101,16 @@ fn log2_ceil(x: f64) -> u32 {
     x.log2().ceil().max(1.0) as u32
 }
 
+/// One scene's α-β gains, what the widths follow from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gains {
+    pub rho_s: f64,
+    pub alpha: f64,
+    pub beta_per_pulse: f64,
+}
+
 /// The costs: the hold, and per signal rate the α-β form and the Kalman filter.
-pub fn costs(scenes: &[SceneImputation], cells: &CellAreas) -> Vec<ImputationCost> {
+pub fn costs(scenes: &[Gains], cells: &CellAreas) -> Vec<ImputationCost> {
     let wc = log2_ceil(BG_WINDOW_MM / LSB_MM);
     let area = |f: u32, fa: u32, and2: u32, mux: u32| {
         f64::from(f) * cells.flop_um2
