@@ -198,52 +198,68 @@ fn yosys_synthesises_without_latches() {
     if !have("yosys") {
         return;
     }
-    for (name, p) in configs() {
-        let dir = render_to(&format!("yosys-{name}"), &p);
-        let script = format!(
-            "read_verilog {}; synth -top {}; select -assert-count {} t:$dlatch t:$_DLATCH_*; tee -o stat.txt stat",
-            sources(&dir).join(" "),
-            module_names(DEFAULT_MODULE_PREFIX).2,
-            // The only latches: the one of the clock-gate module (instantiated per register),
-            // and with latch registers their R·W bits.
-            match p.register_file {
-                RegisterFile::Flops => 0,
-                RegisterFile::ClockGated => 1,
-                RegisterFile::Latch => 1 + p.registers() as u64 * u64::from(p.width),
-            }
-        );
-        let out = Command::new("yosys")
-            .current_dir(&dir)
-            .args(["-q", "-p", &script])
-            .output()
-            .expect("yosys runs");
-        let text = format!(
-            "{}{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        );
-        assert!(out.status.success(), "{name}: {text}");
-        // The only warning allowed: the register file array becomes flip-flops (intended).
-        for line in text.lines().filter(|l| l.contains("Warning")) {
-            assert!(
-                line.contains("Replacing memory \\y with list of registers"),
-                "{name}: {line}"
-            );
+    // Two syntheses at a time (eleven in a row were this binary's long pole, one core idle
+    // for a minute); each configuration's checks run on its own thread.
+    let configs = configs();
+    let half = configs.len().div_ceil(2);
+    std::thread::scope(|s| {
+        for chunk in configs.chunks(half) {
+            s.spawn(move || {
+                for (name, p) in chunk {
+                    synthesises_without_latches(name, p);
+                }
+            });
         }
-        // Flip-flop count: at least the register file R·W (no register optimised away).
-        let stat = std::fs::read_to_string(dir.join("stat.txt")).expect("yosys wrote stat.txt");
-        let dff: u64 = stat
-            .lines()
-            .filter(|l| l.trim_start().starts_with("$_SDFF") || l.trim_start().starts_with("$_DFF"))
-            .filter_map(|l| l.split_whitespace().last()?.parse::<u64>().ok())
-            .sum();
-        // Latch registers: their write enables and one word per adder instead.
-        let floor = match p.register_file {
-            RegisterFile::Latch => (p.registers() + p.adders * p.width as usize) as u64,
-            _ => (p.registers() as u64) * u64::from(p.width),
-        };
-        assert!(dff >= floor, "{name}: {dff} flip-flops");
+    });
+}
+
+/// One configuration's generic synthesis: no latch but the intended ones, the only
+/// warning the register file's, and no register optimised away.
+fn synthesises_without_latches(name: &str, p: &PixelParams) {
+    let dir = render_to(&format!("yosys-{name}"), p);
+    let script = format!(
+        "read_verilog {}; synth -top {}; select -assert-count {} t:$dlatch t:$_DLATCH_*; tee -o stat.txt stat",
+        sources(&dir).join(" "),
+        module_names(DEFAULT_MODULE_PREFIX).2,
+        // The only latches: the one of the clock-gate module (instantiated per register),
+        // and with latch registers their R·W bits.
+        match p.register_file {
+            RegisterFile::Flops => 0,
+            RegisterFile::ClockGated => 1,
+            RegisterFile::Latch => 1 + p.registers() as u64 * u64::from(p.width),
+        }
+    );
+    let out = Command::new("yosys")
+        .current_dir(&dir)
+        .args(["-q", "-p", &script])
+        .output()
+        .expect("yosys runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.status.success(), "{name}: {text}");
+    // The only warning allowed: the register file array becomes flip-flops (intended).
+    for line in text.lines().filter(|l| l.contains("Warning")) {
+        assert!(
+            line.contains("Replacing memory \\y with list of registers"),
+            "{name}: {line}"
+        );
     }
+    // Flip-flop count: at least the register file R·W (no register optimised away).
+    let stat = std::fs::read_to_string(dir.join("stat.txt")).expect("yosys wrote stat.txt");
+    let dff: u64 = stat
+        .lines()
+        .filter(|l| l.trim_start().starts_with("$_SDFF") || l.trim_start().starts_with("$_DFF"))
+        .filter_map(|l| l.split_whitespace().last()?.parse::<u64>().ok())
+        .sum();
+    // Latch registers: their write enables and one word per adder instead.
+    let floor = match p.register_file {
+        RegisterFile::Latch => (p.registers() + p.adders * p.width as usize) as u64,
+        _ => (p.registers() as u64) * u64::from(p.width),
+    };
+    assert!(dff >= floor, "{name}: {dff} flip-flops");
 }
 
 #[test]
