@@ -43,8 +43,6 @@ pub struct FrontEnd {
     zoom: f64,
     output: FrontEndOutput,
     imputer: Imputer,
-    primed: bool,
-    held: f64,
     x: f64,
     pulses: u64,
 }
@@ -84,41 +82,31 @@ impl FrontEnd {
             zoom,
             output,
             imputer: Imputer::new(Imputation::Hold),
-            primed: false,
-            held: 0.0,
             x: 0.0,
             pulses: 0,
         }
     }
 
-    /// One pulse: returns the value the accumulators see (0 before priming).
+    /// One pulse: returns the value the accumulators see (0 before priming). Priming and
+    /// the held depth are the imputer's own state (the hold: the last detection).
     #[inline]
     pub fn step(&mut self, detection: Option<f64>) -> f64 {
         self.pulses += 1;
+        let (was_primed, held_before) = (self.imputer.primed(), self.imputer.depth());
         let imputed = self.imputer.step(detection.map(|v| v - self.zoom));
         match self.output {
-            FrontEndOutput::Held => {
-                if let Some(d) = imputed {
-                    self.held = d;
-                    self.primed = true;
-                }
-                if self.primed { self.held } else { 0.0 }
-            }
+            FrontEndOutput::Held => imputed.unwrap_or(0.0),
             FrontEndOutput::Prefiltered { alpha } => {
-                let out = if self.primed {
-                    self.x += alpha * (self.held - self.x);
+                if was_primed {
+                    self.x += alpha * (held_before - self.x);
                     self.x
                 } else {
-                    0.0
-                };
-                if let Some(d) = imputed {
-                    if !self.primed {
-                        self.primed = true;
+                    // The priming pulse starts x at its own depth and contributes nothing.
+                    if let Some(d) = imputed {
                         self.x = d;
                     }
-                    self.held = d;
+                    0.0
                 }
-                out
             }
         }
     }
@@ -140,11 +128,11 @@ impl FrontEnd {
 
     /// Whether a detection has been seen.
     pub fn primed(&self) -> bool {
-        self.primed
+        self.imputer.primed()
     }
     /// The held (imputed) depth (after zoom).
     pub fn held(&self) -> f64 {
-        self.held
+        self.imputer.depth()
     }
     /// The prefilter state x.
     pub fn prefilter_state(&self) -> f64 {

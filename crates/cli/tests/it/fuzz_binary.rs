@@ -16,23 +16,8 @@ use std::time::Duration;
 
 use common::{default_text, edit};
 
-use tofprobe_design::document::keys::{Key, keys};
+use tofprobe_design::document::keys::{Key, keys_of_the_default};
 use tofprobe_testkit::params::Rng;
-
-/// The keys mutated: every key a document can hold, derived from the schema
-/// (`tofprobe_design::document::keys`: a new key is fuzzed with its type, no list to edit),
-/// a motion's those of the default's motion kind (`scene.motion[0]`).
-fn fuzzed_keys() -> Vec<Key> {
-    let doc: toml::Table = toml::from_str(tofprobe_design::DEFAULT_TOML).unwrap();
-    let kind = doc["scene"]["motion"][0]["kind"]
-        .as_str()
-        .unwrap()
-        .to_string();
-    keys()
-        .into_iter()
-        .filter(|k| k.kind.as_ref().is_none_or(|x| *x == kind))
-        .collect()
-}
 
 /// TOML literals a mutation writes: zero, signs, extremes, non-finite values, wrong types.
 const VALUES: &[&str] = &[
@@ -172,7 +157,7 @@ fn mutated_configurations_through_the_binary_exit_0_or_2_and_name_their_field() 
         .unwrap_or(40);
     let tmp = tempfile::tempdir().unwrap();
     let mut rng = Rng(0x0b1a_2026_1119);
-    let keys = fuzzed_keys();
+    let keys = keys_of_the_default();
     let (mut runs, mut accepted, mut refused) = (0, 0, 0);
     let mut failures = Vec::new();
     for case in 0..cases {

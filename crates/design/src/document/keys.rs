@@ -160,3 +160,18 @@ fn motion_keys<D: DeserializeOwned>(defaults: bool) -> Vec<Key> {
 pub fn keys() -> Vec<Key> {
     collect::<Document>(true)
 }
+
+/// The keys a mutation of the embedded default may touch: every key of [`keys`], a
+/// motion's only those of the default's own motion kind (`scene.motion[0]`) — what both
+/// fuzzers (the library's and the binary's) draw from.
+pub fn keys_of_the_default() -> Vec<Key> {
+    let doc: Option<toml::Table> = toml::from_str(crate::DEFAULT_TOML).ok();
+    let kind = doc
+        .as_ref()
+        .and_then(|d| d.get("scene")?.get("motion")?.get(0)?.get("kind")?.as_str())
+        .map(str::to_string);
+    keys()
+        .into_iter()
+        .filter(|k| k.kind.is_none() || k.kind == kind)
+        .collect()
+}

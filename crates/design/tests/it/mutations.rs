@@ -7,25 +7,10 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-use tofprobe_design::document::keys::{Key, keys};
+use tofprobe_design::document::keys::{Key, keys_of_the_default};
 use tofprobe_design::{DEFAULT_TOML, Document, ProbeCache, RtlOverrides, resolve_with, rtl_params};
 
 use tofprobe_testkit::params::Rng;
-
-/// The keys mutated: every key a document can hold, derived from the schema
-/// (`tofprobe_design::document::keys`: a new key is fuzzed with its type, no list to edit),
-/// a motion's those of the default's motion kind.
-fn fuzzed_keys() -> Vec<Key> {
-    let doc: toml::Table = toml::from_str(DEFAULT_TOML).unwrap();
-    let kind = doc["scene"]["motion"][0]["kind"]
-        .as_str()
-        .unwrap()
-        .to_string();
-    keys()
-        .into_iter()
-        .filter(|k| k.kind.as_ref().is_none_or(|x| *x == kind))
-        .collect()
-}
 
 /// A valid `[array]` for mutations of its keys (the default document has none).
 const BASE_ARRAY: &str = "rows = 2\ncols = 2\npitch_um = 30.0\nmm_per_pixel = 1.0";
@@ -172,7 +157,7 @@ fn mutated_configurations_resolve_or_name_their_field() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(600);
     let vals = values();
-    let keys = fuzzed_keys();
+    let keys = keys_of_the_default();
     let mut rng = Rng(0x7f4a_7c15_2024);
     let mut cache = ProbeCache::default();
     let (mut ok, mut refused, mut panics) = (0, 0, 0);

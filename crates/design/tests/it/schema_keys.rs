@@ -147,3 +147,25 @@ fn a_new_key_is_derived_with_its_type() {
     assert!(k[2].values.contains(&Value::String("clock_gated".into())));
     assert!(!k[2].values.contains(&Value::Integer(1)));
 }
+
+/// The fuzzers' keys: every key outside `scene.motion`, and the default's own motion kind
+/// (a sine) with every one of its keys — no other kind's.
+#[test]
+fn the_fuzzers_draw_every_key_and_the_default_motion_kinds_only() {
+    use tofprobe_design::document::keys::keys_of_the_default;
+    let all = keys();
+    let fuzzed = keys_of_the_default();
+    let outside = |k: &&Key| k.kind.is_none();
+    assert_eq!(
+        fuzzed.iter().filter(outside).count(),
+        all.iter().filter(outside).count()
+    );
+    let kinds: BTreeSet<_> = fuzzed.iter().filter_map(|k| k.kind.clone()).collect();
+    assert_eq!(kinds, BTreeSet::from(["sine".to_string()]), "{kinds:?}");
+    let sine = |k: &&Key| k.kind.as_deref() == Some("sine");
+    assert_eq!(
+        fuzzed.iter().filter(sine).count(),
+        all.iter().filter(sine).count()
+    );
+    assert!(all.iter().any(|k| k.kind.as_deref() == Some("step")));
+}

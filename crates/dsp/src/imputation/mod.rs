@@ -249,6 +249,18 @@ impl Imputer {
         Some(self.x[0])
     }
 
+    /// Whether a detection has been seen.
+    #[inline]
+    pub(crate) fn primed(&self) -> bool {
+        self.primed
+    }
+
+    /// The imputed depth after the last pulse (0 before priming).
+    #[inline]
+    pub(crate) fn depth(&self) -> f64 {
+        self.x[0]
+    }
+
     /// The Kalman filter's predict and (gated) update.
     #[inline]
     fn kalman(&mut self, k: &KalmanParams, detection: Option<f64>) {
