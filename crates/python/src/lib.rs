@@ -353,13 +353,24 @@ impl Design {
     fn probe_rom<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let rom = self.fourier_rom(py, "probe_rom")?;
         let (l, r) = (rom.image.depth(), rom.image.registers());
-        let bits = py.detach(|| {
+        // L·R bytes (512 MB at L = 2^24, R = 32): written in chunks of addresses, so Ctrl-C
+        // stops the copy too (a pending interrupt would otherwise fail numpy's import below).
+        const ADDRESSES: usize = 1 << 16;
+        let progress = Progress::none(l as u64);
+        let bits = long_call::run(py, &progress, None, |watch| {
             let mut v = Vec::with_capacity(l * r);
-            for a in 0..l {
-                v.extend((0..r).map(|j| if rom.image.bit(a, j) { 1i8 } else { -1i8 }));
+            for start in (0..l).step_by(ADDRESSES) {
+                let end = (start + ADDRESSES).min(l);
+                for a in start..end {
+                    v.extend((0..r).map(|j| if rom.image.bit(a, j) { 1i8 } else { -1i8 }));
+                }
+                if !watch.advance((end - start) as u64) {
+                    return Err(());
+                }
             }
-            v
-        });
+            Ok(v)
+        })?
+        .map_err(|()| pyo3::exceptions::PyRuntimeError::new_err("tofprobe: the ROM copy was stopped"))?;
         let array = Array2::from_shape_vec((l, r), bits).map_err(value_error)?;
         Ok(array.into_pyarray(py).into_any())
     }

@@ -55,6 +55,9 @@ def test_ctrl_c_stops_a_long_call_within_a_second(case):
         elapsed = time.monotonic() - t0
     finally:
         p.kill()
-    assert "KeyboardInterrupt" in err, err
+    # The call itself raises KeyboardInterrupt: not a panic whose message names it (a signal
+    # left pending fails numpy's lazy import with a PanicException carrying that text).
+    assert err.strip().splitlines()[-1] == "KeyboardInterrupt", err
+    assert "PanicException" not in err, err
     # One poll (50 ms) plus a chunk, plus the interpreter's exit; the bound is the issue's.
     assert elapsed < 1.0, f"{case}: {elapsed:.2f} s from SIGINT to exit"
