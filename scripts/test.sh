@@ -16,7 +16,8 @@ phase() {
   shift
   local t0
   t0=$(date +%s)
-  "$@"
+  # The status is returned, not left to `set -e` (off inside a lane's `||`).
+  "$@" || { local rc=$?; echo "test.sh: phase ${name} FAILED (exit ${rc})" >&2; return "$rc"; }
   echo "test.sh: phase ${name}: $(( $(date +%s) - t0 )) s" >&2
 }
 
@@ -67,9 +68,22 @@ phase clippy cargo clippy --workspace --all-targets --release -- -D warnings
 phase build-tests cargo test --workspace --release --no-run
 await install-tools
 [ -f "$prep/python-venv.pid" ] && await python-venv
-phase tests cargo test --workspace --release
-# The Python package (crates/python): maturin builds it into the scripts' venv, reusing the
-# library crates just built, and pytest runs its suite against the CLI binary built above.
-phase python scripts/python-package.sh
-phase users-tools scripts/users-tools.sh
+# Two lanes, so both cores stay busy: a test binary ends on its slowest tests with one core
+# idle, and pytest and the users' tools are mostly one process at a time. The CLI's test
+# binary (the largest) runs in one lane, every other test binary, then the Python package
+# and the users' tools in the other (cargo holds no lock while tests run: the build is done).
+# Each lane's output is printed whole when it is awaited; a failing lane fails the suite.
+libs_lane() {
+  phase tests-libraries cargo test --workspace --release --exclude tofprobe-cli &&
+    # The Python package (crates/python): maturin builds it into the scripts' venv, reusing
+    # the library crates built above, and pytest runs its suite against the CLI binary.
+    phase python scripts/python-package.sh &&
+    phase users-tools scripts/users-tools.sh
+}
+tests_start=$(date +%s)
+background lane-cli phase tests-cli cargo test --release -p tofprobe-cli
+background lane-libraries libs_lane
+await lane-libraries
+await lane-cli
+echo "test.sh: phase tests (both lanes): $(( $(date +%s) - tests_start )) s" >&2
 echo "test.sh: all phases passed in $(( $(date +%s) - suite_start )) s" >&2
