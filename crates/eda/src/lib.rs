@@ -4,6 +4,7 @@
 //! W, their Markdown/JSON/SVG output, and sign-off: formal equivalence of netlist and RTL.
 
 pub mod analysis;
+pub mod array;
 pub mod cells;
 pub mod clock_gate;
 pub mod corner_option;
