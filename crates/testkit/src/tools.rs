@@ -98,6 +98,25 @@ pub fn recording_tool(path: &Path) -> PathBuf {
     called
 }
 
+/// A tool's override honoured, the parent's half: runs the test `name` in a child twice
+/// ([`run_in_child`]), first with `var` naming a [`recording_tool`], then with `var` naming
+/// no file ([`NO_SUCH_TOOL`]); returns the arguments the recording tool was called with
+/// (panics if it was not called). The child calls the library that runs the tool and, in
+/// the second run, checks the error names `var` and its value.
+pub fn override_is_honoured(name: &str, var: &str) -> String {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let script = dir.path().join("recording-tool");
+    let called = recording_tool(&script);
+    run_in_child(name, &[(var, script.as_os_str())]);
+    let args = std::fs::read_to_string(&called)
+        .unwrap_or_else(|e| panic!("{name}: ${var} was not run ({e})"));
+    run_in_child(name, &[(var, NO_SUCH_TOOL.as_ref())]);
+    args
+}
+
+/// The path [`override_is_honoured`] sets a tool's variable to in its second run.
+pub const NO_SUCH_TOOL: &str = "/no/such/tool";
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -25,9 +25,9 @@ use crate::error::{EdaError, Result};
 use crate::fsutil::write_atomic;
 use crate::generated::GeneratedPixel;
 use crate::liberty::Liberty;
-use crate::sta::{Timing, parse_report};
+use crate::sta::{Timing, parse_report, run_script};
 use crate::synth::{SynthSpec, synthesise};
-use crate::tools::{Tool, tail};
+use crate::tools::tail;
 use tofprobe_rtlgen::{RenderOptions, render_array};
 
 /// Largest array timed whole (8 × 8); beyond it, a row and a column slice.
@@ -82,18 +82,7 @@ impl PathTiming {
 /// script prints, each part parsed as a `report_checks` text.
 fn run_sta(tcl: &Path, script: &str, parts: &[&str]) -> Result<Vec<Timing>> {
     write_atomic(tcl, script.as_bytes())?;
-    let sta = Tool::Sta.locate()?;
-    let out = std::process::Command::new(&sta)
-        .arg("-no_init")
-        .arg("-exit")
-        .arg(tcl)
-        .output()
-        .map_err(|e| EdaError::io("running", &sta, e))?;
-    let log = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let (_, log) = run_script(tcl)?;
     let mut found = Vec::new();
     for (i, name) in parts.iter().enumerate() {
         let marker = format!("== {name}");

@@ -58,7 +58,7 @@ pub struct ArrayCosimOptions {
     /// The first K pulses of every pixel (or SPAD) present no detection (the priming
     /// rule, array-wide).
     pub lead_misses: u64,
-    /// Thin the scene's detections (`tofprobe_array::rtl_vectors::exercise`) so every
+    /// Thin the scene's detections (`tofprobe_rtlgen::array_vectors::exercise`) so every
     /// count of valid SPADs, the hold and the priming are reached (default on; given
     /// `detections` are replayed as they are).
     pub exercise: bool,
