@@ -2,7 +2,7 @@
 //! the chip rendered with its FuseSoC core ([`rtl`]), the size report's request
 //! ([`sizing`]), gate-level sign-off and equivalence on every library found ([`signoff`]),
 //! and the main flow ([`flow`]: model → RTL → vectors → co-simulation → report); an
-//! `[array]` design's steps are the module folder [`array`]. The
+//! `[array]` design's steps are the module folder [`array`](mod@array). The
 //! measurements it reports on (spectrum, transients, options) come from
 //! `tofprobe-experiments`; the EDA tools are driven by `tofprobe-eda` and `tofprobe-cosim`.
 

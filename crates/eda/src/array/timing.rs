@@ -133,7 +133,7 @@ pub fn slices(rows: usize, cols: usize, whole_max: usize) -> Vec<(String, usize,
 
 /// Times every netlist of `spec.slices` on each liberty of `liberties` (a timing liberty,
 /// then sky130 corners: the top and the pixel mapped on the first of a pair, timed on the
-/// second, see [`time_on`]).
+/// second, see `time_on`).
 pub fn array_timing(
     spec: &ArrayEdaSpec,
     liberties: &[(PathBuf, Option<PathBuf>)],

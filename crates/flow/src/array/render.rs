@@ -16,7 +16,7 @@ use crate::array::vectors::{ArrayStimulus, array_vector_files};
 use crate::error::FlowError;
 
 /// Renders the array chip into `out` (the RTL and its FuseSoC core, one set; with `kit`,
-/// the set's verification kit too: the vector files of [`array_vector_files`] for this chip
+/// the set's verification kit too: the vector files of `vectors::array_vector_files` for this chip
 /// beside the RTL, the testbench `tofprobe_rtlgen::kit` copies, and the core's simulation
 /// targets); returns the file names.
 pub fn render_array_to(
@@ -72,7 +72,7 @@ pub enum ArrayKit {
 /// `tofprobe rtl` on an array design: the chip ROM policy's ROM, N and L as overridden; with
 /// `kit_frames` > 0 the set carries its verification kit ([`render_array_to`]): the golden
 /// vectors of `tofprobe vectors` for `kit_frames` frames (the same code path,
-/// [`array_vector_files`], on the ROM rendered into the set, as `tofprobe cosim --rtl`
+/// `vectors::array_vector_files`, on the ROM rendered into the set, as `tofprobe cosim --rtl`
 /// replays), unless they would exceed `KIT_MAX_CYCLES` cycles.
 pub fn render_array_design(
     design: &ResolvedDesign,
