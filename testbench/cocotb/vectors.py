@@ -99,7 +99,7 @@ class ArrayPins:
 
 @dataclass
 class ArrayVectors:
-    """An array's golden vectors (crates/array/src/rtl_vectors.rs): in an array set's
+    """An array's golden vectors (crates/rtlgen/src/array_vectors.rs): in an array set's
     verification kit, beside the RTL, or in a `tofprobe vectors` directory."""
 
     params: dict

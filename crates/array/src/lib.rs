@@ -17,7 +17,6 @@ pub mod output;
 pub mod plot;
 pub mod rtl;
 mod rtl_run;
-pub mod rtl_vectors;
 pub mod set_plan;
 pub mod shadow;
 pub mod shard;

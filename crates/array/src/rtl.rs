@@ -9,12 +9,12 @@
 //! double_buffer`), the sequencer overlaps the readout with the next frame's pulses and
 //! each pixel's readout streams its [`crate::shadow::Shadow`], loaded by the broadcast swap.
 
-use tofprobe_design::readout::ArrayTile;
 use tofprobe_design::readout::Readout;
 use tofprobe_pixel::{
     ChipSequencer, CycleModel, Mode, NO_DETECTION, PinsIn, PixelParams, Superpixel, Walk,
 };
 use tofprobe_rtlgen::ArrayFault;
+use tofprobe_rtlgen::array::ArrayTile;
 
 use crate::error::ArrayError;
 use crate::shadow::{Shadow, sample};

@@ -2,7 +2,7 @@
 //! harness `testbench/array_harness.cpp` (built once per RTL, cached by content hash like
 //! the pixel's: every run of one design shares the build, whatever vectors it replays) and
 //! the Icarus testbench `testbench/array_tb.v`, both replaying the array's golden vectors
-//! (`tofprobe_array::rtl_vectors`) and reporting mismatches in the harness protocol.
+//! (`tofprobe_rtlgen::array_vectors`) and reporting mismatches in the harness protocol.
 
 use std::path::Path;
 use std::process::Command;

@@ -5,9 +5,9 @@ use std::path::PathBuf;
 /// Errors of the co-simulation drivers.
 #[derive(Debug, thiserror::Error)]
 pub enum CosimError {
-    /// An EDA tool is not installed.
-    #[error("`{tool}` was not found on PATH: run scripts/install-tools.sh to install it")]
-    MissingTool { tool: &'static str },
+    /// An EDA tool is not installed (or its `TOFPROBE_*` variable names no program).
+    #[error("{0}; run scripts/install-tools.sh to install it")]
+    MissingTool(tofprobe_io::tools::ToolNotFound),
     /// A tool ran but failed.
     #[error("{tool} failed (exit status {status}); its output:\n{output}")]
     ToolFailed {

@@ -114,7 +114,7 @@ fn entry_key(
     if objects.is_empty() {
         return None;
     }
-    let dry = Command::new("make")
+    let dry = Command::new(crate::tools::require("make").ok()?)
         .arg("-n")
         .arg("-C")
         .arg(obj)

@@ -1,17 +1,16 @@
-//! Finding the EDA tools: a missing one is named, with the script that installs it; a
-//! tool's `--version`, asked once per process.
+//! Finding the EDA tools through the workspace's one locator (`tofprobe_io::tools::locate`:
+//! `$TOFPROBE_VERILATOR`, `$TOFPROBE_IVERILOG`, … when set, else PATH): a missing one is
+//! named, with its variable and the script that installs it; a tool's `--version`, asked
+//! once per process.
 
 use crate::error::CosimError;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The path of `tool` on PATH, or the error that says to run scripts/install-tools.sh.
-pub fn require(tool: &'static str) -> Result<PathBuf, CosimError> {
-    let path = std::env::var_os("PATH").unwrap_or_default();
-    std::env::split_paths(&path)
-        .map(|d| d.join(tool))
-        .find(|p| p.is_file())
-        .ok_or(CosimError::MissingTool { tool })
+/// The path of `tool` (its `TOFPROBE_*` variable, else PATH), or the error that names the
+/// variable and says to run scripts/install-tools.sh.
+pub fn require(tool: &str) -> Result<PathBuf, CosimError> {
+    tofprobe_io::tools::locate(tool).map_err(CosimError::MissingTool)
 }
 
 /// True when every tool is installed.

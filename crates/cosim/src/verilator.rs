@@ -262,7 +262,7 @@ pub(crate) fn verilate(
     let runtime = tmp
         .parent()
         .and_then(|root| crate::runtime::seed(root, verilator, &obj, tmp, make_flags));
-    let out = Command::new("make")
+    let out = Command::new(require("make")?)
         .arg("-C")
         .arg(&obj)
         .args(["-f", "Vtop.mk", "-j", "2"])

@@ -434,6 +434,3 @@ pub fn resolve_readout(
 ) -> Result<Readout, DesignError> {
     Readout::new(keys, rows, cols, pixel, laser_rate_hz).map_err(|m| DesignError::array(origin, m))
 }
-
-/// A tile of an array (the part of a large array co-simulated).
-pub use tofprobe_rtlgen::array::ArrayTile;

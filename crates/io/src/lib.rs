@@ -6,8 +6,9 @@
 //! before it reaches a generated file ([`text`]) and the FNV-1a content hash ([`fnv1a64`],
 //! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries, and the one
 //! root of the caches ([`cache::root`]), the writer lock of an output directory
-//! ([`lock`]) and the free space on its disk ([`disk`]), and the [`watch::Watch`] a host
-//! stops a long computation with.
+//! ([`lock`]) and the free space on its disk ([`disk`]), the [`watch::Watch`] a host
+//! stops a long computation with, and the one locator of the external tools
+//! ([`tools::locate`]: `$TOFPROBE_<NAME>`, else `PATH`).
 //!
 //! Errors are plain [`std::io::Error`]s: each crate maps them into its own error enum with
 //! the path it was writing.
@@ -25,6 +26,7 @@ mod set;
 mod stage;
 pub mod stale;
 pub mod text;
+pub mod tools;
 pub mod watch;
 
 pub use atomic::{write_atomic, write_svg_atomic};

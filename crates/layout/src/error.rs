@@ -13,12 +13,10 @@ pub enum LayoutError {
     #[error("{0}")]
     Eda(#[from] tofprobe_eda::EdaError),
     /// A program the flow drives is not installed.
-    #[error(
-        "`{tool}` not found on PATH: install Debian's `{package}` (scripts/install-tools.sh does)"
-    )]
+    #[error("{found}; install Debian's `{package}` (scripts/install-tools.sh does)")]
     ToolMissing {
-        /// The executable.
-        tool: &'static str,
+        /// What the one locator (`tofprobe_io::tools::locate`) looked for and where.
+        found: tofprobe_io::tools::ToolNotFound,
         /// The Debian package that provides it.
         package: &'static str,
     },

@@ -4,10 +4,9 @@
 //! the configuration needs. Setup (max) and hold (min) are both reported.
 
 use crate::error::{LayoutError, Result};
-use crate::tools::{Tool, tail};
+use crate::tools::tail;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
-use std::process::Command;
 
 /// The worst path of one path group (OpenSTA's `Path Group:`: `clk`, the clock-gating
 /// checks `**clock_gating_default**`, …) in one check.
@@ -117,32 +116,21 @@ pub fn run(
     dir: &Path,
     corner: &str,
 ) -> Result<PostRoute> {
-    let sta = Tool::Sta.locate()?;
     let path = dir.join(format!("post_route_sta-{corner}.tcl"));
     std::fs::write(&path, script(liberty, netlist, spef, top, period_ns))
         .map_err(|e| LayoutError::io("writing", &path, e))?;
-    let out = Command::new(&sta)
-        .arg("-no_init")
-        .arg("-exit")
-        .arg(&path)
-        .output()
-        .map_err(|e| LayoutError::io("running", &sta, e))?;
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let (status, text) = tofprobe_eda::sta::run_script(&path)?;
     let log = dir.join(format!("post_route_sta-{corner}.log"));
     std::fs::write(&log, &text).map_err(|e| LayoutError::io("writing", &log, e))?;
     // A SPEF the reader stumbles on would leave wires unannotated: an error, not a warning.
     let spef_trouble = text
         .lines()
         .any(|l| l.contains(".spef") && (l.contains("syntax error") || l.contains("not found")));
-    if !out.status.success() || text.contains("Error:") || spef_trouble {
+    if !status.success() || text.contains("Error:") || spef_trouble {
         return Err(LayoutError::ToolFailed {
             step: "post-route timing",
             tool: "sta",
-            status: out.status.code().map_or("killed".into(), |c| c.to_string()),
+            status: status.code().map_or("killed".into(), |c| c.to_string()),
             log,
             tail: tail(&text, 12),
         });

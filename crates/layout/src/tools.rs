@@ -1,4 +1,6 @@
-//! The programs of the layout flow and the Debian packages that provide them.
+//! The programs of the layout flow and the Debian packages that provide them, found by the
+//! workspace's one locator (`tofprobe_io::tools::locate`: `$TOFPROBE_<NAME>` when set —
+//! `TOFPROBE_STA`, `TOFPROBE_QFLOW`, `TOFPROBE_NETGEN_LVS`, … —, else PATH).
 
 use std::path::PathBuf;
 
@@ -61,10 +63,11 @@ impl Tool {
         }
     }
 
-    /// The program's path, or an error naming its package.
+    /// The program's path (its `TOFPROBE_*` variable, else PATH), or an error naming the
+    /// variable and its package.
     pub fn locate(self) -> Result<PathBuf> {
-        search_path(self.binary()).ok_or(LayoutError::ToolMissing {
-            tool: self.binary(),
+        tofprobe_io::tools::locate(self.binary()).map_err(|found| LayoutError::ToolMissing {
+            found,
             package: self.package(),
         })
     }
@@ -73,16 +76,6 @@ impl Tool {
 /// Every tool present, or the first missing one named with its package.
 pub fn require_all() -> Result<()> {
     Tool::ALL.iter().try_for_each(|t| t.locate().map(|_| ()))
-}
-
-fn search_path(name: &str) -> Option<PathBuf> {
-    use std::os::unix::fs::PermissionsExt;
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|d| d.join(name))
-        .find(|p| {
-            std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
-        })
 }
 
 /// The last `n` lines of a text.
@@ -97,14 +90,16 @@ mod tests {
 
     #[test]
     fn a_missing_tool_names_its_debian_package() {
-        assert!(search_path("no-such-tool-tofprobe-layout").is_none());
+        let found = tofprobe_io::tools::locate_in(Tool::Netgen.binary(), |_| None).unwrap_err();
         let e = LayoutError::ToolMissing {
-            tool: Tool::Netgen.binary(),
+            found,
             package: Tool::Netgen.package(),
         }
         .to_string();
         assert!(
-            e.contains("`netgen-lvs`") && e.contains("Debian's `netgen-lvs`"),
+            e.contains("`netgen-lvs`")
+                && e.contains("$TOFPROBE_NETGEN_LVS")
+                && e.contains("Debian's `netgen-lvs`"),
             "{e}"
         );
         assert_eq!(Tool::Sta.package(), "opensta");

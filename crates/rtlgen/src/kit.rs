@@ -2,7 +2,7 @@
 //! configuration writes, in the same atomic set as the RTL and listed by its completion
 //! marker, the self-checking array testbench `testbench/array_tb.v` (copied whole under a
 //! generated header) and the golden vectors of the set's configuration
-//! (`tofprobe_array::rtl_vectors::vector_files`, the files `tofprobe vectors` writes), and
+//! (`crate::array_vectors::vector_files`, the files `tofprobe vectors` writes), and
 //! the set's FuseSoC core gains targets that run them ([`crate::core::render_array_core`]).
 //! A designer re-runs the set after an edit in their own simulator: testbench/README.md
 //! "The array set's verification kit".

@@ -8,6 +8,7 @@
 
 pub mod array;
 pub mod array_fault;
+pub mod array_vectors;
 pub mod core;
 pub mod error;
 pub mod golden;

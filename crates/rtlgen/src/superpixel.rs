@@ -4,7 +4,7 @@
 //! RTL (`templates/array.v`, `[array] superpixel = G > 1`) instantiates it once per pixel
 //! over its G × G SPAD inputs (docs/pixel-contract.md "Superpixel"); it is linted,
 //! simulated against the model (crates/rtlgen/tests/it/superpixel.rs) and synthesised for
-//! the size report's area per SPAD (`tofprobe_flow::array_report`).
+//! the size report's area per SPAD (`tofprobe_eda::array::options`).
 
 use askama::Template;
 use tofprobe_pixel::{PixelParams, Superpixel};

@@ -5,9 +5,10 @@
 //! the stream.
 
 use tofprobe_array::rtl::{ArrayModel, run};
-use tofprobe_design::readout::{ArrayTile, Readout, ReadoutKeys};
+use tofprobe_design::readout::{Readout, ReadoutKeys};
 use tofprobe_pixel::{CycleModel, Mode, PinsIn, PixelParams};
 use tofprobe_rtlgen::ArrayFault;
+use tofprobe_rtlgen::array::ArrayTile;
 use tofprobe_scene::SplitMix64;
 
 pub fn fourier(n: u64) -> PixelParams {

@@ -12,7 +12,8 @@ use tofprobe_eda::{markdown, plot};
 use tofprobe_experiments::options::OptionsReport;
 use tofprobe_experiments::options::markdown::render as options_markdown;
 use tofprobe_experiments::options::plot::front_svg;
-use tofprobe_flow::array_report::{ArraySizeReport, array_report, markdown as array_markdown};
+use tofprobe_flow::array::markdown::markdown as array_markdown;
+use tofprobe_flow::array::report::{ArraySizeReport, array_report};
 use tofprobe_flow::sizing::{SizeOptions, options_request, size_report};
 use tofprobe_layout::report::{PostRouteTable, corners_markdown, read_post_route};
 
@@ -109,7 +110,7 @@ pub struct FullReport {
 pub fn report(a: &SizeArgs) -> Result<FullReport, CliError> {
     let design = crate::commands::load_for_hardware(a.config.as_deref())?;
     // Before minutes of synthesis: the array's options and readout.
-    tofprobe_flow::array_report::check(&design, a.utilisation)?;
+    tofprobe_flow::array::report::check(&design, a.utilisation)?;
     let options = size_options(a);
     // Before minutes of synthesis: the layout report is read (and refused if dirty).
     let post_route = match &a.layout_report {

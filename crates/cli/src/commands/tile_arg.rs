@@ -7,7 +7,7 @@
 
 use tofprobe_cosim::array::MAX_COSIM_PIXELS;
 use tofprobe_design::ResolvedDesign;
-use tofprobe_design::readout::ArrayTile;
+use tofprobe_rtlgen::array::ArrayTile;
 
 use crate::error::CliError;
 

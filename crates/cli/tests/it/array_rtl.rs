@@ -10,10 +10,11 @@
 use std::path::Path;
 
 use tofprobe_array::rtl::{ArrayModel, run};
-use tofprobe_array::rtl_vectors::{exercise, scene_detections};
 use tofprobe_design::{Chip, Document, RomPurpose, RtlOverrides, resolve};
+use tofprobe_flow::array::vectors::scene_detections;
 use tofprobe_flow::array::{ArrayCosimOptions, ArraySimulator, cosim_array};
 use tofprobe_rtlgen::ArrayFault;
+use tofprobe_rtlgen::array_vectors::exercise;
 
 use crate::common::{default_text, edit, have_tools, tofprobe};
 

@@ -83,8 +83,8 @@ fn assert_the_frame_restarts(d: &ResolvedDesign, r: &ArrayRun) {
     };
     let chip = Chip::array_of(d, &ov, RomPurpose::Replayed).unwrap();
     let ro = chip.readout.unwrap();
-    let mut det = tofprobe_array::rtl_vectors::scene_detections(d, 16, 2, None).unwrap();
-    tofprobe_array::rtl_vectors::exercise(&mut det, ro.cols, 1);
+    let mut det = tofprobe_flow::array::vectors::scene_detections(d, 16, 2, None).unwrap();
+    tofprobe_rtlgen::array_vectors::exercise(&mut det, ro.cols, 1);
     let model = || ArrayModel::new(&ro, &chip.pixel, &chip.rom.words, None).unwrap();
     let with = run_with_reset(&mut model(), &det, 1, Some(mid_frame_reset(&ro))).unwrap();
     assert_eq!(with.words, r.words, "the co-simulation's model is this one");

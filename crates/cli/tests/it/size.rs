@@ -169,7 +169,14 @@ fn missing_tools_say_what_to_install() {
         &[("TOFPROBE_YOSYS", "/nonexistent/yosys")],
         &dir,
     );
-    fails_with(&out, &["`yosys`", "apt-get install yosys"]);
+    fails_with(
+        &out,
+        &[
+            "`yosys`",
+            "$TOFPROBE_YOSYS = /nonexistent/yosys",
+            "apt-get install yosys",
+        ],
+    );
     let args = [cfg, "--no-sky130", "--sweep-bins", "1"];
     // Its own cache: the shared one may hold this pixel's timing, and then no STA runs.
     let out = size(
@@ -177,7 +184,10 @@ fn missing_tools_say_what_to_install() {
         &[("TOFPROBE_STA", "/nonexistent/sta")],
         &dir.join("cache"),
     );
-    fails_with(&out, &["`sta`", "opensta"]);
+    fails_with(
+        &out,
+        &["`sta`", "$TOFPROBE_STA = /nonexistent/sta", "opensta"],
+    );
 }
 
 /// `--sky130-pdk DIR` times the pixel on every sky130 corner found beside the osu018

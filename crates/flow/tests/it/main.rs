@@ -1,3 +1,3 @@
 //! The flow crate's integration tests: one binary, a module per file.
 
-mod array_slices;
+mod array_spec;

@@ -4,3 +4,4 @@
 mod laid_out;
 mod routed_factor;
 mod spef_sta;
+mod tools;

@@ -5,6 +5,7 @@
 mod accepted_render;
 mod array_gates;
 mod array_scale;
+mod array_vectors;
 mod gates;
 mod render;
 mod superpixel;

@@ -1,13 +1,13 @@
 //! `tofprobe bench cosim-array CONFIG [--rows 16] [--cols 16] [--frame-pulses N]
 //! [--rom-depth L] [--layouts flat,hierarchical] [--json]`: the whole array co-simulated, each Verilator
-//! layout built cold side by side (`tofprobe_flow::array_cosim_bench` measures; this
+//! layout built cold side by side (`tofprobe_flow::array::cosim_bench` measures; this
 //! prints).
 
 use std::path::PathBuf;
 
 use clap::Args;
 use tofprobe_cosim::array::Layout;
-use tofprobe_flow::array_cosim_bench::{CosimBenchReport, CosimBenchSpec, measure};
+use tofprobe_flow::array::cosim_bench::{CosimBenchReport, CosimBenchSpec, measure};
 
 use crate::error::CliError;
 

@@ -11,28 +11,30 @@
 //! a **row** (1 × C: a row stage drives C pixels, the column select picks one of C) and a
 //! **column** (R × 1: the root drives R row stages, a column bus gathers R pixels).
 //! The ROM's own read path (address register → ROM → root stage) is timed with the ROM
-//! as a black box, i.e. not at all: the ROM is sized apart ([`crate::array_report`]).
+//! as a black box, i.e. not at all: the ROM is sized apart ([`crate::array::rom`]).
 
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
-use tofprobe_design::readout::Readout;
-use tofprobe_design::{Chip, ResolvedDesign, RomPurpose, RtlOverrides};
-use tofprobe_eda::analysis::analyse_point;
-use tofprobe_eda::corners::MARGIN_PERCENT;
-use tofprobe_eda::generated::GeneratedPixel;
-use tofprobe_eda::liberty::Liberty;
-use tofprobe_eda::sta::parse_report;
-use tofprobe_eda::synth::{SynthSpec, synthesise};
-use tofprobe_rtlgen::{ArraySpec, RenderOptions, render_array};
 
-use crate::error::FlowError;
+use crate::analysis::analyse_point;
+use crate::array::spec::{ArrayEdaSpec, ArraySlice};
+use crate::corner_option::CornerOption;
+use crate::corners::MARGIN_PERCENT;
+use crate::error::{EdaError, Result};
+use crate::fsutil::write_atomic;
+use crate::generated::GeneratedPixel;
+use crate::liberty::Liberty;
+use crate::sta::{Timing, parse_report, run_script};
+use crate::synth::{SynthSpec, synthesise};
+use crate::tools::tail;
+use tofprobe_rtlgen::{RenderOptions, render_array};
 
 /// Largest array timed whole (8 × 8); beyond it, a row and a column slice.
 pub const WHOLE_TIMING_MAX_PIXELS: usize = 64;
 
 /// OpenSTA's probe period (ns): long enough that every path has positive slack; the
-/// critical delay is period − slack (as `tofprobe_eda::sta`).
+/// critical delay is period − slack (as [`crate::sta`]).
 const PROBE_PERIOD_NS: f64 = 1000.0;
 
 /// One kind of path of one timed netlist.
@@ -59,11 +61,7 @@ pub struct PathTiming {
 }
 
 impl PathTiming {
-    fn of(
-        t: &tofprobe_eda::sta::Timing,
-        pixel: &tofprobe_eda::sta::Timing,
-        clock_mhz: f64,
-    ) -> Self {
+    fn of(t: &Timing, pixel: &Timing, clock_mhz: f64) -> Self {
         let period = 1e3 / clock_mhz;
         let slack = period - t.critical_path_ns;
         let pct = (slack / period * 1000.0).round() / 10.0;
@@ -82,33 +80,16 @@ impl PathTiming {
 
 /// OpenSTA on `script` (written to `tcl`), its output split at the `== NAME` markers the
 /// script prints, each part parsed as a `report_checks` text.
-fn run_sta(
-    tcl: &Path,
-    script: &str,
-    parts: &[&str],
-) -> Result<Vec<tofprobe_eda::sta::Timing>, FlowError> {
-    tofprobe_io::write_atomic(tcl, script.as_bytes())
-        .map_err(|e| FlowError::output(tcl.to_path_buf(), e.to_string()))?;
-    let sta = tofprobe_eda::tools::Tool::Sta.locate()?;
-    let out = std::process::Command::new(&sta)
-        .arg("-no_init")
-        .arg("-exit")
-        .arg(tcl)
-        .output()
-        .map_err(|e| FlowError::output(sta.clone(), e.to_string()))?;
-    let log = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+fn run_sta(tcl: &Path, script: &str, parts: &[&str]) -> Result<Vec<Timing>> {
+    write_atomic(tcl, script.as_bytes())?;
+    let (_, log) = run_script(tcl)?;
     let mut found = Vec::new();
     for (i, name) in parts.iter().enumerate() {
         let marker = format!("== {name}");
-        let start = log.find(&marker).ok_or_else(|| {
-            FlowError::output(
-                tcl.to_path_buf(),
-                format!("OpenSTA stopped before `{marker}`: {log}"),
-            )
+        let start = log.find(&marker).ok_or_else(|| EdaError::Parse {
+            tool: "sta",
+            what: "a `== NAME` marker of the array's script (OpenSTA stopped before it)",
+            tail: format!("{}: before `{marker}`:\n{}", tcl.display(), tail(&log, 15)),
         })? + marker.len();
         let end = parts
             .get(i + 1)
@@ -150,59 +131,34 @@ pub fn slices(rows: usize, cols: usize, whole_max: usize) -> Vec<(String, usize,
     }
 }
 
-/// Times the array of `design` (with `[array]`) on each liberty of `liberties` (a timing
-/// liberty, then sky130 corners: the top and the pixel mapped on the first of a `group`,
-/// see [`time_on`]).
+/// Times every netlist of `spec.slices` on each liberty of `liberties` (a timing liberty,
+/// then sky130 corners: the top and the pixel mapped on the first of a pair, timed on the
+/// second, see `time_on`).
 pub fn array_timing(
-    design: &ResolvedDesign,
+    spec: &ArrayEdaSpec,
     liberties: &[(PathBuf, Option<PathBuf>)],
     cache: &Path,
-) -> Result<Vec<ArrayTiming>, FlowError> {
-    array_timing_with(design, liberties, cache, WHOLE_TIMING_MAX_PIXELS)
-}
-
-/// [`array_timing`] timing arrays of up to `whole_max` pixels whole (0: always slices; the
-/// slice model is tested against the whole with it).
-pub fn array_timing_with(
-    design: &ResolvedDesign,
-    liberties: &[(PathBuf, Option<PathBuf>)],
-    cache: &Path,
-    whole_max: usize,
-) -> Result<Vec<ArrayTiming>, FlowError> {
-    let chip = Chip::array_of(design, &RtlOverrides::default(), RomPurpose::Rendered)?;
+) -> Result<Vec<ArrayTiming>> {
     let mut out = Vec::new();
     for (map_lib, time_lib) in liberties {
-        for (name, rows, cols) in slices(chip.rows, chip.cols, whole_max) {
-            out.push(time_on(
-                design,
-                &chip,
-                &name,
-                rows,
-                cols,
-                map_lib,
-                time_lib.as_deref(),
-                cache,
-            )?);
+        for slice in &spec.slices {
+            out.push(time_on(spec, slice, map_lib, time_lib.as_deref(), cache)?);
         }
     }
     Ok(out)
 }
 
-/// Times one `rows` × `cols` netlist of the chip's array: mapped on `map_lib`, timed on
-/// `time_lib` (default `map_lib`; another corner of the same cells).
-#[allow(clippy::too_many_arguments)]
+/// Times one netlist of the chip's array: mapped on `map_lib`, timed on `time_lib`
+/// (default `map_lib`; another corner of the same cells).
 fn time_on(
-    design: &ResolvedDesign,
-    chip: &Chip,
-    name: &str,
-    rows: usize,
-    cols: usize,
+    spec: &ArrayEdaSpec,
+    slice: &ArraySlice,
     map_lib: &Path,
     time_lib: Option<&Path>,
     cache: &Path,
-) -> Result<ArrayTiming, FlowError> {
-    let p = &chip.pixel;
-    let clock_mhz = p.cycles_per_pulse as f64 * design.sensor().laser_rate_hz / 1e6;
+) -> Result<ArrayTiming> {
+    let p = &spec.pixel;
+    let clock_mhz = spec.clock_mhz;
     let target_ps = 1e6 / clock_mhz;
     let lib = Liberty::load(map_lib)?;
     // The pixel: the size report's synthesis (same provider, point and target: cached).
@@ -217,26 +173,11 @@ fn time_on(
         Some(target_ps),
     )?;
     // The array's top with the pixel and the ROM as black boxes.
-    let a = design.array.as_ref().expect("an [array] design");
-    let r = Readout::new(&a.readout, rows, cols, p, design.sensor().laser_rate_hz)
-        .map_err(|m| FlowError::option("array slice", format!("{rows} × {cols}"), &m))?;
-    let spec = ArraySpec {
-        rows,
-        cols,
-        bits: r.bits,
-        beats_per_word: r.beats_per_word,
-        beat_cycles: r.beat_cycles,
-        slot_cycles: r.slot_cycles(),
-        fault: None,
-        tile: None,
-        superpixel: 1,
-        double_buffer: false,
-    };
     // The ROM's contents do not reach the top's logic (a black box): render a 1-entry one.
     let mut p1 = p.clone();
     p1.rom_depth = p.rom_depth.clamp(1, 2);
     let rom = vec![0u64; p1.rom_depth * p1.registers().div_ceil(64)];
-    let files = render_array(&p1, &rom, &RenderOptions::default(), &spec)?;
+    let files = render_array(&p1, &rom, &RenderOptions::default(), &slice.array)?;
     let (pixel_name, rom_name, _) =
         tofprobe_rtlgen::module_names(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
     let top = tofprobe_rtlgen::array::array_module_name(tofprobe_rtlgen::DEFAULT_MODULE_PREFIX);
@@ -253,10 +194,9 @@ fn time_on(
     }
     let key = format!("{:016x}", tofprobe_io::fnv1a64(text.as_bytes()));
     let dir = cache.join("array-top").join(&key);
-    std::fs::create_dir_all(&dir).map_err(|e| FlowError::output(dir.clone(), e.to_string()))?;
+    std::fs::create_dir_all(&dir).map_err(|e| EdaError::io("creating", &dir, e))?;
     let src = dir.join(format!("{top}.v"));
-    tofprobe_io::write_atomic(&src, text.as_bytes())
-        .map_err(|e| FlowError::output(src.clone(), e.to_string()))?;
+    write_atomic(&src, text.as_bytes())?;
     let top_syn = synthesise(
         &SynthSpec {
             sources: vec![src],
@@ -314,7 +254,7 @@ fn time_on(
     )?;
     let time_name = Liberty::load(time_lib)?.name;
     Ok(ArrayTiming {
-        netlist: name.into(),
+        netlist: slice.name.clone(),
         library: time_name,
         clock_mhz,
         shared_logic_um2: top_syn.total_area_um2,
@@ -347,7 +287,7 @@ pub struct CornerOptionPaths {
 /// the same), so their slack at the option's clock follows from the delays measured.
 pub fn corner_option_paths(
     timing: &[ArrayTiming],
-    options: &[tofprobe_eda::corner_option::CornerOption],
+    options: &[CornerOption],
 ) -> Vec<CornerOptionPaths> {
     let pct = |delay_ns: f64, clock_mhz: f64| {
         let period = 1e3 / clock_mhz;
@@ -390,7 +330,7 @@ mod tests {
 
     #[test]
     fn paths_are_judged_again_at_a_corner_options_clock() {
-        use tofprobe_eda::corner_option::{CornerOption, CornerTrial};
+        use crate::corner_option::CornerTrial;
         let path = |delay_ns: f64| PathTiming {
             delay_ns,
             slack_ns: 6.25 - delay_ns,

@@ -5,7 +5,7 @@
 //!   accumulates, read out instead of the live registers (rendered by `templates/pixel.v`
 //!   and co-simulated: docs/pixel-contract.md "Double buffer"). Its area here is an
 //!   *estimate*, not a synthesis of that RTL, from the synthesised pixel's register-file
-//!   split (`tofprobe_eda::split`): (R+1)·W flops at the register file's own area per flop (the
+//!   split ([`crate::split`]): (R+1)·W flops at the register file's own area per flop (the
 //!   flop and its private write-enable logic, as the shadow's load enable is), beside the
 //!   bare flops at the liberty's smallest flop. The readout's select multiplexer reads the
 //!   shadow instead of the live registers: it moves, it is not added. Reported for every
@@ -18,12 +18,13 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
-use tofprobe_eda::size_report::{AreaSection, SizeReport};
-use tofprobe_eda::synth::{SynthSpec, synthesise};
 use tofprobe_pixel::{PixelParams, Superpixel};
 
-use crate::array_size::ArrayTotal;
-use crate::error::FlowError;
+use crate::array::area::ArrayTotal;
+use crate::error::{EdaError, Result};
+use crate::fsutil::write_atomic;
+use crate::size_report::{AreaSection, SizeReport};
+use crate::synth::{SynthSpec, synthesise};
 
 /// The double buffer's area on one library.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -165,7 +166,7 @@ pub fn superpixel(
     spad_pitch_um: f64,
     libs: &[&AreaSection],
     cache: &Path,
-) -> Result<SuperpixelSize, FlowError> {
+) -> Result<SuperpixelSize> {
     let g2 = sp.spads() as u32;
     let bits = p.registers() as u64 * u64::from(p.width);
     let area = libs
@@ -181,7 +182,7 @@ pub fn superpixel(
                 plain_per_spad_um2: a.total_area_um2,
             })
         })
-        .collect::<Result<Vec<_>, FlowError>>()?;
+        .collect::<Result<Vec<_>>>()?;
     Ok(SuperpixelSize {
         side: sp.side(),
         spads_per_pixel: g2,
@@ -202,17 +203,16 @@ pub fn front_end_logic(
     sp: &Superpixel,
     liberty: &Path,
     cache: &Path,
-) -> Result<(f64, u64), FlowError> {
+) -> Result<(f64, u64)> {
     let o = tofprobe_rtlgen::RenderOptions::default();
     let f = tofprobe_rtlgen::superpixel::render_superpixel(p, sp, &o)?;
     let dir = cache.join("superpixel").join(format!(
         "{:016x}",
         tofprobe_io::fnv1a64(f.contents.as_bytes())
     ));
-    std::fs::create_dir_all(&dir).map_err(|e| FlowError::output(dir.clone(), e.to_string()))?;
+    std::fs::create_dir_all(&dir).map_err(|e| EdaError::io("creating", &dir, e))?;
     let path = dir.join(&f.name);
-    tofprobe_io::write_atomic(&path, f.contents.as_bytes())
-        .map_err(|e| FlowError::output(path.clone(), e.to_string()))?;
+    write_atomic(&path, f.contents.as_bytes())?;
     let spec = SynthSpec {
         sources: vec![path],
         top: tofprobe_rtlgen::superpixel::module_name(&o.module_prefix),
@@ -232,61 +232,4 @@ pub fn libraries(size: &SizeReport) -> Vec<&AreaSection> {
         v.push(&s.area);
     }
     v
-}
-
-/// The two options as Markdown (a part of the array section).
-pub fn markdown(db: &DoubleBuffer, sp: Option<&SuperpixelSize>) -> String {
-    let mut m = format!(
-        "\n### Double buffer ({}): a shadow copy of the registers\n\n\
-         {} shadow bits per pixel ((R+1)·W: the registers and the status word). Area: {}.\n\n\
-         | library | register file (µm², flops) | shadow (µm², estimate) | bare flops (µm²) | pixel without → with (µm²) | array without → with (mm²) |\n|---|---|---|---|---|---|\n",
-        if db.enabled { "on" } else { "off" },
-        db.shadow_bits_per_pixel,
-        db.basis
-    );
-    for a in &db.areas {
-        m += &format!(
-            "| {} | {:.0} ({}) | {:.0} | {} | {:.0} → {:.0} | {:.3} → {:.3} |\n",
-            a.library,
-            a.register_file_um2,
-            a.register_file_flops,
-            a.shadow_um2,
-            a.shadow_flops_only_um2
-                .map_or("–".to_string(), |v| format!("{v:.0}")),
-            a.pixel_um2,
-            a.pixel_with_um2,
-            a.array_total_um2 / 1e6,
-            a.array_total_with_um2 / 1e6
-        );
-    }
-    if let Some(s) = sp {
-        m += &format!(
-            "\n### Superpixel {g} × {g}: {n} SPADs share one pixel\n\n\
-             The front end (templates/superpixel.v) averages the valid SPADs' codes: a table of \
-             {n} words of {tb} bits (⌈2^{k}/n⌉), a multiply and a shift by {k}; combinational. \
-             SPAD pitch {pitch} µm (a pixel: {g} × that).\n\n\
-             | per SPAD | plain pixel | superpixel |\n|---|---|---|\n\
-             | register bits | {plain} | {per:.1} ({plain} / {n}) |\n",
-            g = s.side,
-            n = s.spads_per_pixel,
-            tb = s.table_bits,
-            k = s.shift,
-            pitch = s.spad_pitch_um,
-            plain = s.plain_bits_per_spad,
-            per = s.bits_per_spad,
-        );
-        for a in &s.area {
-            m += &format!(
-                "| area on {} (µm²) | {:.0} | {:.0} (({:.0} + front end {:.0}, {} cells) / {}) |\n",
-                a.library,
-                a.plain_per_spad_um2,
-                a.per_spad_um2,
-                a.pixel_um2,
-                a.front_end_um2,
-                a.front_end_cells,
-                s.spads_per_pixel
-            );
-        }
-    }
-    m
 }

@@ -1,11 +1,12 @@
-//! The array's golden vectors (docs/pixel-contract.md "Array"): the per-pixel detections
-//! from the array scene, the ports the array model shows every cycle, the readout stream
-//! and per-pixel digests, as the files `testbench/array_harness.cpp` (Verilator) and
-//! `testbench/array_tb.v` (Icarus) replay:
+//! The array's golden vector files (docs/pixel-contract.md "Array"), beside the pixel's
+//! ([`crate::vectors`]): the per-input detections, the ports the array model
+//! (`tofprobe_array::rtl`, run by the flow and handed here as an [`ArrayTrace`]) shows
+//! every cycle, the readout stream and per-pixel digests, as the files
+//! `testbench/array_harness.cpp` (Verilator) and `testbench/array_tb.v` (Icarus) replay:
 //!
 //! - `array_params.vh`: `AR_TOP`, `AR_NP` (pixels present: all, or a tile's), `AR_T`,
 //!   `AR_B`, `AR_CYCLES`, `AR_PULSES`, and with `[array] superpixel = G > 1` `AR_NS` (the
-//!   SPAD inputs, AR_NP·G²), and with a mid-frame reset (`rtl::run_with_reset`)
+//!   SPAD inputs, AR_NP·G²), and with a mid-frame reset (`tofprobe_array::rtl::run_with_reset`)
 //!   `AR_RESET_AT` (its cycle: `rst` is high then, and in power-up's two cycles);
 //! - `array_stim.hex`: one line per pulse the pixels sample, the P·(T+1)-bit value
 //!   {tdc[P·T−1:0], valid[P−1:0]} over the P inputs (pixel i = r·cols + c; with G > 1 the
@@ -13,12 +14,6 @@
 //! - `array_expect.hex`: one line per cycle, `pulse_o ready ro_valid ro_data`;
 //! - `readout.txt`: per frame and pixel (readout order) its R + 1 words;
 //! - `digests.txt`: per frame and pixel, FNV-1a 64 of its words (little-endian u64s).
-
-use tofprobe_design::ResolvedDesign;
-use tofprobe_pixel::PixelParams;
-
-use crate::error::ArrayError;
-use crate::rtl::ArrayRun;
 
 /// The file names of a vector set, the params include first.
 pub const FILES: [&str; 5] = [
@@ -29,44 +24,16 @@ pub const FILES: [&str; 5] = [
     "digests.txt",
 ];
 
-/// Every input's detections for `frames` frames of the design's scene, `frame_pulses` per
-/// frame: row-major over the pixels of `tile` (all when `None`), pixel (r, c)'s own stream
-/// (`ResolvedDesign::pixel_source`); with `[array] superpixel = G > 1`, row-major over the
-/// tile's SPAD grid, SPAD (r, c)'s own stream (`ResolvedDesign::spad_source`).
-pub fn scene_detections(
-    design: &ResolvedDesign,
-    frame_pulses: u64,
-    frames: u64,
-    tile: Option<tofprobe_design::readout::ArrayTile>,
-) -> Result<Vec<Vec<Option<u32>>>, ArrayError> {
-    let a = design
-        .array
-        .as_ref()
-        .ok_or_else(|| ArrayError::Shape("the design has no [array]".into()))?;
-    let n = (frame_pulses * frames) as usize;
-    let t = tile.unwrap_or(tofprobe_design::readout::ArrayTile::whole(a.rows, a.cols));
-    // The SPAD grid of the tile (G = 1: its pixels); SPAD (r, c)'s own stream.
-    let g = a.superpixel;
-    let mut out = Vec::with_capacity(t.pixels() * g * g);
-    for r in t.row0 * g..(t.row0 + t.rows) * g {
-        for c in t.col0 * g..(t.col0 + t.cols) * g {
-            let mut v = vec![None; n];
-            design.spad_source(r, c)?.fill(0, &mut v);
-            out.push(v);
-        }
-    }
-    Ok(out)
-}
-
-/// Thins the detections of `inputs` (as [`scene_detections`] orders them: the tile's
-/// `cols` pixels a row, G × G SPADs each) so the co-simulation reaches what a bright scene
-/// never does (issue 42's mutation study: with every SPAD valid on every pulse, a
-/// superpixel whose `valid` is the AND of its SPADs, two crossed SPAD codes or a wrong
-/// reciprocal entry passed). At pulse n, pixel p keeps k = (n + p) mod (G² + 1) of its G²
-/// SPADs' detections — every count from none to all, exactly one among them — the ones at
-/// positions n, n + 1, … mod G² within the superpixel (so each SPAD is the only one in
-/// turn); with G = 1 a pixel presents its detection on one pulse in two (the hold and the
-/// priming between). Deterministic: the same inputs give the same stimulus.
+/// Thins the detections of `inputs` (as `tofprobe_flow::array::vectors::scene_detections`
+/// orders them: the tile's `cols` pixels a row, G × G SPADs each) so the co-simulation
+/// reaches what a bright scene never does (issue 42's mutation study: with every SPAD valid
+/// on every pulse, a superpixel whose `valid` is the AND of its SPADs, two crossed SPAD
+/// codes or a wrong reciprocal entry passed). At pulse n, pixel p keeps
+/// k = (n + p) mod (G² + 1) of its G² SPADs' detections — every count from none to all,
+/// exactly one among them — the ones at positions n, n + 1, … mod G² within the superpixel
+/// (so each SPAD is the only one in turn); with G = 1 a pixel presents its detection on one
+/// pulse in two (the hold and the priming between). Deterministic: the same inputs give the
+/// same stimulus.
 pub fn exercise(inputs: &mut [Vec<Option<u32>>], cols: usize, g: usize) {
     let g2 = g * g;
     if cols == 0 || g == 0 || !inputs.len().is_multiple_of(cols * g2) {
@@ -107,20 +74,51 @@ pub fn digest(words: &[u64]) -> u64 {
     tofprobe_io::fnv1a64(&bytes)
 }
 
-/// The vector files of `run` (driven by `detections`, pixel `p`), each starting with
-/// `header` (a `//` line naming the generator); `top` is the array module.
+/// The array's ports in one cycle, as `array_expect.hex` holds them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ArrayPorts {
+    /// The pixels sample `valid`/`tdc` this cycle.
+    pub pulse_o: bool,
+    /// Every pixel's pipeline is free.
+    pub ready: bool,
+    /// A beat is on `ro_data`.
+    pub ro_valid: bool,
+    /// The beat (b bits).
+    pub ro_data: u64,
+}
+
+/// What the array model showed over a run, as plain data: what its vector files hold.
+#[derive(Debug, Clone)]
+pub struct ArrayTrace<'a> {
+    /// b: bits per beat of the output port.
+    pub bits: u32,
+    /// G: SPADs per pixel side (the inputs are the pixels' × G²).
+    pub superpixel: usize,
+    /// The ports of every cycle.
+    pub ports: Vec<ArrayPorts>,
+    /// Pulses the pixels sampled (`pulse_o` cycles).
+    pub pulses: usize,
+    /// The pixels present, (row, col) in readout order.
+    pub pixels: Vec<(usize, usize)>,
+    /// Per frame, per pixel present (as `pixels`), its R + 1 words (raw W bits).
+    pub words: &'a [Vec<Vec<u64>>],
+    /// The cycle of a one-cycle reset in the middle of the run, if any.
+    pub reset_at: Option<u64>,
+}
+
+/// The vector files of `run` (driven by `detections`, `tdc_bits`-bit codes), each
+/// starting with `header` (a `//` line naming the generator); `top` is the array module.
 pub fn vector_files(
-    run: &ArrayRun,
+    run: &ArrayTrace<'_>,
     detections: &[Vec<Option<u32>>],
-    p: &PixelParams,
+    tdc_bits: u32,
     top: &str,
     header: &str,
 ) -> Vec<(String, String)> {
-    let ro = &run.readout;
     // The pixels present (a tile of a large array, or all).
     let np = detections.len();
     let g = run.superpixel;
-    let t = p.tdc_bits as usize;
+    let t = tdc_bits as usize;
     let mut params = format!("{header}\n");
     if g > 1 {
         // The SPAD inputs (the harness's and testbench's port widths); absent when G = 1
@@ -130,9 +128,9 @@ pub fn vector_files(
     for (k, v) in [
         ("AR_NP", (np / (g * g)).to_string()),
         ("AR_T", t.to_string()),
-        ("AR_B", ro.bits.to_string()),
-        ("AR_CYCLES", run.cycles().to_string()),
-        ("AR_PULSES", run.pulse_cycles.len().max(1).to_string()),
+        ("AR_B", run.bits.to_string()),
+        ("AR_CYCLES", run.ports.len().to_string()),
+        ("AR_PULSES", run.pulses.max(1).to_string()),
         ("AR_TOP", top.to_string()),
     ] {
         params.push_str(&format!("`define {k} {v}\n"));
@@ -143,7 +141,7 @@ pub fn vector_files(
         params.push_str(&format!("`define AR_RESET_AT {c}\n"));
     }
     let mut stim = format!("{header}\n");
-    for n in 0..run.pulse_cycles.len().max(1) {
+    for n in 0..run.pulses.max(1) {
         let mut bits = vec![false; np * (t + 1)];
         for (i, d) in detections.iter().enumerate() {
             if let Some(Some(code)) = d.get(n) {
@@ -157,7 +155,7 @@ pub fn vector_files(
         stim.push('\n');
     }
     let mut expect = format!("{header}\n");
-    for pin in &run.pins {
+    for pin in &run.ports {
         expect.push_str(&format!(
             "{} {} {} {:x}\n",
             u8::from(pin.pulse_o),
@@ -170,8 +168,7 @@ pub fn vector_files(
         format!("{header}\n# frame row col: words 0..R-1 then the status word (hex, W bits)\n");
     let mut digests = format!("{header}\n# frame row col fnv1a64(words)\n");
     for (f, frame) in run.words.iter().enumerate() {
-        for (&q, words) in run.positions.iter().zip(frame) {
-            let (r, c) = ro.order(q);
+        for (&(r, c), words) in run.pixels.iter().zip(frame) {
             let list: Vec<String> = words.iter().map(|w| format!("{w:x}")).collect();
             readout.push_str(&format!("{f} {r} {c}: {}\n", list.join(" ")));
             digests.push_str(&format!("{f} {r} {c} {:016x}\n", digest(words)));
