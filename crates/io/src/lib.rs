@@ -6,8 +6,9 @@
 //! before it reaches a generated file ([`text`]) and the FNV-1a content hash ([`fnv1a64`],
 //! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries, and the one
 //! root of the caches ([`cache::root`]), the writer lock of an output directory
-//! ([`lock`]) and the free space on its disk ([`disk`]), and the [`watch::Watch`] a host
-//! stops a long computation with.
+//! ([`lock`]) and the free space on its disk ([`disk`]), the [`watch::Watch`] a host
+//! stops a long computation with, and the one instruction-set selection of the vector
+//! kernels ([`isa`]: detected, `TOFPROBE_ISA`, or a benchmark's `--isa`).
 //!
 //! Errors are plain [`std::io::Error`]s: each crate maps them into its own error enum with
 //! the path it was writing.
@@ -17,6 +18,7 @@ pub mod bounded;
 pub mod cache;
 pub mod cpu;
 pub mod disk;
+pub mod isa;
 pub mod live;
 pub mod lock;
 pub mod marker;
