@@ -71,7 +71,7 @@ pub(crate) fn fast_pass(
     t: &Tables,
     bits: &[u64],
     z: &mut [f64],
-    (flags, edges): (&mut [u8], &mut [[f64; 2]]),
+    (flags, edges): (&mut [u64], &mut [[f64; 2]]),
     rejects: &mut Vec<u32>,
 ) {
     debug_assert!(bits.len() == z.len() && z.len() == flags.len() && z.len() == edges.len());
@@ -88,42 +88,22 @@ pub(crate) fn fast_pass(
     {
         let x = abscissa(b) * e[0];
         *zk = x;
-        *fk = u8::from(x.abs() >= e[1]);
+        // All ones or zero: the vector compare's own mask, stored as it is (packing it
+        // to bytes cost more than the compare on AVX2).
+        *fk = 0u64.wrapping_sub(u64::from(x.abs() >= e[1]));
     }
     rejects.clear();
-    // 64 flags to a bit mask (a vector compare), then only the set bits visited: a reject
-    // is rare (≈ 0.7 %), a branch per flag or per byte would cost more than the pass.
-    for (j, w) in flags.chunks(64).enumerate() {
-        let mut mask = flag_mask(w);
-        while mask != 0 {
-            rejects.push((64 * j) as u32 + mask.trailing_zeros());
-            mask &= mask - 1;
+    // A reject is rare (≈ 0.7 %): eight flags at a time are or-ed (two vector loads), and
+    // only a group with a reject is visited flag by flag, in order.
+    for (j, w) in flags.chunks(8).enumerate() {
+        if w.iter().fold(0, |a, &f| a | f) != 0 {
+            for (k, &f) in w.iter().enumerate() {
+                if f != 0 {
+                    rejects.push((8 * j + k) as u32);
+                }
+            }
         }
     }
-}
-
-/// Bit k set iff `flags[k]` is 1 (flags 0 or 1, at most 64): eight flags at a time, by
-/// one multiply that gathers the low bit of each byte of a word into its top byte (the
-/// bytes' bits land at distinct places and never carry). A fold of 64 shifted flags was a
-/// zero-extension, compare and mask per flag on AVX2.
-#[inline(always)]
-pub(crate) fn flag_mask(flags: &[u8]) -> u64 {
-    debug_assert!(flags.len() <= 64 && flags.iter().all(|&f| f <= 1));
-    let pack = |b: [u8; 8]| u64::from_le_bytes(b).wrapping_mul(0x0102_0408_1020_4080) >> 56;
-    let mut mask = 0u64;
-    let mut words = flags.chunks_exact(8);
-    for (i, c) in (&mut words).enumerate() {
-        mask |= pack(c.try_into().expect("8 flags")) << (8 * i);
-    }
-    let rest = words.remainder();
-    if !rest.is_empty() {
-        let mut b = [0u8; 8];
-        for (d, &f) in b.iter_mut().zip(rest) {
-            *d = f;
-        }
-        mask |= pack(b) << (flags.len() - rest.len());
-    }
-    mask
 }
 
 /// Finishes a candidate the fast pass rejected: the ziggurat's slow path for the word
@@ -162,27 +142,6 @@ fn tail(rng: &mut Xoshiro256PlusPlus, u: f64) -> f64 {
 /// A uniform on (0, 1] with 53 bits.
 pub(crate) fn open01(rng: &mut Xoshiro256PlusPlus) -> f64 {
     ((rng.next_u64() >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64)
-}
-
-#[cfg(test)]
-mod mask_tests {
-    /// The multiply's mask against the flag-by-flag one, on every length and random flags
-    /// (a wrong constant, 0x8040…0201, fails here).
-    #[test]
-    fn flag_mask_is_the_flags_bit_by_bit() {
-        let mut g = crate::SplitMix64::new(3);
-        for len in 0..=64 {
-            for _ in 0..50 {
-                let r = g.next_u64();
-                let flags: Vec<u8> = (0..len).map(|k| ((r >> k) & 1) as u8).collect();
-                let naive = flags
-                    .iter()
-                    .enumerate()
-                    .fold(0u64, |m, (k, &f)| m | (u64::from(f) << k));
-                assert_eq!(super::flag_mask(&flags), naive, "{flags:?}");
-            }
-        }
-    }
 }
 
 #[cfg(test)]

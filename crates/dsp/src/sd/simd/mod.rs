@@ -18,7 +18,7 @@
 //! `kernel`; [`lanes`] stands alone; nothing here imports the modulator that uses
 //! [`lanes`].
 
-pub mod kernel;
+mod kernel;
 pub mod lanes;
 pub mod pairs;
 
