@@ -5,7 +5,8 @@
 //! thread) measured in the same run: the Monte Carlo is the physical floor of this
 //! simulation, and `model_share` says how much of the array's CPU time is not Monte Carlo.
 //! Peak memory is the process's high-water mark (VmHWM), for the memory bound linear in
-//! R·C·2B and independent of N.
+//! R·C·2B and independent of N. Each ISA of the vector kernels (`tofprobe_io::isa`: the
+//! Monte Carlo and the pixel's lanes) is its own row ([`measure_isas`]).
 
 use std::time::Instant;
 
@@ -14,6 +15,8 @@ use tofprobe_design::{ArrayConfig, Document, ResolvedDesign, resolve};
 
 use crate::BenchError;
 use crate::cpu::{process_cpu_seconds, thread_cpu_ns};
+use crate::isa::{IsaRows, rows};
+use tofprobe_io::isa::Isa;
 
 /// Fewest pulses the Monte Carlo alone is timed over (≈ 0.1 CPU-s).
 const MC_MIN_PULSES: u64 = 1 << 25;
@@ -45,6 +48,8 @@ pub struct ArrayRun {
 /// The benchmark's report.
 #[derive(Debug, Clone, Serialize)]
 pub struct ArrayReport {
+    /// The instruction set the vector kernels ran on ("scalar", "avx2", "avx512").
+    pub isa: &'static str,
     pub configuration: String,
     pub rows: usize,
     pub cols: usize,
@@ -95,7 +100,17 @@ fn array_design(
     Ok(resolve(doc, &base.origin)?)
 }
 
-/// Runs the benchmark for each frame length in `pulses`.
+/// [`measure`] once per ISA in `isas`, each under that ISA.
+pub fn measure_isas(
+    base: &ResolvedDesign,
+    (rows_, cols): (u32, u32),
+    pulses: &[u64],
+    isas: &[Isa],
+) -> Result<IsaRows<ArrayReport>, BenchError> {
+    rows(isas, |_| measure(base, rows_, cols, pulses))
+}
+
+/// Runs the benchmark for each frame length in `pulses`, on the current ISA.
 pub fn measure(
     base: &ResolvedDesign,
     rows: u32,
@@ -158,6 +173,7 @@ pub fn measure(
     let projected = best.map(|r| 64.0 * 64.0 * 1e7 / (2.0 * r));
     let pass = projected.is_some_and(|s| s <= TARGET_SECONDS);
     Ok(ArrayReport {
+        isa: Isa::current().name(),
         configuration: base.origin.clone(),
         rows: rows as usize,
         cols: cols as usize,

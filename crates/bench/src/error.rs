@@ -20,6 +20,9 @@ pub enum BenchError {
         value: String,
         allowed: String,
     },
+    /// An ISA name that is not one, or one this CPU lacks (`--isa`, `TOFPROBE_ISA`).
+    #[error(transparent)]
+    Isa(#[from] tofprobe_io::isa::IsaError),
     /// An output file that cannot be written.
     #[error("cannot write {}: {message}", path.display())]
     Output { path: PathBuf, message: String },

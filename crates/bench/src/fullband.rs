@@ -15,7 +15,7 @@ use tofprobe_design::ResolvedDesign;
 use tofprobe_dsp::sd::fullband_spectrum::{
     BandSpectrum, BandSummary, periodic_band, prefiltered_record, windowed_band,
 };
-use tofprobe_dsp::sd::{KernelPath, LanePrecision, ProbeDesign, RomMode};
+use tofprobe_dsp::sd::{Isa, LanePrecision, ProbeDesign, RomMode};
 
 use crate::BenchError;
 use crate::cpu::process_cpu_seconds;
@@ -51,7 +51,7 @@ pub struct FullBandReport {
     pub pulses: u64,
     pub threads: usize,
     pub precision: String,
-    /// Instruction path the lanes ran on ("avx512", "avx2" or "baseline") and their group
+    /// Instruction path the lanes ran on ("avx512", "avx2" or "scalar") and their group
     /// width.
     pub path: String,
     pub lanes_per_group: usize,
@@ -99,7 +99,7 @@ pub struct FullBandOptions<'a> {
     /// Bin spacing, Hz (rounded to a multiple of f_s/N).
     pub step_hz: f64,
     pub precision: LanePrecision,
-    pub path: KernelPath,
+    pub path: Isa,
     /// Also read every in-band bin of the periodic ROM (L from `[probe]`).
     pub periodic: bool,
     /// Frame length override (default: the configuration's pulses).
@@ -180,7 +180,7 @@ pub fn measure(
         threads,
         precision: precision.name().into(),
         path: path.name().into(),
-        lanes_per_group: path.lanes(precision),
+        lanes_per_group: precision.lanes_on(path),
         record_seconds,
         steps_per_cpu_second,
         windowed_sd_cpu_seconds: cpu,

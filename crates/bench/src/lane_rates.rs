@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use tofprobe_dsp::sd::fullband_check::naive_sums;
-use tofprobe_dsp::sd::{FullBandProber, KernelPath, LanePrecision, ProbeDesign};
+use tofprobe_dsp::sd::{FullBandProber, Isa, LanePrecision, ProbeDesign};
 
 use crate::BenchError;
 
@@ -22,7 +22,7 @@ const N_FULLBAND: u64 = 1 << 20;
 #[derive(Debug)]
 pub struct FullBandRates {
     pub scalar: f64,
-    pub path: KernelPath,
+    pub path: Isa,
     /// [f64, f32] on `path`.
     pub fast: [f64; 2],
     /// [f64, f32] on the baseline.
@@ -54,7 +54,7 @@ pub fn fullband_rates(design: &ProbeDesign) -> Result<FullBandRates, BenchError>
         .map_err(err)?;
     let scalar = scalar_reference_rate(design, &x)?;
     let bins: Vec<u64> = (1..=64).map(|i| 70 * i).collect();
-    let run = |p: LanePrecision, path: KernelPath| -> Result<(f64, Vec<(f64, f64)>), BenchError> {
+    let run = |p: LanePrecision, path: Isa| -> Result<(f64, Vec<(f64, f64)>), BenchError> {
         let t0 = Instant::now();
         let mut prober =
             FullBandProber::on_path(design, N_FULLBAND, &bins, p, path).map_err(err)?;
@@ -64,16 +64,16 @@ pub fn fullband_rates(design: &ProbeDesign) -> Result<FullBandRates, BenchError>
             prober.sums(),
         ))
     };
-    let path = KernelPath::detect();
+    let path = Isa::current();
     let mut fast = [0.0; 2];
     let mut baseline = [0.0; 2];
     for (i, p) in [LanePrecision::F64, LanePrecision::F32]
         .into_iter()
         .enumerate()
     {
-        let (rate, sums) = run(p, KernelPath::Baseline)?;
+        let (rate, sums) = run(p, Isa::Scalar)?;
         baseline[i] = rate;
-        fast[i] = if path == KernelPath::Baseline {
+        fast[i] = if path == Isa::Scalar {
             rate
         } else {
             let (rate, fast_sums) = run(p, path)?;

@@ -15,6 +15,7 @@ pub mod dsp;
 mod error;
 pub mod fullband;
 mod fullband_svg;
+pub mod isa;
 pub mod lane_rates;
 pub mod pixel;
 pub mod scene;

@@ -11,6 +11,9 @@
 //! cut into eight time segments run in vector lanes and repaired exactly), the frame
 //! driver's choice for a long frame; `pass` judges the driver the library picks.
 //!
+//! Each ISA of the lanes (`tofprobe_io::isa`) is its own row ([`measure_isas`]): the
+//! segmented fold runs the lanes; the other drivers are scalar and are timed again per row.
+//!
 //! The ROM is synthetic (L entries of distinct square-wave sign patterns, L the design's
 //! ROM depth when periodic, else 4096): the speed does not depend on which bits it holds,
 //! only on reading one entry per pulse (and, for the fold, on L).
@@ -22,6 +25,8 @@ use tofprobe_pixel::bench::{
 };
 
 use crate::BenchError;
+use crate::isa::{IsaRows, rows};
+use tofprobe_io::isa::Isa;
 
 /// The target for one 10^7-pulse frame, seconds.
 pub const TARGET_SECONDS: f64 = 0.1;
@@ -35,6 +40,8 @@ pub const PULSES: std::ops::RangeInclusive<u64> = 1000..=1_000_000_000;
 /// The measured rates.
 #[derive(Debug, Clone, Serialize)]
 pub struct PixelReport {
+    /// The instruction set the vector kernels ran on ("scalar", "avx2", "avx512").
+    pub isa: &'static str,
     pub bins: usize,
     pub registers: usize,
     pub width_bits: u32,
@@ -85,8 +92,18 @@ pub struct PixelReport {
     pub pass: bool,
 }
 
+/// [`measure`] once per ISA in `isas`, each under that ISA.
+pub fn measure_isas(
+    design: &ResolvedDesign,
+    pulses: u64,
+    cycle_pulses: u64,
+    isas: &[Isa],
+) -> Result<IsaRows<PixelReport>, BenchError> {
+    rows(isas, |_| measure(design, pulses, cycle_pulses))
+}
+
 /// Times a `pulses`-pulse frame through the transaction model and a `cycle_pulses`-pulse
-/// frame through the cycle model, on the calling thread.
+/// frame through the cycle model, on the calling thread, on the current ISA.
 pub fn measure(
     design: &ResolvedDesign,
     pulses: u64,
@@ -141,6 +158,7 @@ pub fn measure(
     let cycle_rate = rate * params.cycles_per_pulse as f64;
     let target_seconds = TARGET_SECONDS * pulses as f64 / 1e7;
     Ok(PixelReport {
+        isa: Isa::current().name(),
         bins: params.bins,
         registers: params.registers(),
         width_bits: params.width,

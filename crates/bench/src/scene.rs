@@ -7,7 +7,8 @@
 //! alternating halves of the pulses so both see the same machine load, and reports the
 //! ratio (issue 28's target: ≥ 3× per CPU-second). Rates are reported against wall-clock
 //! time and, where Linux exposes it, against the thread's own CPU time: `pass` and the
-//! ratios use the CPU-time rates when available.
+//! ratios use the CPU-time rates when available. Each ISA of the batched kernel
+//! (`tofprobe_io::isa`) is its own row ([`measure_isas`]), its reference timed beside it.
 
 use std::time::Instant;
 
@@ -17,6 +18,8 @@ use tofprobe_scene::PhotonSource;
 
 use crate::BenchError;
 use crate::cpu::thread_cpu_ns;
+use crate::isa::{IsaRows, rows};
+use tofprobe_io::isa::Isa;
 
 /// Target throughput with every pulse a signal photon and no background (pulses/s).
 pub const TARGET_SIGNAL_ONLY: f64 = 50e6;
@@ -31,6 +34,9 @@ pub const CHUNK: usize = 1 << 16;
 /// The measured rates.
 #[derive(Debug, Clone, Serialize)]
 pub struct SceneReport {
+    /// The instruction set the batched kernel ran on ("scalar", "avx2", "avx512"); the
+    /// reference is scalar code on every row.
+    pub isa: &'static str,
     pub pulses: u64,
     pub signal_only_pulses_per_s: f64,
     pub mixed_pulses_per_s: f64,
@@ -131,7 +137,18 @@ fn time_case(
     Ok((rates(acc[0]), rates(acc[1])))
 }
 
-/// Times both cases on the document's scene, `pulses` pulses each (≥ [`CHUNK`]).
+/// [`measure`] once per ISA in `isas`, each under that ISA (each row times its own
+/// reference beside it, so each ratio is of one moment's load).
+pub fn measure_isas(
+    document: &Document,
+    pulses: u64,
+    isas: &[Isa],
+) -> Result<IsaRows<SceneReport>, BenchError> {
+    rows(isas, |_| measure(document, pulses))
+}
+
+/// Times both cases on the document's scene, `pulses` pulses each (≥ [`CHUNK`]), the
+/// batched kernel on the current ISA.
 pub fn measure(document: &Document, pulses: u64) -> Result<SceneReport, BenchError> {
     if pulses < CHUNK as u64 {
         return Err(BenchError::option(
@@ -144,6 +161,7 @@ pub fn measure(document: &Document, pulses: u64) -> Result<SceneReport, BenchErr
     let (b, br) = time_case(document, 0.3, 0.3, pulses)?;
     let speedup = (a.judged() / ar.judged(), b.judged() / br.judged());
     Ok(SceneReport {
+        isa: Isa::current().name(),
         pulses,
         signal_only_pulses_per_s: a.wall,
         mixed_pulses_per_s: b.wall,

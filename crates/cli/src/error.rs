@@ -36,6 +36,10 @@ pub enum CliError {
     #[error("layout: {0}")]
     Layout(#[from] tofprobe_layout::LayoutError),
     /// JSON serialisation failed (should not happen for plain numbers).
+    /// An instruction set refused (`--isa`, `TOFPROBE_ISA`): its origin, value, the names
+    /// allowed or what the CPU lacks.
+    #[error(transparent)]
+    Isa(#[from] tofprobe_io::isa::IsaError),
     #[error("cannot serialise JSON output: {0}")]
     Json(#[from] serde_json::Error),
 }
@@ -114,6 +118,7 @@ impl From<tofprobe_bench::BenchError> for CliError {
                 allowed,
             } => CliError::option(option, value, allowed),
             B::Output { path, message } => CliError::output(path, message),
+            B::Isa(e) => CliError::Isa(e),
             B::Internal { bench, message } => CliError::option(
                 format!("bench {bench}"),
                 message,

@@ -25,6 +25,12 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return clap_exit(&e),
     };
+    // The ISA the environment forces is checked before any kernel runs (a kernel cannot
+    // return the refusal).
+    if let Err(e) = tofprobe_io::isa::from_env() {
+        eprintln!("error: {}", error::CliError::from(e));
+        return ExitCode::from(2);
+    }
     let result = commands::run(cli.command);
     // Output still buffered (a `print!` without newline) fails here, not silently at exit.
     if let Err(e) = std::io::Write::flush(&mut std::io::stdout()) {

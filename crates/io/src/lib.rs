@@ -7,8 +7,13 @@
 //! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries, and the one
 //! root of the caches ([`cache::root`]), the writer lock of an output directory
 //! ([`lock`]) and the free space on its disk ([`disk`]), the [`watch::Watch`] a host
+<<<<<<< HEAD
 //! stops a long computation with, and the one locator of the external tools
 //! ([`tools::locate`]: `$TOFPROBE_<NAME>`, else `PATH`).
+=======
+//! stops a long computation with, and the one instruction-set selection of the vector
+//! kernels ([`isa`]: detected, `TOFPROBE_ISA`, or a benchmark's `--isa`).
+>>>>>>> isa48
 //!
 //! Errors are plain [`std::io::Error`]s: each crate maps them into its own error enum with
 //! the path it was writing.
@@ -18,6 +23,7 @@ pub mod bounded;
 pub mod cache;
 pub mod cpu;
 pub mod disk;
+pub mod isa;
 pub mod live;
 pub mod lock;
 pub mod marker;

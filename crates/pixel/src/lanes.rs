@@ -6,8 +6,8 @@
 //! [`LANES`] pixels side by side: the front-end state of each pixel in a lane of
 //! `[i64; LANES]` arrays, the phase sums laid out [L_v][LANES] (pulse n adds the lanes'
 //! operands into one row), the step written on plain arrays the compiler vectorises (an
-//! AVX-512 copy chosen at run time where the CPU has it, the baseline copy elsewhere: the
-//! same integer operations, bit-identical). Each lane computes exactly the folded driver's
+//! AVX-512 or AVX2 copy chosen at run time by the workspace's ISA, `tofprobe_io::isa`, the
+//! scalar copy elsewhere: the same integer operations, bit-identical). Each lane computes exactly the folded driver's
 //! arithmetic ([`crate::datapath::FourierStream`]), so each pixel's readout is the one
 //! [`crate::FrameDriver`] gives it alone (crates/pixel/tests/it/lanes.rs checks them
 //! against the transaction driver).
@@ -19,6 +19,7 @@
 //! nothing: its lane is masked.
 
 use tofprobe_dsp::RomImage;
+use tofprobe_io::isa::Isa;
 
 use crate::datapath::{Datapath, StepConsts};
 use crate::detections::{Detections, NO_DETECTION};
@@ -216,8 +217,7 @@ pub(crate) struct Lockstep {
     pub addr: usize,
 }
 
-/// The lockstep loop: the AVX-512 copy where the CPU has it (the same integer operations
-/// on the same arrays: bit-identical), the baseline copy elsewhere. Also the segmented
+/// The lockstep loop on the workspace's ISA ([`Isa::current`]). Also the segmented
 /// driver's ([`crate::segments`]: the lanes are segments of one pixel's run).
 pub(crate) fn run_lockstep<D: Detections + ?Sized>(
     ctx: &Lockstep,
@@ -225,17 +225,32 @@ pub(crate) fn run_lockstep<D: Detections + ?Sized>(
     phases: &mut [[i64; LANES]],
     st: &mut LaneState,
 ) {
+    run_lockstep_on(Isa::current(), ctx, streams, phases, st);
+}
+
+/// The lockstep loop on `isa`: the AVX-512 or AVX2 copy where asked for and the CPU has
+/// it (the same integer operations on the same arrays: bit-identical), the scalar copy
+/// otherwise.
+pub(crate) fn run_lockstep_on<D: Detections + ?Sized>(
+    isa: Isa,
+    ctx: &Lockstep,
+    streams: &[&D],
+    phases: &mut [[i64; LANES]],
+    st: &mut LaneState,
+) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-    {
-        // SAFETY: the CPU has both features (checked above), the one requirement of
-        // `lockstep_avx512`.
+    if isa != Isa::Scalar && isa.available() {
+        // SAFETY: the CPU has the path's features (`available`, checked above), the one
+        // requirement of `lockstep_avx512` / `lockstep_avx2`.
         #[allow(unsafe_code)]
         unsafe {
-            return lockstep_avx512(ctx, streams, phases, st);
+            return match isa {
+                Isa::Avx512 => lockstep_avx512(ctx, streams, phases, st),
+                _ => lockstep_avx2(ctx, streams, phases, st),
+            };
         }
     }
+    let _ = isa;
     lockstep_body(ctx, streams, phases, st);
 }
 
@@ -244,6 +259,19 @@ pub(crate) fn run_lockstep<D: Detections + ?Sized>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl")]
 fn lockstep_avx512<D: Detections + ?Sized>(
+    ctx: &Lockstep,
+    streams: &[&D],
+    phases: &mut [[i64; LANES]],
+    st: &mut LaneState,
+) {
+    lockstep_body(ctx, streams, phases, st);
+}
+
+/// [`lockstep_body`] compiled for AVX2 (a state word in two registers; the 64-bit
+/// arithmetic shift, which AVX2 lacks, is a logical shift and a sign fix: exact).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn lockstep_avx2<D: Detections + ?Sized>(
     ctx: &Lockstep,
     streams: &[&D],
     phases: &mut [[i64; LANES]],
@@ -351,8 +379,7 @@ fn step<const SHIFTS: bool>(
 mod tests {
     use super::*;
 
-    /// The dispatched copy (AVX-512 where the CPU has it) and the baseline copy give the
-    /// same phase sums and states, bit for bit, with and without the operand shift, one
+    /// Every copy the CPU runs (AVX2, AVX-512) and the scalar copy give the same phase sums and states, bit for bit, with and without the operand shift, one
     /// lane masked (a reordered or widened operation would move some sums).
     #[test]
     fn every_copy_of_the_lockstep_is_bit_identical() {
@@ -395,12 +422,25 @@ mod tests {
                 x: std::array::from_fn(|j| -(j as i64) * 77),
                 u: std::array::from_fn(|j| (j as i64) * 31 - 100),
             };
-            let (mut a, mut b) = (vec![[0i64; LANES]; 1024], vec![[0i64; LANES]; 1024]);
-            let (mut sa, mut sb) = (start, start);
-            run_lockstep(&ctx, &refs, &mut a, &mut sa);
-            lockstep_body(&ctx, &refs, &mut b, &mut sb);
-            assert_eq!(a, b);
-            assert_eq!((sa.target, sa.x, sa.u), (sb.target, sb.x, sb.u));
+            let mut b = vec![[0i64; LANES]; 1024];
+            let mut sb = start;
+            run_lockstep_on(Isa::Scalar, &ctx, &refs, &mut b, &mut sb);
+            let mut a = b.clone();
+            for isa in [Isa::Avx2, Isa::Avx512] {
+                if !isa.available() {
+                    println!(
+                        "skipped: this CPU lacks {} ({})",
+                        isa.name(),
+                        isa.features()
+                    );
+                    continue;
+                }
+                a = vec![[0i64; LANES]; 1024];
+                let mut sa = start;
+                run_lockstep_on(isa, &ctx, &refs, &mut a, &mut sa);
+                assert_eq!(a, b, "{}", isa.name());
+                assert_eq!((sa.target, sa.x, sa.u), (sb.target, sb.x, sb.u));
+            }
             assert!(a.iter().all(|r| r[5] == 0) && a.iter().any(|r| r[0] != 0));
         }
     }

@@ -18,6 +18,7 @@
 
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
+use tofprobe_io::isa::Isa;
 
 use crate::depths::Depths;
 use crate::lanes::{FILL_BASELINE, Fill, LANES, Lanes, PASS, Streams, Words};
@@ -99,7 +100,7 @@ pub(crate) struct Scratch {
     pass: Box<PassBuffers>,
 }
 
-/// The buffers of one pass of [`PASS`] pulses (≈ 58 bytes a pulse, 29 kB: within L1), each
+/// The buffers of one pass of [`PASS`] pulses (≈ 66 bytes a pulse, 33 kB: about L1), each
 /// a whole pass long; a block's last, shorter pass uses their first pulses.
 #[derive(Debug)]
 struct PassBuffers {
@@ -108,14 +109,32 @@ struct PassBuffers {
     words: Words,
     signal_words: Words,
     background_words: Words,
-    flags: [u8; PASS],
+    flags: [u64; PASS],
     /// Each pulse's ziggurat layer edges.
     edges: [[f64; 2]; PASS],
     rejects: Vec<u32>,
     /// The earliest in-window arrival of each pulse, code units (∞ when none).
     best: [f64; PASS],
-    /// Whether a background photon won the pulse.
-    from_bg: [bool; PASS],
+    bg: Gather,
+}
+
+/// The background's gathered pulses ([`background`]): flags, then the indices and values
+/// of the pulses with a photon in the window.
+#[derive(Debug)]
+struct Gather {
+    flags: [u8; PASS],
+    index: [u32; PASS],
+    value: [f64; PASS],
+}
+
+impl Default for Gather {
+    fn default() -> Self {
+        Gather {
+            flags: [0; PASS],
+            index: [0; PASS],
+            value: [0.0; PASS],
+        }
+    }
 }
 
 impl Default for PassBuffers {
@@ -129,7 +148,28 @@ impl Default for PassBuffers {
             edges: [[0.0; 2]; PASS],
             rejects: Vec::new(),
             best: [0.0; PASS],
-            from_bg: [false; PASS],
+            bg: Gather::default(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod mask_tests {
+    /// The multiply's mask against the flag-by-flag one, on every length and random flags
+    /// (a wrong constant, 0x8040…0201, fails here).
+    #[test]
+    fn flag_mask_is_the_flags_bit_by_bit() {
+        let mut g = crate::SplitMix64::new(3);
+        for len in 0..=64 {
+            for _ in 0..50 {
+                let r = g.next_u64();
+                let flags: Vec<u8> = (0..len).map(|k| ((r >> k) & 1) as u8).collect();
+                let naive = flags
+                    .iter()
+                    .enumerate()
+                    .fold(0u64, |m, (k, &f)| m | (u64::from(f) << k));
+                assert_eq!(super::flag_mask(&flags), naive, "{flags:?}");
+            }
         }
     }
 }
@@ -139,7 +179,7 @@ mod tests {
     use super::*;
     use crate::{MotionConfig, SceneConfig, SensorConfig};
 
-    /// The dispatched copy (AVX-512 or AVX2 where the CPU has them) and the baseline copy
+    /// Every copy the CPU runs (AVX-512, AVX2) and the scalar copy
     /// give the same codes, detections and background wins, bit for bit, on a moving
     /// scene at mixed rates (a reordered or fused operation would move some codes).
     #[test]
@@ -183,30 +223,30 @@ mod tests {
                 first_pulse: block * 4096,
                 n: 4096,
             };
-            let ca = generate(&p, &scene, &depths, blk, &mut sa, (0, 79, &mut a));
-            let cb = generate_body(
+            let cb = generate_on(
+                Isa::Scalar,
                 &p,
                 &scene,
                 &depths,
                 blk,
                 &mut sb,
                 (0, 79, &mut b),
-                FILL_BASELINE,
             );
-            assert_eq!(ca, cb, "block {block}");
-            assert_eq!(a, b, "block {block}");
-            // The AVX2 copy too where the CPU has it (on an AVX-512 machine the dispatch
-            // above ran the AVX-512 copy, so this is the only check of the AVX2 one).
-            #[cfg(target_arch = "x86_64")]
-            if std::arch::is_x86_feature_detected!("avx2") {
+            for isa in [Isa::Avx2, Isa::Avx512] {
+                if !isa.available() {
+                    println!(
+                        "skipped: this CPU lacks {} ({})",
+                        isa.name(),
+                        isa.features()
+                    );
+                    continue;
+                }
                 let (mut c, mut sc) = (vec![None; 4096], Scratch::default());
-                // SAFETY: the CPU has AVX2 (checked on the line above), the one requirement
-                // of `generate_avx2`.
-                #[allow(unsafe_code)]
-                let cc =
-                    unsafe { generate_avx2(&p, &scene, &depths, blk, &mut sc, (0, 79, &mut c)) };
-                assert_eq!((cc, &c), (cb, &b), "AVX2 copy, block {block}");
+                let cc = generate_on(isa, &p, &scene, &depths, blk, &mut sc, (0, 79, &mut c));
+                assert_eq!((cc, &c), (cb, &b), "{} copy, block {block}", isa.name());
             }
+            let ca = generate(&p, &scene, &depths, blk, &mut sa, (0, 79, &mut a));
+            assert_eq!((ca, &a), (cb, &b), "the current ISA's copy, block {block}");
             assert!(ca.0 > 3000 && ca.1 > 500, "block {block}: {ca:?}");
         }
     }
@@ -214,10 +254,24 @@ mod tests {
 
 /// Generates pulses 0 .. n of a block (n ≤ the block length), in passes of [`PASS`] pulses,
 /// and writes pulses `offset .. offset + out.len()` of them as codes into `out` (returns
-/// its detections and background wins):
-/// the AVX-512 or AVX2 copy of the kernel where the CPU has it (the same IEEE operations, no fused
-/// multiply-adds: bit-identical to the baseline copy), the baseline copy elsewhere.
+/// its detections and background wins), on the workspace's ISA
+/// ([`tofprobe_io::isa::Isa::current`]).
 pub(crate) fn generate<O: Slot>(
+    p: &Params,
+    scene: &Scene,
+    depths: &Depths,
+    block: Block,
+    sc: &mut Scratch,
+    out: (usize, u32, &mut [O]),
+) -> (u64, u64) {
+    generate_on(Isa::current(), p, scene, depths, block, sc, out)
+}
+
+/// [`generate`] on `isa`: the AVX-512 or AVX2 copy of the kernel where asked for and the
+/// CPU has it (the same IEEE operations, no fused multiply-adds: bit-identical to the
+/// scalar copy), the scalar copy otherwise.
+pub(crate) fn generate_on<O: Slot>(
+    isa: Isa,
     p: &Params,
     scene: &Scene,
     depths: &Depths,
@@ -226,19 +280,16 @@ pub(crate) fn generate<O: Slot>(
     (offset, last, out): (usize, u32, &mut [O]),
 ) -> (u64, u64) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-        && std::arch::is_x86_feature_detected!("avx512dq")
-    {
-        // SAFETY: the CPU has the three features (checked above), the one requirement
-        // of `generate_avx512`.
+    if isa == Isa::Avx512 && isa.available() {
+        // SAFETY: the CPU has AVX-512 F, VL and DQ (`available`, checked above), the one
+        // requirement of `generate_avx512`.
         #[allow(unsafe_code)]
         unsafe {
             return generate_avx512(p, scene, depths, block, sc, (offset, last, out));
         }
     }
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
+    if isa == Isa::Avx2 && isa.available() {
         // SAFETY: the CPU has AVX2 (checked on the line above), the one requirement of
         // `generate_avx2`; the workspace's second allowed unsafe call (see Cargo.toml).
         #[allow(unsafe_code)]
@@ -246,6 +297,7 @@ pub(crate) fn generate<O: Slot>(
             return generate_avx2(p, scene, depths, block, sc, (offset, last, out));
         }
     }
+    let _ = isa;
     generate_body(
         p,
         scene,
@@ -402,72 +454,121 @@ fn pass<O: Slot>(
         // A pass before the request's start: its streams advanced, nothing is computed.
         return (0, 0);
     }
-    // Signal: t = δ·code_per_mm + σ z − start, kept when inside [0, length).
+    // Signal: t = δ·code_per_mm + σ z − start, kept when inside [0, length) and (ρ_s < 1)
+    // the pulse has its signal photon. Each loop writes a buffer it does not read: a
+    // select between a new value and the old one of the same cell becomes a masked store
+    // (`vmaskmovpd`), which is microcoded and slow on AMD's AVX2 cores (it was a third of
+    // the AVX2 kernel at (ρ_s, ρ_b) = (0.3, 0.3)).
     let (cpm, sigma, start, len) = (p.code_per_mm, p.sigma, p.start, p.length);
     let best = &mut b.best[..m];
-    for ((b, &d), &z) in best.iter_mut().zip(depth).zip(z.iter()) {
-        let x = d * cpm + sigma * z - start;
-        *b = if x >= 0.0 && x < len {
-            x
-        } else {
-            f64::INFINITY
-        };
-    }
     if bern {
         // Both sides < 2^53: the signed compare (the one AVX2 has) is exact.
         let thr = p.signal_threshold.min(1 << 53) as i64;
-        for (b, &w) in best.iter_mut().zip(sw.iter()) {
-            *b = if ((w >> 11) as i64) < thr {
-                *b
+        for (((b, &d), &z), &w) in best.iter_mut().zip(depth).zip(z.iter()).zip(sw.iter()) {
+            let x = d * cpm + sigma * z - start;
+            let keep = x >= 0.0 && x < len && ((w >> 11) as i64) < thr;
+            *b = if keep { x } else { f64::INFINITY };
+        }
+    } else {
+        for ((b, &d), &z) in best.iter_mut().zip(depth).zip(z.iter()) {
+            let x = d * cpm + sigma * z - start;
+            *b = if x >= 0.0 && x < len {
+                x
             } else {
                 f64::INFINITY
             };
         }
     }
-    let from_bg = &mut b.from_bg[..m];
+    let mut wins = 0;
     if bg {
-        let scale = len / p.background_rate;
-        let nb = p.no_background;
-        for ((b, bg), &w) in best.iter_mut().zip(from_bg.iter_mut()).zip(bw.iter()) {
-            // u ∈ (0, 1] on the 2^−52 grid, by the exponent trick (no integer-to-float
-            // conversion, which AVX2 lacks for 64-bit lanes).
-            let u = 2.0 - f64::from_bits((w >> 12) | 0x3FF0_0000_0000_0000);
-            let tb = -ln(u) * scale;
-            let wins = u > nb && tb < *b;
-            *b = if wins { tb } else { *b };
-            *bg = wins;
-        }
-        codes::<O, true>(&best[lo..hi], &from_bg[lo..hi], last, out)
-    } else {
-        codes::<O, false>(&best[lo..hi], &from_bg[lo..hi], last, out)
+        wins = background(p, &bw[lo..hi], &mut best[lo..hi], &mut b.bg);
     }
+    let detections = codes(&best[lo..hi], last, out);
+    (detections, wins)
+}
+
+/// The background's first arrivals of pulses `bw.len()` (their words `bw`): each pulse's
+/// arrival in `best` becomes the background's where that is in the window and earlier
+/// (returns how many were). Only the ≈ 1 − e^(−ρ_b) of pulses with a background photon in
+/// the window need the logarithm: they are gathered (a vector compare, then the set bits
+/// of its mask visited), their −ln(u)·W/ρ_b computed densely in vectors, and scattered
+/// back; every pulse's value is the one the direct loop computes, in half its time at
+/// ρ_b = 0.3 (the direct loop's logarithm of every pulse was half of the AVX2 kernel).
+#[inline(always)]
+fn background(p: &Params, bw: &[u64], best: &mut [f64], g: &mut Gather) -> u64 {
+    // u ∈ (0, 1] on the 2^−52 grid, by the exponent trick (no integer-to-float
+    // conversion, which AVX2 lacks for 64-bit lanes).
+    let uniform = |w: u64| 2.0 - f64::from_bits((w >> 12) | 0x3FF0_0000_0000_0000);
+    let scale = p.length / p.background_rate;
+    let nb = p.no_background;
+    let n = bw.len();
+    for (f, &w) in g.flags[..n].iter_mut().zip(bw) {
+        *f = u8::from(uniform(w) > nb);
+    }
+    let mut k = 0;
+    for (j, w) in g.flags[..n].chunks(64).enumerate() {
+        let mut mask = flag_mask(w);
+        while mask != 0 {
+            let i = 64 * j + mask.trailing_zeros() as usize;
+            (g.index[k], g.value[k]) = (i as u32, uniform(bw[i]));
+            k += 1;
+            mask &= mask - 1;
+        }
+    }
+    for v in &mut g.value[..k] {
+        *v = -ln(*v) * scale;
+    }
+    let mut wins = 0;
+    for (&i, &tb) in g.index[..k].iter().zip(&g.value[..k]) {
+        let b = &mut best[i as usize];
+        let win = tb < *b;
+        wins += u64::from(win);
+        *b = if win { tb } else { *b };
+    }
+    wins
+}
+
+/// Bit k set iff `flags[k]` is 1 (flags 0 or 1, at most 64): eight flags at a time, by
+/// one multiply that gathers the low bit of each byte of a word into its top byte (the
+/// bytes' bits land at distinct places and never carry). A fold of 64 shifted flags was a
+/// zero-extension, compare and mask per flag on AVX2, a branch-free compaction (index
+/// written, count advanced by the flag) a serial add per pulse: each ≈ 12 % of the kernel.
+#[inline(always)]
+fn flag_mask(flags: &[u8]) -> u64 {
+    debug_assert!(flags.len() <= 64 && flags.iter().all(|&f| f <= 1));
+    let pack = |b: [u8; 8]| u64::from_le_bytes(b).wrapping_mul(0x0102_0408_1020_4080) >> 56;
+    let mut mask = 0u64;
+    let mut words = flags.chunks_exact(8);
+    for (i, c) in (&mut words).enumerate() {
+        mask |= pack(c.try_into().expect("8 flags")) << (8 * i);
+    }
+    let rest = words.remainder();
+    if !rest.is_empty() {
+        let mut b = [0u8; 8];
+        for (d, &f) in b.iter_mut().zip(rest) {
+            *d = f;
+        }
+        mask |= pack(b) << (flags.len() - rest.len());
+    }
+    mask
 }
 
 /// Writes `best` as TDC codes into `out` (no detection outside the window); returns the
-/// detections and the background wins among them (none read unless `BG`).
+/// detections.
 #[inline(always)]
-fn codes<O: Slot, const BG: bool>(
-    best: &[f64],
-    from_bg: &[bool],
-    last: u32,
-    out: &mut [O],
-) -> (u64, u64) {
+fn codes<O: Slot>(best: &[f64], last: u32, out: &mut [O]) -> u64 {
     let mut detections = 0u64;
-    let mut wins = 0u64;
     let last_f = f64::from(last);
     // 2^52: a float in [0, 2^32) truncated and added to it holds its integer value in the
     // low mantissa bits (a vector conversion where `as u32`'s saturating one is not).
     const MAGIC: f64 = 4_503_599_627_370_496.0;
-    for (i, (o, &b)) in out.iter_mut().zip(best).enumerate() {
+    for (o, &b) in out.iter_mut().zip(best) {
         // b ∈ [0, length) when hit, ∞ otherwise; the clamp is a float min (an integer min
         // compiles to a branch that a 50 % detection rate would mispredict).
         let hit = b < f64::INFINITY;
         let c = (b.min(last_f).trunc() + MAGIC).to_bits() as u32;
         *o = O::detection(hit, c);
         detections += u64::from(hit);
-        if BG {
-            wins += u64::from(from_bg[i]);
-        }
     }
-    (detections, wins)
+    detections
 }

@@ -18,7 +18,10 @@ pub(crate) fn ln(u: f64) -> f64 {
     const LG6: f64 = 1.531_383_769_920_937_332e-1;
     const LG7: f64 = 1.479_819_860_511_658_591e-1;
     let bits = u.to_bits();
-    let e = ((bits >> 52) as i64 - 1023) as f64;
+    // The biased exponent as a float by the 2^52 trick (exact: it is < 2^11), not an
+    // integer-to-float conversion, which AVX2 lacks for 64-bit lanes (scalar there).
+    const TWO52: f64 = 4_503_599_627_370_496.0;
+    let e = f64::from_bits((bits >> 52) | TWO52.to_bits()) - (TWO52 + 1023.0);
     let m = f64::from_bits((bits & 0x000F_FFFF_FFFF_FFFF) | 0x3FF0_0000_0000_0000);
     let big = m > std::f64::consts::SQRT_2;
     let m = if big { 0.5 * m } else { m };

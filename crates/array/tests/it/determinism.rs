@@ -112,3 +112,28 @@ fn a_lane_group_is_each_pixel_alone() {
     assert_eq!(alone[0], lanes[1]);
     assert_ne!(lanes[0], lanes[1], "pixels differ, so the test can fail");
 }
+
+/// Every ISA path of the vector kernels this CPU runs (`tofprobe_io::isa`: the Monte
+/// Carlo's batch, the pixels' lanes) gives the scalar path's array registers and detection
+/// counts, byte for byte; a path the CPU lacks is skipped with a note. The pixels differ
+/// from each other, so a wrong lane would show.
+#[test]
+fn every_isa_gives_the_scalar_array() {
+    use tofprobe_io::isa::{Isa, with_isa};
+    let d = design(&plate(2, 1), 40_000, ARRAY);
+    let rom = d.probe_rom().unwrap().unwrap();
+    let run = |isa| with_isa(isa, || pool(2).install(|| run_array(&d, Some(&rom.image))));
+    let scalar = run(Isa::Scalar).unwrap();
+    assert_ne!(scalar.pixel(0, 0), scalar.pixel(4, 3));
+    for isa in [Isa::Avx2, Isa::Avx512] {
+        if !isa.available() {
+            println!(
+                "skipped: this CPU lacks {} ({})",
+                isa.name(),
+                isa.features()
+            );
+            continue;
+        }
+        assert_eq!(run(isa).unwrap(), scalar, "{}", isa.name());
+    }
+}

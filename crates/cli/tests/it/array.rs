@@ -303,6 +303,13 @@ fn bench_array_prints_its_rates() {
         assert!(run["peak_memory_bytes"].as_f64().unwrap() < 1e9);
     }
     assert!(r["projected_64x64_1e7_seconds"].as_f64().unwrap() > 0.0);
+    // One row per ISA this CPU runs, each naming its ISA with its own projection and pass.
+    let rows = r["isas"].as_array().unwrap();
+    assert_eq!(rows.len(), tofprobe_io::isa::Isa::supported().len());
+    for row in rows {
+        assert!(row["isa"].is_string() && row["pass"].is_boolean());
+        assert!(row["projected_64x64_1e7_seconds"].as_f64().unwrap() > 0.0);
+    }
 }
 
 /// The set as its users read it: numpy.load reads the .npy arrays and pyuff the UFF file

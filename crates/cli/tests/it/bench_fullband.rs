@@ -109,14 +109,14 @@ fn every_path_reads_the_same_spectrum() {
             "--json",
         ])
     };
-    let base = run("baseline");
+    let base = run("scalar");
     assert!(
         base.status.success(),
         "{}",
         String::from_utf8_lossy(&base.stderr)
     );
     let b: serde_json::Value = serde_json::from_slice(&base.stdout).expect("one JSON object");
-    assert_eq!(b["path"], "baseline");
+    assert_eq!(b["path"], "scalar");
     assert_eq!(b["lanes_per_group"], 4);
     let f = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap_or_else(|| panic!("{k}"));
     assert!(f(&b, "scalar_reference_steps_per_s_per_core") > 0.0);
@@ -129,7 +129,7 @@ fn every_path_reads_the_same_spectrum() {
         String::from_utf8_lossy(&auto.stderr)
     );
     let a: serde_json::Value = serde_json::from_slice(&auto.stdout).expect("one JSON object");
-    assert_eq!(a["path"], tofprobe_dsp::sd::KernelPath::detect().name());
+    assert_eq!(a["path"], tofprobe_dsp::sd::Isa::current().name());
     for k in ["peak_sd_um", "noise_sd_um", "error_um", "peak_dft_um"] {
         assert_eq!(f(&a["windowed"], k), f(&b["windowed"], k), "{k}");
     }
@@ -137,7 +137,7 @@ fn every_path_reads_the_same_spectrum() {
     for (path, lanes) in [("avx2", 8), ("avx512", 16)] {
         let out = run(path);
         let err = String::from_utf8_lossy(&out.stderr);
-        if tofprobe_dsp::sd::KernelPath::parse(path).is_ok() {
+        if tofprobe_dsp::sd::Isa::parse(path, "--path").is_ok() {
             assert!(out.status.success(), "{err}");
             let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
             assert_eq!(
@@ -150,7 +150,7 @@ fn every_path_reads_the_same_spectrum() {
         } else {
             assert_eq!(out.status.code(), Some(2), "{err}");
             assert!(
-                err.contains("--path") && err.contains(path) && err.contains("baseline"),
+                err.contains("--path") && err.contains(path) && err.contains("scalar"),
                 "{err}"
             );
         }

@@ -151,6 +151,53 @@ fn bench_scene_json_has_unit_named_keys() {
     }
     assert!(v["speedup_pass"].is_boolean());
     assert!(v["pass"].is_boolean());
+    // One row per ISA this CPU runs, narrowest first, each naming its ISA and judging
+    // its own targets; the top level is the widest row.
+    let supported: Vec<&str> = tofprobe_io::isa::Isa::supported()
+        .iter()
+        .map(|i| i.name())
+        .collect();
+    let rows = v["isas"].as_array().expect("isas");
+    let names: Vec<&str> = rows.iter().map(|r| r["isa"].as_str().unwrap()).collect();
+    assert_eq!(names, supported);
+    assert_eq!(v["isa"], *supported.last().unwrap());
+    for r in rows {
+        assert!(r["mixed_speedup_vs_reference"].as_f64().unwrap() > 0.0);
+        assert!(r["speedup_pass"].is_boolean());
+    }
+    // `--isa` and TOFPROBE_ISA measure one; a name that is not an ISA is refused with the
+    // allowed names, and so is an ISA this CPU lacks, naming what it lacks.
+    let one = tofprobe(&[
+        "bench", "scene", "--pulses", "70000", "--json", "--isa", "scalar",
+    ]);
+    assert!(one.status.success());
+    let o: serde_json::Value = serde_json::from_slice(&one.stdout).unwrap();
+    assert_eq!(
+        (o["isa"].as_str(), o["isas"].as_array().map(Vec::len)),
+        (Some("scalar"), Some(1))
+    );
+    let allowed = "allowed: \"scalar\", \"avx2\", \"avx512\"";
+    fails_with(
+        &["bench", "scene", "--isa", "avx1024"],
+        &["--isa = \"avx1024\"", allowed],
+    );
+    let env = std::process::Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .args(["bench", "scene", "--pulses", "70000"])
+        .env("TOFPROBE_ISA", "sse9")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&env.stderr);
+    assert_eq!(env.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("TOFPROBE_ISA = \"sse9\"") && err.contains(allowed),
+        "{err}"
+    );
+    if let Some(lacking) = tofprobe_io::isa::Isa::ALL.iter().find(|i| !i.available()) {
+        fails_with(
+            &["bench", "scene", "--isa", lacking.name()],
+            &["this CPU lacks", lacking.features()],
+        );
+    }
     fails_with(
         &["bench", "scene", "--pulses", "10"],
         &["--pulses = 10", "pulses >= 65536"],

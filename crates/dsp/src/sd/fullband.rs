@@ -1,6 +1,6 @@
 //! ΣΔ probing of every bin of a band in one streaming pass: the windowed-frame probe of
 //! each bin k (A·w[n]·cos/sin(2πkn/N), modulated to ±1) is generated and accumulated
-//! against the depth record x[n] in the same loop ([`super::pairs`]), Y_k = Σ x[n]·b_k[n],
+//! against the depth record x[n] in the same loop ([`super::simd::pairs`]), Y_k = Σ x[n]·b_k[n],
 //! so 2·K bitstreams of N samples are never stored. Memory is the groups' states plus one
 //! block of x: records stream in any chunking, and the sums do not depend on it (the
 //! rotators re-anchor at absolute sample positions) nor on the thread count (groups are
@@ -11,13 +11,13 @@
 //! split between ±k), so it reads the windowed DFT of the depth.
 
 use super::config::ProbeConvention;
-use super::isa::KernelPath;
-use super::pairs::{
+use super::probe::ProbeDesign;
+use super::probing::prefilter_response;
+use super::simd::Isa;
+use super::simd::pairs::{
     Coeffs, LANES_F32, LANES_F32_AVX2, LANES_F32_AVX512, LANES_F64, LANES_F64_AVX2,
     LANES_F64_AVX512, Lane, LanePrecision, PairGroup,
 };
-use super::probe::ProbeDesign;
-use super::probing::prefilter_response;
 use crate::error::DspError;
 use crate::window::Window;
 use rayon::prelude::*;
@@ -43,7 +43,7 @@ fn groups<T: Lane, const L: usize>(
     bins: &[u64],
     frame: u64,
     order: usize,
-    path: KernelPath,
+    path: Isa,
 ) -> Vec<PairGroup<T, L>> {
     bins.chunks(L / 2)
         .map(|c| PairGroup::new(c, frame, order, path))
@@ -62,7 +62,7 @@ pub struct FullBandProber {
     frame: u64,
     bins: Vec<u64>,
     precision: LanePrecision,
-    path: KernelPath,
+    path: Isa,
     groups: Groups,
     n: u64,
     aw: Vec<f64>,
@@ -73,14 +73,14 @@ impl FullBandProber {
     /// `frame` pulses with the design's modulator, amplitude and window. The design's
     /// amplitude check (≤ 0.9 × the measured stable limit) is what keeps the lanes
     /// stable; a lane that still leaves the state bound is an error naming its bin.
-    /// Runs on the fastest instruction path of this CPU ([`KernelPath::detect`]).
+    /// Runs on the fastest instruction path of this CPU ([`Isa::detect`]).
     pub fn new(
         design: &ProbeDesign,
         frame: u64,
         bins: &[u64],
         precision: LanePrecision,
     ) -> Result<Self, DspError> {
-        Self::on_path(design, frame, bins, precision, KernelPath::detect())
+        Self::on_path(design, frame, bins, precision, Isa::current())
     }
 
     /// Like [`FullBandProber::new`] on a chosen instruction path (an error if this CPU
@@ -90,9 +90,9 @@ impl FullBandProber {
         frame: u64,
         bins: &[u64],
         precision: LanePrecision,
-        path: KernelPath,
+        path: Isa,
     ) -> Result<Self, DspError> {
-        let path = path.require()?;
+        let path = super::simd::require(path)?;
         let coeffs = Coeffs::new(&design.modulator.ss)?;
         if frame < 16 {
             return Err(DspError::out_of_range("frame_pulses", frame, ">= 16"));
@@ -110,22 +110,14 @@ impl FullBandProber {
         }
         let order = coeffs.order;
         let groups = match (precision, path) {
-            (LanePrecision::F64, KernelPath::Baseline) => {
-                Groups::F64(groups(bins, frame, order, path))
-            }
-            (LanePrecision::F32, KernelPath::Baseline) => {
-                Groups::F32(groups(bins, frame, order, path))
-            }
-            (LanePrecision::F64, KernelPath::Avx2) => {
-                Groups::F64Avx2(groups(bins, frame, order, path))
-            }
-            (LanePrecision::F32, KernelPath::Avx2) => {
-                Groups::F32Avx2(groups(bins, frame, order, path))
-            }
-            (LanePrecision::F64, KernelPath::Avx512) => {
+            (LanePrecision::F64, Isa::Scalar) => Groups::F64(groups(bins, frame, order, path)),
+            (LanePrecision::F32, Isa::Scalar) => Groups::F32(groups(bins, frame, order, path)),
+            (LanePrecision::F64, Isa::Avx2) => Groups::F64Avx2(groups(bins, frame, order, path)),
+            (LanePrecision::F32, Isa::Avx2) => Groups::F32Avx2(groups(bins, frame, order, path)),
+            (LanePrecision::F64, Isa::Avx512) => {
                 Groups::F64Avx512(groups(bins, frame, order, path))
             }
-            (LanePrecision::F32, KernelPath::Avx512) => {
+            (LanePrecision::F32, Isa::Avx512) => {
                 Groups::F32Avx512(groups(bins, frame, order, path))
             }
         };
@@ -193,7 +185,7 @@ impl FullBandProber {
     }
 
     /// The instruction path the lanes run on.
-    pub fn path(&self) -> KernelPath {
+    pub fn path(&self) -> Isa {
         self.path
     }
 

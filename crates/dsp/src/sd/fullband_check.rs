@@ -12,13 +12,13 @@
 //! against its own bound.
 
 use super::fullband::FullBandProber;
-use super::isa::KernelPath;
 use super::modulator::Modulator;
-use super::pairs::{
+use super::probe::ProbeDesign;
+use super::simd::Isa;
+use super::simd::pairs::{
     Coeffs, LANES_F32, LANES_F32_AVX2, LANES_F32_AVX512, LANES_F64, LANES_F64_AVX2,
     LANES_F64_AVX512, Lane, LanePrecision, PairGroup,
 };
-use super::probe::ProbeDesign;
 use crate::error::DspError;
 
 /// Where the fast path and the naive reference part.
@@ -86,8 +86,7 @@ pub fn naive_sums(
     bins.iter()
         .map(|&k| {
             let inputs =
-                PairGroup::<f64, LANES_F64>::new(&[k], frame, m.order, KernelPath::Baseline)
-                    .inputs(0, &aw);
+                PairGroup::<f64, LANES_F64>::new(&[k], frame, m.order, Isa::Scalar).inputs(0, &aw);
             let mut sums = [0.0; 2];
             let mut bits = [Vec::new(), Vec::new()];
             for (q, (sum, b)) in sums.iter_mut().zip(bits.iter_mut()).enumerate() {
@@ -116,29 +115,29 @@ pub fn fast_bits(
     bins: &[u64],
     x: &[f64],
     precision: LanePrecision,
-    path: KernelPath,
+    path: Isa,
 ) -> Result<Vec<[Vec<bool>; 2]>, DspError> {
-    let path = path.require()?;
+    let path = super::simd::require(path)?;
     let k = Coeffs::new(&design.modulator.ss)?;
     let aw = amplitude_window(design, frame, x.len());
     let narrow = |v: &[f64]| v.iter().map(|&v| v as f32).collect::<Vec<f32>>();
     match (precision, path) {
-        (LanePrecision::F64, KernelPath::Baseline) => {
+        (LanePrecision::F64, Isa::Scalar) => {
             traced::<f64, LANES_F64>(&k, frame, bins, &aw, x, path)
         }
-        (LanePrecision::F64, KernelPath::Avx2) => {
+        (LanePrecision::F64, Isa::Avx2) => {
             traced::<f64, LANES_F64_AVX2>(&k, frame, bins, &aw, x, path)
         }
-        (LanePrecision::F32, KernelPath::Baseline) => {
+        (LanePrecision::F32, Isa::Scalar) => {
             traced::<f32, LANES_F32>(&k, frame, bins, &narrow(&aw), &narrow(x), path)
         }
-        (LanePrecision::F32, KernelPath::Avx2) => {
+        (LanePrecision::F32, Isa::Avx2) => {
             traced::<f32, LANES_F32_AVX2>(&k, frame, bins, &narrow(&aw), &narrow(x), path)
         }
-        (LanePrecision::F64, KernelPath::Avx512) => {
+        (LanePrecision::F64, Isa::Avx512) => {
             traced::<f64, LANES_F64_AVX512>(&k, frame, bins, &aw, x, path)
         }
-        (LanePrecision::F32, KernelPath::Avx512) => {
+        (LanePrecision::F32, Isa::Avx512) => {
             traced::<f32, LANES_F32_AVX512>(&k, frame, bins, &narrow(&aw), &narrow(x), path)
         }
     }
@@ -150,7 +149,7 @@ fn traced<T: Lane, const L: usize>(
     bins: &[u64],
     aw: &[T],
     x: &[T],
-    path: KernelPath,
+    path: Isa,
 ) -> Result<Vec<[Vec<bool>; 2]>, DspError> {
     let mut out = Vec::new();
     for chunk in bins.chunks(L / 2) {
@@ -179,7 +178,7 @@ pub fn compare(
     naive_bins: &[u64],
     x: &[f64],
     chunk: usize,
-    path: KernelPath,
+    path: Isa,
 ) -> Result<Option<Mismatch>, DspError> {
     let mut fast = FullBandProber::on_path(design, frame, bins, LanePrecision::F64, path)?;
     for c in x.chunks(chunk.max(1)) {
@@ -257,7 +256,7 @@ mod tests {
         let d = design();
         let x = depths(N as usize, 100, 3.0, 0x9e37_79b9_7f4a_7c15);
         // Chunks of 1000 cross the anchor (1024) and block boundaries off-grid.
-        for path in KernelPath::ALL {
+        for path in Isa::ALL {
             if !path.available() {
                 eprintln!("skipped: this CPU cannot run the {} path", path.name());
                 continue;
@@ -281,7 +280,7 @@ mod tests {
         let x = depths(N as usize, 100, 3.0, 5);
         let mut wrong = BINS;
         wrong[3] = 8;
-        let m = compare(&d, N, &BINS, &wrong, &x, 4096, KernelPath::detect())
+        let m = compare(&d, N, &BINS, &wrong, &x, 4096, Isa::current())
             .unwrap()
             .expect("must differ");
         assert_eq!((m.bin, m.quadrature), (7, false), "{m}");

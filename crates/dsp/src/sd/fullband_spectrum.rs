@@ -12,10 +12,10 @@
 //!   correlates L values; the DFT of the folded record is the record's DFT at those bins.
 
 use super::fullband::{FullBandProber, bin_scale, gain};
-use super::isa::KernelPath;
-use super::pairs::LanePrecision;
 use super::probe::{ProbeDesign, ProbeRom};
 use super::probing::normalise;
+use super::simd::Isa;
+use super::simd::pairs::LanePrecision;
 use crate::dft::windowed_dft_half;
 use crate::error::DspError;
 use crate::preprocess::{FrontEnd, FrontEndOutput};
@@ -91,7 +91,7 @@ pub fn windowed_band(
     bins: &[u64],
     alpha: f64,
     precision: LanePrecision,
-    path: KernelPath,
+    path: Isa,
     mut progress: impl FnMut(u64),
 ) -> Result<BandSpectrum, DspError> {
     let frame = x.len() as u64;
@@ -303,7 +303,7 @@ mod tests {
             &bins,
             1.0 / 32.0,
             LanePrecision::F64,
-            KernelPath::detect(),
+            Isa::current(),
             |_| {},
         )
         .unwrap();

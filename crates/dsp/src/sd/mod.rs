@@ -4,32 +4,27 @@ pub mod config;
 pub mod fullband;
 pub mod fullband_check;
 pub mod fullband_spectrum;
-pub mod isa;
-mod lane;
-pub mod lanes;
 pub mod modulator;
 pub mod ntf;
-pub mod pairs;
-mod pairs_kernel;
 pub mod probe;
 pub mod probing;
 pub mod quality;
 pub mod realize;
+pub mod simd;
 pub mod wrap;
 
 pub use config::{MAX_PERIODIC_ROM_DEPTH, ProbeConfig, ProbeConvention, RomMode};
 pub use fullband::FullBandProber;
-pub use isa::KernelPath;
 pub use modulator::Modulator;
 pub use ntf::{Ntf, synthesize_ntf};
-pub use pairs::LanePrecision;
 pub use probe::{ProbeDesign, ProbeRom, nearest_bin};
 pub use probing::{
     ProbeAccumulator, amplitudes_um, normalise, prefilter_response, probe_detections,
 };
 pub use realize::{Cifb, StateSpace, realize_cifb};
+pub use simd::{Isa, LanePrecision};
 pub use wrap::WrapMetric;
 
 /// |state| above which the modulator is declared unstable (the scalar [`Modulator`] and
-/// the lanes of [`lanes`] and [`pairs`] alike).
+/// the lanes of [`simd::lanes`] and [`simd::pairs`] alike).
 pub const STATE_BOUND: f64 = 100.0;

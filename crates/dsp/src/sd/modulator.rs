@@ -7,9 +7,9 @@
 //! operation the states of the realised (unscaled CIFB) designs stay below ≈ 10, so the
 //! bound leaves an order of magnitude of headroom without letting a run-away go unnoticed.
 
-use super::lanes::{LANES, LaneGroup, LaneProbe};
 use super::ntf::synthesize_ntf;
 use super::realize::{StateSpace, realize_cifb};
+use super::simd::lanes::{LANES, LaneGroup, LaneProbe};
 use crate::error::DspError;
 use crate::window::Window;
 use std::f64::consts::PI;

@@ -27,8 +27,8 @@
 //! (order 5: ≈ 6%; L = 4096 at OSR 64: ≈ 50%), and the ROM says so.
 
 use super::config::{ProbeConfig, ProbeConvention, RomMode};
-use super::lanes::{LANES, LaneGroup, LaneProbe};
 use super::modulator::{Modulator, SAFETY_MARGIN};
+use super::simd::lanes::{LANES, LaneGroup, LaneProbe};
 use super::wrap::{WrapMetric, inband_error_energy};
 use crate::error::DspError;
 use crate::rom::{RomImage, RomManifest};
@@ -645,7 +645,7 @@ mod tests {
                 };
                 // The reference: the scalar modulator on the generator's own input.
                 let g = LaneGroup::new(&[probe], l as u64, Window::Rectangular, 3);
-                let mut u = vec![[0.0; LANES]; super::super::lanes::ANCHOR];
+                let mut u = vec![[0.0; LANES]; super::super::simd::lanes::ANCHOR];
                 let mut x = d.modulator.zero_state();
                 let mut states = Vec::with_capacity(span + 1);
                 let mut v = vec![0.0; span];

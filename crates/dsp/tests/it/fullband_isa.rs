@@ -5,7 +5,7 @@
 //! one it lacks is skipped with a message (and refused, not run).
 
 use tofprobe_dsp::sd::fullband_check::{compare, fast_bits};
-use tofprobe_dsp::sd::{FullBandProber, KernelPath, LanePrecision, ProbeConfig, ProbeDesign};
+use tofprobe_dsp::sd::{FullBandProber, Isa, LanePrecision, ProbeConfig, ProbeDesign};
 
 const N: u64 = 1 << 14;
 /// DC, the DC main lobe, both slots of a group, a group boundary at every width (4, 8,
@@ -61,7 +61,7 @@ fn first_difference(a: &[[Vec<bool>; 2]], b: &[[Vec<bool>; 2]]) -> Option<(usize
     None
 }
 
-fn sums(d: &ProbeDesign, p: LanePrecision, path: KernelPath, x: &[f64], chunk: usize) -> Vec<u64> {
+fn sums(d: &ProbeDesign, p: LanePrecision, path: Isa, x: &[f64], chunk: usize) -> Vec<u64> {
     let mut pr = FullBandProber::on_path(d, N, &BINS, p, path).expect("prober");
     assert_eq!(pr.path(), path);
     for c in x.chunks(chunk) {
@@ -74,7 +74,7 @@ fn sums(d: &ProbeDesign, p: LanePrecision, path: KernelPath, x: &[f64], chunk: u
 }
 
 /// `path`'s bits and sums equal the baseline's, in both precisions, for every design.
-fn same_as_baseline(path: KernelPath) {
+fn same_as_baseline(path: Isa) {
     if !path.available() {
         eprintln!(
             "skipped the {} check: this CPU lacks {} (the baseline path is checked by fullband_check)",
@@ -87,7 +87,7 @@ fn same_as_baseline(path: KernelPath) {
     for (di, d) in designs().iter().enumerate() {
         for p in [LanePrecision::F64, LanePrecision::F32] {
             let bits = |path| fast_bits(d, N, &BINS, &x, p, path).expect("stable");
-            let (base, wide) = (bits(KernelPath::Baseline), bits(path));
+            let (base, wide) = (bits(Isa::Scalar), bits(path));
             assert_eq!(
                 first_difference(&base, &wide),
                 None,
@@ -98,7 +98,7 @@ fn same_as_baseline(path: KernelPath) {
             // Off-grid chunks on one path, whole record on the other: anchors and blocks
             // fall differently, the sums must not move.
             let (sb, sw) = (
-                sums(d, p, KernelPath::Baseline, &x, 777),
+                sums(d, p, Isa::Scalar, &x, 777),
                 sums(d, p, path, &x, x.len()),
             );
             let first = sb.iter().zip(&sw).position(|(a, b)| a != b);
@@ -116,7 +116,7 @@ fn same_as_baseline(path: KernelPath) {
 }
 
 /// `path`'s f64 sums equal the naive scalar reference's (`Modulator::run` per stream).
-fn equals_the_naive_reference(path: KernelPath) {
+fn equals_the_naive_reference(path: Isa) {
     if !path.available() {
         eprintln!("skipped: this CPU lacks {}", path.features());
         return;
@@ -136,35 +136,32 @@ fn equals_the_naive_reference(path: KernelPath) {
 
 #[test]
 fn avx2_and_baseline_give_the_same_bits_and_sums() {
-    same_as_baseline(KernelPath::Avx2);
+    same_as_baseline(Isa::Avx2);
 }
 
 #[test]
 fn avx512_and_baseline_give_the_same_bits_and_sums() {
-    same_as_baseline(KernelPath::Avx512);
+    same_as_baseline(Isa::Avx512);
 }
 
 #[test]
 fn avx2_path_equals_the_naive_scalar_reference() {
-    equals_the_naive_reference(KernelPath::Avx2);
+    equals_the_naive_reference(Isa::Avx2);
 }
 
 #[test]
 fn avx512_path_equals_the_naive_scalar_reference() {
-    equals_the_naive_reference(KernelPath::Avx512);
+    equals_the_naive_reference(Isa::Avx512);
 }
 
 /// The paths group 4, 8 and 16 f64 lanes (16, 32, 32 f32): the widths the two tests above
 /// rely on exercising, and `auto` picks the widest this CPU runs.
 #[test]
 fn each_path_has_its_width_and_auto_is_the_widest() {
-    let f64_lanes = KernelPath::ALL.map(|p| p.lanes(LanePrecision::F64));
-    let f32_lanes = KernelPath::ALL.map(|p| p.lanes(LanePrecision::F32));
+    let f64_lanes = Isa::ALL.map(|p| LanePrecision::F64.lanes_on(p));
+    let f32_lanes = Isa::ALL.map(|p| LanePrecision::F32.lanes_on(p));
     assert_eq!((f64_lanes, f32_lanes), ([4, 8, 16], [16, 32, 32]));
-    assert_eq!(
-        KernelPath::detect(),
-        *KernelPath::supported().last().unwrap()
-    );
+    assert_eq!(Isa::current(), *Isa::supported().last().unwrap());
 }
 
 /// The check can fail: probing bin 100 where the other side probes 101 parts the streams
@@ -173,16 +170,16 @@ fn each_path_has_its_width_and_auto_is_the_widest() {
 fn a_wrong_bin_fails_the_path_check() {
     let d = &designs()[0];
     let x = record(4096);
-    let path = KernelPath::detect();
+    let path = Isa::current();
     let mut wrong = BINS;
     wrong[10] = 100;
     let a = fast_bits(d, N, &BINS, &x, LanePrecision::F64, path).unwrap();
-    let b = fast_bits(d, N, &wrong, &x, LanePrecision::F64, KernelPath::Baseline).unwrap();
+    let b = fast_bits(d, N, &wrong, &x, LanePrecision::F64, Isa::Scalar).unwrap();
     let (i, _, n) = first_difference(&a, &b).expect("must differ");
     assert_eq!(i, 10);
     assert!(n < 1000, "{n}");
     // A path this CPU lacks is refused, not run.
-    for p in KernelPath::ALL.into_iter().filter(|p| !p.available()) {
+    for p in Isa::ALL.into_iter().filter(|p| !p.available()) {
         let e = fast_bits(d, N, &BINS, &x, LanePrecision::F64, p).unwrap_err();
         assert!(e.to_string().contains(p.name()), "{e}");
     }

@@ -81,7 +81,7 @@ pub fn measure_scene(
         LanePrecision::F64,
         // The fastest kernel this CPU runs: bit-identical to the baseline
         // (crates/dsp/tests/fullband_isa.rs).
-        tofprobe_dsp::sd::KernelPath::detect(),
+        tofprobe_dsp::sd::Isa::current(),
         |_| {},
     )?)
 }

@@ -170,3 +170,53 @@ fn the_lane_driver_refuses_misfit_streams() {
         assert!(e.contains(&format!("1 ..= {LANES}")), "{e}");
     }
 }
+
+/// Every ISA path of the lanes this CPU runs (`tofprobe_io::isa`: AVX2, AVX-512) reads out
+/// the scalar path's registers, for the lane driver over random cases and for the
+/// segmented fold (whose segments run in the lanes) on a long frame; a path the CPU
+/// lacks is skipped with a note. Each case is also held to the transaction driver above,
+/// so a path that agreed with a wrong scalar path would fail there.
+#[test]
+fn every_isa_reads_out_the_scalar_registers() {
+    use tofprobe_io::isa::{Isa, with_isa};
+    use tofprobe_pixel::SegmentedModel;
+    let cases: Vec<Case> = (0..40).map(|s| case(0x15A_0000 + s)).collect();
+    let lanes = |isa| {
+        with_isa(isa, || {
+            cases
+                .iter()
+                .map(|c| lane_readouts(c, 0))
+                .collect::<Vec<_>>()
+        })
+    };
+    let params = tofprobe_pixel::PixelParams::fourier_default(30, 400_000, 1000);
+    assert!(tofprobe_pixel::segments_pay(&params));
+    let rom = tofprobe_pixel::bench::synthetic_rom(params.rom_depth, params.registers());
+    let codes = tofprobe_pixel::bench::synthetic_codes(params.frame_pulses as usize, 80);
+    let segmented = |isa| {
+        with_isa(isa, || {
+            let mut m = SegmentedModel::new(&params, &rom).unwrap();
+            m.run(codes.as_slice(), 0);
+            (m.repaired_pulses(), m.readout())
+        })
+    };
+    let (scalar, scalar_seg) = (lanes(Isa::Scalar), segmented(Isa::Scalar));
+    assert!(scalar_seg.1.words.iter().any(|&w| w != 0));
+    for isa in [Isa::Avx2, Isa::Avx512] {
+        if !isa.available() {
+            println!(
+                "skipped: this CPU lacks {} ({})",
+                isa.name(),
+                isa.features()
+            );
+            continue;
+        }
+        assert_eq!(lanes(isa), scalar, "lane driver on {}", isa.name());
+        assert_eq!(
+            segmented(isa),
+            scalar_seg,
+            "segmented fold on {}",
+            isa.name()
+        );
+    }
+}

@@ -23,6 +23,10 @@ pub struct ArrayBenchArgs {
     /// Frame lengths to time, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1000000,10000000")]
     pulses: Vec<u64>,
+    /// Instruction set of the vector kernels: scalar, avx2 or avx512 (default: every one
+    /// this CPU runs, side by side, or the one TOFPROBE_ISA names).
+    #[arg(long)]
+    isa: Option<String>,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
@@ -31,19 +35,21 @@ pub struct ArrayBenchArgs {
 /// Runs the benchmark.
 pub fn run(args: &ArrayBenchArgs) -> Result<(), CliError> {
     let base = crate::commands::load_design(args.config.as_deref())?;
-    let report = tofprobe_bench::array::measure(&base, args.rows, args.cols, &args.pulses)?;
+    let isas = tofprobe_bench::isa::isas_to_measure(args.isa.as_deref())?;
+    let report =
+        tofprobe_bench::array::measure_isas(&base, (args.rows, args.cols), &args.pulses, &isas)?;
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     } else {
-        print_text(&report);
+        report.isas.iter().for_each(print_text);
     }
     Ok(())
 }
 
 fn print_text(r: &ArrayReport) {
     println!(
-        "array model, {} × {} pixels of {} on {} threads",
-        r.rows, r.cols, r.configuration, r.threads
+        "array model, {} × {} pixels of {} on {} threads, ISA {}",
+        r.rows, r.cols, r.configuration, r.threads, r.isa
     );
     for run in &r.runs {
         println!(

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use tofprobe_bench::fullband::{BandOut, FullBandOptions, FullBandReport};
-use tofprobe_dsp::sd::{KernelPath, LanePrecision};
+use tofprobe_dsp::sd::{Isa, LanePrecision};
 
 use crate::error::CliError;
 
@@ -33,9 +33,10 @@ pub struct FullBandArgs {
     /// Modulator lane arithmetic: f64 (bit-exact with the scalar modulator) or f32.
     #[arg(long, default_value = "f64", value_parser = ["f64", "f32"])]
     precision: String,
-    /// Instruction path of the lanes: auto (the fastest this CPU runs), baseline (x86-64,
-    /// SSE2), avx2 or avx512. Every path gives the same sums, bit for bit.
-    #[arg(long, default_value = "auto", value_parser = ["auto", "baseline", "avx2", "avx512"])]
+    /// Instruction path of the lanes: auto (the workspace's ISA: TOFPROBE_ISA, else the
+    /// fastest this CPU runs), scalar (x86-64, SSE2), avx2 or avx512. Every path gives the
+    /// same sums, bit for bit.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "scalar", "avx2", "avx512"])]
     path: String,
     /// Also read every in-band bin of the periodic ROM (L from [probe]).
     #[arg(long)]
@@ -53,14 +54,17 @@ pub fn run(args: &FullBandArgs) -> Result<(), CliError> {
         "f32" => LanePrecision::F32,
         _ => LanePrecision::F64,
     };
-    let path = KernelPath::parse(&args.path).map_err(|_| {
-        let runs: Vec<&str> = KernelPath::supported().iter().map(|p| p.name()).collect();
-        CliError::option(
-            "path",
-            &args.path,
-            format!("auto or {}: this CPU lacks the others", runs.join(", ")),
-        )
-    })?;
+    let path = match args.path.as_str() {
+        "auto" => Isa::current(),
+        name => Isa::parse(name, "--path").map_err(|e| {
+            let runs: Vec<&str> = Isa::supported().iter().map(|p| p.name()).collect();
+            CliError::option(
+                "path",
+                &args.path,
+                format!("auto or {} ({})", runs.join(", "), e.reason),
+            )
+        })?,
+    };
     let pulses = args.pulses.unwrap_or_else(|| loaded.document.pulses());
     let bar = ProgressBar::with_draw_target(Some(pulses), ProgressDrawTarget::hidden());
     if !args.json && std::io::stderr().is_terminal() {

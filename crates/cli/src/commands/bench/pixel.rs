@@ -7,6 +7,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use serde::Serialize;
+use tofprobe_bench::isa::IsaRows;
 use tofprobe_bench::pixel::PixelReport;
 use tofprobe_cosim::{BuildProfile, CosimOptions, cosim};
 use tofprobe_design::{Chip, RomPurpose, RtlOverrides};
@@ -29,6 +30,10 @@ pub struct PixelBenchArgs {
     /// the harness once, cached) and print the cycle model's rate beside Verilator's.
     #[arg(long)]
     verilator: bool,
+    /// Instruction set of the vector kernels: scalar, avx2 or avx512 (default: every one
+    /// this CPU runs, side by side, or the one TOFPROBE_ISA names).
+    #[arg(long)]
+    isa: Option<String>,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
@@ -50,7 +55,7 @@ struct VsVerilator {
 #[derive(Debug, Serialize)]
 struct Json<'a> {
     #[serde(flatten)]
-    report: &'a PixelReport,
+    report: &'a IsaRows<PixelReport>,
     #[serde(flatten)]
     verilator: Option<VsVerilator>,
 }
@@ -93,7 +98,9 @@ fn vs_verilator(args: &PixelBenchArgs, pulses: u64) -> Result<VsVerilator, CliEr
 pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
     let design = crate::commands::load_design(args.config.as_deref())?;
     design.single_pixel("bench pixel")?;
-    let report = tofprobe_bench::pixel::measure(&design, args.pulses, args.cycle_pulses)?;
+    let isas = tofprobe_bench::isa::isas_to_measure(args.isa.as_deref())?;
+    let report =
+        tofprobe_bench::pixel::measure_isas(&design, args.pulses, args.cycle_pulses, &isas)?;
     let verilator = if args.verilator {
         Some(vs_verilator(args, args.cycle_pulses)?)
     } else {
@@ -107,7 +114,7 @@ pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
         };
         println!("{}", serde_json::to_string(&j)?);
     } else {
-        print_text(&report);
+        report.isas.iter().for_each(print_text);
         if let Some(v) = &verilator {
             let m = |r: Option<f64>| r.map_or("-".to_string(), |r| format!("{:.1}", r / 1e6));
             println!(
@@ -138,8 +145,8 @@ pub fn run(args: &PixelBenchArgs) -> Result<(), CliError> {
 
 fn print_text(r: &PixelReport) {
     println!(
-        "bit-true pixel, B = {} ({} registers, W = {} bits), one thread",
-        r.bins, r.registers, r.width_bits
+        "bit-true pixel, B = {} ({} registers, W = {} bits), one thread, ISA {}",
+        r.bins, r.registers, r.width_bits, r.isa
     );
     println!(
         "transaction model  {} pulses in {:.4} s = {:.1} M pulses/s, {:.1}x real time (target <= {:.3} s)",

@@ -17,6 +17,10 @@ pub struct SceneBenchArgs {
     /// Pulses per case.
     #[arg(long, default_value_t = 20_000_000)]
     pulses: u64,
+    /// Instruction set of the vector kernels: scalar, avx2 or avx512 (default: every one
+    /// this CPU runs, side by side, or the one TOFPROBE_ISA names).
+    #[arg(long)]
+    isa: Option<String>,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
@@ -26,19 +30,20 @@ pub struct SceneBenchArgs {
 pub fn run(args: &SceneBenchArgs) -> Result<(), CliError> {
     let design = crate::commands::load_design(args.config.as_deref())?;
     design.single_pixel("bench scene")?;
-    let report = tofprobe_bench::scene::measure(&design.document, args.pulses)?;
+    let isas = tofprobe_bench::isa::isas_to_measure(args.isa.as_deref())?;
+    let report = tofprobe_bench::scene::measure_isas(&design.document, args.pulses, &isas)?;
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     } else {
-        print_text(&report);
+        report.isas.iter().for_each(print_text);
     }
     Ok(())
 }
 
 fn print_text(r: &SceneReport) {
     println!(
-        "scene Monte Carlo, one thread, {} pulses per case: batched kernel beside the per-pulse reference",
-        r.pulses
+        "scene Monte Carlo, one thread, {} pulses per case: batched kernel (ISA {}) beside the per-pulse reference",
+        r.pulses, r.isa
     );
     let cpu = |c: Option<f64>| match c {
         Some(c) => format!("{:7.1} M/CPU-s", c / 1e6),

@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 use tofprobe_dsp::preprocess::{FrontEnd, FrontEndOutput};
-use tofprobe_dsp::sd::{FullBandProber, KernelPath, LanePrecision};
+use tofprobe_dsp::sd::{FullBandProber, Isa, LanePrecision};
 use tofprobe_dsp::stats::interpolate_peak;
 
 use super::super::sigma_delta::{self, BitTrue, ProbeSetup};
@@ -210,7 +210,7 @@ fn sd_largest_um(
         x.len() as u64,
         &bins,
         LanePrecision::F64,
-        KernelPath::detect(),
+        Isa::current(),
     )?;
     for c in x.chunks(1 << 16) {
         prober.push(c)?;

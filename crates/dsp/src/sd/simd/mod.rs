@@ -1,6 +1,37 @@
-//! The full-band kernel's lanes ([`super::pairs`], [`super::pairs_kernel`], the paths of
-//! [`super::isa`]): their arithmetic ([`LanePrecision`] and the [`Lane`] float) and how many
-//! make a group on each instruction path.
+//! The ΣΔ SIMD engine: the bitstream generator's interleaved modulators ([`lanes`]) and the
+//! full-band probe kernel ([`pairs`], its inner loop in `kernel`), with what they share
+//! here: the lanes' arithmetic ([`LanePrecision`] and the [`Lane`] float) and how many make
+//! a group on each instruction path. The path is the workspace's one ISA selection,
+//! [`Isa`] (`tofprobe_io::isa`: detected, `TOFPROBE_ISA`, or a benchmark's `--isa`): the
+//! build targets the x86-64 baseline (SSE2), the kernel is compiled again for AVX2 (twice
+//! the lanes) and for AVX-512 with FMA (four times the f64 lanes; f32 lanes there run the
+//! AVX2 copy, faster for them).
+//!
+//! Determinism: every copy is the same Rust source with the same operations in the same
+//! order per lane; rustc never contracts a·b + c on its own, the AVX2 copy cannot (no
+//! `fma` feature), and the AVX-512 copy fuses only the exact σ·b + v with σ = ±1 (see
+//! `kernel`). The lanes never mix except in the I/Q rotation, whose pairs stay within a
+//! group at every width. So all paths give the same bits and sums on every machine
+//! (crates/dsp/tests/it/fullband_isa.rs proves it for each path the CPU runs).
+//!
+//! Layering inside: `kernel` and [`pairs`] use this module's items, [`pairs`] composes
+//! `kernel`; [`lanes`] stands alone; nothing here imports the modulator that uses
+//! [`lanes`].
+
+mod kernel;
+pub mod lanes;
+pub mod pairs;
+
+pub use tofprobe_io::isa::Isa;
+
+use crate::error::DspError;
+
+/// `isa` if this CPU runs it, else an error naming the path, what the CPU lacks and the
+/// paths it runs.
+pub fn require(isa: Isa) -> Result<Isa, DspError> {
+    Isa::parse(isa.name(), "kernel path")
+        .map_err(|e| DspError::out_of_range("kernel path", isa.name(), e.reason))
+}
 
 use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitXor, Mul};
@@ -10,7 +41,7 @@ use std::ops::{Add, BitAnd, BitXor, Mul};
 pub const LANES_F64: usize = 4;
 /// Lanes per f32 group: four SSE2 registers (8 lanes 1.1·10⁹, 16 lanes 1.3·10⁹, 32 spill).
 pub const LANES_F32: usize = 16;
-/// Lanes per f64 group on the AVX2 path ([`KernelPath::Avx2`](super::isa::KernelPath::Avx2)): two 256-bit registers,
+/// Lanes per f64 group on the AVX2 path ([`Isa::Avx2`](Isa::Avx2)): two 256-bit registers,
 /// the register footprint of the baseline's four lanes (measured in one session, 401 bins
 /// of N = 2·10⁶: 8 lanes 1.0–1.09·10⁹ steps per CPU-second, 12 lanes 0.93–1.0·10⁹, the
 /// baseline's 4 lanes 0.59–0.65·10⁹).
@@ -18,7 +49,7 @@ pub const LANES_F64_AVX2: usize = 8;
 /// Lanes per f32 group on the AVX2 path: four 256-bit registers (same run: 32 lanes
 /// 2.2–2.4·10⁹, 16 lanes 0.94–1.0·10⁹, the baseline's 16 lanes 0.73–0.77·10⁹).
 pub const LANES_F32_AVX2: usize = 32;
-/// Lanes per f64 group on the AVX-512 path ([`KernelPath::Avx512`](super::isa::KernelPath::Avx512)): two 512-bit
+/// Lanes per f64 group on the AVX-512 path ([`Isa::Avx512`]): two 512-bit
 /// registers, the I and the Q halves (measured in one session, 801 bins of N = 2·10⁶,
 /// steps per CPU-second: 16 lanes 2.5–2.8·10⁹, 8 lanes 1.2–2.1·10⁹, 32 lanes 1.1–1.4·10⁹).
 pub const LANES_F64_AVX512: usize = 16;
@@ -46,12 +77,33 @@ impl LanePrecision {
         }
     }
 
-    /// Lanes per interleaved group on the baseline path ([`KernelPath::lanes`](super::isa::KernelPath::lanes) for any).
+    /// Lanes per interleaved group on the baseline path ([`Isa::lanes`] for any).
     pub fn lanes(self) -> usize {
         match self {
             LanePrecision::F64 => LANES_F64,
             LanePrecision::F32 => LANES_F32,
         }
+    }
+
+    /// Lanes (streams) per interleaved group on `isa`.
+    pub fn lanes_on(self, isa: Isa) -> usize {
+        match (isa, self) {
+            (Isa::Scalar, p) => p.lanes(),
+            (Isa::Avx2, LanePrecision::F64) => LANES_F64_AVX2,
+            (Isa::Avx2, LanePrecision::F32) => LANES_F32_AVX2,
+            (Isa::Avx512, LanePrecision::F64) => LANES_F64_AVX512,
+            (Isa::Avx512, LanePrecision::F32) => LANES_F32_AVX512,
+        }
+    }
+
+    /// The path as printed ("avx2 (8 f64 lanes per group)").
+    pub fn describe(self, isa: Isa) -> String {
+        format!(
+            "{} ({} {} lanes per group)",
+            isa.name(),
+            self.lanes_on(isa),
+            self.name()
+        )
     }
 }
 

@@ -1,6 +1,6 @@
-//! The inner loop of the full-band probe kernel ([`super::pairs`]): one anchor span of a
-//! group of `L` lanes, in three copies of one body chosen at run time ([`super::isa`]):
-//! the x86-64 baseline (SSE2), AVX2, and AVX-512 (with FMA; f64 lanes only: f32 lanes on
+//! The inner loop of the full-band probe kernel ([`super::simd::pairs`]): one anchor span of a
+//! group of `L` lanes, in three copies of one body chosen at run time ([`super::Isa`]):
+//! the x86-64 baseline (SSE2, [`Isa::Scalar`]), AVX2, and AVX-512 (with FMA; f64 lanes only: f32 lanes on
 //! the AVX-512 path run the AVX2 copy, faster for them, see `LANES_F32_AVX512`).
 //!
 //! Lane layout: lanes 0 .. L/2 are the I streams of the group's bins, lanes L/2 .. L their
@@ -22,8 +22,7 @@
 // The lane loops index several same-length arrays in lockstep (`x[l]`, `x[l ^ h]`).
 #![allow(clippy::needless_range_loop)]
 
-use super::isa::KernelPath;
-use super::lane::Lane;
+use super::{Isa, Lane};
 
 /// The loop state a span reads and leaves: states, rotators and accumulators.
 pub(crate) struct Span<'a, T: Lane, const L: usize, const N: usize> {
@@ -56,7 +55,7 @@ pub(crate) fn step_on<
     const RES: bool,
     const TRACE: bool,
 >(
-    path: KernelPath,
+    path: Isa,
     span: Span<'_, T, L, N>,
     k: Consts<'_, T, L, N>,
     aw: &[T],
@@ -65,13 +64,13 @@ pub(crate) fn step_on<
 ) {
     #[cfg(target_arch = "x86_64")]
     {
-        if path == KernelPath::Avx512 && T::AVX512 && KernelPath::Avx512.available() {
+        if path == Isa::Avx512 && T::AVX512 && Isa::Avx512.available() {
             // SAFETY: the CPU has AVX-512 F and VL, AVX2 and FMA, checked on the line above.
             unsafe { step_span_avx512::<T, L, N, RES, TRACE>(span, k, aw, x, trace) };
             return;
         }
-        let wide = path == KernelPath::Avx2 || path == KernelPath::Avx512;
-        if wide && std::arch::is_x86_feature_detected!("avx2") {
+        let wide = path == Isa::Avx2 || path == Isa::Avx512;
+        if wide && Isa::Avx2.available() {
             // SAFETY: the CPU has AVX2, checked on the line above.
             unsafe { step_span_avx2::<T, L, N, RES, TRACE>(span, k, aw, x, trace) };
             return;

@@ -15,10 +15,10 @@
 //! ([`Window::symmetric_value`]); still an exact function of n mod L, at the cost of a
 //! sin or cos per sample and lane (≈ 20 ns: seconds for a windowed ROM of 10^7 pulses).
 
-use super::STATE_BOUND;
-use super::config::ProbeConvention;
-use super::realize::StateSpace;
 use crate::error::DspError;
+use crate::sd::STATE_BOUND;
+use crate::sd::config::ProbeConvention;
+use crate::sd::realize::StateSpace;
 use crate::window::Window;
 use std::f64::consts::PI;
 
@@ -313,8 +313,8 @@ mod tests {
         assert_eq!(gather_bits(&[1; LANES]) as u32, (1u32 << LANES) - 1);
     }
 
-    use super::super::modulator::Modulator;
     use super::*;
+    use crate::sd::modulator::Modulator;
 
     /// The rotator inputs must equal directly computed A·w·cos/sin: re-anchoring every
     /// ANCHOR samples keeps the recurrence's rounding to ≈ ANCHOR·ε ≈ 1e-13.

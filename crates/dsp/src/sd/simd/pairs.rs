@@ -1,7 +1,7 @@
 //! The full-band probe kernel: many I/Q modulator pairs stepped together in a
 //! structure-of-arrays loop the compiler vectorises (SSE2 on the x86-64 baseline; copies for
 //! AVX2 with twice the lanes and for AVX-512 with four times, chosen at run time,
-//! [`super::isa`]; the loop itself is [`super::pairs_kernel`]), each lane's ±1 output
+//! [`super::Isa`]; the loop itself is `super::kernel`), each lane's ±1 output
 //! accumulated against the shared depth record x[n] in the same pass, so no bitstream is
 //! ever stored. The lane count only groups independent lanes: a lane's arithmetic, hence
 //! its bits and sums, is the same at every width.
@@ -13,8 +13,8 @@
 //! multiple of [`ANCHOR`] samples, so rounding never accumulates beyond one anchor span and
 //! the input at sample n depends on n alone, whatever the chunking.
 //!
-//! Two precisions, chosen explicitly by the caller ([`LanePrecision`], [`super::lane`]):
-//! - `F64`: bit-exact with the scalar reference [`super::Modulator::run`] fed the same
+//! Two precisions, chosen explicitly by the caller ([`LanePrecision`], [`super`]):
+//! - `F64`: bit-exact with the scalar reference [`crate::sd::Modulator::run`] fed the same
 //!   input. Same operations in the same order; the only rewrites are exact ones: products
 //!   with the CIFB's unit coefficients dropped (1·x = x), ±b₂ and ±x formed by flipping the
 //!   sign bit, and the quantiser's `y ≥ 0` read from the sign bit of y (they differ only at
@@ -32,16 +32,16 @@
 // plain index form is what the vectoriser and the reader both follow best.
 #![allow(clippy::needless_range_loop)]
 
-use super::STATE_BOUND;
-use super::isa::KernelPath;
-pub(crate) use super::lane::Lane;
-pub use super::lane::{
+use super::Isa;
+pub(crate) use super::Lane;
+use super::kernel::{Consts, Span, step_on};
+pub use super::{
     LANES_F32, LANES_F32_AVX2, LANES_F32_AVX512, LANES_F64, LANES_F64_AVX2, LANES_F64_AVX512,
     LanePrecision,
 };
-use super::pairs_kernel::{Consts, Span, step_on};
-use super::realize::StateSpace;
 use crate::error::DspError;
+use crate::sd::STATE_BOUND;
+use crate::sd::realize::StateSpace;
 use std::f64::consts::PI;
 
 /// Samples between exact re-anchorings of the rotators (and f32 accumulator flushes).
@@ -121,13 +121,13 @@ pub(crate) struct PairGroup<T: Lane, const L: usize> {
     /// Accumulated spans (f32 lanes only).
     total: [f64; L],
     /// The instruction path `run` steps on (same bits on either).
-    path: KernelPath,
+    path: Isa,
 }
 
 impl<T: Lane, const L: usize> PairGroup<T, L> {
     /// A group at rest for `bins` (at most L/2), frame length `period` (the window's and
     /// the bins' N), stepping on `path` (the baseline where the CPU lacks it).
-    pub fn new(bins: &[u64], period: u64, order: usize, path: KernelPath) -> Self {
+    pub fn new(bins: &[u64], period: u64, order: usize, path: Isa) -> Self {
         let h = L / 2;
         let mut lane_bins = [0u64; L];
         for (l, b) in lane_bins.iter_mut().enumerate() {
@@ -331,8 +331,8 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::modulator::Modulator;
     use super::*;
+    use crate::sd::modulator::Modulator;
 
     /// The rotator inputs equal direct A·w·cos/sin: f64 within ≈ ANCHOR·ε (1e-12), f32
     /// within its rounding over one anchor span (2 roundings × 1024 steps × 2^-24 ≈ 1.2e-4
@@ -359,7 +359,7 @@ mod tests {
             .collect();
         let mut worst = 0.0f64;
         for chunk in bins.chunks(L / 2) {
-            let g = PairGroup::<T, L>::new(chunk, n, 3, KernelPath::Baseline);
+            let g = PairGroup::<T, L>::new(chunk, n, 3, Isa::Scalar);
             for (t, u) in g.inputs(0, &aw).iter().enumerate() {
                 for (p, q) in (0..chunk.len()).flat_map(|p| [(p, false), (p, true)]) {
                     let l = PairGroup::<T, L>::lane(p, q);
