@@ -21,6 +21,7 @@ pub mod rtl_vectors;
 pub mod set_plan;
 pub mod shadow;
 pub mod shard;
+pub mod statistical;
 mod tile_set;
 pub mod uff;
 

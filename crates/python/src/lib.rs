@@ -370,7 +370,9 @@ impl Design {
             }
             Ok(v)
         })?
-        .map_err(|()| pyo3::exceptions::PyRuntimeError::new_err("tofprobe: the ROM copy was stopped"))?;
+        .map_err(|()| {
+            pyo3::exceptions::PyRuntimeError::new_err("tofprobe: the ROM copy was stopped")
+        })?;
         let array = Array2::from_shape_vec((l, r), bits).map_err(value_error)?;
         Ok(array.into_pyarray(py).into_any())
     }
