@@ -133,9 +133,9 @@ impl std::fmt::Display for ArrayLevel {
 }
 
 /// Refuses a level other than bit-true outside the range its closed forms were validated
-/// on: a Fourier pixel whose scene is a static depth plus sines and plate modes, and (G >
-/// 1) no background, which the superpixel's closed form (`dsp::superpixel`) assumes.
-/// Names the key and the level that works.
+/// on: a Fourier pixel whose scene is a static depth plus sines and plate modes, and
+/// no background with a superpixel (G above 1), which the superpixel's closed form
+/// (`dsp::superpixel`) assumes. Names the key and the level that works.
 pub fn check_level(
     level: ArrayLevel,
     pixel: &tofprobe_pixel::PixelParams,
