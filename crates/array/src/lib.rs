@@ -20,6 +20,7 @@ mod rtl_run;
 pub mod set_plan;
 pub mod shadow;
 pub mod shard;
+pub mod statistical;
 mod tile_set;
 pub mod uff;
 

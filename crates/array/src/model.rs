@@ -253,6 +253,14 @@ pub fn run_tile_watched(
             "tile rows {rows:?} × cols {cols:?} is not a non-empty part of the {nr} × {nc} array"
         )));
     }
+    // The statistical and closed-form levels draw registers instead of running pulses.
+    if design
+        .array
+        .as_ref()
+        .is_some_and(|a| !a.level.is_bit_true())
+    {
+        return crate::statistical::run_tile(design, rows, cols, watch);
+    }
     let w = cols.len();
     let at = |i: usize| (rows.start + i / w, cols.start + i % w);
     let count = rows.len() * w;

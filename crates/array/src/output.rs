@@ -43,6 +43,8 @@ pub struct BinSummary {
 pub struct ArraySummary {
     pub configuration: String,
     pub mode: String,
+    /// The `[array] level` the pixels ran at (bit-true, statistical, closed-form).
+    pub level: String,
     pub rows: usize,
     pub cols: usize,
     pub pitch_um: f64,
@@ -134,6 +136,7 @@ pub fn finish(
     let summary = ArraySummary {
         configuration: configuration_name(design),
         mode: design.pixel.mode.to_string(),
+        level: a.level.name().to_string(),
         rows: a.rows,
         cols: a.cols,
         pitch_um: a.pitch_um,
@@ -270,8 +273,9 @@ fn stream_files(
         )
     })?;
     let name = configuration_name(design);
+    let level = design.array.as_ref().map_or("bit-true", |a| a.level.name());
     add(set, "vibration.uff", &mut |w| {
-        crate::uff::write_to(w, &name, mm, m)
+        crate::uff::write_to(w, &name, level, mm, m)
     })?;
     Ok(names)
 }

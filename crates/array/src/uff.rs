@@ -60,10 +60,12 @@ fn end(out: &mut dyn Write) -> std::io::Result<()> {
 }
 
 /// Writes the file to `out`, one line at a time (never the file in memory: one data set
-/// 58 per pixel is ≈ 1 kB); `name` is the configuration's name in the header.
+/// 58 per pixel is ≈ 1 kB); `name` is the configuration's name in the header, `level`
+/// the `[array] level` the maps were computed at.
 pub fn write_to(
     out: &mut dyn Write,
     name: &str,
+    level: &str,
     mm_per_pixel: f64,
     m: &VibrationMaps,
 ) -> std::io::Result<()> {
@@ -75,7 +77,7 @@ pub fn write_to(
         s,
         "{}",
         a80(&format!(
-            "tofprobe array {} x {}: deflection shapes per probed bin",
+            "tofprobe array {} x {} ({level}): deflection shapes per probed bin",
             m.rows, m.cols
         ))
     )?;
@@ -236,7 +238,8 @@ pub fn write(design: &ResolvedDesign, m: &VibrationMaps) -> String {
     let mut out = Vec::new();
     let mm = design.array.as_ref().map_or(1.0, |a| a.mm_per_pixel);
     // Writing into memory cannot fail.
-    let _ = write_to(&mut out, &crate::configuration_name(design), mm, m);
+    let level = design.array.as_ref().map_or("bit-true", |a| a.level.name());
+    let _ = write_to(&mut out, &crate::configuration_name(design), level, mm, m);
     String::from_utf8_lossy(&out).into_owned()
 }
 
@@ -256,7 +259,7 @@ pub fn file_bytes(rows: usize, cols: usize, bins: usize) -> u64 {
             strongest_bin: vec![0; cols],
         };
         let mut counter = Counter(0);
-        let _ = write_to(&mut counter, "x", 1.0, &m);
+        let _ = write_to(&mut counter, "x", "bit-true", 1.0, &m);
         counter.0
     };
     let (one, two) = (size(1), size(2));
@@ -308,7 +311,7 @@ mod tests {
             strongest_bin: vec![0; n],
         };
         let mut out = Vec::new();
-        super::write_to(&mut out, "a name", 0.25, &m).unwrap();
+        super::write_to(&mut out, "a name", "bit-true", 0.25, &m).unwrap();
         assert_eq!(out.len() as u64, super::file_bytes(rows, cols, bins));
         assert!(super::file_bytes(rows, cols + 1, bins) > out.len() as u64);
     }

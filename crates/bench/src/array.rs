@@ -95,6 +95,7 @@ fn array_design(
         frame_rate_hz: None,
         double_buffer: false,
         superpixel: 1,
+        level: Default::default(),
     });
     (a.rows, a.cols) = (rows, cols);
     Ok(resolve(doc, &base.origin)?)

@@ -83,6 +83,100 @@ pub struct ArrayConfig {
     /// G: G × G SPADs share one pixel, their detections averaged each pulse (1: none).
     #[serde(default = "one_u32", skip_serializing_if = "is_one")]
     pub superpixel: u32,
+    /// The fidelity level every pixel runs at (docs/tradeoff.md "Array levels").
+    #[serde(default, skip_serializing_if = "ArrayLevel::is_bit_true")]
+    pub level: ArrayLevel,
+}
+
+/// How faithfully the array's pixels are computed (`[array] level`); every level writes
+/// the same output set and maps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ArrayLevel {
+    /// Every pulse of every pixel through the Monte Carlo and the one pixel datapath.
+    #[default]
+    BitTrue,
+    /// Each pixel's registers drawn from their predicted distribution: the noise-free
+    /// registers plus correlated Gaussian noise from the closed forms (per-pixel seeds).
+    Statistical,
+    /// Each pixel's noise-free (expected) registers.
+    ClosedForm,
+}
+
+impl ArrayLevel {
+    /// Every level, as written in `[array] level`.
+    pub const ALL: [ArrayLevel; 3] = [
+        ArrayLevel::BitTrue,
+        ArrayLevel::Statistical,
+        ArrayLevel::ClosedForm,
+    ];
+
+    /// Its name as written.
+    pub fn name(self) -> &'static str {
+        match self {
+            ArrayLevel::BitTrue => "bit-true",
+            ArrayLevel::Statistical => "statistical",
+            ArrayLevel::ClosedForm => "closed-form",
+        }
+    }
+
+    /// The default, bit-true.
+    pub fn is_bit_true(&self) -> bool {
+        *self == ArrayLevel::BitTrue
+    }
+}
+
+impl std::fmt::Display for ArrayLevel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Refuses a level other than bit-true outside the range its closed forms were validated
+/// on: a Fourier pixel whose scene is a static depth plus sines and plate modes, and
+/// no background with a superpixel (G above 1), which the superpixel's closed form
+/// (`dsp::superpixel`) assumes. Names the key and the level that works.
+pub fn check_level(
+    level: ArrayLevel,
+    pixel: &tofprobe_pixel::PixelParams,
+    scene: &tofprobe_scene::SceneConfig,
+    superpixel: u32,
+    background_rate: &[f64],
+) -> Result<(), String> {
+    if level.is_bit_true() {
+        return Ok(());
+    }
+    let refuse = |why: String| {
+        Err(format!(
+            "array.level = \"{level}\" is outside its validated range: {why}; \
+             array.level = \"bit-true\" runs it"
+        ))
+    };
+    if pixel.mode != tofprobe_pixel::Mode::Fourier {
+        return refuse(format!(
+            "the pixel is in {} mode (Fourier only)",
+            pixel.mode
+        ));
+    }
+    use tofprobe_scene::MotionConfig as M;
+    if let Some((i, m)) = scene
+        .motions
+        .iter()
+        .enumerate()
+        .find(|(_, m)| !matches!(m, M::Sine { .. } | M::PlateMode { .. }))
+    {
+        return refuse(format!(
+            "scene.motion[{i}] is a {} (sines and plate modes only)",
+            m.kind()
+        ));
+    }
+    if superpixel > 1 && background_rate.iter().any(|&b| b > 0.0) {
+        return refuse(format!(
+            "array.superpixel = {superpixel} with background (the superpixel's closed form \
+             has none)"
+        ));
+    }
+    Ok(())
 }
 
 fn one_u32() -> u32 {
@@ -168,6 +262,9 @@ pub struct SensorArray {
     /// the pixel (its W, C and N), checked once by the resolution.
     #[serde(default)]
     pub readout: crate::readout::ReadoutKeys,
+    /// The fidelity level the pixels run at.
+    #[serde(default)]
+    pub level: ArrayLevel,
 }
 
 impl SensorArray {
@@ -333,6 +430,7 @@ pub fn pixel_seed(seed: u64, r: usize, c: usize) -> u64 {
 pub fn resolve_array(
     a: &ArrayConfig,
     sensor: &tofprobe_scene::SensorConfig,
+    scene: &tofprobe_scene::SceneConfig,
     pixel: &tofprobe_pixel::PixelParams,
     origin: &str,
 ) -> Result<SensorArray, DesignError> {
@@ -511,6 +609,7 @@ pub fn resolve_array(
     let (g, prows, pcols) = (g as usize, prows as usize, pcols as usize);
     crate::readout::Readout::new(&readout, prows, pcols, pixel, sensor.laser_rate_hz)
         .map_err(err)?;
+    check_level(a.level, pixel, scene, g as u32, &background_rate).map_err(err)?;
     Ok(SensorArray {
         rows: prows,
         cols: pcols,
@@ -521,6 +620,7 @@ pub fn resolve_array(
         signal_rate,
         background_rate,
         readout,
+        level: a.level,
     })
 }
 

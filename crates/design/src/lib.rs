@@ -21,7 +21,7 @@ pub mod rom_policy;
 
 pub use adders::{AdderChoice, AdderStatus, AdderTiming, CandidateTiming};
 pub use analysis_mode::ModeDecision;
-pub use array::{ArrayConfig, RateMap, SensorArray, pixel_seed};
+pub use array::{ArrayConfig, ArrayLevel, RateMap, SensorArray, pixel_seed};
 pub use chip::{Chip, RomPurpose, SequencerKind};
 pub use document::{Document, SIZING_SIGMAS, read_text, schema};
 pub use error::DesignError;

@@ -256,7 +256,9 @@ pub fn resolve_timed(
         (Vec::new(), None)
     };
     let array = match &d.array {
-        Some(a) => Some(crate::array::resolve_array(a, &d.sensor, &pixel, origin)?),
+        Some(a) => Some(crate::array::resolve_array(
+            a, &d.sensor, &d.scene, &pixel, origin,
+        )?),
         None => None,
     };
     Ok(ResolvedDesign {

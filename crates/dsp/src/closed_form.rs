@@ -89,6 +89,14 @@ pub fn hold_response_sq(rho: f64, omega: f64) -> f64 {
     rho * rho / hold_denominator(rho, omega)
 }
 
+/// The mean response itself, H(ω) = ρ/(1 − q·e^(−jω)) (q = 1 − ρ): E[held[n]] = Σ ρ q^k
+/// s[n−k] moves a tone by |H| ([`hold_response_sq`]) and delays it by −arg H.
+pub fn hold_response(rho: f64, omega: f64) -> rustfft::num_complex::Complex64 {
+    let q = 1.0 - rho;
+    let z = rustfft::num_complex::Complex64::from_polar(q, -omega);
+    rho / (1.0 - z)
+}
+
 /// The −3 dB frequency (|H|² = ½) of the random hold: 1 − 2q cos ω + q² = 2ρ² gives
 /// 1 − cos ω = ρ²/(2q), i.e. ω = 2·asin(ρ/(2√q)) (the asin form keeps full precision at
 /// small ρ, where cos ω → 1). None when the response stays above ½ up to Nyquist
@@ -250,6 +258,20 @@ pub fn first_arrival(p: &MixtureParams) -> Result<FirstArrival, DspError> {
     })
 }
 
+/// [`first_arrival`], or for a pixel without photons (ρ_s + ρ_b = 0) nothing detected:
+/// ρ_v = 0 at the signal's depth with the jitter's variance.
+pub fn detected(p: &MixtureParams) -> Result<FirstArrival, DspError> {
+    if p.signal_rate + p.background_rate > 0.0 {
+        return first_arrival(p);
+    }
+    Ok(FirstArrival {
+        valid_rate: 0.0,
+        mean_mm: p.signal_depth_mm,
+        variance_mm2: p.jitter_mm * p.jitter_mm,
+        signal_fraction: 0.0,
+    })
+}
+
 /// ∂μ/∂t_s: how much of a small signal motion the mixture's mean follows (1 without
 /// background), by a central difference of ±1% σ_I.
 pub fn mixture_gain(p: &MixtureParams) -> Result<f64, DspError> {
@@ -311,6 +333,26 @@ mod tests {
     }
 
     /// F(ρ, ω) is the DTFT of q^|k|: compare with a direct truncated sum (q^2000 ≈ 0).
+    /// H(ω) against the direct sum Σ ρ q^k e^(−jωk), and |H|² against its closed form.
+    #[test]
+    fn hold_response_is_the_sum_of_the_held_delays() {
+        for (rho, w) in [(0.3, 0.01), (0.03, 0.0028), (0.5, 2.0)] {
+            let q: f64 = 1.0 - rho;
+            let (mut re, mut im) = (0.0, 0.0);
+            for k in 0..4000 {
+                let a = rho * q.powi(k);
+                re += a * (w * k as f64).cos();
+                im -= a * (w * k as f64).sin();
+            }
+            let h = hold_response(rho, w);
+            assert!(
+                (h.re - re).abs() < 1e-9 && (h.im - im).abs() < 1e-9,
+                "{h} {re} {im}"
+            );
+            assert!((h.norm_sqr() - hold_response_sq(rho, w)).abs() < 1e-12);
+        }
+    }
+
     #[test]
     fn hold_noise_factor_is_the_dtft_of_the_autocovariance() {
         for (rho, w) in [(0.3, 0.01), (0.03, 0.0028), (0.5, 2.0)] {

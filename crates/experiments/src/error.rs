@@ -63,6 +63,9 @@ pub enum ExperimentError {
     /// Co-simulation failed to run (a tool missing: the message names the install script).
     #[error("{0}")]
     Cosim(#[from] tofprobe_cosim::CosimError),
+    /// The array model refused (boxed: it carries the design's error).
+    #[error(transparent)]
+    Array(#[from] Box<tofprobe_array::ArrayError>),
 }
 
 impl ExperimentError {

@@ -11,7 +11,7 @@
 use rustfft::num_complex::Complex64;
 use tofprobe_design::{DesignError, ResolvedDesign};
 use tofprobe_dsp::bins::SelectedBins;
-use tofprobe_dsp::closed_form::{FirstArrival, MixtureParams, first_arrival, noise_floor_hold_mm};
+use tofprobe_dsp::closed_form::{MixtureParams, noise_floor_hold_mm};
 use tofprobe_dsp::sd::{ProbeRom, normalise, probe_detections};
 
 use crate::error::ExperimentError;
@@ -96,16 +96,7 @@ pub fn detection_noise(design: &ResolvedDesign) -> Result<DetectionNoise, tofpro
         jitter_mm: s.jitter_mm(),
         window_mm: s.window_end_mm() - s.window_start_mm(),
     };
-    let arrival = if mixture.signal_rate + mixture.background_rate > 0.0 {
-        first_arrival(&mixture)?
-    } else {
-        FirstArrival {
-            valid_rate: 0.0,
-            mean_mm: mixture.signal_depth_mm,
-            variance_mm2: mixture.jitter_mm * mixture.jitter_mm,
-            signal_fraction: 0.0,
-        }
-    };
+    let arrival = tofprobe_dsp::closed_form::detected(&mixture)?;
     let lsb_mm = design.sensor().tdc_lsb_mm();
     Ok(DetectionNoise {
         mixture,

@@ -7,5 +7,6 @@ mod double_buffer;
 mod rtl;
 mod set_size;
 mod shard;
+mod statistical;
 mod superpixel;
 mod validation;

@@ -3,7 +3,9 @@
 //! every fidelity level on each configuration (the embedded default without one), timed
 //! per simulated second and scored against the float DFT and the scene's truth (a Haar
 //! pixel: float Haar, bit-true, cycle-accurate, Verilator, scored by the coefficient error
-//! against the float Haar and the event time error, `tradeoff::haar`); with
+//! against the float Haar and the event time error, `tradeoff::haar`; an `[array]`
+//! configuration: each `[array] level` timed and scored against the bit-true array,
+//! `tradeoff::array`, JSON key `array_scenes`); with
 //! `--knobs` the bit-true knob sweep ([`tofprobe_experiments::tradeoff::knobs::DEFAULT_SWEEP`]) and with
 //! `--skips` the skipped-stage speedups, both on a frame of at most `--sweep-pulses` and
 //! timed as the median of `--reps` runs; with `--imputation` the motion-model imputation
@@ -18,6 +20,8 @@ use std::path::PathBuf;
 use clap::Args;
 use serde::Serialize;
 
+use tofprobe_design::ArrayLevel;
+use tofprobe_experiments::tradeoff::array::{self as array_levels, ArrayTradeoff, measure_array};
 use tofprobe_experiments::tradeoff::haar::{self, HaarSceneResult, measure_haar};
 use tofprobe_experiments::tradeoff::imputation::{self, ImputationReport};
 use tofprobe_experiments::tradeoff::imputation_cost::CellAreas;
@@ -80,6 +84,8 @@ struct JsonOut<'a> {
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     haar_scenes: &'a [HaarSceneResult],
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    array_scenes: &'a [ArrayTradeoff],
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
     knobs: &'a [KnobSweep],
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     skips: &'a [SkipReport],
@@ -106,11 +112,19 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     }
     let mut scenes = Vec::new();
     let mut haar_scenes = Vec::new();
+    let mut array_scenes = Vec::new();
     let mut sweeps = Vec::new();
     let mut skip_reports = Vec::new();
     let mut tables = Vec::new();
     for p in paths {
         let design = crate::commands::load_for_hardware(p)?;
+        if design.array.is_some() && design.pixel.mode == tofprobe_pixel::Mode::Fourier {
+            // An [array] configuration: its array levels against bit-true.
+            let r = measure_array(&design, &ArrayLevel::ALL)?;
+            tables.push(array_levels::markdown(&r));
+            array_scenes.push(r);
+            continue;
+        }
         design.single_pixel("tradeoff")?;
         if design.pixel.mode == tofprobe_pixel::Mode::Haar {
             let h = measure_haar(&design, args.verilator)?;
@@ -170,6 +184,7 @@ pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
             serde_json::to_string(&JsonOut {
                 scenes: &scenes,
                 haar_scenes: &haar_scenes,
+                array_scenes: &array_scenes,
                 knobs: &sweeps,
                 skips: &skip_reports,
                 imputation: imputation_report.as_ref(),

@@ -248,15 +248,12 @@ fn single_pixel_commands_refuse_an_array_and_spatial_motions_need_one() {
         "rows = 2\ncols = 2\npitch_um = 30.0\nmm_per_pixel = 10.0",
     );
     let c = cfg.to_str().unwrap();
-    for args in [
-        vec!["tradeoff", c],
-        vec!["bench", "pixel", "--config", c, "--pulses", "4096"],
-    ] {
-        let o = run(&args);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains("simulate CONFIG --out DIR"), "{args:?}: {err}");
-    }
+    // (`tradeoff` measures an array's levels instead: tradeoff_array.rs.)
+    let args = ["bench", "pixel", "--config", c, "--pulses", "4096"];
+    let o = run(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert!(err.contains("simulate CONFIG --out DIR"), "{args:?}: {err}");
     // `rtl` renders an array (docs/pixel-contract.md "Array"): the array's module.
     let out = tmp.path().join("array-rtl");
     let o = run(&["rtl", c, "--out", out.to_str().unwrap()]);

@@ -54,3 +54,4 @@ mod size;
 mod soak_arrays;
 mod tile_option;
 mod tradeoff;
+mod tradeoff_array;

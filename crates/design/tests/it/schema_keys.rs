@@ -31,6 +31,7 @@ fn full_document() -> Document {
         frame_rate_hz: Some(100.0),
         double_buffer: true,
         superpixel: 2,
+        level: tofprobe_design::array::ArrayLevel::Statistical,
     });
     let mut t = toml::Value::try_from(&doc).unwrap();
     let pixel = t.get_mut("pixel").unwrap().as_table_mut().unwrap();
@@ -93,7 +94,7 @@ fn every_key_of_a_full_document_is_derived_with_values_of_its_type() {
         };
         assert_eq!(of(&names), of(&seen), "[{section}]");
     }
-    assert_eq!(names.iter().filter(|p| p.starts_with("array.")).count(), 13);
+    assert_eq!(names.iter().filter(|p| p.starts_with("array.")).count(), 14);
     // Each key's values fit it alone, and a key has values of its type.
     for k in &derived {
         assert!(!k.values.is_empty(), "{}: no value of its type", path(k));
@@ -106,6 +107,7 @@ fn every_key_of_a_full_document_is_derived_with_values_of_its_type() {
         values("pixel.mode").contains(&s("haar")) || values("pixel.mode").contains(&s("fourier"))
     );
     assert!(values("array.double_buffer").contains(&Value::Boolean(true)));
+    assert!(values("array.level").contains(&s("statistical")));
     assert!(values("array.pitch_um").contains(&Value::Float(1.5)));
     assert!(!values("array.rows").contains(&Value::Float(1.5)));
     assert!(

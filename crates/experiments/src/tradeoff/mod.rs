@@ -5,6 +5,7 @@
 //! tone amplitude and the noise floor (mean amplitude over the noise bins) against the
 //! float full DFT and against the scene's true amplitude.
 
+pub mod array;
 pub mod haar;
 pub mod imputation;
 pub mod imputation_cost;

@@ -1,0 +1,97 @@
+//! `tofprobe tradeoff` on an `[array]` configuration (issue 48): the plate-mode example
+//! shrunk to 8 × 8 pixels and 2 ROM periods; exit 0, one JSON object whose `array_scenes`
+//! lists the three array levels with finite times and accuracy keys naming their unit,
+//! and the level named in `simulate --out`'s summary.
+
+use std::process::Command;
+
+fn config(dir: &std::path::Path, level: &str) -> std::path::PathBuf {
+    let text = include_str!("../../../../scenes/plate-mode.toml")
+        .replacen("rows = 32", "rows = 8", 1)
+        .replacen("cols = 32", "cols = 8", 1)
+        .replacen("mm_per_pixel = 10.0", "mm_per_pixel = 40.0", 1)
+        .replacen("pulses = 1000000", "pulses = 40000", 1)
+        + &format!("level = \"{level}\"\n");
+    let cfg = dir.join(format!("plate8-{level}.toml"));
+    std::fs::write(&cfg, text).expect("write");
+    cfg
+}
+
+#[test]
+fn tradeoff_lists_the_array_levels_with_time_and_accuracy() {
+    let dir = tempfile::tempdir().expect("dir");
+    let res = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .args(["tradeoff", "--json"])
+        .arg(config(dir.path(), "bit-true"))
+        .output()
+        .expect("run");
+    assert!(
+        res.status.success(),
+        "{}",
+        String::from_utf8_lossy(&res.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&res.stdout).expect("one JSON object");
+    let scene = &v["array_scenes"][0];
+    assert_eq!(scene["rows"], 8);
+    let levels = scene["levels"].as_array().expect("levels");
+    let names: Vec<&str> = levels
+        .iter()
+        .map(|l| l["level"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["bit-true", "statistical", "closed-form"]);
+    for l in levels {
+        for key in [
+            "seconds",
+            "pixel_pulses_per_s",
+            "amplitude_rms_error_um",
+            "amplitude_error_ratio",
+            "phase_rms_error_deg",
+            "noise_floor_ratio",
+            "mac",
+            "noise_ks_statistic",
+            "noise_ks_p_value",
+        ] {
+            let x = l[key].as_f64().unwrap_or(f64::NAN);
+            assert!(x.is_finite() && x >= 0.0, "{}: {key} = {x}", l["level"]);
+        }
+    }
+    // The statistical level is as close to bit-true as bit-true's own spread (the ratio's
+    // sd over 64 pixels is ≈ 0.1); the closed form has no noise floor.
+    let st = &levels[1];
+    assert!(st["amplitude_error_ratio"].as_f64().unwrap() < 1.5, "{st}");
+    assert!(levels[2]["noise_floor_ratio"].as_f64().unwrap() < 0.3);
+}
+
+#[test]
+fn simulate_names_the_level_in_the_summary_and_the_uff_header() {
+    let dir = tempfile::tempdir().expect("dir");
+    let out = dir.path().join("set");
+    let res = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .arg("simulate")
+        .arg(config(dir.path(), "statistical"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("run");
+    assert!(
+        res.status.success(),
+        "{}",
+        String::from_utf8_lossy(&res.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["level"], "statistical");
+    let uff = std::fs::read_to_string(out.join("vibration.uff")).unwrap();
+    assert!(uff.contains("(statistical)"));
+    // A level that does not exist: exit non-zero, the allowed names listed.
+    let res = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
+        .args(["config"])
+        .arg(config(dir.path(), "fastest"))
+        .output()
+        .expect("run");
+    let err = String::from_utf8_lossy(&res.stderr);
+    assert!(
+        !res.status.success() && err.contains("closed-form"),
+        "{err}"
+    );
+}
