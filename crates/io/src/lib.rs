@@ -7,13 +7,10 @@
 //! [`Fnv1a64`]) that names configurations, ROMs, vector files and cache entries, and the one
 //! root of the caches ([`cache::root`]), the writer lock of an output directory
 //! ([`lock`]) and the free space on its disk ([`disk`]), the [`watch::Watch`] a host
-<<<<<<< HEAD
-//! stops a long computation with, and the one locator of the external tools
-//! ([`tools::locate`]: `$TOFPROBE_<NAME>`, else `PATH`).
-=======
-//! stops a long computation with, and the one instruction-set selection of the vector
-//! kernels ([`isa`]: detected, `TOFPROBE_ISA`, or a benchmark's `--isa`).
->>>>>>> isa48
+//! stops a long computation with, the one locator of the external tools
+//! ([`tools::locate`]: `$TOFPROBE_<NAME>`, else `PATH`) and the one instruction-set
+//! selection of the vector kernels ([`isa`]: detected, `TOFPROBE_ISA`, or a benchmark's
+//! `--isa`).
 //!
 //! Errors are plain [`std::io::Error`]s: each crate maps them into its own error enum with
 //! the path it was writing.

@@ -616,6 +616,9 @@ impl Design {
 /// tofprobe's library from Python: ``tofprobe.Design``.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // The ISA `TOFPROBE_ISA` forces is checked at import, as the CLI checks it at start-up:
+    // a kernel cannot return the refusal (it would panic inside the call).
+    tofprobe_io::isa::from_env().map_err(|e| errors::input(e.to_string()))?;
     m.add_class::<Design>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

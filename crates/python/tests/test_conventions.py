@@ -159,3 +159,18 @@ def test_the_docstrings_say_what_the_letters_are_and_the_rom_cost():
 def test_no_benchmark_helper_in_the_public_api():
     public = {n for n in dir(tofprobe.Design) if not n.startswith("_")}
     assert not any("time" in n or "bench" in n for n in public), public
+
+
+@pytest.mark.parametrize("value, says", [("sse9", "allowed"), ("", None)])
+def test_a_bad_forced_isa_is_refused_at_import(value, says):
+    # TOFPROBE_ISA is read once, at import, as the CLI reads it at start-up: a name that is
+    # no ISA is an error naming the variable, never a panic inside a kernel; empty is unset.
+    import subprocess
+    env = dict(os.environ, TOFPROBE_ISA=value)
+    p = subprocess.run([sys.executable, "-c", "import tofprobe; print('imported')"],
+                       env=env, capture_output=True, text=True, timeout=60)
+    if says is None:
+        assert p.returncode == 0 and "imported" in p.stdout, p.stderr
+        return
+    assert p.returncode != 0 and "PanicException" not in p.stderr, p.stderr
+    assert "TOFPROBE_ISA" in p.stderr and "sse9" in p.stderr and says in p.stderr, p.stderr
