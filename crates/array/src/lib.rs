@@ -11,6 +11,7 @@
 
 mod error;
 pub mod events;
+mod frame;
 pub mod maps;
 pub mod model;
 pub mod output;

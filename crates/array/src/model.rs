@@ -14,7 +14,6 @@
 use std::ops::Range;
 
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 use tofprobe_design::ResolvedDesign;
 use tofprobe_dsp::rom::RomImage;
 use tofprobe_io::watch::Watch;
@@ -22,6 +21,7 @@ use tofprobe_pixel::{FoldLanes, FrameDriver, LANES, Superpixel, fold_pays};
 use tofprobe_scene::PhotonSource;
 
 use crate::error::ArrayError;
+pub use crate::frame::{ArrayFrame, Tile};
 
 /// Pulses per streamed chunk of one pixel (64 k pulses: 256 kB of codes per thread).
 const CHUNK: usize = 1 << 16;
@@ -29,40 +29,6 @@ const CHUNK: usize = 1 << 16;
 /// Pulses per streamed chunk of a lane group (16 k pulses: 64 kB of codes per pixel, 512
 /// kB per group of eight).
 const LANE_CHUNK: usize = 1 << 14;
-
-/// The registers of a rectangle of pixels after one frame.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Tile {
-    pub rows: Range<usize>,
-    pub cols: Range<usize>,
-    /// Registers per pixel (2B Fourier, 2^(U+1) − 1 Haar).
-    pub registers_per_pixel: usize,
-    /// Row-major over the tile, `registers_per_pixel` words per pixel (sign-extended).
-    pub registers: Vec<i64>,
-    /// Detections of each pixel's frame, row-major over the tile.
-    pub detections: Vec<u64>,
-}
-
-/// The whole array's registers after one frame.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-pub struct ArrayFrame {
-    pub rows: usize,
-    pub cols: usize,
-    pub registers_per_pixel: usize,
-    /// [R, C, registers] row-major.
-    pub registers: Vec<i64>,
-    /// [R, C] detections per pixel.
-    pub detections: Vec<u64>,
-}
-
-impl ArrayFrame {
-    /// Pixel (r, c)'s register words.
-    pub fn pixel(&self, r: usize, c: usize) -> &[i64] {
-        let k = self.registers_per_pixel;
-        let i = (r * self.cols + c) * k;
-        &self.registers[i..i + k]
-    }
-}
 
 /// The pulses pixel (r, c) sees: its one SPAD's codes, or (G > 1) its G² SPADs' codes
 /// averaged by the superpixel front end.

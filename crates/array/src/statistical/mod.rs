@@ -34,7 +34,7 @@ use tofprobe_scene::splitmix::{SplitMix64, mix};
 use tofprobe_scene::{MotionConfig, Scene};
 
 use crate::error::ArrayError;
-use crate::model::Tile;
+use crate::frame::Tile;
 use pixel::{CodeStats, NoiseKey, PixelScene, code_stats, pixel_scene};
 use spectra::{ProbeBands, cholesky};
 
