@@ -94,6 +94,27 @@ impl Isa {
         Self::ALL.into_iter().filter(|i| i.available()).collect()
     }
 
+    /// The vector paths a bit-identity test holds to the scalar one: those this CPU runs,
+    /// each it lacks named on stdout as skipped (so a run on an AVX2-only CPU says what it
+    /// did not check).
+    pub fn vector_paths_to_test() -> Vec<Isa> {
+        Self::ALL[1..]
+            .iter()
+            .copied()
+            .filter(|isa| {
+                let here = isa.available();
+                if !here {
+                    println!(
+                        "skipped: this CPU lacks {} ({})",
+                        isa.name(),
+                        isa.features()
+                    );
+                }
+                here
+            })
+            .collect()
+    }
+
     /// The ISA named `value` (read from `origin`, for the message), refused if the name is
     /// unknown (naming the allowed ones) or the CPU lacks it (naming what it lacks and
     /// what it runs).

@@ -426,15 +426,7 @@ mod tests {
             let mut sb = start;
             run_lockstep_on(Isa::Scalar, &ctx, &refs, &mut b, &mut sb);
             let mut a = b.clone();
-            for isa in [Isa::Avx2, Isa::Avx512] {
-                if !isa.available() {
-                    println!(
-                        "skipped: this CPU lacks {} ({})",
-                        isa.name(),
-                        isa.features()
-                    );
-                    continue;
-                }
+            for isa in Isa::vector_paths_to_test() {
                 a = vec![[0i64; LANES]; 1024];
                 let mut sa = start;
                 run_lockstep_on(isa, &ctx, &refs, &mut a, &mut sa);

@@ -232,15 +232,7 @@ mod tests {
                 &mut sb,
                 (0, 79, &mut b),
             );
-            for isa in [Isa::Avx2, Isa::Avx512] {
-                if !isa.available() {
-                    println!(
-                        "skipped: this CPU lacks {} ({})",
-                        isa.name(),
-                        isa.features()
-                    );
-                    continue;
-                }
+            for isa in Isa::vector_paths_to_test() {
                 let (mut c, mut sc) = (vec![None; 4096], Scratch::default());
                 let cc = generate_on(isa, &p, &scene, &depths, blk, &mut sc, (0, 79, &mut c));
                 assert_eq!((cc, &c), (cb, &b), "{} copy, block {block}", isa.name());

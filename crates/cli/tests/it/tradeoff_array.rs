@@ -3,7 +3,7 @@
 //! lists the three array levels with finite times and accuracy keys naming their unit,
 //! and the level named in `simulate --out`'s summary.
 
-use std::process::Command;
+use crate::common::tofprobe;
 
 fn config(dir: &std::path::Path, level: &str) -> std::path::PathBuf {
     let text = include_str!("../../../../scenes/plate-mode.toml")
@@ -20,11 +20,8 @@ fn config(dir: &std::path::Path, level: &str) -> std::path::PathBuf {
 #[test]
 fn tradeoff_lists_the_array_levels_with_time_and_accuracy() {
     let dir = tempfile::tempdir().expect("dir");
-    let res = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .args(["tradeoff", "--json"])
-        .arg(config(dir.path(), "bit-true"))
-        .output()
-        .expect("run");
+    let cfg = config(dir.path(), "bit-true");
+    let res = tofprobe(&["tradeoff", "--json", cfg.to_str().unwrap()]);
     assert!(
         res.status.success(),
         "{}",
@@ -66,13 +63,13 @@ fn tradeoff_lists_the_array_levels_with_time_and_accuracy() {
 fn simulate_names_the_level_in_the_summary_and_the_uff_header() {
     let dir = tempfile::tempdir().expect("dir");
     let out = dir.path().join("set");
-    let res = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .arg("simulate")
-        .arg(config(dir.path(), "statistical"))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .expect("run");
+    let cfg = config(dir.path(), "statistical");
+    let res = tofprobe(&[
+        "simulate",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert!(
         res.status.success(),
         "{}",
@@ -83,15 +80,15 @@ fn simulate_names_the_level_in_the_summary_and_the_uff_header() {
     assert_eq!(summary["level"], "statistical");
     let uff = std::fs::read_to_string(out.join("vibration.uff")).unwrap();
     assert!(uff.contains("(statistical)"));
-    // A level that does not exist: exit non-zero, the allowed names listed.
-    let res = Command::new(env!("CARGO_BIN_EXE_tofprobe"))
-        .args(["config"])
-        .arg(config(dir.path(), "fastest"))
-        .output()
-        .expect("run");
+    // A level that does not exist: bad input's exit code 2, the allowed names listed.
+    let cfg = config(dir.path(), "fastest");
+    let res = tofprobe(&["config", cfg.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&res.stderr);
     assert!(
-        !res.status.success() && err.contains("closed-form"),
+        res.status.code() == Some(2)
+            && ["bit-true", "statistical", "closed-form"]
+                .iter()
+                .all(|n| err.contains(n)),
         "{err}"
     );
 }

@@ -202,15 +202,7 @@ fn every_isa_reads_out_the_scalar_registers() {
     };
     let (scalar, scalar_seg) = (lanes(Isa::Scalar), segmented(Isa::Scalar));
     assert!(scalar_seg.1.words.iter().any(|&w| w != 0));
-    for isa in [Isa::Avx2, Isa::Avx512] {
-        if !isa.available() {
-            println!(
-                "skipped: this CPU lacks {} ({})",
-                isa.name(),
-                isa.features()
-            );
-            continue;
-        }
+    for isa in Isa::vector_paths_to_test() {
         assert_eq!(lanes(isa), scalar, "lane driver on {}", isa.name());
         assert_eq!(
             segmented(isa),
