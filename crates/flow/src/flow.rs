@@ -142,9 +142,7 @@ pub fn recommended(
 /// set ([`crate::flowset`]): the old report and marker go first, the new marker last, and a
 /// failed flow removes the directory if it created it.
 pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome, FlowError> {
-    if a.frames == 0 || a.frames > 100 {
-        return Err(FlowError::option("frames", a.frames, "1..=100"));
-    }
+    crate::command::check_frames(a.frames)?;
     // Before minutes of co-simulation, not after: a hand-written report.md stays.
     refuse_foreign_report(&a.out.join("report.md"))?;
     let created = crate::flowset::open(&a.out)?;

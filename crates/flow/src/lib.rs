@@ -8,6 +8,7 @@
 
 pub mod adders;
 pub mod array;
+pub mod command;
 pub mod error;
 pub mod flow;
 pub mod flowset;

@@ -6,7 +6,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tofprobe_flow::flow::{FlowOptions, run_flow};
+use tofprobe_flow::command::{Recommend, choose, run_any};
+use tofprobe_flow::flow::FlowOptions;
 
 use crate::error::CliError;
 
@@ -58,21 +59,13 @@ pub struct FlowArgs {
 
 /// Runs `tofprobe flow`.
 pub fn run(a: &FlowArgs) -> Result<super::Verdict, CliError> {
-    if a.frames == 0 || a.frames > 100 {
-        return Err(CliError::option("frames", a.frames.to_string(), "1..=100"));
-    }
-    let mut design = crate::commands::load_for_hardware(a.config.as_deref())?;
-    if design.array.is_some() && a.recommended {
-        return Err(CliError::option(
-            "recommended",
-            "given",
-            "a single-pixel configuration",
-        ));
-    }
-    let options = if a.recommended {
-        let (chosen, report) =
-            tofprobe_flow::flow::recommended(&design, a.only.clone(), a.target_error_um)?;
-        design = chosen;
+    let design = crate::commands::load_for_hardware(a.config.as_deref())?;
+    let recommend = a.recommended.then(|| Recommend {
+        only: a.only.clone(),
+        target_error_um: a.target_error_um,
+    });
+    let (design, options) = choose(design, a.frames, recommend.as_ref())?;
+    if let Some(report) = &options {
         println!(
             "recommended: {} ({:.0} µm² on {}, tone error {:.3} µm ≤ {} µm)",
             report.recommendation.option,
@@ -81,16 +74,8 @@ pub fn run(a: &FlowArgs) -> Result<super::Verdict, CliError> {
             report.recommendation.tone_error_um,
             report.recommendation.target_error_um
         );
-        Some(report)
-    } else {
-        None
-    };
-    let run = if design.array.is_some() {
-        tofprobe_flow::array::run_array_flow
-    } else {
-        run_flow
-    };
-    let o = run(
+    }
+    let o = run_any(
         &design,
         &FlowOptions {
             out: a.out.clone(),

@@ -18,20 +18,12 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use serde::Serialize;
 
-use tofprobe_design::ArrayLevel;
-use tofprobe_experiments::tradeoff::array::{self as array_levels, ArrayTradeoff, measure_array};
-use tofprobe_experiments::tradeoff::haar::{self, HaarSceneResult, measure_haar};
-use tofprobe_experiments::tradeoff::imputation::{self, ImputationReport};
-use tofprobe_experiments::tradeoff::imputation_cost::CellAreas;
-use tofprobe_experiments::tradeoff::knobs::{self, DEFAULT_SWEEP, KnobSweep};
-use tofprobe_experiments::tradeoff::skips::{self, SkipReport, measure_skips};
-use tofprobe_experiments::tradeoff::{SceneResult, markdown, measure, plot::pareto_svg_text};
+use tofprobe_experiments::tradeoff::imputation;
+use tofprobe_experiments::tradeoff::study::{self, StudyRequest};
 
 use crate::error::CliError;
 
-/// Arguments of `tofprobe tradeoff`.
 #[derive(Debug, Args)]
 pub struct TradeoffArgs {
     /// Configuration files (TOML); none = the embedded default.
@@ -78,120 +70,47 @@ pub struct TradeoffArgs {
     out: Option<PathBuf>,
 }
 
-#[derive(Serialize)]
-struct JsonOut<'a> {
-    scenes: &'a [SceneResult],
-    #[serde(skip_serializing_if = "<[_]>::is_empty")]
-    haar_scenes: &'a [HaarSceneResult],
-    #[serde(skip_serializing_if = "<[_]>::is_empty")]
-    array_scenes: &'a [ArrayTradeoff],
-    #[serde(skip_serializing_if = "<[_]>::is_empty")]
-    knobs: &'a [KnobSweep],
-    #[serde(skip_serializing_if = "<[_]>::is_empty")]
-    skips: &'a [SkipReport],
-    #[serde(skip_serializing_if = "Option::is_none")]
-    imputation: Option<&'a ImputationReport>,
-}
-
-/// Runs the command.
+/// Runs the command: the study is the library's (`tofprobe_experiments::tradeoff::study`);
+/// this parses, loads each configuration, writes the set and prints.
 pub fn run(args: &TradeoffArgs) -> Result<(), CliError> {
     let paths: Vec<Option<&std::path::Path>> = if args.configs.is_empty() {
         vec![None]
     } else {
         args.configs.iter().map(|p| Some(p.as_path())).collect()
     };
-    let reps = usize::try_from(args.reps).unwrap_or(1);
-    if let Some(bad) = args
-        .only_knobs
-        .iter()
-        .find(|k| !DEFAULT_SWEEP.iter().any(|s| s.knob == k.as_str()))
-    {
-        let mut names: Vec<&str> = DEFAULT_SWEEP.iter().map(|s| s.knob).collect();
-        names.dedup();
-        return Err(CliError::option("knob", bad.clone(), names.join(", ")));
-    }
-    let mut scenes = Vec::new();
-    let mut haar_scenes = Vec::new();
-    let mut array_scenes = Vec::new();
-    let mut sweeps = Vec::new();
-    let mut skip_reports = Vec::new();
-    let mut tables = Vec::new();
-    for p in paths {
-        let design = crate::commands::load_for_hardware(p)?;
-        if design.array.is_some() && design.pixel.mode == tofprobe_pixel::Mode::Fourier {
-            // An [array] configuration: its array levels against bit-true.
-            let r = measure_array(&design, &ArrayLevel::ALL)?;
-            tables.push(array_levels::markdown(&r));
-            array_scenes.push(r);
-            continue;
-        }
-        design.single_pixel("tradeoff")?;
-        if design.pixel.mode == tofprobe_pixel::Mode::Haar {
-            let h = measure_haar(&design, args.verilator)?;
-            tables.push(haar::markdown(&h));
-            if args.knobs || args.skips {
-                tables.push(format!(
-                    "(--knobs / --skips measure the Fourier pixel's knobs and stages: skipped for the Haar pixel of {})\n",
-                    design.origin
-                ));
-            }
-            haar_scenes.push(h);
-            continue;
-        }
-        let scene = measure(&design, args.verilator)?;
-        tables.push(markdown(&scene));
-        scenes.push(scene);
-        if args.knobs {
-            let settings = knobs::select(DEFAULT_SWEEP, &args.only_knobs);
-            let sw = knobs::sweep(&design, &settings, args.sweep_pulses, reps);
-            tables.push(knobs::markdown(&sw));
-            sweeps.push(sw);
-        }
-        if args.skips {
-            let sk = measure_skips(&design, args.sweep_pulses, reps)?;
-            tables.push(skips::markdown(&sk));
-            skip_reports.push(sk);
-        }
-    }
-    let imputation_report = if args.imputation {
-        let cells = CellAreas::sky130()?;
-        let seeds = usize::try_from(args.imputation_seeds).unwrap_or(2);
-        let r = imputation::measure(args.imputation_pulses, seeds, cells.as_ref())?;
-        tables.push(imputation::markdown(&r));
-        Some(r)
-    } else {
-        None
+    let designs = paths
+        .into_iter()
+        .map(crate::commands::load_for_hardware)
+        .collect::<Result<Vec<_>, _>>()?;
+    let request = StudyRequest {
+        verilator: args.verilator,
+        knobs: args.knobs,
+        only_knobs: args.only_knobs.clone(),
+        skips: args.skips,
+        sweep_pulses: args.sweep_pulses,
+        reps: usize::try_from(args.reps).unwrap_or(1),
+        imputation: args.imputation.then(|| {
+            (
+                args.imputation_pulses,
+                usize::try_from(args.imputation_seeds).unwrap_or(2),
+            )
+        }),
     };
-    let table = tables.join("\n");
+    let result = study::run(&designs, &request)?;
     if let Some(dir) = &args.out {
         // One set, whole or absent (tofprobe_io::OutputSet), the table last.
         let io = |e: std::io::Error| CliError::output(dir.clone(), e.to_string());
-        let svg = if scenes.is_empty() {
-            None
-        } else {
-            Some(pareto_svg_text(&dir.join("pareto.svg"), &scenes)?)
-        };
+        let files = result.files(dir)?;
         let mut set = tofprobe_io::OutputSet::begin(dir).map_err(io)?;
-        if let Some(svg) = svg {
-            set.add("pareto.svg", svg.as_bytes()).map_err(io)?;
+        for (name, text) in &files {
+            set.add(name, text.as_bytes()).map_err(io)?;
         }
-        set.add("tradeoff.md", table.as_bytes()).map_err(io)?;
         set.commit(Some("tradeoff.md")).map_err(io)?;
     }
     if args.json {
-        println!(
-            "{}",
-            serde_json::to_string(&JsonOut {
-                scenes: &scenes,
-                haar_scenes: &haar_scenes,
-                array_scenes: &array_scenes,
-                knobs: &sweeps,
-                skips: &skip_reports,
-                imputation: imputation_report.as_ref(),
-            })?
-        );
+        println!("{}", serde_json::to_string(&result)?);
     } else {
-        print!("{table}");
+        print!("{}", result.markdown());
     }
     Ok(())
 }

@@ -13,6 +13,7 @@ pub mod knobs;
 pub mod overrides;
 pub mod plot;
 pub mod skips;
+pub mod study;
 pub mod timing;
 
 use std::time::Instant;

@@ -6,4 +6,5 @@ mod imputation;
 mod levels;
 mod scalogram_figures;
 mod simulation;
+mod study;
 mod transients;

@@ -88,9 +88,7 @@ pub fn run_array_flow(
             "the pixel's flow (an array is co-simulated here; its synthesis and timing are `tofprobe size`)",
         ));
     }
-    if a.frames == 0 || a.frames > 100 {
-        return Err(FlowError::option("frames", a.frames, "1..=100"));
-    }
+    crate::command::check_frames(a.frames)?;
     crate::flow::refuse_foreign_report(&a.out.join("report.md"))?;
     let created = crate::flowset::open(&a.out)?;
     let r = array_flow_in(design, a);

@@ -1,3 +1,4 @@
 //! The flow crate's integration tests: one binary, a module per file.
 
 mod array_spec;
+mod command;
