@@ -27,7 +27,6 @@ mod cosim_directed;
 mod cosim_exact;
 mod docs_tables;
 mod exit_codes;
-mod extremes;
 mod finite_json;
 mod flow;
 mod fuzz_binary;

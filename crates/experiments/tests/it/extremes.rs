@@ -1,7 +1,9 @@
-//! Issue 8 point 3: the extremes matrix through `tofprobe simulate --json` (scene Monte
-//! Carlo → probe ROM → bit-true pixel → spectrum) on short frames. Every case either runs
-//! with finite outputs within its stated tolerance, or is refused at load time with a
-//! clear message (exit 2, `error:`, the key at fault) — never a panic or a NaN.
+//! Issue 8 point 3: the extremes matrix through the simulation `tofprobe simulate --json`
+//! prints (`simulation::simulate`: scene Monte Carlo → probe ROM → bit-true pixel →
+//! spectrum) on short frames. Every case either runs with finite outputs within its stated
+//! tolerance, or is refused at resolution with a clear message naming the key at fault —
+//! never a panic or a NaN. (The binary's exit code 2 and `error:` for a refusal, and finite
+//! JSON from every command, are the CLI's tests: exit_codes.rs, finite_json.rs.)
 //!
 //! Base: the default scene shortened to N = 2^14 pulses, B = 4 bins (C = 4), the tone
 //! moved onto bin 40 (40·f_s/2^14 = 24.4 kHz: well away from DC, whose 30 mm static depth
@@ -9,9 +11,8 @@
 //! (≈ 3 s in release) with a periodic ROM of depth 2^14 on the same bin grid: a windowed
 //! 2^27-entry ROM would be 512 MiB, the periodic one is 2^14 entries.
 
-use crate::common;
-
-use common::{tofprobe, windowed_default};
+use tofprobe_design::{DEFAULT_TOML, Document, ProbeCache, resolve_with};
+use tofprobe_experiments::simulation::simulate;
 
 const N: u64 = 1 << 14;
 
@@ -19,11 +20,12 @@ fn bin_hz(k: f64) -> f64 {
     k * 10e6 / N as f64
 }
 
-/// Runs `simulate --json` on the base config with `edits`; Ok(json) or Err(stderr).
+/// Resolves the base config with `edits` and simulates it (what `tofprobe simulate --json`
+/// prints); Ok(json) or Err(the refusal's message).
 fn run(name: &str, edits: &[(&str, String)]) -> Result<serde_json::Value, String> {
     // Short windowed frames (L = N), so the tones sit on k·f_s/N; the 2^27 case switches
     // back to periodic.
-    let mut text = windowed_default();
+    let mut text = DEFAULT_TOML.replacen("rom_mode = \"periodic\"", "rom_mode = \"windowed\"", 1);
     let base = [
         ("duration_s = 1.0", format!("pulses = {N}")),
         ("bins = 16", "bins = 4".to_string()),
@@ -41,22 +43,14 @@ fn run(name: &str, edits: &[(&str, String)]) -> Result<serde_json::Value, String
         assert!(text.contains(from), "{name}: default lacks `{from}`");
         text = text.replacen(from, to, 1);
     }
-    let dir = std::env::temp_dir().join(format!("tofprobe-extremes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("dir");
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).expect("write");
-    let out = tofprobe(&["simulate", p.to_str().expect("path"), "--json"]);
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!err.contains("panicked"), "{name}: {err}");
-    if out.status.success() {
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
-        assert_finite(name, &v);
-        Ok(v)
-    } else {
-        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
-        assert!(err.starts_with("error: "), "{name}: {err}");
-        Err(err)
-    }
+    let origin = format!("{name}.toml");
+    let design = Document::from_toml_str(&text, &origin)
+        .and_then(|doc| resolve_with(doc, &origin, &mut ProbeCache::default()))
+        .map_err(|e| e.to_string())?;
+    let sim = simulate(&design, |_| {}).map_err(|e| e.to_string())?;
+    let v = serde_json::to_value(&sim).expect("serialises");
+    assert_finite(name, &v);
+    Ok(v)
 }
 
 /// Every number in the output is finite (serde_json writes NaN/inf as null).
