@@ -9,6 +9,7 @@
 //! A dev-dependency only: no library crate of the workspace depends on it.
 
 pub mod data;
+pub mod fuzz;
 pub mod imports;
 pub mod mutants;
 pub mod params;

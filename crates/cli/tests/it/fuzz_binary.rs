@@ -9,6 +9,7 @@
 //! included, with no list here to keep.
 
 use crate::common;
+use tofprobe_testkit::fuzz::{dotted_paths, value_forms};
 
 use std::path::Path;
 use std::process::Command;
@@ -102,41 +103,6 @@ fn mutate(rng: &mut Rng, keys: &[Key]) -> (String, Vec<(String, String)>) {
         muts.push((key, lit));
     }
     (toml::to_string(&doc).unwrap(), muts)
-}
-
-/// The forms a value may take in a message (as written, or as Rust prints the number).
-fn value_forms(lit: &str) -> Vec<String> {
-    let mut f = vec![lit.trim_matches('"').to_string()];
-    if let Ok(x) = lit.parse::<f64>() {
-        f.extend([
-            format!("{x}"),
-            format!("{x:?}"),
-            format!("{x:e}"),
-            tofprobe_io::text::number(x),
-        ]);
-    }
-    if lit == "nan" {
-        f.push("NaN".into());
-    }
-    f
-}
-
-/// `section.key` of every key of `doc` (`scene.motion[i].key` for the motions).
-fn dotted_paths(doc: &toml::Table) -> Vec<String> {
-    let mut v = Vec::new();
-    for (section, body) in doc {
-        for (key, value) in body.as_table().into_iter().flatten() {
-            if let Some(list) = value.as_array().filter(|_| key == "motion") {
-                for (i, m) in list.iter().enumerate() {
-                    for k in m.as_table().into_iter().flatten().map(|(k, _)| k) {
-                        v.push(format!("scene.motion[{i}].{k}"));
-                    }
-                }
-            }
-            v.push(format!("{section}.{key}"));
-        }
-    }
-    v
 }
 
 /// Runs the binary with a time limit; (exit code, stderr). A run past the limit is killed

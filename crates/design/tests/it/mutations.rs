@@ -6,6 +6,7 @@
 //! docs/reliability.md used 5000).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use tofprobe_testkit::fuzz::{dotted_paths, value_forms};
 
 use tofprobe_design::document::keys::{Key, keys_of_the_default};
 use tofprobe_design::{DEFAULT_TOML, Document, ProbeCache, RtlOverrides, resolve_with, rtl_params};
@@ -115,39 +116,6 @@ fn mutate(rng: &mut Rng, keys: &[Key], vals: &[String]) -> (String, Vec<(String,
         }
     }
     (toml::to_string(&doc).unwrap(), muts)
-}
-
-/// The forms a value may take in a message (as written, or as Rust prints the number).
-fn value_forms(lit: &str) -> Vec<String> {
-    let mut f = vec![lit.trim_matches('"').to_string()];
-    if let Ok(x) = lit.parse::<f64>() {
-        f.push(format!("{x}"));
-        f.push(format!("{x:?}"));
-        f.push(format!("{x:e}"));
-        f.push(tofprobe_io::text::number(x));
-    }
-    if lit == "nan" {
-        f.push("NaN".into());
-    }
-    f
-}
-
-/// `section.key` of every key of `doc` (`scene.motion[i].key` for the motions).
-fn dotted_paths(doc: &toml::Table) -> Vec<String> {
-    let mut v = Vec::new();
-    for (section, body) in doc {
-        for (key, value) in body.as_table().into_iter().flatten() {
-            if let Some(list) = value.as_array().filter(|_| key == "motion") {
-                for (i, m) in list.iter().enumerate() {
-                    for k in m.as_table().into_iter().flatten().map(|(k, _)| k) {
-                        v.push(format!("scene.motion[{i}].{k}"));
-                    }
-                }
-            }
-            v.push(format!("{section}.{key}"));
-        }
-    }
-    v
 }
 
 #[test]

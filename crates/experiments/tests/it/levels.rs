@@ -6,30 +6,18 @@
 //! ladder reads the same numbers as the whole ladder (each level is a function of the
 //! record, not of which others ran), and a Haar level is refused on a Fourier design.
 
-use tofprobe_design::{DEFAULT_TOML, Document, ProbeCache, resolve_with};
+use tofprobe_design::ProbeCache;
+
+use crate::common::short_tone_frame;
 use tofprobe_experiments::level::Level;
 use tofprobe_experiments::spectrum::setup;
 use tofprobe_experiments::tradeoff::{measure_levels, measure_setup};
 
 const N: u64 = 1 << 15;
 
-/// The default, windowed, 2^15 pulses, B = 4 with a 1 mm tone on ROM bin 30.
-fn design() -> tofprobe_design::ResolvedDesign {
-    let f = 30.0 * 10e6 / N as f64;
-    let text = DEFAULT_TOML
-        .replacen("duration_s = 1.0", &format!("pulses = {N}"), 1)
-        .replacen("amplitude_mm = 0.1", "amplitude_mm = 1.0", 1)
-        .replacen("frequency_hz = 4500.0", &format!("frequency_hz = {f}"), 1)
-        .replacen("bins = 16", "bins = 4", 1)
-        .replacen("cycles_per_pulse = 16", "cycles_per_pulse = 4", 1)
-        .replacen("rom_mode = \"periodic\"", "rom_mode = \"windowed\"", 1);
-    let doc = Document::from_toml_str(&text, "short.toml").expect("parses");
-    resolve_with(doc, "short.toml", &mut ProbeCache::default()).expect("resolves")
-}
-
 #[test]
 fn every_fourier_level_reads_the_tone_and_a_subset_reads_the_same() {
-    let d = design();
+    let d = short_tone_frame(N);
     let su = setup(&d).unwrap();
     let all = measure_setup(&d, &su, false).unwrap();
     let names: Vec<&str> = all.levels.iter().map(|l| l.level.as_str()).collect();
@@ -89,7 +77,7 @@ fn every_fourier_level_reads_the_tone_and_a_subset_reads_the_same() {
 
 #[test]
 fn a_haar_level_is_refused_on_a_fourier_design() {
-    let d = design();
+    let d = short_tone_frame(N);
     let su = setup(&d).unwrap();
     let e = measure_levels(&d, &su, &[Level::FloatHaar])
         .unwrap_err()
@@ -106,7 +94,7 @@ fn option_accuracy_is_the_bit_true_error_against_the_dft_per_seed() {
     use tofprobe_experiments::options::accuracy::measure;
     use tofprobe_experiments::options::catalogue::ArchOption;
     use tofprobe_experiments::tradeoff::overrides::with_overrides;
-    let d = design();
+    let d = short_tone_frame(N);
     let options = vec![
         ArchOption {
             name: "baseline".into(),

@@ -2,6 +2,7 @@
 //! entries tested through the library (the binary's tests in crates/cli test what users
 //! run). Run one module with `cargo test --release -p tofprobe-experiments --test it MODULE::`.
 
+mod common;
 mod extremes;
 mod imputation;
 mod levels;

@@ -2,24 +2,14 @@
 //! computation over the same source's record, the progress callback reaches the record's
 //! length, and the bit-true part is the Fourier frame's spectrum at the design's bins.
 
-use tofprobe_design::{DEFAULT_TOML, Document, ProbeCache, resolve_with};
+use crate::common::{resolved, windowed_short};
 use tofprobe_experiments::simulation::{simulate, summarise};
 
 const N: u64 = 1 << 16;
 
-fn design() -> tofprobe_design::ResolvedDesign {
-    let text = DEFAULT_TOML
-        .replacen("duration_s = 1.0", &format!("pulses = {N}"), 1)
-        .replacen("bins = 16", "bins = 4", 1)
-        .replacen("cycles_per_pulse = 16", "cycles_per_pulse = 4", 1)
-        .replacen("rom_mode = \"periodic\"", "rom_mode = \"windowed\"", 1);
-    let doc = Document::from_toml_str(&text, "short.toml").expect("parses");
-    resolve_with(doc, "short.toml", &mut ProbeCache::default()).expect("resolves")
-}
-
 #[test]
 fn the_summary_is_the_naive_statistics_of_the_record() {
-    let d = design();
+    let d = resolved(&windowed_short(N));
     let source = d.photon_source().unwrap();
     let mut last = 0;
     let s = summarise(&source, N, |done| last = done);
@@ -48,7 +38,7 @@ fn the_summary_is_the_naive_statistics_of_the_record() {
 
 #[test]
 fn a_fourier_simulation_carries_its_spectrum_and_no_transients() {
-    let d = design();
+    let d = resolved(&windowed_short(N));
     let sim = simulate(&d, |_| {}).unwrap();
     let b = sim.bit_true.as_ref().expect("a Fourier frame");
     assert_eq!(b.bins.len(), 4);

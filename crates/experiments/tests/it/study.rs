@@ -8,27 +8,11 @@
 //! The results are checked as `--json` prints them (serde), so the keys users read are
 //! what is tested.
 
-use tofprobe_design::{DEFAULT_TOML, Document, ProbeCache, ResolvedDesign, resolve_with};
+use tofprobe_design::{Document, ProbeCache, ResolvedDesign, resolve_with};
+
+use crate::common::short_tone_frame;
 use tofprobe_experiments::ExperimentError;
 use tofprobe_experiments::tradeoff::study::{StudyRequest, run};
-
-/// The default, windowed, `n` pulses, B = 4 (C = 4), a 1 mm tone on ROM bin 30.
-fn short_tone_frame(n: u64) -> ResolvedDesign {
-    let f = 30.0 * 10e6 / n as f64;
-    let text = DEFAULT_TOML
-        .replacen("duration_s = 1.0", &format!("pulses = {n}"), 1)
-        .replacen("amplitude_mm = 0.1", "amplitude_mm = 1.0", 1)
-        .replacen("frequency_hz = 4500.0", &format!("frequency_hz = {f}"), 1)
-        .replacen("bins = 16", "bins = 4", 1)
-        .replacen("cycles_per_pulse = 16", "cycles_per_pulse = 4", 1)
-        .replacen("rom_mode = \"periodic\"", "rom_mode = \"windowed\"", 1);
-    assert!(
-        text.contains("pulses = ") && text.contains("\"windowed\""),
-        "default changed"
-    );
-    let doc = Document::from_toml_str(&text, "short.toml").expect("parses");
-    resolve_with(doc, "short.toml", &mut ProbeCache::default()).expect("resolves")
-}
 
 fn json(designs: &[ResolvedDesign], req: &StudyRequest) -> serde_json::Value {
     let study = run(designs, req).unwrap_or_else(|e| panic!("{e}"));
