@@ -11,7 +11,6 @@ mod array_refusals;
 mod array_rtl;
 mod array_sets;
 mod array_size;
-mod array_stimulus;
 mod bench_cosim_array;
 mod bench_fullband;
 mod bench_sd;

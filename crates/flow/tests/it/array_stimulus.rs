@@ -18,8 +18,6 @@ use tofprobe_flow::array::{ArrayCosimOptions, ArrayCosimReport, ArraySimulator, 
 use tofprobe_pixel::Fault;
 use tofprobe_rtlgen::ArrayFault;
 
-use crate::common::have_tools;
-
 fn example_text() -> String {
     let path =
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../testbench/array-2x2/array-2x2.toml");
@@ -98,7 +96,7 @@ fn assert_the_frame_restarts(d: &ResolvedDesign, r: &ArrayRun) {
 
 #[test]
 fn a_mid_frame_reset_restarts_the_array_and_catches_the_reset_escapes() {
-    if !have_tools(&["verilator", "iverilog", "vvp"]) {
+    if !tofprobe_testkit::tools::have(&["verilator", "iverilog", "vvp"], "flow::array_stimulus") {
         return;
     }
     let d = example();
@@ -135,7 +133,7 @@ fn a_mid_frame_reset_restarts_the_array_and_catches_the_reset_escapes() {
 /// accumulate that holds instead is caught (Icarus).
 #[test]
 fn haar_words_wrap_at_a_narrow_width_and_catch_hold_on_overflow() {
-    if !have_tools(&["iverilog", "vvp"]) {
+    if !tofprobe_testkit::tools::have(&["iverilog", "vvp"], "flow::array_stimulus") {
         return;
     }
     let d = haar_example();
@@ -178,7 +176,7 @@ fn top_bits(r: &ArrayCosimReport) -> (usize, usize) {
 
 #[test]
 fn narrow_registers_wrap_reach_their_top_bits_and_catch_hold_on_overflow() {
-    if !have_tools(&["verilator", "iverilog", "vvp"]) {
+    if !tofprobe_testkit::tools::have(&["verilator", "iverilog", "vvp"], "flow::array_stimulus") {
         return;
     }
     let d = example();
