@@ -62,7 +62,7 @@ pub fn header<T: NpyElement>(shape: &[usize]) -> Vec<u8> {
     out
 }
 
-/// The size in bytes of the `.npy` file of `shape` with 8-byte elements (what [`write`]
+/// The size in bytes of the `.npy` file of `shape` with 8-byte elements (what [`write()`]
 /// writes), saturating: an output set's size is estimated from it before any work.
 pub fn file_bytes(shape: &[usize]) -> u64 {
     let count = shape.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
@@ -125,7 +125,7 @@ pub fn write<T: NpyElement>(out: &mut dyn Write, shape: &[usize], data: &[T]) ->
     write_iter(out, shape, data.iter().copied())
 }
 
-/// The bytes of an `.npy` file holding `data` (C order) of `shape` ([`write`] into
+/// The bytes of an `.npy` file holding `data` (C order) of `shape` ([`write()`] into
 /// memory: for small arrays and tests).
 pub fn to_bytes<T: NpyElement>(shape: &[usize], data: &[T]) -> Result<Vec<u8>, Error> {
     let mut out = Vec::new();

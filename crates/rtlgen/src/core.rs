@@ -88,7 +88,7 @@ pub fn core_file_name(module_prefix: &str) -> String {
 }
 
 /// Renders the core and its helper files for the already rendered `rtl` (the output of
-/// [`crate::render`] for the same `p` and `o`): the core, the yosys script and, with `sim`,
+/// [`crate::render()`] for the same `p` and `o`): the core, the yosys script and, with `sim`,
 /// the testbench's macro file. Names derive from `o.module_prefix` (a validated
 /// identifier); the paths in `sim` must pass [`check_core_path`].
 pub fn render_core(
