@@ -13,9 +13,9 @@ use tofprobe_pixel::{PixelContext, PixelError, PixelParams};
 use tofprobe_scene::{PhotonSource, Scene};
 
 use crate::adders::{AdderStatus, AdderTiming};
-use crate::analysis_mode::ModeDecision;
 use crate::document::Document;
 use crate::error::DesignError;
+use crate::mode_decision::ModeDecision;
 use crate::probe_cache::ProbeCache;
 
 /// Longest frame a windowed ROM (L = N) may span: 2^24 pulses (1.68 s at 10 MHz).
@@ -155,7 +155,7 @@ impl ResolvedDesign {
     /// mode), as `ORIGIN: …`: the front ends show it (the CLI on stderr as `warning: …`,
     /// Python as a `UserWarning`); the library only decides it.
     pub fn ignored_warning(&self) -> Option<String> {
-        crate::analysis_mode::ignored_probe_warning(&self.document, self.pixel.mode)
+        crate::mode_decision::ignored_probe_warning(&self.document, self.pixel.mode)
             .map(|w| format!("{}: {w}", self.origin))
     }
 

@@ -25,7 +25,6 @@
 //! - [`superpixel`]: the averaging of G × G SPADs in front of the datapath ([`Superpixel`]).
 
 pub mod autobins;
-pub mod bench;
 pub mod chip;
 pub mod config;
 pub mod cycle;
@@ -46,6 +45,7 @@ pub mod segments;
 pub mod sequencer;
 pub mod sizing;
 pub mod spectrum;
+pub mod speed;
 pub mod superpixel;
 pub mod transaction;
 pub mod valid_codes;

@@ -8,10 +8,10 @@ use tofprobe_scene::{PhotonSource, Scene};
 
 use super::{MAX_WINDOWED_FRAME, derived_from};
 use crate::adders::{AdderStatus, AdderTiming};
-use crate::analysis_mode::{ModeDecision, check_haar, decide_mode};
-use crate::bins::bin_indices_in;
+use crate::bin_choice::bin_indices_in;
 use crate::document::Document;
 use crate::error::DesignError;
+use crate::mode_decision::{ModeDecision, check_haar, decide_mode};
 use crate::probe_cache::ProbeCache;
 
 /// The sensor, the scene and the acquisition: an array checks the scene over the whole
@@ -175,7 +175,7 @@ impl<'a> Resolution<'a> {
         // (it used to be reported against `pixel.bins` or `pixel.rom_depth`).
         if fourier && d.pixel.frequencies_hz.is_empty() {
             let l = self.px.rom_depth.unwrap_or(probe_depth) as u64;
-            if let Err(why) = crate::bins::band_check(l, d.probe.osr, 1) {
+            if let Err(why) = crate::bin_choice::band_check(l, d.probe.osr, 1) {
                 return Err(self.probe_err(
                     tofprobe_dsp::DspError::out_of_range(
                         "probe.osr",

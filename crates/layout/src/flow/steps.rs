@@ -499,7 +499,7 @@ impl<'a> Run<'a> {
         &self,
         s: &Synthesised,
         def: &crate::def::DefFigures,
-    ) -> Result<Option<crate::bins::BinsPerPitch>> {
+    ) -> Result<Option<crate::pitch_bins::BinsPerPitch>> {
         let model = AreaModel::fit(
             &s.points
                 .iter()
@@ -509,7 +509,7 @@ impl<'a> Run<'a> {
         .ok();
         let routed_factor = def.die_area_um2() / s.main().total_area_um2;
         Ok(match model {
-            Some(m) => Some(crate::bins::bins_per_pitch(
+            Some(m) => Some(crate::pitch_bins::bins_per_pitch(
                 m,
                 routed_factor,
                 def.die_area_um2(),
