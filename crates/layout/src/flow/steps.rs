@@ -134,7 +134,7 @@ impl<'a> Run<'a> {
         })
     }
 
-    /// 1. Synthesis: the configured pixel and a smaller B for the area model; the
+    /// Step 1, synthesis: the configured pixel and a smaller B for the area model; the
     /// netlist's cells must all have a layout view.
     pub(super) fn synthesise(&mut self) -> Result<Synthesised> {
         (self.progress)("synthesis");
@@ -183,7 +183,7 @@ impl<'a> Run<'a> {
         })
     }
 
-    /// 2. The qflow project: convert, then place and route, lower densities on failure.
+    /// Step 2, the qflow project: convert, then place and route, lower densities on failure.
     pub(super) fn place_and_route(&mut self, s: &Synthesised) -> Result<Routed> {
         let syn = s.main();
         let name = format!("{}-{}", self.tech.tech.name(), syn.key);
@@ -267,7 +267,7 @@ impl<'a> Run<'a> {
         Ok(attempts)
     }
 
-    /// 3. Checks and views; a dirty route is repaired by re-routing the nets at its errors.
+    /// Step 3, checks and views; a dirty route is repaired by re-routing the nets at its errors.
     pub(super) fn check(&mut self, r: &Routed) -> Result<Checked> {
         let project = &r.project;
         let die_growth = project.grow_die()?;
@@ -299,7 +299,7 @@ impl<'a> Run<'a> {
         })
     }
 
-    /// 4. The routed DEF's boundary and counts, the GDS read back, the laid-out netlist
+    /// Step 4, the routed DEF's boundary and counts, the GDS read back, the laid-out netlist
     /// proven equivalent to the RTL.
     pub(super) fn inspect(&mut self, s: &Synthesised, r: &Routed) -> Result<Inspected> {
         (self.progress)("boundary, GDS, equivalence");
@@ -348,7 +348,7 @@ impl<'a> Run<'a> {
         })
     }
 
-    /// 5. Post-route timing at every corner, the option for a corner missed.
+    /// Step 5, post-route timing at every corner, the option for a corner missed.
     pub(super) fn post_route_timing(
         &mut self,
         s: &Synthesised,
@@ -398,7 +398,7 @@ impl<'a> Run<'a> {
         Ok(timed_corners)
     }
 
-    /// 6. The picture (klayout), drawn into the project's layout directory.
+    /// Step 6, the picture (klayout), drawn into the project's layout directory.
     pub(super) fn picture(&mut self, r: &Routed) -> Result<PathBuf> {
         (self.progress)("picture");
         let t = Instant::now();
