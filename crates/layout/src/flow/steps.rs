@@ -54,6 +54,18 @@ impl Synthesised {
     fn main(&self) -> &Synthesis {
         &self.points[0].synthesis
     }
+
+    /// The configured pixel's synthesis as the report gives it.
+    fn figures(&self) -> SynthFigures {
+        let (syn, timing) = (self.main(), self.points[0].timing.as_ref());
+        SynthFigures {
+            area_um2: syn.total_area_um2,
+            cells: syn.cell_count,
+            f_max_mhz: timing.map(|t| t.f_max_mhz),
+            slack_ns: timing.map(|t| self.period_ns - t.critical_path_ns),
+            key: syn.key.clone(),
+        }
+    }
 }
 
 /// Step 2's product: the qflow project, placed and routed.
@@ -431,20 +443,9 @@ impl<'a> Run<'a> {
             gds,
             equivalence,
         } = inspected;
-        let syn = s.main();
         let def = crate::def::parse_def(&def_text, &s.sizes, &self.tech.fill, &def_path)?;
         let bins_per_pitch = self.bins_per_pitch(&s, &def)?;
-        let main = &s.points[0];
-        let synthesis = SynthFigures {
-            area_um2: syn.total_area_um2,
-            cells: syn.cell_count,
-            f_max_mhz: main.timing.as_ref().map(|t| t.f_max_mhz),
-            slack_ns: main
-                .timing
-                .as_ref()
-                .map(|t| s.period_ns - t.critical_path_ns),
-            key: syn.key.clone(),
-        };
+        let synthesis = s.figures();
         let Checks {
             drc_errors,
             drc_rules,
