@@ -7,8 +7,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 use tofprobe_dsp::Window;
-use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::dft::amplitude_spectrum;
+use tofprobe_dsp::selected_bins::SelectedBins;
 use tofprobe_experiments::paper::table2;
 
 use crate::BenchError;

@@ -20,7 +20,7 @@
 
 use serde::Serialize;
 use tofprobe_design::ResolvedDesign;
-use tofprobe_pixel::bench::{
+use tofprobe_pixel::speed::{
     bench_cycle, bench_fold, bench_segmented, bench_transaction, synthetic_rom,
 };
 

@@ -181,7 +181,7 @@ pub fn measure(svg: Option<&Path>, rom_dir: Option<&Path>) -> Result<SdReport, B
     let depth = loaded.document.probe.depth(N_ROM);
     let b = loaded.pixel.bins;
     let chip_bins =
-        tofprobe_design::bins::bin_indices(&loaded.document, b, depth as u64).map_err(err)?;
+        tofprobe_design::bin_choice::bin_indices(&loaded.document, b, depth as u64).map_err(err)?;
     let chip_design = ProbeDesign::with_known_limit(
         &loaded.document.probe,
         design.max_stable_amplitude,

@@ -1,17 +1,17 @@
 //! The configuration document and its ONE resolution: [`Document`] (the TOML file or the
 //! embedded default) → [`resolve`] → [`ResolvedDesign`] (scene, sensor, pixel parameters
 //! and widths, Fourier bins, the stability-checked ΣΔ probe design). Every `tofprobe`
-//! command starts from a `ResolvedDesign`. Also the bin chooser ([`bins`]), the chip the RTL
+//! command starts from a `ResolvedDesign`. Also the bin chooser ([`bin_choice`]), the chip the RTL
 //! commands build ([`chip`]: array shape, the broadcast probe ROM by the ROM policy
 //! [`rom_policy`], the sequencer) and `adders = "auto"`'s pure choice ([`adders`]).
 
 pub mod adders;
-pub mod analysis_mode;
 pub mod array;
-pub mod bins;
+pub mod bin_choice;
 pub mod chip;
 pub mod document;
 pub mod error;
+pub mod mode_decision;
 pub mod overrides;
 pub mod probe_cache;
 mod rate_image;
@@ -20,11 +20,11 @@ pub mod resolve;
 pub mod rom_policy;
 
 pub use adders::{AdderChoice, AdderStatus, AdderTiming, CandidateTiming};
-pub use analysis_mode::ModeDecision;
 pub use array::{ArrayConfig, ArrayLevel, RateMap, SensorArray, pixel_seed};
 pub use chip::{Chip, RomPurpose, SequencerKind};
 pub use document::{Document, SIZING_SIGMAS, read_text, schema};
 pub use error::DesignError;
+pub use mode_decision::ModeDecision;
 pub use probe_cache::ProbeCache;
 pub use readout::{Readout, ReadoutKeys};
 pub use resolve::{ResolvedDesign, load, resolve, resolve_timed, resolve_with};

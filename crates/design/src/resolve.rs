@@ -4,17 +4,18 @@
 //! command starts from a `ResolvedDesign`, so `tofprobe config FILE` accepts exactly what
 //! the other commands accept and every refusal reads the same.
 
+mod steps;
+
 use std::path::Path;
 
-use tofprobe_dsp::sd::{ProbeDesign, ProbeRom, RomMode};
-use tofprobe_pixel::{Mode, PixelContext, PixelError, PixelParams};
+use tofprobe_dsp::sd::{ProbeDesign, ProbeRom};
+use tofprobe_pixel::{PixelContext, PixelError, PixelParams};
 use tofprobe_scene::{PhotonSource, Scene};
 
 use crate::adders::{AdderStatus, AdderTiming};
-use crate::analysis_mode::{ModeDecision, check_haar, decide_mode};
-use crate::bins::bin_indices_in;
 use crate::document::Document;
 use crate::error::DesignError;
+use crate::mode_decision::ModeDecision;
 use crate::probe_cache::ProbeCache;
 
 /// Longest frame a windowed ROM (L = N) may span: 2^24 pulses (1.68 s at 10 MHz).
@@ -89,189 +90,25 @@ pub fn resolve_timed(
     cache: &mut ProbeCache,
     timing: Option<&dyn AdderTiming>,
 ) -> Result<ResolvedDesign, DesignError> {
-    let scene_err = |e| DesignError::scene(origin, e);
-    let probe_err = |e| DesignError::probe(origin, e);
-    let pixel_err = |e| DesignError::pixel(origin, e);
     let d = &document;
-    d.sensor.validate().map_err(scene_err)?;
-    let scene = Scene::new(&d.scene).map_err(scene_err)?;
-    d.acquisition
-        .validate(d.sensor.laser_rate_hz)
-        .map_err(scene_err)?;
-    match &d.array {
-        // An array checks the scene over the whole plane (its spatial motions' bounds);
-        // each pixel's own scene is a point of it.
-        Some(_) => tofprobe_scene::check_scene(&d.sensor, &scene).map_err(scene_err)?,
-        None => {
-            PhotonSource::new(&d.sensor, &scene, d.acquisition.seed).map_err(scene_err)?;
-        }
-    }
-    let frame = d.pixel.frame_pulses.unwrap_or(d.pulses());
-    // A frame is part of the acquisition (docs: "N: pulses per frame; default: the whole
-    // acquisition"): a longer one would read pulses that were never simulated.
-    if frame > d.pulses() {
-        return Err(pixel_err(PixelError::invalid(
-            "frame_pulses",
-            frame,
-            format!(
-                "a frame is at most the acquisition's {} pulses (acquisition.pulses, or \
-                 acquisition.duration_s × sensor.laser_rate_hz)",
-                d.pulses()
-            ),
-            format!("{} (or leave pixel.frame_pulses out)", d.pulses()),
-        )));
-    }
-    // The pixel reads the ROM the probe design generates: its depth defaults to the
-    // `[probe]` design's (L = N windowed, `probe.rom_depth` periodic).
-    // A Fourier pixel addresses exactly that ROM: another `pixel.rom_depth` would read the
-    // generated ROM on the wrong bin grid (it used to be replaced silently by `rtl`).
-    let context = d.pixel_context();
-    let mut px = d.pixel.clone();
-    let mode = decide_mode(d, &mut px, frame);
-    // Haar mode reads no ΣΔ probe ROM: a `[probe]` section is ignored (with a warning,
-    // `ignored_probe_warning`), neither validated nor checked against the frame.
-    let fourier = mode.mode == Mode::Fourier;
-    if fourier {
-        d.probe.validate().map_err(probe_err)?;
-        d.probe.check_frame(frame).map_err(probe_err)?;
-    }
-    // A windowed ROM is one frame deep, and `simulate` builds it whole (≈ 24 bytes per
-    // pulse): bounded here, once, as `rtl` and `vectors` bound theirs.
-    if mode.mode == Mode::Fourier
-        && d.probe.rom_mode == RomMode::Windowed
-        && frame > MAX_WINDOWED_FRAME
-    {
-        return Err(probe_err(
-            tofprobe_dsp::DspError::out_of_range(
-                "probe.rom_mode",
-                "\"windowed\"",
-                format!(
-                    "a windowed ROM is one frame deep (L = N = {frame} pulses from acquisition or \
-                     pixel.frame_pulses); at most {MAX_WINDOWED_FRAME} pulses (≈ 400 MB of ROM)"
-                ),
-            )
-            .with_hint(format!(
-                "rom_mode = \"periodic\", or pixel.frame_pulses <= {MAX_WINDOWED_FRAME}"
-            )),
-        ));
-    }
-
-    let mut notes: Vec<String> = mode.auto.iter().filter_map(|c| c.note.clone()).collect();
-    if mode.mode == Mode::Haar {
-        notes.extend(check_haar(d, &px, &mode, frame, origin)?);
-    }
-    let probe_depth = if fourier {
-        d.probe.depth(frame)
-    } else {
-        tofprobe_dsp::sd::ProbeConfig::default().depth(frame)
-    };
-    match px.rom_depth {
-        None => px.rom_depth = Some(probe_depth),
-        Some(l) if l != probe_depth && mode.mode == Mode::Fourier => {
-            return Err(pixel_err(PixelError::invalid(
-                "rom_depth",
-                l,
-                format!(
-                    "the pixel reads the [probe] ROM, which is L = {probe_depth} deep ({})",
-                    match d.probe.rom_mode {
-                        RomMode::Periodic => "probe.rom_depth, periodic mode",
-                        RomMode::Windowed => "one frame, windowed mode",
-                    }
-                ),
-                format!("{probe_depth} (or leave pixel.rom_depth out)"),
-            )));
-        }
-        Some(_) => {}
-    }
-    // An OSR whose band f_s/(2·OSR) lies below the ROM's first bin is the OSR's fault
-    // (it used to be reported against `pixel.bins` or `pixel.rom_depth`).
-    if mode.mode == Mode::Fourier && d.pixel.frequencies_hz.is_empty() {
-        let l = px.rom_depth.unwrap_or(probe_depth) as u64;
-        if let Err(why) = crate::bins::band_check(l, d.probe.osr, 1) {
-            return Err(probe_err(
-                tofprobe_dsp::DspError::out_of_range(
-                    "probe.osr",
-                    tofprobe_io::text::number(d.probe.osr),
-                    format!(
-                        "osr < L/2 = {}: {why}; the band must hold at least the ROM's first bin f_s/L",
-                        l as f64 / 2.0
-                    ),
-                )
-                .with_hint(format!("osr = {}", (l as f64 / 4.0).clamp(4.0, 32.0))),
-            ));
-        }
-    }
-    // `adders = "auto"`: A and C from measured timing when an oracle is given
-    // (crate::adders), else a provisional A, open; then the pixel resolves with them like any
-    // explicit value.
-    // `timing_liberty` is read only to time the candidates of `adders = "auto"`: beside an
-    // explicit A it would be ignored silently, so it is refused, naming both keys.
-    if let (Some(lib), tofprobe_pixel::config::Choice::Value(a)) =
-        (&d.pixel.timing_liberty, &d.pixel.adders)
-    {
-        return Err(pixel_err(PixelError::invalid(
-            "timing_liberty",
-            format!("\"{}\"", tofprobe_io::text::clip(lib, 60)),
-            format!(
-                "it is read only by pixel.adders = \"auto\" (the liberty its candidates are timed on); \
-                 pixel.adders = {a} is explicit, so it would be ignored"
-            ),
-            "remove pixel.timing_liberty, or set pixel.adders = \"auto\"",
-        )));
-    }
-    let adders = if matches!(px.adders, tofprobe_pixel::config::Choice::Auto(_)) {
-        let (status, a, c) = match timing {
-            Some(t) => {
-                let choice = crate::adders::choose(&px, &context, origin, t)?;
-                notes.push(choice.note());
-                let (a, c) = (choice.adders, choice.cycles_per_pulse);
-                (AdderStatus::Chosen(choice), a, c)
-            }
-            None => {
-                let (a, c) = crate::adders::provisional(&px, &context)
-                    .map_err(|e| pixel_err(derived_from(e, d)))?;
-                notes.push(crate::adders::open_note(a));
-                (AdderStatus::Open { provisional: a }, a, c)
-            }
-        };
-        px.adders = tofprobe_pixel::config::Choice::Value(a);
-        px.cycles_per_pulse = c;
-        status
-    } else {
-        AdderStatus::Explicit
-    };
-    let pixel = px
-        .resolve(&context)
-        .map_err(|e| pixel_err(derived_from(e, d)))?;
-
-    let (bins, probe_design) = if pixel.mode == Mode::Fourier {
-        let bins =
-            bin_indices_in(d, &context, pixel.bins, pixel.rom_depth as u64).map_err(pixel_err)?;
-        // The modulator's stability limit is lowest towards DC: check at the lowest bin.
-        let lowest = bins.iter().copied().min().unwrap_or(1).max(1);
-        let f_norm = lowest as f64 / pixel.rom_depth as f64;
-        let design = cache.design(&d.probe, f_norm).map_err(probe_err)?;
-        (bins, Some(design))
-    } else {
-        (Vec::new(), None)
-    };
-    let array = match &d.array {
-        Some(a) => Some(crate::array::resolve_array(
-            a, &d.sensor, &d.scene, &pixel, origin,
-        )?),
-        None => None,
-    };
+    steps::check_scene(d, origin)?;
+    let frame = steps::frame(d, origin)?;
+    let mut r = steps::Resolution::new(d, origin, frame);
+    r.check_probe()?;
+    r.rom_depth()?;
+    let adders = r.adders(timing)?;
+    let parts = r.finish(cache)?;
     Ok(ResolvedDesign {
         origin: origin.to_string(),
         document,
-        context,
-        pixel,
-        bins,
-        probe_design,
-        mode,
-        notes,
+        context: parts.context,
+        pixel: parts.pixel,
+        bins: parts.bins,
+        probe_design: parts.probe_design,
+        mode: parts.mode,
+        notes: parts.notes,
         adders,
-        array,
+        array: parts.array,
     })
 }
 
@@ -318,7 +155,7 @@ impl ResolvedDesign {
     /// mode), as `ORIGIN: …`: the front ends show it (the CLI on stderr as `warning: …`,
     /// Python as a `UserWarning`); the library only decides it.
     pub fn ignored_warning(&self) -> Option<String> {
-        crate::analysis_mode::ignored_probe_warning(&self.document, self.pixel.mode)
+        crate::mode_decision::ignored_probe_warning(&self.document, self.pixel.mode)
             .map(|w| format!("{}: {w}", self.origin))
     }
 

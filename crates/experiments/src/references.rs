@@ -1,7 +1,7 @@
 //! Float references of one frame of a caller's own detections (TDC codes, `None` = no
 //! detection), at the design's probe bins, composed from the one implementation of each:
 //! the depth of a code (`PhotonSource::code_to_depth_mm`), the float front end's hold
-//! ([`crate::records::held_record`]), the selected-bin DFT (`dsp::bins::SelectedBins`) at
+//! ([`crate::records::held_record`]), the selected-bin DFT (`dsp::selected_bins::SelectedBins`) at
 //! the ROM's bins as N-point DFT indices ([`dft_bins`]) with the ROM's
 //! window, float ΣΔ probing (`dsp::sd::probe_detections` + `normalise`, α = 2^−S: the
 //! pixel's float twin), and the closed-form noise floor (eq. 12 with the 1NN-hold and
@@ -10,9 +10,9 @@
 
 use rustfft::num_complex::Complex64;
 use tofprobe_design::{DesignError, ResolvedDesign};
-use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::closed_form::{MixtureParams, noise_floor_hold_mm};
 use tofprobe_dsp::sd::{ProbeRom, normalise, probe_detections};
+use tofprobe_dsp::selected_bins::SelectedBins;
 
 use crate::error::ExperimentError;
 use crate::records::held_record;

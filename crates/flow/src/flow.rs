@@ -12,18 +12,17 @@
 //! scalloping (≈ 12 % for Blackman at half a bin), which would hide whether the chain
 //! reads the right amplitude.
 
+mod steps;
+
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use tofprobe_cosim::{CosimOptions, cosim};
-use tofprobe_design::rom_policy::RtlOverrides;
-use tofprobe_design::{Chip, ResolvedDesign, RomPurpose};
-use tofprobe_pixel::Mode;
+use tofprobe_design::ResolvedDesign;
 use tofprobe_pixel::fixed::sign_extend as sext;
-use tofprobe_rtlgen::write::write_atomic;
 
 use crate::error::FlowError;
-use crate::sizing::{SizeOptions, size_report};
+use crate::sizing::SizeOptions;
+use steps::FlowRun;
 
 /// What the flow runs on a design.
 #[derive(Debug, Clone, PartialEq)]
@@ -153,192 +152,18 @@ pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome,
     r
 }
 
+/// The flow's steps in order; the report's sections are written as their step runs.
 fn run_flow_in(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome, FlowError> {
     let t_start = std::time::Instant::now();
-    let config = &design.document;
-    let fs = config.sensor.laser_rate_hz;
-    let n_override = if a.full_frame {
-        a.frame_pulses
-    } else {
-        let band = fs / (2.0 * config.probe.osr);
-        // Haar frames must be a power of two and have no bins to align.
-        let haar = design.pixel.mode == tofprobe_pixel::Mode::Haar;
-        let probe = &config.probe;
-        let periodic = probe.rom_mode == tofprobe_dsp::sd::RomMode::Periodic;
-        Some(if haar {
-            a.frame_pulses.unwrap_or(SHORT_FRAME)
-        } else if periodic {
-            // The bins are already on the ROM's grid: whole periods, as many as fit.
-            a.frame_pulses
-                .unwrap_or_else(|| periodic_short_frame(probe.rom_depth as u64))
-        } else {
-            a.frame_pulses
-                .unwrap_or_else(|| short_frame(design.tones(), fs, band))
-        })
-    };
-    let overrides = RtlOverrides {
-        frame_pulses: n_override,
-        rom_depth: None,
-    };
-    let chip = Chip::of(design, &overrides, RomPurpose::Configured)?;
-    let (p, rom) = (chip.pixel, chip.rom);
-    if a.signoff {
-        // Before the co-simulation: a trace too long for gate level is refused at once.
-        crate::signoff::check_length(&p, a.frames)?;
-    }
-    // Scene → TDC stream.
-    let source = design.photon_source()?;
-    let mut stim = vec![None; (a.frames * p.frame_pulses) as usize];
-    source.fill(0, &mut stim);
-    let mut o = CosimOptions::new(&a.out);
-    o.frames = a.frames;
-    o.seed = config.acquisition.seed;
-    o.stimulus = Some(stim);
-    o.rom = Some(rom.words.clone());
-    if a.frames * p.frame_pulses * p.cycles_per_pulse as u64 > 2_000_000 {
-        o.digest_pulses = 1024;
-        o.profile = tofprobe_cosim::BuildProfile::Speed;
-    }
-    let r = cosim(&p, &o)?;
-    let lsb_mm = config.sensor.tdc_lsb_mm();
-    let mut md = String::new();
-    let _ = writeln!(md, "{REPORT_TITLE}\n");
-    let _ = writeln!(
-        md,
-        "Configuration: {} (hash {}), {:?} mode, N = {} pulses/frame, {} frame(s), L = {}.\n\nROM: {}.\n",
-        tofprobe_io::text::sanitize(&design.origin),
-        tofprobe_rtlgen::config_hash(&p),
-        p.mode,
-        p.frame_pulses,
-        a.frames,
-        p.rom_depth,
-        rom.note
-    );
-    if let Some(o) = &a.options {
-        let _ = writeln!(
-            md,
-            "## Recommended architecture\n\nThis pixel is the option `{}` that `tofprobe size --options` recommends (target: tone error ≤ {} µm against the float DFT; the table below).\n",
-            o.recommendation.option, o.target_error_um
-        );
-    }
-    let _ = writeln!(md, "## Verdict\n");
-    let _ = writeln!(
-        md,
-        "Co-simulation (Verilator vs the pixel crate's cycle model): **{}**, {} cycles, {} mismatches, Verilator {:.2} s, model {:.2} s (the model {:.1}x Verilator).{}\n",
-        if r.pass { "PASS" } else { "FAIL" },
-        r.cycles,
-        r.outcome.mismatches,
-        r.verilator_seconds,
-        r.model_seconds,
-        r.model_speedup(),
-        r.first
-            .as_ref()
-            .map(|m| format!(
-                " First mismatch: cycle {} pulse {} {} expected {} actual {}.",
-                m.cycle, m.pulse, m.signal, m.expected, m.actual
-            ))
-            .unwrap_or_default()
-    );
-    let _ = writeln!(md, "## Register widths\n");
-    let _ = writeln!(
-        md,
-        "{} registers x W = {} bits ({} bits of readout per frame); operand {} bits (T = {}, F = {}{}); TDC LSB {:.4} mm.\n",
-        p.registers(),
-        p.width,
-        p.registers() as u64 * u64::from(p.width),
-        p.operand_bits(),
-        p.tdc_bits,
-        p.effective_frac_bits(),
-        // G only where it differs from F, so the default's report reads as before.
-        if p.register_frac_bits() < p.effective_frac_bits() {
-            format!(", G = {}", p.register_frac_bits())
-        } else {
-            String::new()
-        },
-        lsb_mm
-    );
-    let mut headline = String::new();
-    if let Some(f) = r.readouts.first() {
-        if p.mode == Mode::Fourier {
-            headline = spectrum(&mut md, &p, f, rom.sd.as_ref(), lsb_mm);
-        } else {
-            headline =
-                tofprobe_experiments::transients::flow_section(&mut md, design, &p, f, &a.out)?;
-        }
-    }
-    let size_line = if a.no_size {
-        "sizing skipped (--no-size)".to_string()
-    } else {
-        let sa = SizeOptions {
-            liberty: None,
-            no_sky130: !a.sky130,
-            sky130_pdk: None,
-            node_nm: 40.0,
-            // The configured point only: the B/W sweeps are `tofprobe size`'s job.
-            sweep_bins: Some(vec![p.bins as u64]),
-            sweep_widths: Some(vec![p.width]),
-            cache: None,
-            // The flow reports the corners; the search for the adders that meet a missed
-            // one is `tofprobe size`'s (minutes of synthesis).
-            corner_trials: 0,
-        };
-        match size_report(design, &sa) {
-            Ok(s) => tofprobe_eda::markdown::summary(&s),
-            // Non-fatal: the flow's verdict is the co-simulation; say what is missing.
-            Err(e) => format!(
-                "sizing not available ({e}); run scripts/install-tools.sh, or pass --no-size"
-            ),
-        }
-    };
-    let _ = writeln!(
-        md,
-        "## Sizing\n\n{size_line}{}\n",
-        if a.sky130 {
-            ""
-        } else {
-            " (sky130 skipped; --sky130 includes it)"
-        }
-    );
-    if let Some(o) = &a.options {
-        md += &tofprobe_experiments::options::markdown::render(o);
-        md += "\n";
-    }
-    let mut signoff = Vec::new();
-    if a.signoff {
-        let _ = writeln!(md, "## Sign-off\n");
-        if r.pass {
-            signoff = crate::signoff::sign_off_all(
-                &p,
-                fs,
-                &r.rtl_dir,
-                &r.vectors_dir,
-                &a.out.join("signoff"),
-            )?;
-            for l in &signoff {
-                let _ = writeln!(md, "- {}", l.text);
-            }
-            let _ = writeln!(md);
-        } else {
-            let _ = writeln!(md, "Not run: the co-simulation failed.\n");
-        }
-    }
-    let seconds = t_start.elapsed().as_secs_f64();
-    let _ = writeln!(md, "Flow time: {seconds:.1} s.");
-    let path = a.out.join("report.md");
-    refuse_foreign_report(&path)?;
-    write_atomic(&path, md.as_bytes())?;
-    crate::flowset::seal(&a.out)?;
-    Ok(FlowOutcome {
-        pass: r.pass && signoff.iter().all(|l| l.pass()),
-        frame_pulses: p.frame_pulses,
-        cycles: r.cycles,
-        mismatches: r.outcome.mismatches,
-        seconds,
-        headline,
-        size_line,
-        report: path,
-        signoff,
-    })
+    let mut run = FlowRun::new(design, a)?;
+    let r = run.cosimulate()?;
+    run.write_verdict(&r);
+    run.write_widths();
+    let headline = run.write_readout(&r)?;
+    let size_line = run.size_line();
+    run.write_sizing(&size_line);
+    let signoff = run.sign_off(&r)?;
+    run.finish(t_start, &r, headline, size_line, signoff)
 }
 
 /// First line of every flow report: a `report.md` that does not start with it was written by

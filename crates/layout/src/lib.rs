@@ -9,7 +9,6 @@
 //! (klayout), its area turned into bins per pitch, and judged (`verdict`). See
 //! docs/layout.md.
 
-pub mod bins;
 pub mod boundary;
 pub mod corners;
 pub mod def;
@@ -20,6 +19,7 @@ pub mod gds;
 pub mod netlist;
 pub mod options;
 pub mod picture;
+pub mod pitch_bins;
 pub mod qflow;
 pub mod readers;
 pub mod repair;

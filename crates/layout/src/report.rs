@@ -6,8 +6,8 @@ use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
 pub use crate::Step;
-use crate::bins::BinsPerPitch;
 use crate::def::DefFigures;
+use crate::pitch_bins::BinsPerPitch;
 use crate::sta::PostRoute;
 
 pub mod verdict;

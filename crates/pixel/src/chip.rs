@@ -3,7 +3,7 @@
 //! readout walk over the pixels (row-major, one readout strobe every slot), single-buffered
 //! after the frame, double-buffered beside the next one. The single pixel's reference
 //! sequencer ([`crate::Sequencer`]) steps it walking one pixel (slot R + 1); the array's
-//! register-level model (`tofprobe_array::rtl`) steps it walking the array. Neither counts
+//! register-level model (`tofprobe_array::rtl_model`) steps it walking the array. Neither counts
 //! the schedule itself, so the two tops cannot disagree about it.
 
 /// What the readout walks: the pixels, the row's length, the slot and the buffering.

@@ -5,7 +5,7 @@
 //! S = 5 (α = 1/32), F = [`crate::DEFAULT_FRAC_BITS`], T from the sensor, N from the
 //! acquisition, L = N (one windowed ROM period per frame), W from the sizing. Haar: U =
 //! [`DEFAULT_HAAR_SCALES`]. `mode = "auto"` is decided from the scene by the design's
-//! resolution (`tofprobe_dsp::analysis_mode::mode_for_scene`) before this section resolves.
+//! resolution (`tofprobe_dsp::scene_analysis::mode_for_scene`) before this section resolves.
 
 use serde::{Deserialize, Serialize};
 

@@ -22,10 +22,11 @@
 //! - [`sizing`]: register widths, readout bytes and compression from a scene;
 //! - [`random`]: the one generator of random valid parameters (the tests', `cosim --random`'s);
 //! - [`spectrum`]: the bit-true spectrum of a scene for `tofprobe simulate`;
-//! - [`superpixel`]: the averaging of G × G SPADs in front of the datapath ([`Superpixel`]).
+//! - [`superpixel`]: the averaging of G × G SPADs in front of the datapath ([`Superpixel`]);
+//! - [`speed`]: the fidelities' speed (pulses and clock edges per second, `tofprobe bench
+//!   pixel`) and the thread CPU clock benchmarks are judged on.
 
 pub mod autobins;
-pub mod bench;
 pub mod chip;
 pub mod config;
 pub mod cycle;
@@ -46,6 +47,7 @@ pub mod segments;
 pub mod sequencer;
 pub mod sizing;
 pub mod spectrum;
+pub mod speed;
 pub mod superpixel;
 pub mod transaction;
 pub mod valid_codes;

@@ -153,11 +153,59 @@ pub fn render_array(
     o: &RenderOptions,
     a: &ArraySpec,
 ) -> Result<Vec<RtlFile>, RtlError> {
-    let bad = |field: &'static str, value: String, allowed: String| RtlError::Array {
+    let tile = check_shape(p, o, a)?;
+    let sp = check_superpixel(p, a)?;
+    check_fault(a, &tile)?;
+    check_double_buffer(p, a)?;
+    // The pixel and the ROM exactly as the single pixel's set has them (the pixel with its
+    // shadow registers when double-buffered; with a pixel fault, in every pixel).
+    let pixel_fault = a.fault.and_then(ArrayFault::pixel);
+    let with_fault = RenderOptions {
+        mutation: pixel_fault.or(o.mutation),
+        ..o.clone()
+    };
+    let o = &with_fault;
+    let mut files: Vec<RtlFile> = render_set(p, rom, o, a.double_buffer)?
+        .into_iter()
+        .filter(|f| f.template != "top.v")
+        .collect();
+    let (pixel_name, rom_name, _) = crate::naming::module_names(&o.module_prefix);
+    let seq_name = crate::naming::sequencer_module_name(&o.module_prefix);
+    let name = array_module_name(&o.module_prefix);
+    let names = ModuleNames {
+        name: &name,
+        pixel_name: &pixel_name,
+        rom_name: &rom_name,
+        seq_name: &seq_name,
+    };
+    let t = array_template(p, o, a, &tile, names);
+    if let Some(sp) = &sp {
+        let fault = a.fault.filter(|f| f.in_superpixel());
+        files.push(crate::superpixel::render_superpixel_with(p, sp, o, fault)?);
+    }
+    files.push(RtlFile {
+        name: format!("{name}.v"),
+        template: "array.v",
+        contents: t.render().map_err(|e| RtlError::Render {
+            template: "array.v",
+            message: e.to_string(),
+        })? + "\n",
+    });
+    Ok(files)
+}
+
+/// The refusal of `field`'s `value`, naming what is `allowed`.
+fn bad(field: &'static str, value: String, allowed: String) -> RtlError {
+    RtlError::Array {
         field,
         value,
         allowed,
-    };
+    }
+}
+
+/// The sequencer, the shape, the readout's beats and slot, and the rendered tile: the tile
+/// (the whole array when none is asked for) or the first of them that is refused.
+fn check_shape(p: &PixelParams, o: &RenderOptions, a: &ArraySpec) -> Result<ArrayTile, RtlError> {
     if o.directed.is_some() {
         return Err(bad(
             "sequencer",
@@ -167,7 +215,6 @@ pub fn render_array(
                 .into(),
         ));
     }
-    let np = a.rows * a.cols;
     if a.rows == 0 || a.cols == 0 || a.rows > 4096 || a.cols > 4096 {
         return Err(bad(
             "array.rows × array.cols",
@@ -195,8 +242,7 @@ pub fn render_array(
         ));
     }
     let tile = a.tile.unwrap_or(ArrayTile::whole(a.rows, a.cols));
-    let npt = tile.pixels();
-    if npt == 0 || tile.row0 + tile.rows > a.rows || tile.col0 + tile.cols > a.cols {
+    if tile.pixels() == 0 || tile.row0 + tile.rows > a.rows || tile.col0 + tile.cols > a.cols {
         return Err(bad(
             "tile",
             format!(
@@ -209,6 +255,14 @@ pub fn render_array(
             ),
         ));
     }
+    Ok(tile)
+}
+
+/// The superpixel's front end for G ≥ 2 (none for G = 1), or G refused.
+fn check_superpixel(
+    p: &PixelParams,
+    a: &ArraySpec,
+) -> Result<Option<tofprobe_pixel::Superpixel>, RtlError> {
     let g = a.superpixel as usize;
     let sp = (g > 1)
         .then(|| tofprobe_pixel::Superpixel::new(a.superpixel, p.tdc_bits))
@@ -227,49 +281,54 @@ pub fn render_array(
             format!("1..={}", tofprobe_pixel::superpixel::MAX_SUPERPIXEL),
         ));
     }
+    Ok(sp)
+}
+
+/// An array mutant refused where it has nothing to break: its row or pixel outside the
+/// tile, or the part it breaks (a second pixel, the superpixel, the double buffer) absent.
+fn check_fault(a: &ArraySpec, tile: &ArrayTile) -> Result<(), RtlError> {
+    let (np, npt) = (a.rows * a.cols, tile.pixels());
     match a.fault {
-        Some(ArrayFault::OrderSwap) if np < 2 => {
-            return Err(bad(
-                "mutation",
-                "order_swap".into(),
-                "an array of 2 pixels or more".into(),
-            ));
-        }
+        Some(ArrayFault::OrderSwap) if np < 2 => Err(bad(
+            "mutation",
+            "order_swap".into(),
+            "an array of 2 pixels or more".into(),
+        )),
         Some(ArrayFault::RowLate { row } | ArrayFault::RowStuck { row })
             if !(tile.row0..tile.row0 + tile.rows).contains(&row) =>
         {
-            return Err(bad(
+            Err(bad(
                 "mutation row",
                 row.to_string(),
                 format!("{}..{}", tile.row0, tile.row0 + tile.rows),
-            ));
+            ))
         }
-        Some(f) if f.in_superpixel() && a.superpixel < 2 => {
-            return Err(bad(
-                "mutation",
-                f.name().into(),
-                "a superpixel array (array.superpixel ≥ 2)".into(),
-            ));
-        }
-        Some(ArrayFault::SwapLate) if !a.double_buffer => {
-            return Err(bad(
-                "mutation",
-                "swap_late".into(),
-                "a double-buffered array (array.double_buffer = true)".into(),
-            ));
-        }
+        Some(f) if f.in_superpixel() && a.superpixel < 2 => Err(bad(
+            "mutation",
+            f.name().into(),
+            "a superpixel array (array.superpixel ≥ 2)".into(),
+        )),
+        Some(ArrayFault::SwapLate) if !a.double_buffer => Err(bad(
+            "mutation",
+            "swap_late".into(),
+            "a double-buffered array (array.double_buffer = true)".into(),
+        )),
         Some(ArrayFault::NeighbourTdc { row, col }) if !tile.contains(row, col) || npt < 2 => {
-            return Err(bad(
+            Err(bad(
                 "mutation pixel",
                 format!("({row}, {col})"),
                 format!(
                     "inside the rendered {} × {} pixels (2 pixels or more)",
                     tile.rows, tile.cols
                 ),
-            ));
+            ))
         }
-        _ => {}
+        _ => Ok(()),
     }
+}
+
+/// The double buffer's swap edge needs a cycle after the last pulse's last register write.
+fn check_double_buffer(p: &PixelParams, a: &ArraySpec) -> Result<(), RtlError> {
     if a.double_buffer && p.cycles_per_pulse <= p.slots() {
         return Err(bad(
             "pixel.cycles_per_pulse",
@@ -281,24 +340,26 @@ pub fn render_array(
             ),
         ));
     }
-    // The pixel and the ROM exactly as the single pixel's set has them (the pixel with its
-    // shadow registers when double-buffered; with a pixel fault, in every pixel).
-    let pixel_fault = a.fault.and_then(ArrayFault::pixel);
-    let with_fault = RenderOptions {
-        mutation: pixel_fault.or(o.mutation),
-        ..o.clone()
-    };
-    let o = &with_fault;
-    let mut files: Vec<RtlFile> = render_set(p, rom, o, a.double_buffer)?
-        .into_iter()
-        .filter(|f| f.template != "top.v")
-        .collect();
-    let (pixel_name, rom_name, _) = crate::naming::module_names(&o.module_prefix);
-    let seq_name = crate::naming::sequencer_module_name(&o.module_prefix);
-    let name = array_module_name(&o.module_prefix);
+    Ok(())
+}
+
+/// The modules `array.v` names: its own and those it instantiates.
+struct ModuleNames<'a> {
+    name: &'a str,
+    pixel_name: &'a str,
+    rom_name: &'a str,
+    seq_name: &'a str,
+}
+
+/// `array.v`'s variables for a checked spec (`o` with the pixel fault applied).
+fn array_template<'a>(
+    p: &PixelParams,
+    o: &RenderOptions,
+    a: &ArraySpec,
+    tile: &ArrayTile,
+    names: ModuleNames<'a>,
+) -> ArrayT<'a> {
     let r = p.registers();
-    let ib = p.rd_index_bits();
-    let k = a.beats_per_word;
     let neighbour = match a.fault {
         Some(ArrayFault::NeighbourTdc { row, col }) => tile.local(row, col),
         _ => None,
@@ -307,11 +368,59 @@ pub fn render_array(
         Some(ArrayFault::RowLate { row } | ArrayFault::RowStuck { row }) => row,
         _ => 0,
     };
+    let acc = p.frame_pulses.saturating_mul(p.cycles_per_pulse as u64);
+    ArrayT {
+        header: array_header(p, o, a, tile, acc),
+        name: names.name,
+        pixel_name: names.pixel_name,
+        rom_name: names.rom_name,
+        seq_name: names.seq_name,
+        fourier: p.mode == Mode::Fourier,
+        mutation: a
+            .fault
+            .filter(|f| !f.in_superpixel() && f.pixel().is_none())
+            .map(ArrayFault::name)
+            .unwrap_or(""),
+        t: p.tdc_bits as usize,
+        w: p.width as usize,
+        r,
+        c: p.cycles_per_pulse,
+        n: p.frame_pulses,
+        ib: p.rd_index_bits() as usize,
+        aw: clog2(p.rom_depth as u64) as usize,
+        rows: a.rows,
+        cols: a.cols,
+        tile_row0: tile.row0,
+        tile_col0: tile.col0,
+        trows: tile.rows,
+        tcols: tile.cols,
+        b: a.bits as usize,
+        g: a.beat_cycles,
+        acc,
+        words: (0..=r).collect(),
+        fault_row,
+        neighbour,
+        sp: a.superpixel as usize,
+        sp_name: crate::superpixel::module_name(&o.module_prefix),
+        dbuf: a.double_buffer,
+    }
+}
+
+/// `array.v`'s header: the generator's, then the array's shape, readout, tile, superpixel,
+/// double buffer and mutant; `acc` is N·C.
+fn array_header(
+    p: &PixelParams,
+    o: &RenderOptions,
+    a: &ArraySpec,
+    tile: &ArrayTile,
+    acc: u64,
+) -> String {
+    let g = a.superpixel as usize;
     let mut h = header(p, "array.v", o);
     h.push_str(&format!(
         "\n// Array: {} x {} pixels, readout {} bits x {} beat(s) per word, one beat every {} \
          cycle(s), slot {} cycles (docs/pixel-contract.md \"Array\").",
-        a.rows, a.cols, a.bits, k, a.beat_cycles, a.slot_cycles
+        a.rows, a.cols, a.bits, a.beats_per_word, a.beat_cycles, a.slot_cycles
     ));
     if a.tile.is_some() {
         h.push_str(&format!(
@@ -329,8 +438,8 @@ pub fn render_array(
         ));
     }
     // D = P·S + 1; double-buffered, the frame is max(N·C + 1, D) cycles.
+    let np = a.rows * a.cols;
     let d = (np as u64).saturating_mul(a.slot_cycles).saturating_add(1);
-    let acc = p.frame_pulses.saturating_mul(p.cycles_per_pulse as u64);
     if a.double_buffer {
         h.push_str(&format!(
             "\n// Double-buffered: the readout streams each pixel's shadow while the next frame \
@@ -344,54 +453,7 @@ pub fn render_array(
             f.name()
         ));
     }
-    let t = ArrayT {
-        header: h,
-        name: &name,
-        pixel_name: &pixel_name,
-        rom_name: &rom_name,
-        seq_name: &seq_name,
-        fourier: p.mode == Mode::Fourier,
-        mutation: a
-            .fault
-            .filter(|f| !f.in_superpixel() && f.pixel().is_none())
-            .map(ArrayFault::name)
-            .unwrap_or(""),
-        t: p.tdc_bits as usize,
-        w: w as usize,
-        r,
-        c: p.cycles_per_pulse,
-        n: p.frame_pulses,
-        ib: ib as usize,
-        aw: clog2(p.rom_depth as u64) as usize,
-        rows: a.rows,
-        cols: a.cols,
-        tile_row0: tile.row0,
-        tile_col0: tile.col0,
-        trows: tile.rows,
-        tcols: tile.cols,
-        b: a.bits as usize,
-        g: a.beat_cycles,
-        acc,
-        words: (0..=r).collect(),
-        fault_row,
-        neighbour,
-        sp: g,
-        sp_name: crate::superpixel::module_name(&o.module_prefix),
-        dbuf: a.double_buffer,
-    };
-    if let Some(sp) = &sp {
-        let fault = a.fault.filter(|f| f.in_superpixel());
-        files.push(crate::superpixel::render_superpixel_with(p, sp, o, fault)?);
-    }
-    files.push(RtlFile {
-        name: format!("{name}.v"),
-        template: "array.v",
-        contents: t.render().map_err(|e| RtlError::Render {
-            template: "array.v",
-            message: e.to_string(),
-        })? + "\n",
-    });
-    Ok(files)
+    h
 }
 
 #[cfg(test)]

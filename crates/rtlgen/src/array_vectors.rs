@@ -1,12 +1,12 @@
 //! The array's golden vector files (docs/pixel-contract.md "Array"), beside the pixel's
 //! ([`crate::vectors`]): the per-input detections, the ports the array model
-//! (`tofprobe_array::rtl`, run by the flow and handed here as an [`ArrayTrace`]) shows
+//! (`tofprobe_array::rtl_model`, run by the flow and handed here as an [`ArrayTrace`]) shows
 //! every cycle, the readout stream and per-pixel digests, as the files
 //! `testbench/array_harness.cpp` (Verilator) and `testbench/array_tb.v` (Icarus) replay:
 //!
 //! - `array_params.vh`: `AR_TOP`, `AR_NP` (pixels present: all, or a tile's), `AR_T`,
 //!   `AR_B`, `AR_CYCLES`, `AR_PULSES`, and with `[array] superpixel = G > 1` `AR_NS` (the
-//!   SPAD inputs, AR_NP·G²), and with a mid-frame reset (`tofprobe_array::rtl::run_with_reset`)
+//!   SPAD inputs, AR_NP·G²), and with a mid-frame reset (`tofprobe_array::rtl_driver::run_with_reset`)
 //!   `AR_RESET_AT` (its cycle: `rst` is high then, and in power-up's two cycles);
 //! - `array_stim.hex`: one line per pulse the pixels sample, the P·(T+1)-bit value
 //!   {tdc[P·T−1:0], valid[P−1:0]} over the P inputs (pixel i = r·cols + c; with G > 1 the

@@ -5,7 +5,8 @@
 //! — during the readout; the frame is max(N·C + 1, D) cycles, the beats at the contract's
 //! cycles; and the shadow taken a cycle late is caught at the first beat it spoils.
 
-use tofprobe_array::rtl::{ArrayModel, run};
+use tofprobe_array::rtl_driver::run;
+use tofprobe_array::rtl_model::ArrayModel;
 use tofprobe_design::readout::{BROADCAST_LATENCY, Readout};
 use tofprobe_pixel::PixelParams;
 use tofprobe_pixel::sequencer::RESET_CYCLES;

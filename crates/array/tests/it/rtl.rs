@@ -1,10 +1,11 @@
-//! The array at the clock edge (`tofprobe_array::rtl`) against the contract: every pixel's
+//! The array at the clock edge (`tofprobe_array::rtl_model`, driven by `tofprobe_array::rtl_driver`) against the contract: every pixel's
 //! words in the stream are the words its own pixel model reads out under the pixel's
 //! reference sequence (a naive per-pixel drive, no array logic), the beats sit exactly at
 //! the cycles of the contract's formula, no pulse is refused, and each array fault changes
 //! the stream.
 
-use tofprobe_array::rtl::{ArrayModel, run};
+use tofprobe_array::rtl_driver::run;
+use tofprobe_array::rtl_model::ArrayModel;
 use tofprobe_design::readout::{Readout, ReadoutKeys};
 use tofprobe_pixel::{CycleModel, Mode, PinsIn, PixelParams};
 use tofprobe_rtlgen::ArrayFault;
@@ -155,7 +156,7 @@ fn check(p: &PixelParams, ro: &Readout, frames: u64, seed: u64) {
         ro.rows, ro.cols, ro.bits, ro.beat_cycles
     );
     // The tail (6 cycles) shows the next frame's first pulses, from 2 cycles after its start.
-    let tail = (tofprobe_array::rtl::TAIL_CYCLES - 2).div_ceil(p.cycles_per_pulse as u64);
+    let tail = (tofprobe_array::rtl_model::TAIL_CYCLES - 2).div_ceil(p.cycles_per_pulse as u64);
     assert_eq!(r.pulse_cycles.len() as u64, frames * p.frame_pulses + tail);
     // Every pixel's words are its own reference's, status 0 (nothing refused).
     for (q, (row, col)) in ro.order_iter().enumerate() {
@@ -279,7 +280,7 @@ fn a_tile_streams_its_pixels_at_the_whole_arrays_cycles() {
             );
         }
     }
-    let beats = |r: &tofprobe_array::rtl::ArrayRun| -> Vec<u64> {
+    let beats = |r: &tofprobe_array::rtl_driver::ArrayRun| -> Vec<u64> {
         (0..r.cycles())
             .filter(|&c| r.pins[c as usize].ro_valid)
             .collect()

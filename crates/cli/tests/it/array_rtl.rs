@@ -9,7 +9,8 @@
 
 use std::path::Path;
 
-use tofprobe_array::rtl::{ArrayModel, run};
+use tofprobe_array::rtl_driver::run;
+use tofprobe_array::rtl_model::ArrayModel;
 use tofprobe_design::{Chip, Document, RomPurpose, RtlOverrides, resolve};
 use tofprobe_flow::array::vectors::scene_detections;
 use tofprobe_flow::array::{ArrayCosimOptions, ArraySimulator, cosim_array};

@@ -19,15 +19,15 @@ pub mod timing;
 use std::time::Instant;
 
 use serde::Serialize;
-use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::closed_form::{
     hold_response_sq, mixture_gain, noise_floor_hold_mm, noise_floor_mm,
 };
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_detections};
+use tofprobe_dsp::selected_bins::SelectedBins;
 use tofprobe_pixel::autobins::choose_bins;
-use tofprobe_pixel::bench::bench_cycle;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
+use tofprobe_pixel::speed::bench_cycle;
 
 use tofprobe_design::{DesignError, ResolvedDesign};
 use tofprobe_scene::PhotonSource;
@@ -353,7 +353,7 @@ impl<'a> Ladder<'a> {
                 // accuracy is the transaction model's.
                 let bt = self.reading(Level::BitTrue)?;
                 let short = self.short_frame();
-                let rom = tofprobe_pixel::bench::synthetic_rom(short.rom_depth, short.registers());
+                let rom = tofprobe_pixel::speed::synthetic_rom(short.rom_depth, short.registers());
                 let cb = bench_cycle(&short, &rom, 1).map_err(|source| {
                     ExperimentError::from(DesignError::pixel(&self.design.origin, source))
                 })?;

@@ -11,8 +11,8 @@
 //!   against the bit-true model plus the held record and its full FFT.
 
 use serde::Serialize;
-use tofprobe_dsp::bins::SelectedBins;
 use tofprobe_dsp::dft::amplitude_spectrum;
+use tofprobe_dsp::selected_bins::SelectedBins;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
 
 use super::overrides::{shortened, with_overrides};

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use tofprobe_array::rtl::ArrayRun;
+use tofprobe_array::rtl_driver::ArrayRun;
 use tofprobe_cosim::RunOutcome;
 use tofprobe_design::readout::Readout;
 use tofprobe_design::rom_policy::RtlOverrides;
@@ -68,7 +68,7 @@ pub struct ArrayCosimOptions {
     /// Another build cache root (`None`: the user's; an empty directory: a cold build).
     pub cache: Option<PathBuf>,
     /// A test option: one cycle of `rst` in the middle of the first frame, while the
-    /// pixels accumulate a pulse (`tofprobe_array::rtl::mid_frame_reset`); model and RTL
+    /// pixels accumulate a pulse (`tofprobe_array::rtl_driver::mid_frame_reset`); model and RTL
     /// restart and the frames follow it (default off).
     pub mid_frame_reset: bool,
     /// A test option: registers W bits wide, narrower than the configuration's sizing

@@ -2,7 +2,7 @@
 //! `tofprobe_rtlgen::render_array`, R × C of the one pixel, the broadcast ROM and
 //! sequencer, the readout of `tofprobe_design::readout`, with its FuseSoC core and its
 //! verification kit); its golden vectors ([`vectors`]: the array model
-//! `tofprobe_array::rtl` run on the array scene, the files written by
+//! `tofprobe_array::rtl_model` run (by `tofprobe_array::rtl_driver`) on the array scene, the files written by
 //! `tofprobe_rtlgen::array_vectors`); its co-simulation at the array's ports ([`cosim`]:
 //! the model against Verilator or Icarus, the first mismatch named by pixel (r, c),
 //! register, cycle and pulse) and the layouts' cold-build benchmark ([`cosim_bench`]); the

@@ -145,7 +145,7 @@ fn array_flow_in(
     let _ = writeln!(md, "## Verdict\n");
     let _ = writeln!(
         md,
-        "Co-simulation at the array's ports (Verilator vs the array model `tofprobe_array::rtl`): **{}**, {} cycles, {} mismatches; build {:.1} s{}, Verilator {:.2} s, model {:.2} s; {} detections over the {}.{}\n",
+        "Co-simulation at the array's ports (Verilator vs the array model `tofprobe_array::rtl_model`): **{}**, {} cycles, {} mismatches; build {:.1} s{}, Verilator {:.2} s, model {:.2} s; {} detections over the {}.{}\n",
         if r.pass { "PASS" } else { "FAIL" },
         r.cycles,
         r.mismatches,

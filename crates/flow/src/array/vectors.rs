@@ -1,4 +1,4 @@
-//! The array's golden vectors: the array model (`tofprobe_array::rtl`) run on the array
+//! The array's golden vectors: the array model (`tofprobe_array::rtl_model`, driven by `tofprobe_array::rtl_driver`) run on the array
 //! scene's detections (or given ones), its run handed as plain data
 //! ([`tofprobe_rtlgen::array_vectors::ArrayTrace`]) to the one writer of the files,
 //! `tofprobe_rtlgen::array_vectors` (as the pixel's are written by `tofprobe_rtlgen::vectors`):
@@ -6,7 +6,8 @@
 
 use std::path::Path;
 
-use tofprobe_array::rtl::{ArrayModel, ArrayRun, mid_frame_reset, run_with_reset};
+use tofprobe_array::rtl_driver::{ArrayRun, mid_frame_reset, run_with_reset};
+use tofprobe_array::rtl_model::ArrayModel;
 use tofprobe_design::readout::Readout;
 use tofprobe_design::rom_policy::RtlOverrides;
 use tofprobe_design::{Chip, ResolvedDesign, RomPurpose};

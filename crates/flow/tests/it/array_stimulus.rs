@@ -12,7 +12,8 @@
 
 use std::path::PathBuf;
 
-use tofprobe_array::rtl::{ArrayModel, ArrayRun, mid_frame_reset, run, run_with_reset};
+use tofprobe_array::rtl_driver::{ArrayRun, mid_frame_reset, run, run_with_reset};
+use tofprobe_array::rtl_model::ArrayModel;
 use tofprobe_design::{Chip, Document, ResolvedDesign, RomPurpose, RtlOverrides, resolve};
 use tofprobe_flow::array::{ArrayCosimOptions, ArrayCosimReport, ArraySimulator, cosim_array};
 use tofprobe_pixel::Fault;

@@ -191,8 +191,8 @@ fn every_isa_reads_out_the_scalar_registers() {
     };
     let params = tofprobe_pixel::PixelParams::fourier_default(30, 400_000, 1000);
     assert!(tofprobe_pixel::segments_pay(&params));
-    let rom = tofprobe_pixel::bench::synthetic_rom(params.rom_depth, params.registers());
-    let codes = tofprobe_pixel::bench::synthetic_codes(params.frame_pulses as usize, 80);
+    let rom = tofprobe_pixel::speed::synthetic_rom(params.rom_depth, params.registers());
+    let codes = tofprobe_pixel::speed::synthetic_codes(params.frame_pulses as usize, 80);
     let segmented = |isa| {
         with_isa(isa, || {
             let mut m = SegmentedModel::new(&params, &rom).unwrap();

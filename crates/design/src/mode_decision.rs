@@ -1,12 +1,12 @@
 //! The pixel's analysis mode as the resolution decides it: `[pixel] mode = "auto"` picked
-//! from the scene (`tofprobe_dsp::analysis_mode::mode_for_scene`: periodic motions →
+//! from the scene (`tofprobe_dsp::scene_analysis::mode_for_scene`: periodic motions →
 //! Fourier, transients → Haar), U chosen when Haar is auto-picked, and the Haar frame's
 //! checks (N a power of two, U ≤ log₂N − 1, no Fourier bin frequencies, transients inside
 //! the frame) with errors and notes that name the field. Part of the one resolution, so
 //! every command refuses or notes the same.
 
-use tofprobe_dsp::analysis_mode::{AnalysisMode, ModeChoice, mode_for_scene};
 use tofprobe_dsp::haar::checks::{check_frame_pulses, check_scales, transients_outside_frame};
+use tofprobe_dsp::scene_analysis::{AnalysisMode, ModeChoice, mode_for_scene};
 use tofprobe_dsp::sd::ProbeConfig;
 use tofprobe_pixel::config::{Choice, DEFAULT_HAAR_SCALES};
 use tofprobe_pixel::{Mode, PixelConfig};

@@ -1,9 +1,10 @@
-//! The array at the clock edge: docs/pixel-contract.md "Array" register by register, as
-//! `templates/array.v` builds it — the root sequencer and probe ROM, the two broadcast
-//! stages, R × C of the pixel's one cycle model (`tofprobe_pixel::CycleModel`), the row
-//! select onto the column buses, the readout buffer and the port. [`ArrayModel::step`] is
-//! one rising edge; [`run`] drives frames of per-pixel detections through it and records
-//! what the array's ports show every cycle (the golden vectors of `tofprobe cosim` on an
+//! The array's register-level model, at the clock edge: docs/pixel-contract.md "Array"
+//! register by register, as `templates/array.v` builds it — the root sequencer and probe
+//! ROM, the two broadcast stages, R × C of the pixel's one cycle model
+//! (`tofprobe_pixel::CycleModel`), the row select onto the column buses, the readout buffer
+//! and the port. [`ArrayModel::step`] is one rising edge; [`crate::rtl_driver::run`] drives
+//! frames of per-pixel detections through it and records what the array's ports show
+//! every cycle (the golden vectors of `tofprobe cosim` on an
 //! array). The array's faults ([`ArrayFault`]) are carried exactly, so the cycle where a
 //! broken RTL first differs is predicted by the model. Double-buffered (`Readout::
 //! double_buffer`), the sequencer overlaps the readout with the next frame's pulses and
@@ -474,5 +475,3 @@ impl ArrayModel {
         (self.ro_valid, self.ro_data) = (false, 0);
     }
 }
-
-pub use crate::rtl_run::{ArrayRun, mid_frame_reset, run, run_with_reset};

@@ -1,5 +1,6 @@
-//! Frames through the array at the clock edge ([`run`]): reset, then every pulse's
-//! per-pixel detections presented while `pulse_o`, the array's ports recorded every cycle,
+//! The driver of the array's register-level model ([`crate::rtl_model`]): frames through
+//! the array at the clock edge ([`run`]): reset, then every pulse's per-pixel detections
+//! presented while `pulse_o`, the array's ports recorded every cycle,
 //! each frame's words reassembled from the stream at the contract's beat cycles
 //! ([`ArrayRun`], the golden vectors of `tofprobe cosim` on an array). [`run_with_reset`]
 //! adds one cycle of `rst` in the middle of the first frame: the array restarts, and its
@@ -9,7 +10,7 @@ use tofprobe_design::readout::Readout;
 use tofprobe_pixel::sequencer::RESET_CYCLES;
 
 use crate::error::ArrayError;
-use crate::rtl::{ArrayModel, ArrayPins, TAIL_CYCLES};
+use crate::rtl_model::{ArrayModel, ArrayPins, TAIL_CYCLES};
 
 /// What the array's ports showed over a run, cycle by cycle.
 #[derive(Debug, Clone)]
