@@ -15,8 +15,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 use tofprobe_design::{DesignError, ResolvedDesign};
+use tofprobe_dsp::haar::FAMILY_RATE;
 use tofprobe_dsp::haar::checks::transient_span_s;
-use tofprobe_dsp::haar::paper::FAMILY_RATE;
 use tofprobe_dsp::haar::{EventReport, HaarNoise, Scalogram, Thresholds, detect_events};
 use tofprobe_io::markdown::Table;
 use tofprobe_pixel::fixed::sign_extend;

@@ -13,6 +13,7 @@ pub mod bandwidth;
 pub mod chart;
 pub mod fig4;
 pub mod figures;
+pub mod haar_figures;
 pub mod plots;
 pub mod reproduce;
 pub mod setup;

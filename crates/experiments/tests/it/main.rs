@@ -2,6 +2,7 @@
 //! entries tested through the library (the binary's tests in crates/cli test what users
 //! run). Run one module with `cargo test --release -p tofprobe-experiments --test it MODULE::`.
 
+mod haar_figures;
 mod imputation;
 mod levels;
 mod scalogram_figures;
