@@ -13,8 +13,8 @@
 use rayon::prelude::*;
 use serde::Serialize;
 use tofprobe_design::ResolvedDesign;
+use tofprobe_dsp::haar::FAMILY_RATE;
 use tofprobe_dsp::haar::analysis::Scalogram;
-use tofprobe_dsp::haar::paper::FAMILY_RATE;
 use tofprobe_dsp::haar::{HaarNoise, Thresholds, fit_transition};
 
 use crate::model::ArrayFrame;

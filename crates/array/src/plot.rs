@@ -5,7 +5,7 @@
 
 use std::io::Write;
 
-use plotters::prelude::*;
+use tofprobe_io::chart::prelude::*;
 
 /// What a map's values are.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -84,64 +84,38 @@ fn heat_map_frame(
     scale: Scale,
     max: f64,
 ) -> Result<(String, [f64; 4]), String> {
-    let e = |e: &dyn std::fmt::Display| e.to_string();
     let (lo, hi) = match scale {
         Scale::Amplitude | Scale::Index => (0.0, max),
         Scale::Phase => (-180.0, 180.0),
     };
-    let mut svg = String::new();
-    let area;
-    {
-        let root = SVGBackend::with_string(&mut svg, (760, 620)).into_drawing_area();
-        root.fill(&WHITE).map_err(|x| e(&x))?;
+    let mut area = [0.0; 4];
+    let mut svg = svg((760, 620), |root| {
         let (map_area, bar_area) = root.split_horizontally(640);
         let caption = format!(
             "{title} ({rows} × {cols} pixels, {:.2} × {:.2} mm)",
             cols as f64 * mm_per_pixel,
             rows as f64 * mm_per_pixel
         );
-        let mut chart = ChartBuilder::on(&map_area)
-            .caption(caption, ("sans-serif", 16))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(50)
-            .build_cartesian_2d(0.0..cols as f64, rows as f64..0.0)
-            .map_err(|x| e(&x))?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .label_style(("sans-serif", 13))
-            .x_desc("column (pixel)")
-            .y_desc("row (pixel)")
-            .draw()
-            .map_err(|x| e(&x))?;
+        let frame = Frame::new(caption, 16)
+            .label_areas(40, 50)
+            .axes("column (pixel)", "row (pixel)")
+            .fonts(13, None)
+            .without_grid();
+        let mut chart = frame.build(&map_area, 0.0..cols as f64, rows as f64..0.0)?;
+        frame.draw_mesh(&mut chart)?;
         let (x0, y0) = chart.backend_coord(&(0.0, 0.0));
         let (x1, y1) = chart.backend_coord(&(cols as f64, rows as f64));
         area = [f64::from(x0), f64::from(y0), f64::from(x1), f64::from(y1)];
-        let mut bar = ChartBuilder::on(&bar_area)
-            .margin_top(40)
-            .margin_bottom(50)
-            .margin_right(10)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..1.0, lo..hi.max(lo + f64::MIN_POSITIVE))
-            .map_err(|x| e(&x))?;
-        bar.configure_mesh()
-            .disable_mesh()
-            .disable_x_axis()
-            .y_label_style(("sans-serif", 13))
-            .axis_desc_style(("sans-serif", 14))
-            .y_desc(unit)
-            .draw()
-            .map_err(|x| e(&x))?;
-        let steps = 64;
-        bar.draw_series((0..steps).map(|k| {
-            let a = lo + (hi - lo) * k as f64 / steps as f64;
-            let b = lo + (hi - lo) * (k + 1) as f64 / steps as f64;
-            Rectangle::new([(0.0, a), (1.0, b)], colour(scale, a, max).filled())
-        }))
-        .map_err(|x| e(&x))?;
-        root.present().map_err(|x| e(&x))?;
-    }
+        ColourBar {
+            range: (lo, hi.max(lo + f64::MIN_POSITIVE)),
+            desc: unit,
+            label_area: 60,
+            strips: 64,
+            ticks: None,
+        }
+        .draw(&bar_area, |a, _| colour(scale, a, max))
+    })
+    .map_err(|e| e.to_string())?;
     let end = svg
         .rfind("</svg>")
         .ok_or_else(|| "the plot backend wrote no </svg>".to_string())?;

@@ -3,10 +3,10 @@
 
 use std::path::Path;
 
-use plotters::prelude::*;
 use tofprobe_dsp::sd::fullband_spectrum::BandSpectrum;
 
 use crate::BenchError;
+use tofprobe_io::chart::prelude::*;
 
 fn err(e: impl std::fmt::Display) -> BenchError {
     BenchError::internal("fullband --svg", e)
@@ -27,47 +27,28 @@ pub(crate) fn write(path: &Path, s: &BandSpectrum, origin: &str) -> Result<(), B
     );
     let f_max = s.frequencies_hz.last().copied().unwrap_or(1.0).max(1.0);
     let y_max = sd.iter().chain(&dft).map(|p| p.1).fold(1.0, f64::max) * 2.0;
-    let mut text = String::new();
-    {
-        let root = SVGBackend::with_string(&mut text, (1000, 520)).into_drawing_area();
-        root.fill(&WHITE).map_err(err)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                format!(
-                    "Full-band spectrum, {} bins: sigma-delta probing vs DFT ({origin})",
-                    s.bins.len()
-                ),
-                ("sans-serif", 18),
-            )
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..f_max, (0.1f64..y_max).log_scale())
-            .map_err(err)?;
+    let text = svg((1000, 520), |root| {
+        let frame = Frame::new(
+            format!(
+                "Full-band spectrum, {} bins: sigma-delta probing vs DFT ({origin})",
+                s.bins.len()
+            ),
+            18,
+        )
+        .axes("frequency (Hz)", "amplitude (um)");
+        let mut chart = frame.build(root, 0.0..f_max, (0.1f64..y_max).log_scale())?;
+        frame.draw_mesh(&mut chart)?;
         chart
-            .configure_mesh()
-            .x_desc("frequency (Hz)")
-            .y_desc("amplitude (um)")
-            .draw()
-            .map_err(err)?;
-        chart
-            .draw_series(LineSeries::new(dft, &BLUE))
-            .map_err(err)?
+            .draw_series(LineSeries::new(dft, &BLUE))?
             .label("DFT")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
         chart
-            .draw_series(LineSeries::new(sd, &RED))
-            .map_err(err)?
+            .draw_series(LineSeries::new(sd, &RED))?
             .label("sigma-delta probing")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE)
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
-        root.present().map_err(err)?;
-    }
+        legend(&mut chart, SeriesLabelPosition::MiddleRight, 1.0, None)
+    })
+    .map_err(err)?;
     tofprobe_io::write_svg_atomic(path, text.as_bytes()).map_err(|e| BenchError::Output {
         path: path.to_path_buf(),
         message: e.to_string(),

@@ -2,29 +2,27 @@
 
 use crate::size_report::{AreaSection, SizeReport};
 use std::fmt::Write as _;
+use tofprobe_io::markdown::{Align, Table};
 
 fn split_table(out: &mut String, a: &AreaSection) {
     let s = &a.split;
     let total = s.total_area_um2().max(f64::MIN_POSITIVE);
-    let _ = writeln!(
-        out,
-        "| block | area µm² | share | cells | flops |\n|---|---:|---:|---:|---:|"
-    );
+    let mut t = Table::numeric(["block", "area µm²", "share", "cells", "flops"]);
     for (name, b) in [
         ("register file", s.register_file),
         ("adders (+ operand/register routing)", s.adders),
         ("hold / prefilter", s.hold_prefilter),
         ("control (schedule, readout, status)", s.control),
     ] {
-        let _ = writeln!(
-            out,
-            "| {name} | {:.1} | {:.1} % | {} | {} |",
-            b.area_um2,
-            100.0 * b.area_um2 / total,
-            b.cells,
-            b.flops
-        );
+        t.row([
+            name.to_string(),
+            format!("{:.1}", b.area_um2),
+            format!("{:.1} %", 100.0 * b.area_um2 / total),
+            b.cells.to_string(),
+            b.flops.to_string(),
+        ]);
     }
+    out.push_str(&t.render());
 }
 
 fn area_block(out: &mut String, a: &AreaSection, bins: u64) {
@@ -64,22 +62,39 @@ fn corner_table(out: &mut String, r: &SizeReport) {
     let Some(first) = r.timing_corners.first() else {
         return;
     };
-    let _ = writeln!(
+    let _ = write!(
         out,
-        "\n### Per liberty and corner, at C·f_laser = {:.1} MHz\n\n| library | corner | f_max MHz | slack ns | verdict (margin ≥ {:.0} %) | critical path | registers per adder (paper: ≥ {}) |\n|---|---|---:|---:|---|---|---:|",
+        "\n### Per liberty and corner, at C·f_laser = {:.1} MHz\n\n",
         first.clock_mhz,
-        crate::corners::MARGIN_PERCENT,
-        first.paper_registers_per_adder_min
     );
+    let mut t = Table::new([
+        ("library".to_string(), Align::Left),
+        ("corner".into(), Align::Left),
+        ("f_max MHz".into(), Align::Right),
+        ("slack ns".into(), Align::Right),
+        (
+            format!("verdict (margin ≥ {:.0} %)", crate::corners::MARGIN_PERCENT),
+            Align::Left,
+        ),
+        ("critical path".into(), Align::Left),
+        (
+            format!(
+                "registers per adder (paper: ≥ {})",
+                first.paper_registers_per_adder_min
+            ),
+            Align::Right,
+        ),
+    ]);
     for c in &r.timing_corners {
-        let _ = writeln!(
-            out,
-            "| {} | {} | {:.1} | {:+.3}{} | {} | `{}` → `{}` ({} cells) | {} |",
-            c.library,
-            c.corner,
-            c.f_max_mhz,
-            c.slack_ns,
-            if c.meets_clock { "" } else { " **fails**" },
+        t.row([
+            c.library.clone(),
+            c.corner.clone(),
+            format!("{:.1}", c.f_max_mhz),
+            format!(
+                "{:+.3}{}",
+                c.slack_ns,
+                if c.meets_clock { "" } else { " **fails**" }
+            ),
             if c.meets_margin {
                 format!("fits, {:.1} % slack", c.slack_percent)
             } else if c.meets_clock {
@@ -87,12 +102,14 @@ fn corner_table(out: &mut String, r: &SizeReport) {
             } else {
                 format!("**fails** by {:.3} ns", -c.slack_ns)
             },
-            c.startpoint,
-            c.endpoint,
-            c.path_cells,
-            c.registers_per_adder
-        );
+            format!(
+                "`{}` → `{}` ({} cells)",
+                c.startpoint, c.endpoint, c.path_cells
+            ),
+            c.registers_per_adder.to_string(),
+        ]);
     }
+    out.push_str(&t.render());
 }
 
 /// For each corner below the margin: the number of adders that meets it, and the
@@ -101,10 +118,16 @@ fn corner_options(out: &mut String, r: &SizeReport) {
     if r.corner_options.is_empty() {
         return;
     }
-    let _ = writeln!(
-        out,
-        "\n### The option that meets each missed corner\n\nMore adders, fewer cycles per pulse, a slower clock: each candidate synthesised and timed at the corner.\n\n| library | corner | configured f_max MHz | candidates (A, C, clock → f_max, slack) | option |\n|---|---|---:|---|---|"
+    out.push_str(
+        "\n### The option that meets each missed corner\n\nMore adders, fewer cycles per pulse, a slower clock: each candidate synthesised and timed at the corner.\n\n",
     );
+    let mut t = Table::new([
+        ("library", Align::Left),
+        ("corner", Align::Left),
+        ("configured f_max MHz", Align::Right),
+        ("candidates (A, C, clock → f_max, slack)", Align::Left),
+        ("option", Align::Left),
+    ]);
     for o in &r.corner_options {
         let trials = o
             .trials
@@ -121,20 +144,19 @@ fn corner_options(out: &mut String, r: &SizeReport) {
             (Some(a), Some(c)) => format!("**A = {a}, C = {c}**"),
             _ => "none found".to_string(),
         };
-        let _ = writeln!(
-            out,
-            "| {} | {} | {:.1} | {} | {} |",
-            o.library,
-            o.corner,
-            o.configured_f_max_mhz,
+        t.row([
+            o.library.clone(),
+            o.corner.clone(),
+            format!("{:.1}", o.configured_f_max_mhz),
             if trials.is_empty() {
                 "—".into()
             } else {
                 trials
             },
-            option
-        );
+            option,
+        ]);
     }
+    out.push_str(&t.render());
     let _ = writeln!(out);
     for o in &r.corner_options {
         let _ = writeln!(out, "- {}", o.note);
@@ -156,24 +178,50 @@ pub fn render(r: &SizeReport) -> String {
         d.cycles_per_pulse,
         d.laser_rate_hz / 1e6
     );
-    let _ = writeln!(
-        out,
-        "## Memory\n\n| figure | value |\n|---|---:|\n| width each register needs | {} bits |\n| width used | {} bits{} |\n| bits per pixel | {} |\n| bytes per pixel (= readout per frame) | {} |\n| frames per second | {:.4} |\n| readout bytes per second per pixel | {:.1} |\n| raw timestamps per frame | {:.0} bytes |\n| compression vs raw timestamps (bytes) | {:.0}× |\n| timestamps per read-out value | {:.1} |\n",
-        m.required_width_bits,
-        m.width_bits,
-        if m.width_too_small {
-            " — **too narrow: readout values alias**"
-        } else {
-            ""
-        },
-        m.bits_per_pixel,
-        m.bytes_per_pixel,
-        m.frames_per_second,
-        m.readout_bytes_per_second,
-        m.raw_bytes_per_frame,
-        m.compression_vs_raw,
-        m.compression_in_values,
-    );
+    let mut memory = Table::numeric(["figure", "value"]);
+    for (figure, value) in [
+        (
+            "width each register needs",
+            format!("{} bits", m.required_width_bits),
+        ),
+        (
+            "width used",
+            format!(
+                "{} bits{}",
+                m.width_bits,
+                if m.width_too_small {
+                    " — **too narrow: readout values alias**"
+                } else {
+                    ""
+                }
+            ),
+        ),
+        ("bits per pixel", m.bits_per_pixel.to_string()),
+        (
+            "bytes per pixel (= readout per frame)",
+            m.bytes_per_pixel.to_string(),
+        ),
+        ("frames per second", format!("{:.4}", m.frames_per_second)),
+        (
+            "readout bytes per second per pixel",
+            format!("{:.1}", m.readout_bytes_per_second),
+        ),
+        (
+            "raw timestamps per frame",
+            format!("{:.0} bytes", m.raw_bytes_per_frame),
+        ),
+        (
+            "compression vs raw timestamps (bytes)",
+            format!("{:.0}×", m.compression_vs_raw),
+        ),
+        (
+            "timestamps per read-out value",
+            format!("{:.1}", m.compression_in_values),
+        ),
+    ] {
+        memory.row([figure.to_string(), value]);
+    }
+    let _ = writeln!(out, "## Memory\n\n{memory}");
     if !r.paper_section8.is_empty() {
         let _ = writeln!(out, "{}", crate::paper_memory::markdown(&r.paper_section8));
     }
@@ -216,21 +264,29 @@ pub fn render(r: &SizeReport) -> String {
             )
         };
         area_block(&mut out, &s.area, d.bins);
-        let _ = writeln!(
+        let _ = write!(
             out,
-            "\nScaled to {} nm by (node/130 nm)² = {:.4} (first-order assumption): {:.1} µm².\n\n| pixel | bins that fit at {} nm (synthesised pixel, W = {}) | flops only (2·W flops per bin) | paper |\n|---|---:|---:|---:|",
-            s.target_node_nm, s.area_factor, s.scaled_area_um2, s.target_node_nm, d.width
+            "\nScaled to {} nm by (node/130 nm)² = {:.4} (first-order assumption): {:.1} µm².\n\n",
+            s.target_node_nm, s.area_factor, s.scaled_area_um2
         );
+        let mut t = Table::numeric([
+            "pixel".to_string(),
+            format!(
+                "bins that fit at {} nm (synthesised pixel, W = {})",
+                s.target_node_nm, d.width
+            ),
+            "flops only (2·W flops per bin)".into(),
+            "paper".into(),
+        ]);
         for f in &s.fits {
-            let _ = writeln!(
-                out,
-                "| {0:.0}×{0:.0} µm | {1} | {2} | {3} |",
-                f.pixel_side_um,
-                f.bins,
-                f.flop_only_bins,
-                f.paper_bins.map_or("–".to_string(), |b| b.to_string())
-            );
+            t.row([
+                format!("{0:.0}×{0:.0} µm", f.pixel_side_um),
+                f.bins.to_string(),
+                f.flop_only_bins.to_string(),
+                f.paper_bins.map_or("–".to_string(), |b| b.to_string()),
+            ]);
         }
+        out.push_str(&t.render());
         if let Some(p) = &s.paper_implied {
             let _ = writeln!(
                 out,
@@ -245,24 +301,31 @@ pub fn render(r: &SizeReport) -> String {
             );
         }
     }
-    let _ = writeln!(
-        out,
-        "\n## Sweeps\n\n| B | W | area µm² | cells | f_max MHz | critical ns | sky130 area µm² |\n|---:|---:|---:|---:|---:|---:|---:|"
+    let mut sweeps = Table::new(
+        [
+            "B",
+            "W",
+            "area µm²",
+            "cells",
+            "f_max MHz",
+            "critical ns",
+            "sky130 area µm²",
+        ]
+        .map(|h| (h, Align::Right)),
     );
     for row in &r.sweep {
         let opt = |v: Option<f64>, p: usize| v.map_or("–".to_string(), |v| format!("{v:.p$}"));
-        let _ = writeln!(
-            out,
-            "| {} | {} | {:.1} | {} | {} | {} | {} |",
-            row.bins,
-            row.width,
-            row.area_um2,
-            row.cells,
+        sweeps.row([
+            row.bins.to_string(),
+            row.width.to_string(),
+            format!("{:.1}", row.area_um2),
+            row.cells.to_string(),
             opt(row.f_max_mhz, 1),
             opt(row.critical_path_ns, 3),
-            opt(row.sky130_area_um2, 1)
-        );
+            opt(row.sky130_area_um2, 1),
+        ]);
     }
+    let _ = write!(out, "\n## Sweeps\n\n{sweeps}");
     let _ = writeln!(out, "\n## Assumptions\n");
     for a in &r.assumptions {
         let _ = writeln!(out, "- {a}");

@@ -16,6 +16,7 @@
 //!   27-bit registers: 864 B and 20,254.6×.
 
 use serde::{Deserialize, Serialize};
+use tofprobe_io::markdown::{Align, Table};
 
 use crate::error::Result;
 use crate::memory::{MemoryInput, WidthConvention, memory, register_width};
@@ -158,23 +159,27 @@ pub fn section8() -> Result<Vec<PaperFigure>> {
 /// Markdown lines: the figures as a table, the paper's beside them, "**differs**" where
 /// they do.
 pub fn markdown(figures: &[PaperFigure]) -> String {
-    let mut s = String::from(
-        "The paper's Section 8 example (10 mm motion, 1 mm LSB, N = 10^7, 128 bins, 14-bit \
-         timestamps), computed:\n\n| figure | computed | printed | | derivation |\n|---|---:|---:|---|---|\n",
-    );
+    let mut t = Table::new([
+        ("figure", Align::Left),
+        ("computed", Align::Right),
+        ("printed", Align::Right),
+        ("", Align::Left),
+        ("derivation", Align::Left),
+    ]);
     for f in figures {
-        s += &format!(
-            "| {} | {} {} | {} | {} | {} |\n",
-            f.figure,
-            fmt(f.computed),
-            f.unit,
+        t.row([
+            f.figure.to_string(),
+            format!("{} {}", fmt(f.computed), f.unit),
             f.printed
                 .map_or_else(|| "–".to_string(), |p| format!("{} {}", fmt(p), f.unit)),
-            if f.differs { "**differs**" } else { "" },
-            f.derivation
-        );
+            if f.differs { "**differs**" } else { "" }.to_string(),
+            f.derivation.to_string(),
+        ]);
     }
-    s
+    format!(
+        "The paper's Section 8 example (10 mm motion, 1 mm LSB, N = 10^7, 128 bins, 14-bit \
+         timestamps), computed:\n\n{t}"
+    )
 }
 
 /// Thousands separated; integers as integers, others with one decimal.

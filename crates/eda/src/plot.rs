@@ -3,22 +3,21 @@
 
 use crate::error::{EdaError, Result};
 use crate::size_report::SizeReport;
-use plotters::prelude::*;
 use std::path::Path;
+use tofprobe_io::chart::prelude::*;
 
 type Series = Vec<(f64, f64)>;
 
 fn panel(
-    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    area: &Root<'_>,
     title: &str,
     x_label: &str,
     y_label: &str,
     series: &[(&str, Series, RGBColor)],
-) -> std::result::Result<(), String> {
+) -> std::result::Result<(), ChartError> {
     let pts: Vec<(f64, f64)> = series.iter().flat_map(|s| s.1.iter().copied()).collect();
     if pts.is_empty() {
-        area.titled(&format!("{title}: no data"), ("sans-serif", 16))
-            .map_err(|e| e.to_string())?;
+        area.titled(&format!("{title}: no data"), ("sans-serif", 16))?;
         return Ok(());
     }
     let (x0, x1) = pts
@@ -26,45 +25,29 @@ fn panel(
         .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
     let y1 = pts.iter().fold(0.0f64, |a, p| a.max(p.1));
     let pad = if x1 > x0 { 0.05 * (x1 - x0) } else { 1.0 };
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 16))
+    let frame = Frame::new(title, 16)
         .margin(8)
-        .x_label_area_size(35)
-        .y_label_area_size(60)
-        .build_cartesian_2d((x0 - pad)..(x1 + pad), 0.0..(y1 * 1.1).max(1e-9))
-        .map_err(|e| e.to_string())?;
-    chart
-        .configure_mesh()
-        .x_desc(x_label)
-        .y_desc(y_label)
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .label_areas(35, 60)
+        .axes(x_label, y_label);
+    let mut chart = frame.build(area, (x0 - pad)..(x1 + pad), 0.0..(y1 * 1.1).max(1e-9))?;
+    frame.draw_mesh(&mut chart)?;
     for (name, s, color) in series {
         if s.is_empty() {
             continue;
         }
         let c = *color;
         chart
-            .draw_series(LineSeries::new(s.iter().copied(), c.stroke_width(2)))
-            .map_err(|e| e.to_string())?
+            .draw_series(LineSeries::new(s.iter().copied(), c.stroke_width(2)))?
             .label(*name)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
-        chart
-            .draw_series(PointSeries::of_element(
-                s.iter().copied(),
-                4,
-                c.filled(),
-                &|p, sz, st| EmptyElement::at(p) + Circle::new((0, 0), sz, st),
-            ))
-            .map_err(|e| e.to_string())?;
+        chart.draw_series(PointSeries::of_element(
+            s.iter().copied(),
+            4,
+            c.filled(),
+            &|p, sz, st| EmptyElement::at(p) + Circle::new((0, 0), sz, st),
+        ))?;
     }
-    chart
-        .configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.8))
-        .draw()
-        .map_err(|e| e.to_string())?;
-    Ok(())
+    legend(&mut chart, SeriesLabelPosition::MiddleRight, 0.8, None)
 }
 
 /// Renders the sweep plot as SVG text.
@@ -92,10 +75,7 @@ pub fn sweep_svg(report: &SizeReport) -> std::result::Result<String, String> {
         .iter()
         .filter_map(|r| r.f_max_mhz.map(|f| (f64::from(r.width), f)))
         .collect();
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (1100, 760)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+    svg((1100, 760), |root| {
         let panels = root.split_evenly((2, 2));
         panel(
             &panels[0],
@@ -127,10 +107,9 @@ pub fn sweep_svg(report: &SizeReport) -> std::result::Result<String, String> {
             "register width W (bits)",
             "f_max (MHz)",
             &[(lib.as_str(), fmax_w, BLUE)],
-        )?;
-        root.present().map_err(|e| e.to_string())?;
-    }
-    Ok(svg)
+        )
+    })
+    .map_err(|e| e.to_string())
 }
 
 /// Writes the sweep plot to `path` atomically.

@@ -12,9 +12,9 @@
 
 use std::path::Path;
 
-use plotters::prelude::*;
 use serde::Serialize;
 use tofprobe_dsp::haar::{EventReport, Scalogram};
+use tofprobe_io::chart::prelude::*;
 
 use tofprobe_eda::error::{EdaError, Result};
 
@@ -82,34 +82,26 @@ pub fn scalogram_svg_with_notes(
     let vmax = check(s)?;
     let u_max = s.scales;
     let t_ms = s.duration_s() * 1e3;
-    let e = |e: &dyn std::fmt::Display| e.to_string();
-    let mut svg = String::new();
-    {
-        let map_h = 80 + 50 * (u_max + 1);
-        let root =
-            SVGBackend::with_string(&mut svg, (1000, map_h + NOTE_H * notes.len() as u32 + 8))
-                .into_drawing_area();
-        root.fill(&WHITE).map_err(|x| e(&x))?;
+    let map_h = 80 + 50 * (u_max + 1);
+    let size = (1000, map_h + NOTE_H * notes.len() as u32 + 8);
+    svg(size, |root| {
         let (upper, lower) = root.split_vertically(map_h);
         for (i, note) in notes.iter().enumerate() {
-            lower
-                .draw(&Text::new(
-                    note.clone(),
-                    (20, (NOTE_H * i as u32) as i32),
-                    ("sans-serif", 14).into_font().color(&BLACK),
-                ))
-                .map_err(|x| e(&x))?;
+            lower.draw(&Text::new(
+                note.clone(),
+                (20, (NOTE_H * i as u32) as i32),
+                ("sans-serif", 14).into_font().color(&BLACK),
+            ))?;
         }
         let (main, bar) = upper.split_horizontally(880);
         // Row u spans y ∈ [U − u − ½, U − u + ½]: integer ticks fall on the row centres.
         let y_top = f64::from(u_max) + 0.5;
-        let mut chart = ChartBuilder::on(&main)
-            .caption(title, ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(130)
-            .build_cartesian_2d(0.0..t_ms, -0.5..y_top)
-            .map_err(|x| e(&x))?;
+        let frame = Frame::new(title, 18)
+            .label_areas(40, 130)
+            .axes("time (ms)", "scale (wavelet duration)")
+            .fonts(14, Some(15))
+            .without_grid();
+        let mut chart = frame.build(&main, 0.0..t_ms, -0.5..y_top)?;
         let row_label = move |y: &f64| {
             let k = y.round();
             if (y - k).abs() > 1e-6 || k < 0.0 || k > f64::from(u_max) {
@@ -119,72 +111,42 @@ pub fn scalogram_svg_with_notes(
             let d = t_ms / (1u64 << u) as f64;
             format!("u = {u} ({d:.3} ms)")
         };
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("time (ms)")
-            .y_desc("scale (wavelet duration)")
-            .label_style(("sans-serif", 14))
-            .axis_desc_style(("sans-serif", 15))
+        frame
+            .mesh(&mut chart)
             .y_labels(u_max as usize + 2)
             .y_label_formatter(&row_label)
-            .draw()
-            .map_err(|x| e(&x))?;
+            .draw()?;
         let row = |u: u32| f64::from(u_max - u);
-        chart
-            .draw_series(s.coefficients.iter().map(|c| {
+        chart.draw_series(s.coefficients.iter().map(|c| {
+            let y = row(c.u);
+            Rectangle::new(
+                [(c.start_s * 1e3, y - 0.5), (c.end_s * 1e3, y + 0.5)],
+                diverging(c.value_mm / vmax).filled(),
+            )
+        }))?;
+        if let Some(ev) = events {
+            chart.draw_series(ev.events.iter().map(|v| {
+                let c = &v.peak;
                 let y = row(c.u);
                 Rectangle::new(
                     [(c.start_s * 1e3, y - 0.5), (c.end_s * 1e3, y + 0.5)],
-                    diverging(c.value_mm / vmax).filled(),
+                    BLACK.stroke_width(2),
                 )
-            }))
-            .map_err(|x| e(&x))?;
-        if let Some(ev) = events {
-            chart
-                .draw_series(ev.events.iter().map(|v| {
-                    let c = &v.peak;
-                    let y = row(c.u);
-                    Rectangle::new(
-                        [(c.start_s * 1e3, y - 0.5), (c.end_s * 1e3, y + 0.5)],
-                        BLACK.stroke_width(2),
-                    )
-                }))
-                .map_err(|x| e(&x))?;
+            }))?;
         }
-        // Colour bar: 100 strips from −max|w| to +max|w|.
-        let mut cb = ChartBuilder::on(&bar)
-            .margin_top(40)
-            .margin_bottom(50)
-            .margin_right(10)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..1.0, -vmax..vmax)
-            .map_err(|x| e(&x))?;
-        cb.configure_mesh()
-            .disable_mesh()
-            .disable_x_axis()
-            .y_desc("w (mm)")
-            // Explicit sizes: plotters scales its default label font with the area, which
-            // made the narrow colour bar's labels 4 px.
-            .label_style(("sans-serif", 13))
-            .axis_desc_style(("sans-serif", 14))
-            .y_labels(7)
-            .y_label_formatter(&|y: &f64| format!("{y:+.3}"))
-            .draw()
-            .map_err(|x| e(&x))?;
-        let strips = 100;
-        cb.draw_series((0..strips).map(|i| {
-            let lo = -vmax + 2.0 * vmax * i as f64 / strips as f64;
-            let hi = -vmax + 2.0 * vmax * (i + 1) as f64 / strips as f64;
-            Rectangle::new(
-                [(0.0, lo), (1.0, hi)],
-                diverging(0.5 * (lo + hi) / vmax).filled(),
-            )
-        }))
-        .map_err(|x| e(&x))?;
-        root.present().map_err(|x| e(&x))?;
-    }
-    Ok(svg)
+        // Colour bar: 100 strips from −max|w| to +max|w| (the bar's explicit font sizes:
+        // plotters scales its default label font with the area, which made the narrow
+        // colour bar's labels 4 px).
+        ColourBar {
+            range: (-vmax, vmax),
+            desc: "w (mm)",
+            label_area: 70,
+            strips: 100,
+            ticks: Some((7, &|y: &f64| format!("{y:+.3}"))),
+        }
+        .draw(&bar, |lo, hi| diverging(0.5 * (lo + hi) / vmax))
+    })
+    .map_err(|e| e.to_string())
 }
 
 /// Writes the scalogram SVG to `path` atomically.

@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use plotters::prelude::*;
 use tofprobe_design::{DesignError, ResolvedDesign};
 use tofprobe_dsp::sd::ProbeRom;
+use tofprobe_io::chart::prelude::*;
 use tofprobe_pixel::spectrum::{BitTrueSpectrum, bit_true_spectrum};
 use tofprobe_pixel::{PixelError, PixelParams};
 use tofprobe_scene::PhotonSource;
@@ -70,48 +70,28 @@ pub fn write_svg(
     let x1 = pts.iter().fold(0.0f64, |m, p| m.max(p.0)) * 1.05;
     let y0 = pts.iter().fold(f64::INFINITY, |m, p| m.min(p.1)) * 0.5;
     let y1 = pts.iter().fold(0.0f64, |m, p| m.max(p.1)) * 2.0;
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (900, 520)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(&e))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
+    let svg = svg((900, 520), |root| {
+        let frame = Frame::new(title, 20)
             .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..x1, (y0..y1).log_scale())
-            .map_err(|e| err(&e))?;
+            .axes("frequency (Hz)", "amplitude (µm)");
+        let mut chart = frame.build(root, 0.0..x1, (y0..y1).log_scale())?;
+        frame.draw_mesh(&mut chart)?;
+        chart.draw_series(
+            pts.iter()
+                .map(|&(x, y)| PathElement::new(vec![(x, y0), (x, y)], BLUE.stroke_width(2))),
+        )?;
         chart
-            .configure_mesh()
-            .x_desc("frequency (Hz)")
-            .y_desc("amplitude (µm)")
-            .draw()
-            .map_err(|e| err(&e))?;
-        chart
-            .draw_series(
-                pts.iter()
-                    .map(|&(x, y)| PathElement::new(vec![(x, y0), (x, y)], BLUE.stroke_width(2))),
-            )
-            .map_err(|e| err(&e))?;
-        chart
-            .draw_series(pts.iter().map(|&p| Circle::new(p, 4, BLUE.filled())))
-            .map_err(|e| err(&e))?
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 4, BLUE.filled())))?
             .label("bit-true bins")
             .legend(|(x, y)| Circle::new((x, y), 4, BLUE.filled()));
         let noise = spectrum.median_amplitude_um.max(1e-6);
         chart
-            .draw_series(LineSeries::new(vec![(0.0, noise), (x1, noise)], RED))
-            .map_err(|e| err(&e))?
+            .draw_series(LineSeries::new(vec![(0.0, noise), (x1, noise)], RED))?
             .label("noise estimate (median over bins)")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE)
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| err(&e))?;
-        root.present().map_err(|e| err(&e))?;
-    }
+        legend(&mut chart, SeriesLabelPosition::MiddleRight, 1.0, None)
+    })
+    .map_err(|e| err(&e))?;
     tofprobe_io::write_svg_atomic(path, svg.as_bytes()).map_err(|e| ExperimentError::Output {
         path: path.to_path_buf(),
         message: e.to_string(),

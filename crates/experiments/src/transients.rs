@@ -15,9 +15,10 @@ use std::time::Instant;
 
 use serde::Serialize;
 use tofprobe_design::{DesignError, ResolvedDesign};
+use tofprobe_dsp::haar::FAMILY_RATE;
 use tofprobe_dsp::haar::checks::transient_span_s;
-use tofprobe_dsp::haar::paper::FAMILY_RATE;
 use tofprobe_dsp::haar::{EventReport, HaarNoise, Scalogram, Thresholds, detect_events};
+use tofprobe_io::markdown::Table;
 use tofprobe_pixel::fixed::sign_extend;
 use tofprobe_pixel::{Mode, PixelError, PixelParams, TransactionModel};
 use tofprobe_scene::PhotonSource;
@@ -280,13 +281,17 @@ impl HaarAnalysis {
             self.events.family_rate,
             self.events.z
         );
-        let _ = writeln!(
-            md,
-            "| scale | wavelet (ms) | max abs(w) (mm) | sd(w) (mm) | threshold (mm) |\n|---|---|---|---|---|"
-        );
+        let mut t = Table::left([
+            "scale",
+            "wavelet (ms)",
+            "max abs(w) (mm)",
+            "sd(w) (mm)",
+            "threshold (mm)",
+        ]);
         for c in self.threshold_rows() {
-            let _ = writeln!(md, "| {} |", c.join(" | "));
+            t.row(c);
         }
+        md += &t.render();
         let _ = writeln!(md, "\n### Events\n");
         for line in self.events.text().lines() {
             let _ = writeln!(md, "- {line}");

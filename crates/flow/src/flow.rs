@@ -18,6 +18,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use tofprobe_design::ResolvedDesign;
+use tofprobe_io::markdown::Table;
 use tofprobe_pixel::fixed::sign_extend as sext;
 
 use crate::error::FlowError;
@@ -200,13 +201,13 @@ fn spectrum(
             md,
             "## Spectrum at the bins (frame 0, sign-of-cosine probes: unnormalised)\n"
         );
-        let _ = writeln!(md, "| bin | I (codes) | Q (codes) |\n|---|---|---|");
+        let mut t = Table::left(["bin", "I (codes)", "Q (codes)"]);
         for k in 0..p.bins {
             let i = sext(f[2 * k], p.width) as f64 / frac;
             let q = sext(f[2 * k + 1], p.width) as f64 / frac;
-            let _ = writeln!(md, "| {k} | {i} | {q} |");
+            t.row([k.to_string(), i.to_string(), q.to_string()]);
         }
-        let _ = writeln!(md);
+        let _ = writeln!(md, "{t}");
         return "sign-probe ROM: spectrum not normalised".into();
     };
     // The frame's register words (the readout ends with the status word).
@@ -238,28 +239,33 @@ not normalised: {e}
         p.shift,
         lsb_mm
     );
-    let _ = writeln!(
-        md,
-        "| reg pair | k | f (Hz) | I | Q | abs(H_pre) | amplitude (µm) | phase (deg) |\n|---|---|---|---|---|---|---|---|"
-    );
+    let mut t = Table::left([
+        "reg pair",
+        "k",
+        "f (Hz)",
+        "I",
+        "Q",
+        "abs(H_pre)",
+        "amplitude (µm)",
+        "phase (deg)",
+    ]);
     let mut best = (0usize, f64::MIN);
     for (b, r) in bins.iter().enumerate() {
         if r.amplitude_um > best.1 {
             best = (b, r.amplitude_um);
         }
-        let _ = writeln!(
-            md,
-            "| {b} | {} | {:.1} | {:.3} | {:.3} | {:.4} | {:.2} | {:.1} |",
-            rom.bin_indices[b],
-            rom.bins[b],
-            r.i_codes,
-            r.q_codes,
-            r.prefilter_gain,
-            r.amplitude_um,
-            r.phase_deg
-        );
+        t.row([
+            b.to_string(),
+            rom.bin_indices[b].to_string(),
+            format!("{:.1}", rom.bins[b]),
+            format!("{:.3}", r.i_codes),
+            format!("{:.3}", r.q_codes),
+            format!("{:.4}", r.prefilter_gain),
+            format!("{:.2}", r.amplitude_um),
+            format!("{:.1}", r.phase_deg),
+        ]);
     }
-    let _ = writeln!(md);
+    let _ = writeln!(md, "{t}");
     // Noise estimate: the median of the other bins (autobins' noise bins keep clear of the
     // tones' main lobes, so they read the floor: photon jitter and ΣΔ noise over N pulses).
     let mut rest: Vec<f64> = bins.iter().skip(1).map(|r| r.amplitude_um).collect();

@@ -10,7 +10,8 @@
 //! stops a long computation with, the one locator of the external tools
 //! ([`tools::locate`]: `$TOFPROBE_<NAME>`, else `PATH`) and the one instruction-set
 //! selection of the vector kernels ([`isa`]: detected, `TOFPROBE_ISA`, or a benchmark's
-//! `--isa`).
+//! `--isa`), the one Markdown table writer of the reports ([`markdown::Table`]) and, behind
+//! the `chart` feature, the one builder of the SVG plots (`chart`: the only user of plotters).
 //!
 //! Errors are plain [`std::io::Error`]s: each crate maps them into its own error enum with
 //! the path it was writing.
@@ -18,11 +19,14 @@
 mod atomic;
 pub mod bounded;
 pub mod cache;
+#[cfg(feature = "chart")]
+pub mod chart;
 pub mod cpu;
 pub mod disk;
 pub mod isa;
 pub mod live;
 pub mod lock;
+pub mod markdown;
 pub mod marker;
 pub mod npy;
 mod set;

@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
+use tofprobe_io::markdown::{Align, Table};
 
 pub use crate::Step;
 use crate::def::DefFigures;
@@ -177,64 +178,134 @@ impl LayoutReport {
         )
     }
 
+    /// The macro's figures: die, core, cells, utilisation, routing, DRC, LVS.
+    fn macro_table(&self) -> Table {
+        let d = &self.def;
+        let mut t = Table::numeric(["figure", "value"]);
+        t.row([
+            "die".to_string(),
+            format!(
+                "{:.2} × {:.2} µm = {:.0} µm²",
+                d.die_width_um,
+                d.die_height_um,
+                d.die_area_um2()
+            ),
+        ])
+        .row([
+            "core (placed cells' extent)".to_string(),
+            format!(
+                "{:.2} × {:.2} µm = {:.0} µm²",
+                d.core_width_um,
+                d.core_height_um,
+                d.core_area_um2()
+            ),
+        ])
+        .row([
+            "logic cells".to_string(),
+            format!(
+                "{} ({:.0} µm², {} of them clock buffers; {} fill cells)",
+                d.cells, d.cell_area_um2, self.clock_buffers, d.fill_cells
+            ),
+        ])
+        .row([
+            "utilisation (cells / core)".to_string(),
+            format!("{:.1} %", 100.0 * d.utilisation()),
+        ])
+        .row([
+            "target density routed".to_string(),
+            self.density().to_string(),
+        ])
+        .row([
+            "routed wirelength".to_string(),
+            format!(
+                "{:.0} µm{}",
+                d.wirelength_um,
+                if self.route_cleanup {
+                    ""
+                } else {
+                    " (qrouter stage 3 skipped)"
+                }
+            ),
+        ])
+        .row([
+            "DRC errors (magic)".to_string(),
+            self.drc_errors.to_string(),
+        ])
+        .row([
+            "LVS (netgen, layout vs synthesised netlist)".to_string(),
+            format!(
+                "{} — {}",
+                if self.lvs_match { "match" } else { "MISMATCH" },
+                if self.lvs_errors.is_empty() {
+                    self.lvs_result.clone()
+                } else {
+                    format!("{} ({})", self.lvs_result, self.lvs_errors.join(", "))
+                }
+            ),
+        ]);
+        t
+    }
+
+    /// Synthesis beside post-route at the configuration's clock.
+    fn timing_table(&self) -> Table {
+        let p = &self.post_route;
+        let opt = |v: Option<f64>, d: usize| v.map_or("—".into(), |v| format!("{v:.d$}"));
+        let mut t = Table::new([
+            ("", Align::Left),
+            ("synthesis (ideal clock, no wires)", Align::Right),
+            ("post-route (SPEF, propagated clock)", Align::Right),
+        ]);
+        t.row([
+            "f_max (MHz)".to_string(),
+            opt(self.synthesis.f_max_mhz, 1),
+            format!("{:.1}", p.f_max_mhz),
+        ])
+        .row([
+            "setup slack (ns)".to_string(),
+            opt(self.synthesis.slack_ns, 3),
+            format!("{:.3}", p.setup_slack_ns),
+        ])
+        .row([
+            "hold slack (ns), all paths".to_string(),
+            "—".into(),
+            format!("{:.3}", p.hold_slack_ns),
+        ])
+        .row([
+            "hold slack (ns), register to register".to_string(),
+            "—".into(),
+            format!("{:.3}", p.hold_slack_registers_ns),
+        ]);
+        t
+    }
+
     /// The Markdown report.
     pub fn markdown(&self) -> String {
-        let d = &self.def;
         let mut s = format!(
-            "# Layout of `{}` on {}\n\nConfiguration: `{}`; B = {}, W = {}.\n\n## Macro\n\n\
-             | figure | value |\n|---|---:|\n\
-             | die | {:.2} × {:.2} µm = {:.0} µm² |\n| core (placed cells' extent) | {:.2} × {:.2} µm = {:.0} µm² |\n\
-             | logic cells | {} ({:.0} µm², {} of them clock buffers; {} fill cells) |\n| utilisation (cells / core) | {:.1} % |\n\
-             | target density routed | {} |\n| routed wirelength | {:.0} µm{} |\n| DRC errors (magic) | {} |\n\
-             | LVS (netgen, layout vs synthesised netlist) | {} — {} |\n\n",
+            "# Layout of `{}` on {}\n\nConfiguration: `{}`; B = {}, W = {}.\n\n## Macro\n\n{}\n",
             self.top,
             self.tech,
             self.config,
             self.bins,
             self.width,
-            d.die_width_um,
-            d.die_height_um,
-            d.die_area_um2(),
-            d.core_width_um,
-            d.core_height_um,
-            d.core_area_um2(),
-            d.cells,
-            d.cell_area_um2,
-            self.clock_buffers,
-            d.fill_cells,
-            100.0 * d.utilisation(),
-            self.density(),
-            d.wirelength_um,
-            if self.route_cleanup {
-                ""
-            } else {
-                " (qrouter stage 3 skipped)"
-            },
-            self.drc_errors,
-            if self.lvs_match { "match" } else { "MISMATCH" },
-            if self.lvs_errors.is_empty() {
-                self.lvs_result.clone()
-            } else {
-                format!("{} ({})", self.lvs_result, self.lvs_errors.join(", "))
-            },
+            self.macro_table(),
         );
         // The verdict first, after the title; the checks' details after the macro table.
         let at = s.find("## Macro").unwrap_or(s.len());
         s.insert_str(at, &verdict::verdict_markdown(self));
         s += &verdict::checks_markdown(self);
         if !self.drc_rules.is_empty() {
-            s += "DRC errors by rule (magic's `drc listall why`):\n\n| rule | error boxes |\n|---|---:|\n";
+            let mut t = Table::numeric(["rule", "error boxes"]);
             for r in &self.drc_rules {
-                let _ = writeln!(s, "| {} | {} |", r.rule, r.boxes);
+                t.row([r.rule.clone(), r.boxes.to_string()]);
             }
-            s += "\n";
+            let _ = writeln!(s, "DRC errors by rule (magic's `drc listall why`):\n\n{t}");
         }
         if let Some(r) = &self.repair {
             let _ = writeln!(
                 s,
                 "ECO re-route of the dirty stage-2 route (the nets at the DRC error boxes and \
                  netgen's unmatched nets ripped up and routed again, at most {} rounds): DRC {} → {}, \
-                 LVS errors {} → {}; {}.\n\n| round | nets re-routed | unrouted | DRC after | LVS errors after | re-route (s) | checks (s) |\n|---:|---|---:|---:|---:|---:|---:|",
+                 LVS errors {} → {}; {}.\n",
                 crate::repair::MAX_ROUNDS,
                 r.drc_before,
                 self.drc_errors,
@@ -242,58 +313,58 @@ impl LayoutReport {
                 r.rounds.last().map_or(r.lvs_before, |x| x.lvs_errors),
                 r.stopped,
             );
+            let mut t = Table::numeric([
+                "round",
+                "nets re-routed",
+                "unrouted",
+                "DRC after",
+                "LVS errors after",
+                "re-route (s)",
+                "checks (s)",
+            ]);
             for (i, x) in r.rounds.iter().enumerate() {
-                let _ = writeln!(
-                    s,
-                    "| {} | {} | {} | {} | {} | {:.1} | {:.1} |",
-                    i + 1,
+                t.row([
+                    (i + 1).to_string(),
                     x.nets
                         .iter()
                         .map(|n| format!("`{n}`"))
                         .collect::<Vec<_>>()
                         .join(", "),
-                    x.unrouted,
-                    x.drc_errors,
-                    x.lvs_errors,
-                    x.route_seconds,
-                    x.check_seconds
-                );
+                    x.unrouted.to_string(),
+                    x.drc_errors.to_string(),
+                    x.lvs_errors.to_string(),
+                    format!("{:.1}", x.route_seconds),
+                    format!("{:.1}", x.check_seconds),
+                ]);
             }
-            s += "\n";
+            let _ = writeln!(s, "{t}");
         }
         if self.attempts.len() > 1 {
-            s += "Placement attempts:\n\n| density | unrouted nets |\n|---:|---|\n";
+            let mut t = Table::new([("density", Align::Right), ("unrouted nets", Align::Left)]);
             for a in &self.attempts {
-                let _ = writeln!(
-                    s,
-                    "| {} | {}{} |",
-                    a.density,
-                    a.unrouted,
-                    if a.unrouted_nets.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" ({})", a.unrouted_nets.join(", "))
-                    }
-                );
+                t.row([
+                    a.density.to_string(),
+                    format!(
+                        "{}{}",
+                        a.unrouted,
+                        if a.unrouted_nets.is_empty() {
+                            String::new()
+                        } else {
+                            format!(" ({})", a.unrouted_nets.join(", "))
+                        }
+                    ),
+                ]);
             }
-            s += "\n";
+            let _ = writeln!(s, "Placement attempts:\n\n{t}");
         }
         let p = &self.post_route;
-        let opt = |v: Option<f64>, d: usize| v.map_or("—".into(), |v| format!("{v:.d$}"));
         let _ = write!(
             s,
-            "## Timing at the configuration's clock ({:.3} ns, {:.1} MHz)\n\n\
-             | | synthesis (ideal clock, no wires) | post-route (SPEF, propagated clock) |\n|---|---:|---:|\n\
-             | f_max (MHz) | {} | {:.1} |\n| setup slack (ns) | {} | {:.3} |\n| hold slack (ns), all paths | — | {:.3} |\n| hold slack (ns), register to register | — | {:.3} |\n\n\
+            "## Timing at the configuration's clock ({:.3} ns, {:.1} MHz)\n\n{}\n\
              Worst setup path: `{}` → `{}`; worst hold path: `{}` → `{}`; {} nets annotated from the SPEF.\n\n",
             p.period_ns,
             1e3 / p.period_ns,
-            opt(self.synthesis.f_max_mhz, 1),
-            p.f_max_mhz,
-            opt(self.synthesis.slack_ns, 3),
-            p.setup_slack_ns,
-            p.hold_slack_ns,
-            p.hold_slack_registers_ns,
+            self.timing_table(),
             p.setup_path.0,
             p.setup_path.1,
             p.hold_path.0,
@@ -308,8 +379,7 @@ impl LayoutReport {
             let _ = write!(
                 s,
                 "## Bins per pitch at {} nm\n\nSynthesis model A(B) = {:.0} + {:.0}·B µm² ({} nm), routed factor k = die / cell area = {:.3}, scaled by ({}/{})² = {:.4}.\n\n\
-                 The routed macro of this pixel (B = {}) needs a {:.1} × {:.1} µm pitch at {} nm.\n\n\
-                 | pitch | from layout | from synthesis | paper |\n|---|---:|---:|---:|\n",
+                 The routed macro of this pixel (B = {}) needs a {:.1} × {:.1} µm pitch at {} nm.\n\n",
                 b.target_node_nm,
                 b.synthesis_model.fixed_um2,
                 b.synthesis_model.per_bin_um2,
@@ -323,24 +393,24 @@ impl LayoutReport {
                 b.routed_side_um,
                 b.target_node_nm,
             );
+            let mut t = Table::numeric(["pitch", "from layout", "from synthesis", "paper"]);
             for p in &b.pitches {
-                let _ = writeln!(
-                    s,
-                    "| {0} × {0} µm | {1} | {2} | {3} |",
-                    p.side_um,
-                    p.layout_bins,
-                    p.synthesis_bins,
-                    p.paper_bins.map_or("—".into(), |n| n.to_string())
-                );
+                t.row([
+                    format!("{0} × {0} µm", p.side_um),
+                    p.layout_bins.to_string(),
+                    p.synthesis_bins.to_string(),
+                    p.paper_bins.map_or("—".into(), |n| n.to_string()),
+                ]);
             }
-            s += "\n";
+            let _ = writeln!(s, "{t}");
         }
-        s += "## Steps\n\n| step | seconds |\n|---|---:|\n";
+        let mut steps = Table::numeric(["step", "seconds"]);
         for st in &self.steps {
-            let _ = writeln!(s, "| {} | {:.1} |", st.step, st.seconds);
+            steps.row([st.step.to_string(), format!("{:.1}", st.seconds)]);
         }
         let total: f64 = self.steps.iter().map(|s| s.seconds).sum();
-        let _ = writeln!(s, "| total | {total:.1} |\n\n## Notes\n");
+        steps.row(["total".to_string(), format!("{total:.1}")]);
+        let _ = writeln!(s, "## Steps\n\n{steps}\n## Notes\n");
         for n in &self.notes {
             let _ = writeln!(s, "- {n}");
         }
@@ -351,28 +421,34 @@ impl LayoutReport {
 /// The corner table: synthesis beside post-route, setup and hold, per library and corner
 /// (the layout report's and `tofprobe size --layout-report`'s).
 pub fn corners_markdown(corners: &[CornerRow]) -> String {
-    let mut s = String::from(
-        "| library | corner | synthesis f_max (MHz) | synthesis slack (ns) | post-route f_max (MHz) | post-route setup slack (ns) | hold slack (ns), all / register to register | meets the clock |\n|---|---|---:|---:|---:|---:|---:|---|\n",
-    );
+    let right = |h: &'static str| (h, Align::Right);
+    let mut t = Table::new([
+        ("library", Align::Left),
+        ("corner", Align::Left),
+        right("synthesis f_max (MHz)"),
+        right("synthesis slack (ns)"),
+        right("post-route f_max (MHz)"),
+        right("post-route setup slack (ns)"),
+        right("hold slack (ns), all / register to register"),
+        ("meets the clock", Align::Left),
+    ]);
     for c in corners {
         let p = &c.post_route;
-        let _ = writeln!(
-            s,
-            "| {} | {} | {:.1} | {:.3} | {:.1} | {:.3} | {:.3} / {:.3} | {} |",
-            c.library,
-            c.corner,
-            c.synthesis_f_max_mhz,
-            c.synthesis_slack_ns,
-            p.f_max_mhz,
-            p.setup_slack_ns,
-            p.hold_slack_ns,
-            p.hold_slack_registers_ns,
+        t.row([
+            c.library.clone(),
+            c.corner.clone(),
+            format!("{:.1}", c.synthesis_f_max_mhz),
+            format!("{:.3}", c.synthesis_slack_ns),
+            format!("{:.1}", p.f_max_mhz),
+            format!("{:.3}", p.setup_slack_ns),
+            format!("{:.3} / {:.3}", p.hold_slack_ns, p.hold_slack_registers_ns),
             if p.setup_slack_ns >= 0.0 && p.hold_slack_registers_ns >= 0.0 {
                 "yes"
             } else {
                 "**no**"
             }
-        );
+            .to_string(),
+        ]);
     }
-    s
+    t.render()
 }

@@ -58,8 +58,8 @@
 //! estimates the rate as r̂ = −4·w_{u′,v′}/T_u′ at the peak (`paper_rate_m_per_s`, the
 //! negative of the paper's 4·w/(T/2^u′) in this crate's sign). A transient shorter than
 //! the wavelet is averaged over it: a ramp of height h and duration D centred in a wavelet
-//! of duration T_u gives |r̂| = (2h/T_u)·(1 − D/(2T_u)), not h/D ([`super::paper`] shows
-//! both); `peak_wavelet_longer_than_event` says when that is so.
+//! of duration T_u gives |r̂| = (2h/T_u)·(1 − D/(2T_u)), not h/D (the paper's Fig. 12
+//! reproduction, `tofprobe_experiments::paper::haar_figures`, shows both); `peak_wavelet_longer_than_event` says when that is so.
 
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -69,6 +69,11 @@ use super::noise::Thresholds;
 use super::profile::{PLATEAU_CELLS, Profile, Shape};
 use super::{register_count, register_index};
 use crate::error::DspError;
+
+/// Family-wise false-alarm probability of one frame's events: the rate every caller
+/// thresholds at (the array's event maps, the flow's transient analysis, the paper's
+/// transient figures).
+pub const FAMILY_RATE: f64 = 0.01;
 
 /// Which way the depth moved over an event's peak wavelet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

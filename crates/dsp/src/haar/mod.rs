@@ -29,11 +29,10 @@ pub mod events;
 pub mod fit;
 pub mod montecarlo;
 pub mod noise;
-pub mod paper;
 pub mod profile;
 
 pub use analysis::{Coefficient, Scalogram, held_codes};
-pub use events::{Event, EventReport, detect_events};
+pub use events::{Event, EventReport, FAMILY_RATE, detect_events};
 pub use fit::{TransitionFit, fit_transition};
 pub use noise::{HaarNoise, Thresholds, inverse_normal_cdf};
 pub use profile::Shape;

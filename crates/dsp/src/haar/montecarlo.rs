@@ -16,6 +16,22 @@ use super::noise::{HaarNoise, Thresholds};
 use super::{check_scales, haar_sums_prefix, register_count, register_index};
 use crate::error::DspError;
 
+/// The sensor the noise model is checked on (and the paper's transient figures are
+/// simulated with: the paper states none): 10 MHz, σ_I = 20 ps (3 mm), 5 ps TDC LSB
+/// (0.75 mm), a 400 ps (60 mm) window, at the signal and background rates ρ_s, ρ_b per
+/// pulse that the checks sweep.
+pub fn sensor_with_rates(signal_rate: f64, background_rate: f64) -> SensorConfig {
+    SensorConfig {
+        laser_rate_hz: 10e6,
+        jitter_ps: 20.0,
+        tdc_lsb_ps: 5.0,
+        window_start_ps: 0.0,
+        window_length_ps: 400.0,
+        signal_rate,
+        background_rate,
+    }
+}
+
 /// Measured against predicted sd of one scale.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ScaleNoise {
@@ -143,7 +159,7 @@ pub fn static_noise_check(
 mod tests {
     use super::*;
 
-    use crate::haar::paper::sensor_with_rates as sensor;
+    use super::sensor_with_rates as sensor;
 
     /// Measured per-scale sd against the closed form, three sensors (ρ_s = 1; ρ_s = 0.3;
     /// ρ_s = 0.3 with ρ_b = 0.1), 300 frames of 2^14 pulses, U = 6. Scale u has 300·2^u

@@ -356,7 +356,17 @@ mod tests {
     /// The sensor path: ρ_s = 1, no background → σ² = σ_I² + a²/12, ρ = 1.
     #[test]
     fn static_scene_noise_from_the_sensor() {
-        let sensor = crate::haar::paper::sensor();
+        // The noise checks' sensor (`montecarlo::sensor_with_rates(1.0, 0.0)`), written out:
+        // σ_I = 20 ps = 3 mm, LSB 5 ps = 0.75 mm.
+        let sensor = SensorConfig {
+            laser_rate_hz: 10e6,
+            jitter_ps: 20.0,
+            tdc_lsb_ps: 5.0,
+            window_start_ps: 0.0,
+            window_length_ps: 400.0,
+            signal_rate: 1.0,
+            background_rate: 0.0,
+        };
         let n = HaarNoise::for_static_scene(&sensor, 30.0).unwrap();
         assert!((n.sample_sd_mm - (9.0f64 + 0.75 * 0.75 / 12.0).sqrt()).abs() < 1e-6);
         assert!((n.valid_rate - 1.0).abs() < 1e-9);

@@ -4,8 +4,8 @@
 //! `cargo test --release -p tofprobe-dsp --test it haar_noise:: -- --ignored --nocapture`
 //! (≈ 10 s); the same function (`static_noise_check`) serves `tofprobe reproduce`.
 
+use tofprobe_dsp::haar::montecarlo::sensor_with_rates as sensor;
 use tofprobe_dsp::haar::montecarlo::static_noise_check;
-use tofprobe_dsp::haar::paper::sensor_with_rates as sensor;
 
 /// Tolerances as in the unit tests: 4 standard errors of an sd estimate (1/sqrt(2m)) plus
 /// 1 % for the model's approximations; false-event frames within 5 Poisson sd.

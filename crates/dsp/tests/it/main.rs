@@ -4,5 +4,4 @@
 
 mod fullband_isa;
 mod haar_noise;
-mod haar_paper;
 mod probe_convention;

@@ -3,6 +3,8 @@
 
 use std::fmt::Write;
 
+use tofprobe_io::markdown::{Align, Table};
+
 use super::OptionsReport;
 
 fn lib_short(name: &str) -> String {
@@ -29,19 +31,20 @@ pub fn render(r: &OptionsReport) -> String {
             .map(|l| lib_short(&l.library))
             .collect()
     });
-    let mut head =
-        "| option | W | G | rounding | register file | tone error µm (mean, range) |".to_string();
-    let mut rule = "|---|---:|---:|---|---|---|".to_string();
+    let mut t = Table::new([
+        ("option", Align::Left),
+        ("W", Align::Right),
+        ("G", Align::Right),
+        ("rounding", Align::Left),
+        ("register file", Align::Left),
+        ("tone error µm (mean, range)", Align::Left),
+    ]);
     for l in &libs {
-        let _ = write!(
-            head,
-            " {l} area µm² | {l} fixed + per bin µm² | {l} slack |"
-        );
-        rule += "---:|---:|---|";
+        t.column(format!("{l} area µm²"), Align::Right)
+            .column(format!("{l} fixed + per bin µm²"), Align::Right)
+            .column(format!("{l} slack"), Align::Left);
     }
-    head += " front |";
-    rule += "---|";
-    let _ = writeln!(s, "{head}\n{rule}");
+    t.column("front", Align::Left);
     for row in &r.rows {
         let recommended = row.option.name == r.recommendation.option;
         let mark = match (recommended, row.on_front) {
@@ -51,18 +54,14 @@ pub fn render(r: &OptionsReport) -> String {
             (false, false) => "",
         };
         let e = &row.tone_error_um;
-        let _ = write!(
-            s,
-            "| {} | {} | {} | {} | {} | {:.3} ({:.3}–{:.3}) |",
-            row.option.name,
-            row.width_bits,
-            row.register_frac_bits,
-            row.prefilter_rounding,
-            row.register_file,
-            e.mean,
-            e.min,
-            e.max
-        );
+        let mut cells = vec![
+            row.option.name.clone(),
+            row.width_bits.to_string(),
+            row.register_frac_bits.to_string(),
+            row.prefilter_rounding.to_string(),
+            row.register_file.to_string(),
+            format!("{:.3} ({:.3}–{:.3})", e.mean, e.min, e.max),
+        ];
         for l in &row.libraries {
             let slack = l.timing.as_ref().map_or("untimed".to_string(), |t| {
                 if t.meets_margin {
@@ -71,14 +70,17 @@ pub fn render(r: &OptionsReport) -> String {
                     format!("**{:.1} %**", t.slack_percent)
                 }
             });
-            let _ = write!(
-                s,
-                " {:.0} | {:.0} + {:.0} | {slack} |",
-                l.total_area_um2, l.model.fixed_um2, l.model.per_bin_um2
-            );
+            cells.push(format!("{:.0}", l.total_area_um2));
+            cells.push(format!(
+                "{:.0} + {:.0}",
+                l.model.fixed_um2, l.model.per_bin_um2
+            ));
+            cells.push(slack);
         }
-        let _ = writeln!(s, " {mark} |");
+        cells.push(mark.to_string());
+        t.row(cells);
     }
+    s += &t.render();
 
     let _ = writeln!(
         s,
@@ -99,24 +101,18 @@ pub fn render(r: &OptionsReport) -> String {
                 .map(|f| (f.pixel_side_um, f.paper_bins))
                 .collect()
         });
-    let mut head = "| option |".to_string();
-    let mut rule = "|---|".to_string();
+    let mut t = Table::left(["option"]);
     for l in &libs {
         for (side, _) in &sides {
-            let _ = write!(head, " {l} {side:.0}×{side:.0} µm |");
-            rule += "---:|";
+            t.column(format!("{l} {side:.0}×{side:.0} µm"), Align::Right);
         }
     }
-    let _ = writeln!(s, "{head}\n{rule}");
-    let paper: Vec<String> = libs
-        .iter()
-        .flat_map(|_| {
-            sides
-                .iter()
-                .map(|(_, p)| p.map_or("—".into(), |n| n.to_string()))
-        })
-        .collect();
-    let _ = writeln!(s, "| paper (40 nm estimate) | {} |", paper.join(" | "));
+    let paper = libs.iter().flat_map(|_| {
+        sides
+            .iter()
+            .map(|(_, p)| p.map_or("—".into(), |n| n.to_string()))
+    });
+    t.row(std::iter::once("paper (40 nm estimate)".to_string()).chain(paper));
     for row in &r.rows {
         let cells: Vec<String> = row
             .libraries
@@ -128,8 +124,9 @@ pub fn render(r: &OptionsReport) -> String {
         } else {
             row.option.name.clone()
         };
-        let _ = writeln!(s, "| {name} | {} |", cells.join(" | "));
+        t.row(std::iter::once(name).chain(cells));
     }
+    s += &t.render();
 
     if let Some(k) = &r.layout {
         layout_table(&mut s, r, k);
@@ -185,32 +182,32 @@ fn layout_table(s: &mut String, r: &OptionsReport, k: &tofprobe_eda::scaling::Ro
     let Some(first) = r.rows.first() else {
         return;
     };
-    let mut head = "| option |".to_string();
-    let mut rule = "|---|".to_string();
+    let mut t = Table::left(["option"]);
     for l in first.libraries.iter().filter(|l| l.layout_fits.is_some()) {
         for f in &l.fits {
-            let _ = write!(
-                head,
-                " {} {:.0}×{:.0} µm: layout (synthesis) |",
-                lib_short(&l.library),
-                f.pixel_side_um,
-                f.pixel_side_um
+            t.column(
+                format!(
+                    "{} {:.0}×{:.0} µm: layout (synthesis)",
+                    lib_short(&l.library),
+                    f.pixel_side_um,
+                    f.pixel_side_um
+                ),
+                Align::Right,
             );
-            rule += "---:|";
         }
     }
-    let _ = writeln!(s, "{head}\n{rule}");
     for row in &r.rows {
-        let mut line = format!("| {} |", row.option.name);
+        let mut cells = vec![row.option.name.clone()];
         for l in &row.libraries {
             if let Some(lf) = &l.layout_fits {
                 for (a, b) in lf.iter().zip(&l.fits) {
-                    let _ = write!(line, " {} ({}) |", a.bins, b.bins);
+                    cells.push(format!("{} ({})", a.bins, b.bins));
                 }
             }
         }
-        let _ = writeln!(s, "{line}");
+        t.row(cells);
     }
+    s.push_str(&t.render());
 }
 
 /// The recommended option's bins per pitch from layout, in words (none without a layout).

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use plotters::prelude::*;
+use tofprobe_io::chart::prelude::*;
 
 use super::OptionsReport;
 use crate::error::ExperimentError;
@@ -54,56 +54,39 @@ pub fn front_svg(path: &Path, r: &OptionsReport) -> Result<String, ExperimentErr
             .filter(|q| (q.1 - pts[i].1).abs() < 0.02 * (x1 - x0 + 1.0))
             .count()
     };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (900, 560)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(&e))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                format!(
-                    "area per bin ({}) vs tone error against the float DFT, B = {}",
-                    r.front_library, r.bins
-                ),
-                ("sans-serif", 18),
-            )
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(x0 - pad..x1 + pad, (y0 / 2.0..y1 * 2.0).log_scale())
-            .map_err(|e| err(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("area per bin (µm²)")
-            .y_desc("tone error vs float DFT (µm)")
-            .draw()
-            .map_err(|e| err(&e))?;
+    svg((900, 560), |root| {
+        let frame = Frame::new(
+            format!(
+                "area per bin ({}) vs tone error against the float DFT, B = {}",
+                r.front_library, r.bins
+            ),
+            18,
+        )
+        .margin(12)
+        .axes("area per bin (µm²)", "tone error vs float DFT (µm)");
+        let mut chart = frame.build(root, x0 - pad..x1 + pad, (y0 / 2.0..y1 * 2.0).log_scale())?;
+        frame.draw_mesh(&mut chart)?;
         let target = r.target_error_um;
         chart
             .draw_series(LineSeries::new(
                 [(x0 - pad, target), (x1 + pad, target)],
                 RED.stroke_width(1),
-            ))
-            .map_err(|e| err(&e))?
+            ))?
             .label(format!("target {target} µm"))
             .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED));
         let mut front: Vec<(f64, f64)> = pts.iter().filter(|p| p.5).map(|p| (p.1, p.2)).collect();
         front.sort_by(|a, b| a.0.total_cmp(&b.0));
         chart
-            .draw_series(LineSeries::new(front, BLUE.stroke_width(2)))
-            .map_err(|e| err(&e))?
+            .draw_series(LineSeries::new(front, BLUE.stroke_width(2)))?
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLUE));
         for (i, p) in pts.iter().enumerate() {
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    [(p.1, p.3), (p.1, p.4)],
-                    BLACK.mix(0.5),
-                )))
-                .map_err(|e| err(&e))?;
+            chart.draw_series(std::iter::once(PathElement::new(
+                [(p.1, p.3), (p.1, p.4)],
+                BLACK.mix(0.5),
+            )))?;
             let colour = if p.5 { BLUE } else { BLACK };
-            chart
-                .draw_series(std::iter::once(Circle::new((p.1, p.2), 5, colour.filled())))
-                .map_err(|e| err(&e))?;
+            chart.draw_series(std::iter::once(Circle::new((p.1, p.2), 5, colour.filled())))?;
             chart
                 // Options of (nearly) equal area per bin, like the baseline and one adder,
                 // would print their labels over each other: the k-th such point's label
@@ -112,26 +95,16 @@ pub fn front_svg(path: &Path, r: &OptionsReport) -> Result<String, ExperimentErr
                     p.0.clone(),
                     (p.1, p.2 * LABEL_STEPS[same_x(i) % LABEL_STEPS.len()]),
                     ("sans-serif", 12).into_font(),
-                )))
-                .map_err(|e| err(&e))?;
+                )))?;
             if p.0 == r.recommendation.option {
-                chart
-                    .draw_series(std::iter::once(Circle::new(
-                        (p.1, p.2),
-                        10,
-                        GREEN.stroke_width(2),
-                    )))
-                    .map_err(|e| err(&e))?;
+                chart.draw_series(std::iter::once(Circle::new(
+                    (p.1, p.2),
+                    10,
+                    GREEN.stroke_width(2),
+                )))?;
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE)
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| err(&e))?;
-        root.present().map_err(|e| err(&e))?;
-    }
-    Ok(svg)
+        legend(&mut chart, SeriesLabelPosition::UpperLeft, 1.0, None)
+    })
+    .map_err(|e| err(&e))
 }

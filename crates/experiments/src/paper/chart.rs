@@ -3,9 +3,8 @@
 //! SVG text by plotters on linear or logarithmic axes. Rendering never writes a file: the
 //! reproduction stages every figure into one output set (`reproduce`), whole or absent.
 
-use plotters::coord::Shift;
-use plotters::coord::ranged1d::{AsRangedCoord, Ranged, ValueFormatter};
-use plotters::prelude::*;
+use tofprobe_io::chart::plotters::coord::ranged1d::{AsRangedCoord, Ranged, ValueFormatter};
+use tofprobe_io::chart::prelude::*;
 
 use crate::ExperimentError;
 
@@ -234,11 +233,8 @@ impl Chart {
         }
         let (x0, x1) = self.range(true)?;
         let (y0, y1) = self.range(false)?;
-        let mut svg = String::new();
-        {
-            let h = CHART_H + LINE_H * self.notes.len() as u32 + 8;
-            let root = SVGBackend::with_string(&mut svg, (960, h)).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| plot_err(&self.file, e))?;
+        let h = CHART_H + LINE_H * self.notes.len() as u32 + 8;
+        svg((960, h), |root| {
             let (upper, lower) = root.split_vertically(CHART_H);
             let xk = || {
                 (x0..x1)
@@ -253,17 +249,15 @@ impl Chart {
                 (true, true) => self.draw(&upper, xk(), yk()),
             }?;
             for (i, note) in self.notes.iter().enumerate() {
-                lower
-                    .draw(&Text::new(
-                        note.clone(),
-                        (80, (LINE_H * i as u32) as i32),
-                        ("sans-serif", 14).into_font().color(&BLACK),
-                    ))
-                    .map_err(|e| plot_err(&self.file, e))?;
+                lower.draw(&Text::new(
+                    note.clone(),
+                    (80, (LINE_H * i as u32) as i32),
+                    ("sans-serif", 14).into_font().color(&BLACK),
+                ))?;
             }
-            root.present().map_err(|e| plot_err(&self.file, e))?;
-        }
-        Ok(svg)
+            Ok(())
+        })
+        .map_err(|e| plot_err(&self.file, e))
     }
 
     /// The legend's box (x0, y0, x1, y1 in pixels) in `corner` of the plotting area, as
@@ -308,39 +302,27 @@ impl Chart {
             .unwrap_or(self.legend)
     }
 
-    fn draw<'a, X, Y>(
-        &self,
-        root: &DrawingArea<SVGBackend<'a>, Shift>,
-        xr: X,
-        yr: Y,
-    ) -> Result<(), ExperimentError>
+    fn draw<X, Y>(&self, root: &Root<'_>, xr: X, yr: Y) -> Result<(), ChartError>
     where
         X: AsRangedCoord<Value = f64>,
         Y: AsRangedCoord<Value = f64>,
         X::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
         Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
-        let e = |e: &dyn std::fmt::Display| plot_err(&self.file, e);
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, ("sans-serif", 19))
+        let frame = Frame::new(self.title.as_str(), 19)
             .margin(14)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d(xr, yr)
-            .map_err(|x| e(&x))?;
-        chart
-            .configure_mesh()
+            .label_areas(44, 64)
+            .axes(self.x_label.as_str(), self.y_label.as_str())
+            .fonts(14, Some(15));
+        let mut chart = frame.build(root, xr, yr)?;
+        frame
+            .mesh(&mut chart)
             .x_label_formatter(&tick)
             .y_label_formatter(&tick)
-            .x_desc(self.x_label.as_str())
-            .y_desc(self.y_label.as_str())
-            .label_style(("sans-serif", 14))
-            .axis_desc_style(("sans-serif", 15))
             // Grid lines at the labelled ticks only: plotters' light lines between them
             // drew dense grey bands on log axes.
             .light_line_style(TRANSPARENT)
-            .draw()
-            .map_err(|x| e(&x))?;
+            .draw()?;
         let (y_lo, y_hi) = {
             let r = chart.y_range();
             (r.start, r.end)
@@ -353,8 +335,7 @@ impl Chart {
         for s in &self.lines {
             let c = next();
             chart
-                .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
-                .map_err(|x| e(&x))?
+                .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))?
                 .label(s.name.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c));
         }
@@ -366,16 +347,13 @@ impl Chart {
                 let lo = if self.y_log { (m - d).max(y_lo) } else { m - d };
                 PathElement::new(vec![(x, lo), (x, m + d)], c.stroke_width(2))
             };
-            chart
-                .draw_series(s.points.iter().map(bar))
-                .map_err(|x| e(&x))?;
+            chart.draw_series(s.points.iter().map(bar))?;
             chart
                 .draw_series(
                     s.points
                         .iter()
                         .map(|&(x, m, _)| Circle::new((x, m), 4, c.filled())),
-                )
-                .map_err(|x| e(&x))?
+                )?
                 .label(s.name.as_str())
                 .legend(move |(x, y)| Circle::new((x + 8, y), 4, c.filled()));
         }
@@ -386,27 +364,23 @@ impl Chart {
                     s.points
                         .iter()
                         .map(|&p| Cross::new(p, 6, c.stroke_width(2))),
-                )
-                .map_err(|x| e(&x))?
+                )?
                 .label(s.name.as_str())
                 .legend(move |(x, y)| Cross::new((x + 8, y), 5, c.stroke_width(2)));
         }
         for (i, (label, x)) in self.marks.iter().enumerate() {
             let c = BLACK.mix(0.6);
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    vec![(*x, y_lo), (*x, y_hi)],
-                    c.stroke_width(1),
-                )))
-                .map_err(|x| e(&x))?;
+            chart.draw_series(std::iter::once(PathElement::new(
+                vec![(*x, y_lo), (*x, y_hi)],
+                c.stroke_width(1),
+            )))?;
             // Labels stacked down from the top so that close marks do not overprint.
             let (px, py) = chart.backend_coord(&(*x, y_hi));
             root.draw(&Text::new(
                 label.clone(),
                 (px + 4, py + 6 + 17 * i as i32),
                 ("sans-serif", 13).into_font().color(&BLACK),
-            ))
-            .map_err(|x| e(&x))?;
+            ))?;
         }
         let markers: Vec<(i32, i32)> = self
             .error_bars
@@ -421,15 +395,7 @@ impl Chart {
             (area.0.start, area.0.end),
             (area.1.start, area.1.end),
         );
-        chart
-            .configure_series_labels()
-            .position(corner.position())
-            .label_font(("sans-serif", 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|x| e(&x))?;
-        Ok(())
+        legend(&mut chart, corner.position(), 0.85, Some(14))
     }
 }
 

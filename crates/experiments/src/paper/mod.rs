@@ -13,6 +13,7 @@ pub mod bandwidth;
 pub mod chart;
 pub mod fig4;
 pub mod figures;
+pub mod haar_figures;
 pub mod plots;
 pub mod reproduce;
 pub mod setup;
@@ -23,6 +24,7 @@ pub mod table2;
 pub mod transients;
 
 use serde::Serialize;
+use tofprobe_io::markdown::Table;
 
 /// How a row is judged.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -155,10 +157,19 @@ fn fmt_opt(v: Option<f64>) -> String {
 
 /// The Markdown table.
 pub fn markdown(rows: &[Row]) -> String {
-    let mut s = String::from(
-        "| experiment | row | unit | paper | corrected | measured | closed form / reference | same-record DFT | tolerance | pass | note |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|\n",
-    );
+    let mut t = Table::left([
+        "experiment",
+        "row",
+        "unit",
+        "paper",
+        "corrected",
+        "measured",
+        "closed form / reference",
+        "same-record DFT",
+        "tolerance",
+        "pass",
+        "note",
+    ]);
     for r in rows {
         let tol = match r.tolerance {
             Tolerance::Relative { rel } => format!("±{:.0}%", rel * 100.0),
@@ -184,26 +195,25 @@ pub fn markdown(rows: &[Row]) -> String {
                 z(r.z_closed_form)
             )
         };
-        s += &format!(
-            "| {} | {} | {} | {} | {} | {:.4} | {} | {} | {} | {} | {} |\n",
-            r.family,
-            // A literal | (as in |w|) would split the Markdown cell.
-            r.label.replace('|', "\\|"),
-            r.unit,
+        // A literal | (as in |w|) would split a Markdown cell: the table escapes it.
+        t.row([
+            r.family.to_string(),
+            r.label.to_string(),
+            r.unit.to_string(),
             fmt_opt(r.paper),
             fmt_opt(r.design),
-            r.measured,
+            format!("{:.4}", r.measured),
             fmt_opt(r.closed_form),
             match (r.same_record_dft, r.same_record_tolerance) {
                 (Some(v), Some(t)) => format!("{v:.4} ± {t:.4}"),
                 _ => "–".to_string(),
             },
             tol,
-            if r.pass { "pass" } else { "FAIL" },
-            (stats + &r.note).replace('|', "\\|")
-        );
+            if r.pass { "pass" } else { "FAIL" }.to_string(),
+            stats + &r.note,
+        ]);
     }
-    s
+    t.render()
 }
 
 #[cfg(test)]

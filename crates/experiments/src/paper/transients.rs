@@ -1,14 +1,14 @@
 //! The paper's transient figures in the reproduction: Fig. 3 (the float Haar scalogram of
 //! an impulse, a fast and a slow edge) and Fig. 12 (a 25 mm step from the pixel's Haar
 //! registers: the largest coefficient's scale, the event time and the ramp rate), computed
-//! by `tofprobe_dsp::haar::paper` and mapped to the reproduction's [`Row`]s, plus their
+//! by `paper::haar_figures` and mapped to the reproduction's [`Row`]s, plus their
 //! scalogram SVGs.
 //!
 //! A `TransientRow` is judged by an absolute tolerance (or a structural claim stated in its
 //! note) that the dsp crate evaluates; the row keeps that verdict ([`Tolerance::Bound`],
 //! the tolerance written into the note) and shows its reference in the closed-form column.
 
-use tofprobe_dsp::haar::paper::{TransientFigure, TransientRow, fig3, fig12};
+use super::haar_figures::{TransientFigure, TransientRow, fig3, fig12};
 
 use super::{Row, Tolerance};
 use crate::ExperimentError;

@@ -15,6 +15,7 @@ use tofprobe_array::model::run_array;
 use tofprobe_design::{ArrayLevel, DesignError, ResolvedDesign};
 use tofprobe_dsp::sd::ProbeRom;
 use tofprobe_dsp::stats::ks_two_sample;
+use tofprobe_io::markdown::Table;
 
 use crate::error::ExperimentError;
 
@@ -218,12 +219,41 @@ pub fn measure_array(
 
 /// The Markdown table of one array configuration.
 pub fn markdown(r: &ArrayTradeoff) -> String {
-    let mut s = format!(
+    let mut t = Table::left([
+        "level",
+        "s",
+        "pixel-pulses/s",
+        "amp. RMS err µm",
+        "× bit-true spread",
+        "amp. bias µm",
+        "phase RMS err °",
+        "× bit-true",
+        "noise floor µm",
+        "× bit-true",
+        "MAC",
+        "KS D",
+        "KS p",
+    ]);
+    for l in &r.levels {
+        t.row([
+            l.level.to_string(),
+            format!("{:.3}", l.seconds),
+            format!("{:.3e}", l.pixel_pulses_per_s),
+            format!("{:.3}", l.amplitude_rms_error_um),
+            format!("{:.2}", l.amplitude_error_ratio),
+            format!("{:+.3}", l.amplitude_bias_um),
+            format!("{:.2}", l.phase_rms_error_deg),
+            format!("{:.2}", l.phase_error_ratio),
+            format!("{:.3}", l.noise_floor_um),
+            format!("{:.3}", l.noise_floor_ratio),
+            format!("{:.5}", l.mac),
+            format!("{:.3}", l.noise_ks_statistic),
+            format!("{:.2e}", l.noise_ks_p_value),
+        ]);
+    }
+    format!(
         "### {} ({} × {} pixels, N = {}; mode at {:.1} Hz, bin {}; bit-true spread {:.3} µm, \
-         {:.2}°; bit-true MAC between seeds {:.5})\n\n\
-         | level | s | pixel-pulses/s | amp. RMS err µm | × bit-true spread | amp. bias µm \
-         | phase RMS err ° | × bit-true | noise floor µm | × bit-true | MAC | KS D | KS p |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         {:.2}°; bit-true MAC between seeds {:.5})\n\n{t}",
         r.origin,
         r.rows,
         r.cols,
@@ -233,24 +263,5 @@ pub fn markdown(r: &ArrayTradeoff) -> String {
         r.bit_true_spread_um,
         r.bit_true_phase_spread_deg,
         r.bit_true_mac
-    );
-    for l in &r.levels {
-        s.push_str(&format!(
-            "| {} | {:.3} | {:.3e} | {:.3} | {:.2} | {:+.3} | {:.2} | {:.2} | {:.3} | {:.3} | {:.5} | {:.3} | {:.2e} |\n",
-            l.level,
-            l.seconds,
-            l.pixel_pulses_per_s,
-            l.amplitude_rms_error_um,
-            l.amplitude_error_ratio,
-            l.amplitude_bias_um,
-            l.phase_rms_error_deg,
-            l.phase_error_ratio,
-            l.noise_floor_um,
-            l.noise_floor_ratio,
-            l.mac,
-            l.noise_ks_statistic,
-            l.noise_ks_p_value
-        ));
-    }
-    s
+    )
 }

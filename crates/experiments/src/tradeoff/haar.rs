@@ -18,6 +18,7 @@ use std::time::Instant;
 use serde::Serialize;
 use tofprobe_design::{DesignError, ResolvedDesign};
 use tofprobe_dsp::haar::{EventReport, Scalogram};
+use tofprobe_io::markdown::Table;
 use tofprobe_pixel::{CycleModel, PixelError, PixelParams, ReadoutCollector, Sequencer};
 
 use super::CYCLE_FRAME;
@@ -314,20 +315,27 @@ pub fn markdown(r: &HaarSceneResult) -> String {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let mut s = format!(
-        "### {} (Haar, N = {}, U = {}, scene transients at {truth})\n\n| level | wall s per simulated s | max abs(Δw) vs float Haar mm | events | event time err vs float ms | vs true ms | note |\n|---|---|---|---|---|---|---|\n",
-        r.origin, r.pulses, r.scales
-    );
+    let mut t = Table::left([
+        "level",
+        "wall s per simulated s",
+        "max abs(Δw) vs float Haar mm",
+        "events",
+        "event time err vs float ms",
+        "vs true ms",
+        "note",
+    ]);
     let f = |x: Option<f64>, p: usize| x.map_or_else(|| "–".into(), |v| format!("{v:.p$}"));
     for l in &r.levels {
-        s.push_str(&format!(
-            "| {}{} | {} | {} | {} | {} | {} | {} |\n",
-            l.level,
-            if l.extrapolated {
-                " (extrapolated)"
-            } else {
-                ""
-            },
+        t.row([
+            format!(
+                "{}{}",
+                l.level,
+                if l.extrapolated {
+                    " (extrapolated)"
+                } else {
+                    ""
+                }
+            ),
             l.seconds_per_sim_second
                 .map_or_else(|| "–".into(), |v| format!("{v:.3e}")),
             l.coefficient_err_mm
@@ -335,10 +343,13 @@ pub fn markdown(r: &HaarSceneResult) -> String {
             l.events.map_or_else(|| "–".into(), |e| e.to_string()),
             f(l.event_time_err_vs_float_ms, 3),
             f(l.event_time_err_vs_true_ms, 3),
-            l.note
-        ));
+            l.note.clone(),
+        ]);
     }
-    s
+    format!(
+        "### {} (Haar, N = {}, U = {}, scene transients at {truth})\n\n{t}",
+        r.origin, r.pulses, r.scales
+    )
 }
 
 #[cfg(test)]

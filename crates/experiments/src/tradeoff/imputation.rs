@@ -31,6 +31,7 @@ use tofprobe_dsp::imputation::response::{mean_response, noise_factor};
 use tofprobe_dsp::imputation::{AlphaBeta, Imputation, KalmanParams};
 use tofprobe_dsp::preprocess::{FrontEnd, FrontEndOutput};
 use tofprobe_dsp::stats::{NoiseBand, interpolate_peak, noise_floor};
+use tofprobe_io::markdown::{Align, Table};
 
 use crate::ExperimentError;
 use crate::paper::setup::FS_HZ;
@@ -360,56 +361,77 @@ pub fn measure(
 
 /// The Markdown tables.
 pub fn markdown(r: &ImputationReport) -> String {
-    let mut s = format!(
-        "### Imputation: Kalman and α-β against the 1NN hold (Table 2's scenes, N = {}, {} seeds, mean ± sd)\n\n\
-         | σ_s mm | ρ_s | ρ_b | method | noise floor µm (closed form) | amplitude µm (closed form) | floor at tone µm (closed form) | SNR at tone dB | vs hold dB (closed form) |\n\
-         |---:|---:|---:|---|---|---|---|---|---|\n",
-        r.pulses, r.seeds
-    );
+    let right = |h: &'static str| (h, Align::Right);
+    let left = |h: &'static str| (h, Align::Left);
+    let mut t = Table::new([
+        right("σ_s mm"),
+        right("ρ_s"),
+        right("ρ_b"),
+        left("method"),
+        left("noise floor µm (closed form)"),
+        left("amplitude µm (closed form)"),
+        left("floor at tone µm (closed form)"),
+        left("SNR at tone dB"),
+        left("vs hold dB (closed form)"),
+    ]);
     let cf = |x: Option<f64>| x.map(|v| format!(" ({v:.2})")).unwrap_or_default();
     let ms = |x: &Spread| format!("{:.2} ± {:.2}", x.mean, x.sd);
     for sc in &r.scenes {
         for m in &sc.methods {
-            s.push_str(&format!(
-                "| {} | {} | {} | {} | {}{} | {}{} | {}{} | {} | {:+.2} ± {:.2}{} |\n",
-                sc.sigma_s_mm,
-                sc.rho_s,
-                sc.rho_b,
-                m.method,
-                ms(&m.noise_floor_um),
-                cf(m.closed_form_noise_floor_um),
-                ms(&m.amplitude_um),
-                cf(m.closed_form_amplitude_um),
-                ms(&m.noise_at_tone_um),
-                cf(m.closed_form_noise_at_tone_um),
+            t.row([
+                sc.sigma_s_mm.to_string(),
+                sc.rho_s.to_string(),
+                sc.rho_b.to_string(),
+                m.method.to_string(),
+                ms(&m.noise_floor_um) + &cf(m.closed_form_noise_floor_um),
+                ms(&m.amplitude_um) + &cf(m.closed_form_amplitude_um),
+                ms(&m.noise_at_tone_um) + &cf(m.closed_form_noise_at_tone_um),
                 ms(&m.snr_at_tone_db),
-                m.snr_gain_over_hold_db.mean,
-                m.snr_gain_over_hold_db.sd,
-                m.closed_form_snr_gain_over_hold_db
-                    .map(|v| format!(" ({v:+.2})"))
-                    .unwrap_or_default(),
-            ));
+                format!(
+                    "{:+.2} ± {:.2}{}",
+                    m.snr_gain_over_hold_db.mean,
+                    m.snr_gain_over_hold_db.sd,
+                    m.closed_form_snr_gain_over_hold_db
+                        .map(|v| format!(" ({v:+.2})"))
+                        .unwrap_or_default(),
+                ),
+            ]);
         }
     }
-    s.push_str(
-        "\nKalman: σ_w = σ_s, σ_a = A·ω² (the tone's peak acceleration), gate 3 sd; α-β: Kalata's gains at T = 1/ρ_s rounded to powers of two. Without background no imputation gains more than 10·log10(2 − ρ) dB (bound below) over the hold at equal response (tofprobe_dsp::imputation::response); with background the gate also drops outliers the hold keeps, so the gain can exceed it, and the α-β closed form (no gate) sits above the gated floor.\n\n| ρ_s | σ_w mm | σ_a mm/pulse² | α | β 1/pulse | bound dB |\n|---:|---:|---:|---:|---:|---:|\n",
+    let mut s = format!(
+        "### Imputation: Kalman and α-β against the 1NN hold (Table 2's scenes, N = {}, {} seeds, mean ± sd)\n\n{t}",
+        r.pulses, r.seeds
     );
+    s.push_str(
+        "\nKalman: σ_w = σ_s, σ_a = A·ω² (the tone's peak acceleration), gate 3 sd; α-β: Kalata's gains at T = 1/ρ_s rounded to powers of two. Without background no imputation gains more than 10·log10(2 − ρ) dB (bound below) over the hold at equal response (tofprobe_dsp::imputation::response); with background the gate also drops outliers the hold keeps, so the gain can exceed it, and the α-β closed form (no gate) sits above the gated floor.\n\n",
+    );
+    let mut gains = Table::new([
+        right("ρ_s"),
+        right("σ_w mm"),
+        right("σ_a mm/pulse²"),
+        right("α"),
+        right("β 1/pulse"),
+        right("bound dB"),
+    ]);
     let mut seen = Vec::new();
     for sc in r.scenes.iter().filter(|sc| {
         let new = !seen.contains(&sc.rho_s);
         seen.push(sc.rho_s);
         new
     }) {
-        s.push_str(&format!(
-            "| {} | {} | {:.3e} | 2^{} | 2^{} | {:.2} |\n",
-            sc.rho_s,
-            sc.measurement_noise_mm,
-            sc.process_noise_mm_per_pulse2,
-            sc.alpha.log2(),
-            sc.beta_per_pulse.log2(),
-            tofprobe_dsp::imputation::response::snr_bound_db(sc.rho_s)
-        ));
+        gains.row([
+            sc.rho_s.to_string(),
+            sc.measurement_noise_mm.to_string(),
+            format!("{:.3e}", sc.process_noise_mm_per_pulse2),
+            format!("2^{}", sc.alpha.log2()),
+            format!("2^{}", sc.beta_per_pulse.log2()),
+            format!(
+                "{:.2}",
+                tofprobe_dsp::imputation::response::snr_bound_db(sc.rho_s)
+            ),
+        ]);
     }
+    s.push_str(&gains.render());
     s.push_str(&super::imputation_cost::markdown(&r.pixel_cost));
     s
 }

@@ -21,6 +21,7 @@
 
 use serde::Serialize;
 use tofprobe_eda::liberty::Liberty;
+use tofprobe_io::markdown::Table;
 
 use crate::ExperimentError;
 use crate::paper::setup::{BG_WINDOW_MM, LSB_MM};
@@ -183,24 +184,34 @@ pub fn markdown(rows: &[ImputationCost]) -> String {
     if rows.is_empty() {
         return "\n(pixel cost: no sky130 liberty found; see `tofprobe size`)\n".into();
     }
-    let mut s = format!(
-        "\n#### Pixel cost (cells of {}, no wiring or sharing)\n\n| form | ρ_s | depth bits | velocity bits | covariance bits | flops | full adders | multipliers | dividers | area µm² |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
-        rows[0].library
-    );
+    let mut t = Table::numeric([
+        "form",
+        "ρ_s",
+        "depth bits",
+        "velocity bits",
+        "covariance bits",
+        "flops",
+        "full adders",
+        "multipliers",
+        "dividers",
+        "area µm²",
+    ]);
     for r in rows {
-        s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} |\n",
-            r.form,
+        t.row([
+            r.form.to_string(),
             r.rho_s.map(|x| x.to_string()).unwrap_or_else(|| "–".into()),
-            r.depth_bits,
-            r.velocity_bits,
-            r.covariance_bits,
-            r.flops,
-            r.full_adders,
-            r.multipliers,
-            r.dividers,
-            r.area_um2
-        ));
+            r.depth_bits.to_string(),
+            r.velocity_bits.to_string(),
+            r.covariance_bits.to_string(),
+            r.flops.to_string(),
+            r.full_adders.to_string(),
+            r.multipliers.to_string(),
+            r.dividers.to_string(),
+            format!("{:.0}", r.area_um2),
+        ]);
     }
-    s
+    format!(
+        "\n#### Pixel cost (cells of {}, no wiring or sharing)\n\n{t}",
+        rows[0].library
+    )
 }

@@ -7,6 +7,7 @@
 //! (e.g. W below the sizing) is a row with the refusal, not a failed command.
 
 use serde::Serialize;
+use tofprobe_io::markdown::Table;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
 
 use tofprobe_design::{DesignError, Document, ProbeCache, ResolvedDesign};
@@ -319,9 +320,7 @@ fn measure_row(
 /// The Markdown table of a sweep.
 pub fn markdown(s: &KnobSweep) -> String {
     let mut out = format!(
-        "### Knobs within the bit-true level: {} (N = {}{}, bit-true time = median of {} runs{})\n\n\
-         | knob | value | W | B | L | bit-true s per simulated s | amplitude µm | err vs DFT µm | err vs true µm | noise µm | noise vs DFT | noise vs closed form |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "### Knobs within the bit-true level: {} (N = {}{}, bit-true time = median of {} runs{})\n\n",
         s.origin,
         s.pulses,
         if s.shortened { ", shortened frame" } else { "" },
@@ -336,20 +335,32 @@ pub fn markdown(s: &KnobSweep) -> String {
             .unwrap_or_else(|| "–".into())
     };
     let u = |x: Option<usize>| x.map(|v| v.to_string()).unwrap_or_else(|| "–".into());
+    let mut t = Table::left([
+        "knob",
+        "value",
+        "W",
+        "B",
+        "L",
+        "bit-true s per simulated s",
+        "amplitude µm",
+        "err vs DFT µm",
+        "err vs true µm",
+        "noise µm",
+        "noise vs DFT",
+        "noise vs closed form",
+    ]);
     for r in &s.rows {
         if let Some(why) = &r.rejected {
-            out.push_str(&format!(
-                "| {} | {} | rejected: {} |||||||||\n",
-                r.knob,
-                r.value,
-                why.replace('|', "/").replace('\n', " ")
-            ));
+            t.row_spanning([
+                r.knob.to_string(),
+                r.value.to_string(),
+                format!("rejected: {}", why.replace('|', "/").replace('\n', " ")),
+            ]);
             continue;
         }
-        out.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
-            r.knob,
-            r.value,
+        t.row([
+            r.knob.to_string(),
+            r.value.to_string(),
             r.width_bits
                 .map(|w| w.to_string())
                 .unwrap_or_else(|| "–".into()),
@@ -364,8 +375,9 @@ pub fn markdown(s: &KnobSweep) -> String {
             f(r.noise_um),
             pct(r.noise_rel_err_vs_dft),
             pct(r.noise_rel_err_vs_closed_form),
-        ));
+        ]);
     }
+    out += &t.render();
     out
 }
 

@@ -25,6 +25,7 @@ use tofprobe_dsp::closed_form::{
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_dsp::sd::{amplitudes_um, normalise, probe_detections};
 use tofprobe_dsp::selected_bins::SelectedBins;
+use tofprobe_io::markdown::Table;
 use tofprobe_pixel::autobins::choose_bins;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
 use tofprobe_pixel::speed::bench_cycle;
@@ -460,31 +461,41 @@ impl<'a> Ladder<'a> {
 
 /// The Markdown table of one scene.
 pub fn markdown(r: &SceneResult) -> String {
-    let mut s = format!(
-        "### {} (N = {}, true amplitude {})\n\n| level | wall s per simulated s | amplitude µm | err vs DFT µm | err vs true µm | noise µm | noise vs DFT |\n|---|---|---|---|---|---|---|\n",
+    let mut t = Table::left([
+        "level",
+        "wall s per simulated s",
+        "amplitude µm",
+        "err vs DFT µm",
+        "err vs true µm",
+        "noise µm",
+        "noise vs DFT",
+    ]);
+    let f = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "–".into());
+    for l in &r.levels {
+        t.row([
+            format!(
+                "{}{}",
+                l.level,
+                if l.extrapolated {
+                    " (extrapolated)"
+                } else {
+                    ""
+                }
+            ),
+            format!("{:.3e}", l.seconds_per_sim_second),
+            f(l.amplitude_um),
+            f(l.amplitude_err_vs_dft_um),
+            f(l.amplitude_err_vs_true_um),
+            format!("{:.3}", l.noise_um),
+            format!("{:+.1}%", l.noise_rel_err_vs_dft * 100.0),
+        ]);
+    }
+    format!(
+        "### {} (N = {}, true amplitude {})\n\n{t}",
         r.origin,
         r.pulses,
         r.true_amplitude_um
             .map(|a| format!("{a:.2} µm"))
             .unwrap_or_else(|| "–".into())
-    );
-    let f = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "–".into());
-    for l in &r.levels {
-        s.push_str(&format!(
-            "| {}{} | {:.3e} | {} | {} | {} | {:.3} | {:+.1}% |\n",
-            l.level,
-            if l.extrapolated {
-                " (extrapolated)"
-            } else {
-                ""
-            },
-            l.seconds_per_sim_second,
-            f(l.amplitude_um),
-            f(l.amplitude_err_vs_dft_um),
-            f(l.amplitude_err_vs_true_um),
-            l.noise_um,
-            l.noise_rel_err_vs_dft * 100.0
-        ));
-    }
-    s
+    )
 }

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use plotters::prelude::*;
+use tofprobe_io::chart::prelude::*;
 
 use super::SceneResult;
 use crate::error::ExperimentError;
@@ -49,29 +49,19 @@ pub fn pareto_svg_text(path: &Path, scenes: &[SceneResult]) -> Result<String, Ex
     let (y0, y1) = pts
         .iter()
         .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.2), b.max(p.2)));
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (900, 560)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(&e))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                "speed/accuracy: wall s per simulated s vs amplitude error",
-                ("sans-serif", 20),
-            )
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(
-                (x0 / 3.0..x1 * 3.0).log_scale(),
-                (y0 / 3.0..y1 * 3.0).log_scale(),
-            )
-            .map_err(|e| err(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("wall seconds per simulated second")
-            .y_desc("|A − A_true| (µm)")
-            .draw()
-            .map_err(|e| err(&e))?;
+    svg((900, 560), |root| {
+        let frame = Frame::new(
+            "speed/accuracy: wall s per simulated s vs amplitude error",
+            20,
+        )
+        .margin(12)
+        .axes("wall seconds per simulated second", "|A − A_true| (µm)");
+        let mut chart = frame.build(
+            root,
+            (x0 / 3.0..x1 * 3.0).log_scale(),
+            (y0 / 3.0..y1 * 3.0).log_scale(),
+        )?;
+        frame.draw_mesh(&mut chart)?;
         let mut names: Vec<String> = pts.iter().map(|p| p.0.clone()).collect();
         names.dedup();
         names.sort();
@@ -84,18 +74,11 @@ pub fn pareto_svg_text(path: &Path, scenes: &[SceneResult]) -> Result<String, Ex
                 .map(|p| (p.1, p.2))
                 .collect();
             chart
-                .draw_series(series.iter().map(|&p| Circle::new(p, 6, c.filled())))
-                .map_err(|e| err(&e))?
+                .draw_series(series.iter().map(|&p| Circle::new(p, 6, c.filled())))?
                 .label(name.as_str())
                 .legend(move |(x, y)| Circle::new((x, y), 5, c.filled()));
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE)
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| err(&e))?;
-        root.present().map_err(|e| err(&e))?;
-    }
-    Ok(svg)
+        legend(&mut chart, SeriesLabelPosition::MiddleRight, 1.0, None)
+    })
+    .map_err(|e| err(&e))
 }

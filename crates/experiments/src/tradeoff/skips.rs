@@ -13,6 +13,7 @@
 use serde::Serialize;
 use tofprobe_dsp::dft::amplitude_spectrum;
 use tofprobe_dsp::selected_bins::SelectedBins;
+use tofprobe_io::markdown::Table;
 use tofprobe_pixel::spectrum::bit_true_spectrum;
 
 use super::overrides::{shortened, with_overrides};
@@ -183,19 +184,27 @@ pub fn measure_skips(
 
 /// The Markdown table of the skips.
 pub fn markdown(r: &SkipReport) -> String {
-    let mut out = format!(
-        "### Skipped stages: {} (N = {}{}, median of {} runs)\n\n\
-         | stage skipped | compared | with skip s | without s | speedup |\n|---|---|---|---|---|\n",
+    let mut t = Table::left([
+        "stage skipped",
+        "compared",
+        "with skip s",
+        "without s",
+        "speedup",
+    ]);
+    for s in &r.stages {
+        t.row([
+            s.stage.to_string(),
+            s.comparison.to_string(),
+            format!("{:.4}", s.seconds_with_skip),
+            format!("{:.4}", s.seconds_without_skip),
+            format!("{:.2}×", s.speedup_ratio),
+        ]);
+    }
+    format!(
+        "### Skipped stages: {} (N = {}{}, median of {} runs)\n\n{t}",
         r.origin,
         r.pulses,
         if r.shortened { ", shortened frame" } else { "" },
         r.reps
-    );
-    for s in &r.stages {
-        out.push_str(&format!(
-            "| {} | {} | {:.4} | {:.4} | {:.2}× |\n",
-            s.stage, s.comparison, s.seconds_with_skip, s.seconds_without_skip, s.speedup_ratio
-        ));
-    }
-    out
+    )
 }

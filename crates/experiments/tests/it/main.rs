@@ -4,6 +4,7 @@
 
 mod common;
 mod extremes;
+mod haar_figures;
 mod imputation;
 mod levels;
 mod scalogram_figures;

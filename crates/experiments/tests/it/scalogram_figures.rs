@@ -2,7 +2,7 @@
 //! (the pixel's 2^19 frame) as SVG with their events, and as JSON. Set
 //! TOFPROBE_SCALOGRAM_DIR to keep the files for a look.
 
-use tofprobe_dsp::haar::paper::{fig3, fig12};
+use tofprobe_experiments::paper::haar_figures::{fig3, fig12};
 use tofprobe_experiments::scalogram::{scalogram_json, scalogram_svg};
 
 #[test]

@@ -4,6 +4,7 @@
 
 use tofprobe_eda::array::options::{DoubleBuffer, SuperpixelSize};
 use tofprobe_eda::array::timing::PathTiming;
+use tofprobe_io::markdown::Table;
 
 use crate::array::report::ArraySizeReport;
 
@@ -13,17 +14,23 @@ pub fn markdown(a: &ArraySizeReport) -> String {
         "\n## The array: {} × {} = {} pixels\n\n",
         a.rows, a.cols, a.pixels
     );
-    m += "| library | pixel cell area (µm²) | utilisation | node (nm) | implied pitch (µm) |\n|---|---|---|---|---|\n";
+    let mut t = Table::left([
+        "library",
+        "pixel cell area (µm²)",
+        "utilisation",
+        "node (nm)",
+        "implied pitch (µm)",
+    ]);
     for p in &a.pitch {
-        m += &format!(
-            "| {} | {:.0} | {:.0} % | {} | {:.1} |\n",
-            p.library,
-            p.cell_area_um2,
-            p.utilisation * 100.0,
-            p.node_nm,
-            p.pitch_um
-        );
+        t.row([
+            p.library.clone(),
+            format!("{:.0}", p.cell_area_um2),
+            format!("{:.0} %", p.utilisation * 100.0),
+            p.node_nm.to_string(),
+            format!("{:.1}", p.pitch_um),
+        ]);
     }
+    m += &t.render();
     m += &format!(
         "\nConfigured pitch {} µm: {}.\n",
         a.configured_pitch_um,
@@ -35,65 +42,95 @@ pub fn markdown(a: &ArraySizeReport) -> String {
     );
     if let Some(r) = &a.rom {
         m += &format!(
-            "\n### The probe ROM (shared, broadcast)\n\n{} entries × {} bits = {} bits ({:.1} kB).\n\n\
-             | technology | µm² per bit | ROM macro area (mm², estimate) | basis |\n|---|---|---|---|\n",
+            "\n### The probe ROM (shared, broadcast)\n\n{} entries × {} bits = {} bits ({:.1} kB).\n\n",
             r.depth,
             r.width_bits,
             r.bits,
             r.bits as f64 / 8000.0
         );
+        let mut t = Table::left([
+            "technology",
+            "µm² per bit",
+            "ROM macro area (mm², estimate)",
+            "basis",
+        ]);
         for e in &r.macro_estimates {
-            m += &format!(
-                "| {} | {:.2} | {:.3} | {} |\n",
-                e.technology,
-                e.um2_per_bit,
-                e.area_um2 / 1e6,
-                e.basis
-            );
+            t.row([
+                e.technology.to_string(),
+                format!("{:.2}", e.um2_per_bit),
+                format!("{:.3}", e.area_um2 / 1e6),
+                e.basis.to_string(),
+            ]);
         }
-        m += "\n| library | entries synthesised | their area (µm²) | cells | whole ROM as logic (mm², scaled) |\n|---|---|---|---|---|\n";
+        m += &t.render();
+        let mut t = Table::left([
+            "library",
+            "entries synthesised",
+            "their area (µm²)",
+            "cells",
+            "whole ROM as logic (mm², scaled)",
+        ]);
         for l in &r.logic {
-            m += &format!(
-                "| {} | {} | {:.0} | {} | {:.3} |\n",
-                l.library,
-                l.synthesised_depth,
-                l.synthesised_area_um2,
-                l.synthesised_cells,
-                l.area_um2 / 1e6
-            );
+            t.row([
+                l.library.clone(),
+                l.synthesised_depth.to_string(),
+                format!("{:.0}", l.synthesised_area_um2),
+                l.synthesised_cells.to_string(),
+                format!("{:.3}", l.area_um2 / 1e6),
+            ]);
         }
+        m += &format!("\n{t}");
     }
-    m += "\n### Array area\n\n| library | pixels (mm²) | ROM macro (mm², estimate) | shared logic (mm²) | total (mm²) | pixels' share |\n|---|---|---|---|---|---|\n";
+    let mut area = Table::left([
+        "library",
+        "pixels (mm²)",
+        "ROM macro (mm², estimate)",
+        "shared logic (mm²)",
+        "total (mm²)",
+        "pixels' share",
+    ]);
     for t in &a.totals {
-        m += &format!(
-            "| {} | {:.3} | {:.3} | {} | {:.3} | {:.0} % |\n",
-            t.library,
-            t.pixels_um2 / 1e6,
-            t.rom_macro_um2 / 1e6,
+        area.row([
+            t.library.clone(),
+            format!("{:.3}", t.pixels_um2 / 1e6),
+            format!("{:.3}", t.rom_macro_um2 / 1e6),
             t.shared_logic_um2
                 .map_or("–".to_string(), |s| format!("{:.3}", s / 1e6)),
-            t.total_um2 / 1e6,
-            t.pixel_share * 100.0
-        );
+            format!("{:.3}", t.total_um2 / 1e6),
+            format!("{:.0} %", t.pixel_share * 100.0),
+        ]);
     }
+    m += &format!("\n### Array area\n\n{area}");
     if !a.timing.is_empty() {
         m += &format!(
             "\n### Broadcast and readout timing (pixel clock {:.1} MHz, margin 10 %)\n\n\
              Each path's delay is the whole path (the array's part + the pixel's own part, the pixel \
-             timed alone from those inputs or to those outputs).\n\n\
-             | netlist | library | array logic (µm²) | broadcast delay (ns): array + pixel | slack | readout delay (ns): array + pixel | slack |\n|---|---|---|---|---|---|---|\n",
+             timed alone from those inputs or to those outputs).\n\n",
             a.timing[0].clock_mhz
         );
+        let mut table = Table::left([
+            "netlist",
+            "library",
+            "array logic (µm²)",
+            "broadcast delay (ns): array + pixel",
+            "slack",
+            "readout delay (ns): array + pixel",
+            "slack",
+        ]);
         for t in &a.timing {
-            m += &format!(
-                "| {} | {} | {:.0} | {} | {} |\n",
-                t.netlist,
-                t.library,
-                t.shared_logic_um2,
-                path_cells(&t.broadcast),
-                path_cells(&t.readout)
-            );
+            let [broadcast, broadcast_slack] = path_cells(&t.broadcast);
+            let [readout, readout_slack] = path_cells(&t.readout);
+            table.row([
+                t.netlist.to_string(),
+                t.library.clone(),
+                format!("{:.0}", t.shared_logic_um2),
+                broadcast,
+                broadcast_slack,
+                readout,
+                readout_slack,
+            ]);
         }
+        m += &table.render();
         m += &format!(
             "\nBroadcast and readout {} the pixel clock with ≥ 10 % slack on every library and corner timed.\n",
             if a.timing_meets_margin {
@@ -121,34 +158,56 @@ pub fn markdown(a: &ArraySizeReport) -> String {
     }
     m += &options(&a.double_buffer, a.superpixel.as_ref());
     let r = &a.readout;
-    m += &format!(
-        "\n### Readout\n\n\
-         | figure | value |\n|---|---|\n\
-         | port | {} bits per beat, one beat every {} cycle(s) at f_clk = {:.1} MHz: {:.3} Gbit/s |\n\
-         | words per pixel | registers + status, {} beat(s) each |\n\
-         | bits per frame | {} payload, {} on the port |\n\
-         | readout | {} cycles = {:.3} ms |\n\
-         | frame | {} cycles{}: {:.4} frames/s, pixels see {:.3} % of the pulses |\n\
-         | mean output rate | {:.3} Mbit/s |\n",
-        r.bits_per_beat,
-        r.cycles_per_beat,
-        r.clock_hz / 1e6,
-        r.port_bits_per_s / 1e9,
-        r.beats_per_word,
-        r.payload_bits_per_frame,
-        r.stream_bits_per_frame,
-        r.readout_cycles,
-        r.readout_seconds * 1e3,
-        r.frame_cycles,
-        if r.double_buffer {
-            " (double-buffered: max(N·C + 1, D))"
-        } else {
-            " (N·C + D)"
-        },
-        r.frame_rate_hz,
-        r.duty * 100.0,
-        r.mean_bits_per_s / 1e6
-    );
+    let mut readout = Table::left(["figure", "value"]);
+    readout
+        .row([
+            "port".to_string(),
+            format!(
+                "{} bits per beat, one beat every {} cycle(s) at f_clk = {:.1} MHz: {:.3} Gbit/s",
+                r.bits_per_beat,
+                r.cycles_per_beat,
+                r.clock_hz / 1e6,
+                r.port_bits_per_s / 1e9
+            ),
+        ])
+        .row([
+            "words per pixel".to_string(),
+            format!("registers + status, {} beat(s) each", r.beats_per_word),
+        ])
+        .row([
+            "bits per frame".to_string(),
+            format!(
+                "{} payload, {} on the port",
+                r.payload_bits_per_frame, r.stream_bits_per_frame
+            ),
+        ])
+        .row([
+            "readout".to_string(),
+            format!(
+                "{} cycles = {:.3} ms",
+                r.readout_cycles,
+                r.readout_seconds * 1e3
+            ),
+        ])
+        .row([
+            "frame".to_string(),
+            format!(
+                "{} cycles{}: {:.4} frames/s, pixels see {:.3} % of the pulses",
+                r.frame_cycles,
+                if r.double_buffer {
+                    " (double-buffered: max(N·C + 1, D))"
+                } else {
+                    " (N·C + D)"
+                },
+                r.frame_rate_hz,
+                r.duty * 100.0
+            ),
+        ])
+        .row([
+            "mean output rate".to_string(),
+            format!("{:.3} Mbit/s", r.mean_bits_per_s / 1e6),
+        ]);
+    m += &format!("\n### Readout\n\n{readout}");
     let t = &a.timestamps;
     m += &format!(
         "\n### Against reading every timestamp out\n\n\
@@ -180,71 +239,90 @@ pub fn markdown(a: &ArraySizeReport) -> String {
 
 /// A path's two cells of the timing table: its delay (array + pixel) and its slack, marked
 /// **short** below the margin.
-fn path_cells(p: &PathTiming) -> String {
-    format!(
-        "{:.3}: {:.3} + {:.3} | {:.3} ns ({:.1} %){}",
-        p.delay_ns,
-        p.array_part_ns,
-        p.pixel_part_ns,
-        p.slack_ns,
-        p.slack_percent,
-        if p.meets_margin { "" } else { " **short**" }
-    )
+fn path_cells(p: &PathTiming) -> [String; 2] {
+    [
+        format!(
+            "{:.3}: {:.3} + {:.3}",
+            p.delay_ns, p.array_part_ns, p.pixel_part_ns
+        ),
+        format!(
+            "{:.3} ns ({:.1} %){}",
+            p.slack_ns,
+            p.slack_percent,
+            if p.meets_margin { "" } else { " **short**" }
+        ),
+    ]
 }
 
 /// The two options as Markdown (a part of the array section).
 fn options(db: &DoubleBuffer, sp: Option<&SuperpixelSize>) -> String {
     let mut m = format!(
         "\n### Double buffer ({}): a shadow copy of the registers\n\n\
-         {} shadow bits per pixel ((R+1)·W: the registers and the status word). Area: {}.\n\n\
-         | library | register file (µm², flops) | shadow (µm², estimate) | bare flops (µm²) | pixel without → with (µm²) | array without → with (mm²) |\n|---|---|---|---|---|---|\n",
+         {} shadow bits per pixel ((R+1)·W: the registers and the status word). Area: {}.\n\n",
         if db.enabled { "on" } else { "off" },
         db.shadow_bits_per_pixel,
         db.basis
     );
+    let mut t = Table::left([
+        "library",
+        "register file (µm², flops)",
+        "shadow (µm², estimate)",
+        "bare flops (µm²)",
+        "pixel without → with (µm²)",
+        "array without → with (mm²)",
+    ]);
     for a in &db.areas {
-        m += &format!(
-            "| {} | {:.0} ({}) | {:.0} | {} | {:.0} → {:.0} | {:.3} → {:.3} |\n",
-            a.library,
-            a.register_file_um2,
-            a.register_file_flops,
-            a.shadow_um2,
+        t.row([
+            a.library.clone(),
+            format!("{:.0} ({})", a.register_file_um2, a.register_file_flops),
+            format!("{:.0}", a.shadow_um2),
             a.shadow_flops_only_um2
                 .map_or("–".to_string(), |v| format!("{v:.0}")),
-            a.pixel_um2,
-            a.pixel_with_um2,
-            a.array_total_um2 / 1e6,
-            a.array_total_with_um2 / 1e6
-        );
+            format!("{:.0} → {:.0}", a.pixel_um2, a.pixel_with_um2),
+            format!(
+                "{:.3} → {:.3}",
+                a.array_total_um2 / 1e6,
+                a.array_total_with_um2 / 1e6
+            ),
+        ]);
     }
+    m += &t.render();
     if let Some(s) = sp {
         m += &format!(
             "\n### Superpixel {g} × {g}: {n} SPADs share one pixel\n\n\
              The front end (templates/superpixel.v) averages the valid SPADs' codes: a table of \
              {n} words of {tb} bits (⌈2^{k}/n⌉), a multiply and a shift by {k}; combinational. \
-             SPAD pitch {pitch} µm (a pixel: {g} × that).\n\n\
-             | per SPAD | plain pixel | superpixel |\n|---|---|---|\n\
-             | register bits | {plain} | {per:.1} ({plain} / {n}) |\n",
+             SPAD pitch {pitch} µm (a pixel: {g} × that).\n\n",
             g = s.side,
             n = s.spads_per_pixel,
             tb = s.table_bits,
             k = s.shift,
             pitch = s.spad_pitch_um,
-            plain = s.plain_bits_per_spad,
-            per = s.bits_per_spad,
         );
+        let mut t = Table::left(["per SPAD", "plain pixel", "superpixel"]);
+        t.row([
+            "register bits".to_string(),
+            s.plain_bits_per_spad.to_string(),
+            format!(
+                "{:.1} ({} / {})",
+                s.bits_per_spad, s.plain_bits_per_spad, s.spads_per_pixel
+            ),
+        ]);
         for a in &s.area {
-            m += &format!(
-                "| area on {} (µm²) | {:.0} | {:.0} (({:.0} + front end {:.0}, {} cells) / {}) |\n",
-                a.library,
-                a.plain_per_spad_um2,
-                a.per_spad_um2,
-                a.pixel_um2,
-                a.front_end_um2,
-                a.front_end_cells,
-                s.spads_per_pixel
-            );
+            t.row([
+                format!("area on {} (µm²)", a.library),
+                format!("{:.0}", a.plain_per_spad_um2),
+                format!(
+                    "{:.0} (({:.0} + front end {:.0}, {} cells) / {})",
+                    a.per_spad_um2,
+                    a.pixel_um2,
+                    a.front_end_um2,
+                    a.front_end_cells,
+                    s.spads_per_pixel
+                ),
+            ]);
         }
+        m += &t.render();
     }
     m
 }

@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 
 use tofprobe_design::rom_policy::RtlOverrides;
 use tofprobe_design::{Chip, ResolvedDesign, RomPurpose};
+use tofprobe_io::markdown::Table;
 
 use crate::array::cosim::{ArrayCosimOptions, cosim_array};
 use crate::error::FlowError;
@@ -173,22 +174,18 @@ fn array_flow_in(
         ro.readout_cycles()
     );
     if let Some(words) = r.run.words.first() {
-        let _ = writeln!(
-            md,
-            "| pixel | register 0 | register 1 | status |\n|---|---|---|---|"
-        );
+        let mut t = Table::left(["pixel", "register 0", "register 1", "status"]);
         for (q, w) in words.iter().enumerate().take(16) {
             let (row, col) = ro.order(q);
             let signed = |v: u64| tofprobe_pixel::fixed::sign_extend(v, ro.width);
-            let _ = writeln!(
-                md,
-                "| ({row}, {col}) | {} | {} | {} |",
-                signed(w[0]),
-                w.get(1).map(|&v| signed(v)).unwrap_or(0),
-                w[ro.registers]
-            );
+            t.row([
+                format!("({row}, {col})"),
+                signed(w[0]).to_string(),
+                w.get(1).map(|&v| signed(v)).unwrap_or(0).to_string(),
+                w[ro.registers].to_string(),
+            ]);
         }
-        let _ = writeln!(md);
+        let _ = writeln!(md, "{t}");
     }
     readout_section(design, &mut md)?;
     let size_line =

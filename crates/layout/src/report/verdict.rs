@@ -5,6 +5,8 @@
 
 use std::fmt::Write as _;
 
+use tofprobe_io::markdown::Table;
+
 use crate::report::LayoutReport;
 
 /// Each failed check, in words (empty: every check passed).
@@ -107,40 +109,46 @@ pub fn verdict_markdown(r: &LayoutReport) -> String {
 /// The sections on the checks beyond DRC and LVS: the boundary, the stream, the laid-out
 /// netlist's proof, the options for corners missed after routing.
 pub fn checks_markdown(r: &LayoutReport) -> String {
-    let mut s = String::from("## Boundary, stream and netlist\n\n| check | result |\n|---|---|\n");
+    let mut t = Table::left(["check", "result"]);
     if let Some(g) = &r.die_growth {
-        let _ = writeln!(
-            s,
-            "| die margin | {:.2} µm left and right, {:.2} µm top and bottom (a track pitch past the edge tracks, which the router is kept to); {} pins extended to the edge |",
-            g.margin_x_um, g.margin_y_um, g.pins_extended
-        );
+        t.row([
+            "die margin".to_string(),
+            format!(
+                "{:.2} µm left and right, {:.2} µm top and bottom (a track pitch past the edge tracks, which the router is kept to); {} pins extended to the edge",
+                g.margin_x_um, g.margin_y_um, g.pins_extended
+            ),
+        ]);
     }
     if let Some(o) = &r.def_boundary {
-        let _ = writeln!(
-            s,
-            "| DEF shapes past the die | {} of {}{} |",
-            o.outside,
-            o.shapes,
-            if o.outside > 0 {
-                format!(", up to {:.3} µm ({})", o.worst_um, o.examples.join("; "))
-            } else {
-                String::new()
-            }
-        );
+        t.row([
+            "DEF shapes past the die".to_string(),
+            format!(
+                "{} of {}{}",
+                o.outside,
+                o.shapes,
+                if o.outside > 0 {
+                    format!(", up to {:.3} µm ({})", o.worst_um, o.examples.join("; "))
+                } else {
+                    String::new()
+                }
+            ),
+        ]);
     }
     if let Some(g) = &r.gds {
-        let _ = writeln!(
-            s,
-            "| GDS shapes past the die (klayout) | {} of {}{} |\n| GDS holds | {} |",
-            g.outside,
-            g.shapes,
-            if g.outside > 0 {
-                format!(", up to {:.3} µm", g.worst_um)
-            } else {
-                String::new()
-            },
-            g.holds()
-        );
+        t.row([
+            "GDS shapes past the die (klayout)".to_string(),
+            format!(
+                "{} of {}{}",
+                g.outside,
+                g.shapes,
+                if g.outside > 0 {
+                    format!(", up to {:.3} µm", g.worst_um)
+                } else {
+                    String::new()
+                }
+            ),
+        ]);
+        t.row(["GDS holds".to_string(), g.holds().to_string()]);
     }
     if !r.def_counts.is_empty() {
         let counts: Vec<String> = r
@@ -154,11 +162,10 @@ pub fn checks_markdown(r: &LayoutReport) -> String {
                 }
             })
             .collect();
-        let _ = writeln!(
-            s,
-            "| DEF sections (declared = listed) | {} |",
-            counts.join(", ")
-        );
+        t.row([
+            "DEF sections (declared = listed)".to_string(),
+            counts.join(", "),
+        ]);
     }
     if let Some(e) = &r.equivalence {
         let physical: Vec<String> = e
@@ -166,9 +173,10 @@ pub fn checks_markdown(r: &LayoutReport) -> String {
             .iter()
             .map(|(c, n)| format!("{n} {c}"))
             .collect();
-        let _ = writeln!(
-            s,
-            "| laid-out netlist ≡ RTL (yosys) | {} — {} of {} pairs proven; {} cells from the routed DEF (`{}`), physical-only cells left out: {}; {:.1} s{} |",
+        t.row([
+            "laid-out netlist ≡ RTL (yosys)".to_string(),
+            format!(
+            "{} — {} of {} pairs proven; {} cells from the routed DEF (`{}`), physical-only cells left out: {}; {:.1} s{}",
             if e.proven() {
                 "proven"
             } else {
@@ -185,9 +193,10 @@ pub fn checks_markdown(r: &LayoutReport) -> String {
             },
             e.seconds,
             if e.cached { " (cached)" } else { "" }
-        );
+            ),
+        ]);
     }
-    s += "\n";
+    let mut s = format!("## Boundary, stream and netlist\n\n{t}\n");
     if !r.corner_options.is_empty() {
         s += "## Options for the corners missed after routing\n\n";
         for o in &r.corner_options {

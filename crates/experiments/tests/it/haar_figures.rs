@@ -1,12 +1,14 @@
-//! The paper's transient figures (Fig. 3, Fig. 12) through `tofprobe_dsp::haar::paper`:
+//! The paper's transient figures (Fig. 3, Fig. 12) through `tofprobe_experiments::paper::haar_figures` (moved here from dsp with the reproduction):
 //! every row passes its stated check on two seeds, the structural claims hold, and the
 //! committed scene files are the same setups.
 
 use tofprobe_dsp::haar::events::DepthChange;
-use tofprobe_dsp::haar::paper::{TransientSetup, fig3, fig3_setup, fig12, fig12_setup};
+use tofprobe_experiments::paper::haar_figures::{
+    TransientSetup, fig3, fig3_setup, fig12, fig12_setup,
+};
 use tofprobe_scene::{SceneConfig, SensorConfig};
 
-fn print(rows: &[tofprobe_dsp::haar::paper::TransientRow]) {
+fn print(rows: &[tofprobe_experiments::paper::haar_figures::TransientRow]) {
     for r in rows {
         println!(
             "{} | {} | paper {:?} | measured {:.4} | reference {:?} | ±{} | {} | {}",

@@ -1,6 +1,9 @@
 //! The paper's transient results (Sec. 4, Fig. 3 and Fig. 12), computed: each function
 //! simulates its scene through the photon Monte Carlo, turns the held record into a
-//! scalogram and events, and returns rows with the paper's value beside ours.
+//! scalogram and events with dsp's Haar algorithms (`tofprobe_dsp::haar`: the scalogram,
+//! the noise model, the thresholds, the events), and returns rows with the paper's value
+//! beside ours. A reproduction, so it lives with the others (`paper::transients` maps its
+//! rows into the reproduction's); dsp keeps only the algorithms it runs.
 //!
 //! # Fig. 3 (the float Haar, N not a power of two)
 //! 100,000 timestamps at 10 MHz (10 ms) of a static 30 mm with a brief impulse (+3 mm for
@@ -33,14 +36,13 @@
 use serde::{Deserialize, Serialize};
 use tofprobe_scene::{MotionConfig, PhotonSource, Scene, SceneConfig, SensorConfig};
 
-use super::analysis::{Scalogram, held_codes};
-use super::events::{EventReport, detect_events};
-use super::noise::{HaarNoise, Thresholds};
-use super::{compression_ratio, haar_sums_prefix};
-use crate::error::DspError;
+use tofprobe_dsp::haar::montecarlo::sensor_with_rates;
+use tofprobe_dsp::haar::{
+    EventReport, FAMILY_RATE, HaarNoise, Scalogram, Thresholds, compression_ratio, detect_events,
+    haar_sums_prefix, held_codes,
+};
 
-/// Family-wise false-alarm probability of the reproduced figures' events.
-pub const FAMILY_RATE: f64 = 0.01;
+use crate::error::ExperimentError;
 
 /// A scene, a frame and the scales of one figure.
 #[derive(Debug, Clone, PartialEq)]
@@ -103,24 +105,12 @@ pub struct TransientFigure {
     pub rows: Vec<TransientRow>,
 }
 
-/// The sensor of both figures (the paper does not state one): 10 MHz, σ_I = 20 ps (3 mm),
-/// 5 ps TDC LSB (0.75 mm), a 400 ps (60 mm) window, every pulse detects, no background.
+/// The sensor of both figures (the paper does not state one): the noise model's checking
+/// sensor (`tofprobe_dsp::haar::montecarlo::sensor_with_rates`: 10 MHz, σ_I = 20 ps (3 mm),
+/// 5 ps TDC LSB (0.75 mm), a 400 ps (60 mm) window) with every pulse detecting and no
+/// background.
 pub fn sensor() -> SensorConfig {
     sensor_with_rates(1.0, 0.0)
-}
-
-/// The same sensor with other signal and background rates (ρ_s, ρ_b per pulse): the noise
-/// model's checks sweep them.
-pub fn sensor_with_rates(signal_rate: f64, background_rate: f64) -> SensorConfig {
-    SensorConfig {
-        laser_rate_hz: 10e6,
-        jitter_ps: 20.0,
-        tdc_lsb_ps: 5.0,
-        window_start_ps: 0.0,
-        window_length_ps: 400.0,
-        signal_rate,
-        background_rate,
-    }
 }
 
 /// Fig. 3's scene over the paper's 100,000 pulses (see the module doc).
@@ -172,7 +162,7 @@ pub fn fig12_setup() -> TransientSetup {
 }
 
 /// Simulates a setup: the held depth record in mm (bin centres) and the held codes.
-fn simulate(setup: &TransientSetup, seed: u64) -> Result<(Vec<f64>, Vec<i64>), DspError> {
+fn simulate(setup: &TransientSetup, seed: u64) -> Result<(Vec<f64>, Vec<i64>), ExperimentError> {
     let scene = Scene::new(&setup.scene)?;
     let source = PhotonSource::new(&setup.sensor, &scene, seed)?;
     let det = source.record(setup.pulses);
@@ -184,9 +174,14 @@ fn simulate(setup: &TransientSetup, seed: u64) -> Result<(Vec<f64>, Vec<i64>), D
     Ok((mm, codes))
 }
 
-fn thresholds(setup: &TransientSetup) -> Result<Thresholds, DspError> {
+fn thresholds(setup: &TransientSetup) -> Result<Thresholds, ExperimentError> {
     let noise = HaarNoise::for_static_scene(&setup.sensor, setup.scene.depth_mm)?;
-    Thresholds::new(&noise, setup.pulses as usize, setup.u_max, FAMILY_RATE)
+    Ok(Thresholds::new(
+        &noise,
+        setup.pulses as usize,
+        setup.u_max,
+        FAMILY_RATE,
+    )?)
 }
 
 /// Per scale, the largest |w| (mm) among the coefficients whose support overlaps [a, b) s
@@ -224,7 +219,7 @@ fn show(p: &[(u32, f64)]) -> String {
 }
 
 /// Fig. 3: the scalogram of the synthetic record and the structure the paper describes.
-pub fn fig3(seed: u64) -> Result<TransientFigure, DspError> {
+pub fn fig3(seed: u64) -> Result<TransientFigure, ExperimentError> {
     let setup = fig3_setup();
     let fs = setup.sensor.laser_rate_hz;
     let (mm, _) = simulate(&setup, seed)?;
@@ -357,7 +352,7 @@ impl TransientRow {
 
 /// Fig. 12: the step's scalogram from the pixel's registers, the largest coefficient's
 /// scale, the event's time and the ramp-rate estimate against the scene.
-pub fn fig12(seed: u64) -> Result<TransientFigure, DspError> {
+pub fn fig12(seed: u64) -> Result<TransientFigure, ExperimentError> {
     let setup = fig12_setup();
     let fs = setup.sensor.laser_rate_hz;
     let (_, codes) = simulate(&setup, seed)?;
