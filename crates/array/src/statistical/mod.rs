@@ -399,7 +399,6 @@ pub fn shared_model(
     design: &ResolvedDesign,
     level: ArrayLevel,
 ) -> Result<Arc<StatisticalModel>, ArrayError> {
-    static CACHE: Mutex<Vec<(String, Arc<StatisticalModel>)>> = Mutex::new(Vec::new());
     let d = &design.document;
     let key = serde_json::to_string(&(
         &design.pixel,
@@ -429,6 +428,15 @@ pub fn shared_model(
     }
     cache.push((key, Arc::clone(&model)));
     Ok(model)
+}
+
+/// The models [`shared_model`] keeps: (key, model), oldest first.
+static CACHE: Mutex<Vec<(String, Arc<StatisticalModel>)>> = Mutex::new(Vec::new());
+
+/// Forgets every model [`shared_model`] kept (a benchmark timing each level's whole cost,
+/// its model's build included).
+pub fn clear_shared_models() {
+    CACHE.lock().unwrap_or_else(|e| e.into_inner()).clear();
 }
 
 /// Models kept by [`shared_model`] (a model is ≈ 2B·(1 + 2·tones) sums and the probe's
