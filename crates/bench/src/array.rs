@@ -63,7 +63,9 @@ pub struct ArrayReport {
     pub target_seconds: f64,
     pub pass: bool,
     /// Each `[array] level` at the last frame length, side by side with its bit-true run
-    /// (`array_levels`): CPU-s, rate, speed-up and the 256 × 256 × 10^7 projection.
+    /// (`array_levels`): CPU-s, rate, speed-up and the 256 × 256 × 10^7 projection. Measured
+    /// on the widest ISA only (the top level's; the narrower rows leave it out).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub levels: Vec<LevelRun>,
 }
 
@@ -117,15 +119,20 @@ pub fn measure_isas(
     pulses: &[u64],
     isas: &[Isa],
 ) -> Result<IsaRows<ArrayReport>, BenchError> {
-    rows(isas, |_| measure(base, rows_, cols, pulses))
+    let widest = isas.last().copied();
+    rows(isas, |isa| {
+        measure(base, rows_, cols, pulses, Some(isa) == widest)
+    })
 }
 
-/// Runs the benchmark for each frame length in `pulses`, on the current ISA.
+/// Runs the benchmark for each frame length in `pulses`, on the current ISA, and (if
+/// `with_levels`) each `[array] level` at the last.
 pub fn measure(
     base: &ResolvedDesign,
     rows: u32,
     cols: u32,
     pulses: &[u64],
+    with_levels: bool,
 ) -> Result<ArrayReport, BenchError> {
     let threads = rayon::current_num_threads();
     let mut runs = Vec::new();
@@ -179,9 +186,9 @@ pub fn measure(
         });
         last = Some((d, seconds, bit_true_cpu));
     }
-    let levels = match &last {
-        Some((d, secs, cpu)) => measure_levels(d, *secs, *cpu)?,
-        None => Vec::new(),
+    let levels = match (&last, with_levels) {
+        (Some((d, secs, cpu)), true) => measure_levels(d, *secs, *cpu)?,
+        _ => Vec::new(),
     };
     let best = runs
         .iter()

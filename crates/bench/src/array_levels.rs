@@ -109,6 +109,12 @@ pub fn measure_levels(
     let Some(rom) = d.probe_rom()? else {
         return Ok(out); // Haar: bit-true only (the drawn levels are Fourier's).
     };
+    // The model's fixed parts alone (the ROM, the bands), once: every level's are alike.
+    let c0 = process_cpu_seconds();
+    let t0 = std::time::Instant::now();
+    let rom_again = d.probe_rom()?;
+    std::hint::black_box(rom_again.map(|r| ProbeBands::new(&r)));
+    let fixed = cpu_since(c0, t0.elapsed().as_secs_f64(), threads);
     for level in [
         ArrayLevel::Statistical,
         ArrayLevel::ClosedForm,
@@ -132,13 +138,7 @@ pub fn measure_levels(
             ArrayLevel::Auto => ArrayLevel::Statistical,
             l => l,
         };
-        // The fixed parts alone (the ROM, the bands), then the whole model (the ROM, the
-        // bands and the twin), then the pixels with the model built.
-        let c0 = process_cpu_seconds();
-        let t0 = std::time::Instant::now();
-        let rom_again = dl.probe_rom()?;
-        std::hint::black_box(rom_again.map(|r| ProbeBands::new(&r)));
-        let fixed = cpu_since(c0, t0.elapsed().as_secs_f64(), threads);
+        // The whole model (the ROM, the bands and the twin), then the pixels with it built.
         clear_shared_models();
         let c0 = process_cpu_seconds();
         let t0 = std::time::Instant::now();
