@@ -21,9 +21,9 @@ use tofprobe_pixel::{FoldLanes, FrameDriver, LANES, Superpixel, fold_pays};
 use tofprobe_scene::PhotonSource;
 
 use crate::error::ArrayError;
+pub use crate::frame::{ArrayFrame, Tile};
 use crate::statistical::auto::AUTO_THRESHOLD;
 use crate::statistical::shared_model;
-pub use crate::frame::{ArrayFrame, Tile};
 
 /// Pulses per streamed chunk of one pixel (64 k pulses: 256 kB of codes per thread).
 const CHUNK: usize = 1 << 16;
@@ -254,8 +254,7 @@ pub fn run_tile_watched(
             let (registers, detections) = run_pixels(design, rom, &pixels, watch)?;
             let k = tile.registers_per_pixel;
             for (j, &i) in which.iter().enumerate() {
-                tile.registers[i * k..(i + 1) * k]
-                    .copy_from_slice(&registers[j * k..(j + 1) * k]);
+                tile.registers[i * k..(i + 1) * k].copy_from_slice(&registers[j * k..(j + 1) * k]);
                 tile.detections[i] = detections[j];
             }
             Ok(tile)

@@ -130,7 +130,12 @@ pub fn finish(
     let levels = level_map(design)?;
     let level_pixels = ArrayLevel::ALL
         .iter()
-        .map(|&l| (l.name().to_string(), levels.iter().filter(|&&x| x == l).count()))
+        .map(|&l| {
+            (
+                l.name().to_string(),
+                levels.iter().filter(|&&x| x == l).count(),
+            )
+        })
         .collect();
     let pixels = (frame.rows * frame.cols) as f64;
     let bins = maps

@@ -155,8 +155,8 @@ pub fn measure_levels(
             .filter(|l| l.is_bit_true())
             .count();
         let twin = (model - fixed).max(0.0);
-        let drawn = (fixed + twin * scale_pulses + (cpu - model).max(0.0) * scale_pixels)
-            / PROJECTED_CORES;
+        let drawn =
+            (fixed + twin * scale_pulses + (cpu - model).max(0.0) * scale_pixels) / PROJECTED_CORES;
         let projected = match level {
             ArrayLevel::Auto => {
                 bt_px as f64 / pixels.max(1.0) * bt_projected + statistical_projected

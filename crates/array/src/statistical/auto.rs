@@ -85,5 +85,8 @@ pub fn level_map(design: &ResolvedDesign) -> Result<Vec<ArrayLevel>, ArrayError>
 /// The code of `level` in `level.npy`: its index in [`ArrayLevel::ALL`] (0 bit-true,
 /// 1 statistical, 2 closed-form).
 pub fn level_code(level: ArrayLevel) -> i64 {
-    ArrayLevel::ALL.iter().position(|&l| l == level).unwrap_or(0) as i64
+    ArrayLevel::ALL
+        .iter()
+        .position(|&l| l == level)
+        .unwrap_or(0) as i64
 }

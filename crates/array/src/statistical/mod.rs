@@ -410,7 +410,9 @@ pub fn shared_model(
     ))
     .map_err(|e| ArrayError::Shape(format!("the statistical model's key: {e}")))?;
     let found = |c: &Vec<(String, Arc<StatisticalModel>)>| {
-        c.iter().find(|(k, _)| *k == key).map(|(_, m)| Arc::clone(m))
+        c.iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, m)| Arc::clone(m))
     };
     if let Some(m) = found(&CACHE.lock().unwrap_or_else(|e| e.into_inner())) {
         return Ok(m);

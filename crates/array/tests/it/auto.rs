@@ -48,7 +48,10 @@ fn the_moving_half_runs_bit_true_and_only_it() {
     // A rule that never runs a pixel bit-true (an infinite threshold) fails the map.
     let model = shared_model(&d, ArrayLevel::Statistical).unwrap();
     let never = model.auto_levels(&d, 0..8, 0..8, f64::INFINITY).unwrap();
-    assert!(never.iter().all(|m| !m), "an infinite threshold moved a pixel");
+    assert!(
+        never.iter().all(|m| !m),
+        "an infinite threshold moved a pixel"
+    );
     // The summary counts the levels.
     let (_, _, s) = tofprobe_array::output::simulate(&d).unwrap();
     assert_eq!(s.level_pixels["bit-true"], 32);
@@ -80,8 +83,16 @@ fn a_motion_far_below_the_noise_floor_runs_statistical() {
     let moves_at = |d: &ResolvedDesign, m: &tofprobe_array::statistical::StatisticalModel, k| {
         m.auto_levels(d, 0..8, 4..8, k).unwrap()
     };
-    assert!(moves_at(&big, &big_model, 2.0 * AUTO_THRESHOLD).iter().all(|m| *m));
-    assert!(moves_at(&d, &model, AUTO_THRESHOLD / 2.0).iter().all(|m| !m));
+    assert!(
+        moves_at(&big, &big_model, 2.0 * AUTO_THRESHOLD)
+            .iter()
+            .all(|m| *m)
+    );
+    assert!(
+        moves_at(&d, &model, AUTO_THRESHOLD / 2.0)
+            .iter()
+            .all(|m| !m)
+    );
 }
 
 /// The auto frame's bit-true pixels are the bit-true frame's, its statistical pixels the
@@ -128,6 +139,10 @@ fn auto_tiles_merge_into_the_whole_frame() {
             .install(|| tofprobe_array::run_tile(&d, Some(&rom.image), rows, cols))
             .unwrap()
     };
-    let tiles = vec![tile(0..3, 0..8, 1), tile(3..8, 0..5, 2), tile(3..8, 5..8, 1)];
+    let tiles = vec![
+        tile(0..3, 0..8, 1),
+        tile(3..8, 0..5, 2),
+        tile(3..8, 5..8, 1),
+    ];
     assert_eq!(merge(8, 8, &tiles).unwrap(), whole);
 }

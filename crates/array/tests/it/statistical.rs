@@ -174,7 +174,11 @@ fn bad_levels_are_refused_with_the_way_out() {
     );
     // Auto runs pixels at the statistical level: refused the same way, naming itself.
     for level in ["statistical", "auto"] {
-        let t = t.replacen("level = \"statistical\"", &format!("level = \"{level}\""), 1);
+        let t = t.replacen(
+            "level = \"statistical\"",
+            &format!("level = \"{level}\""),
+            1,
+        );
         let d = tofprobe_design::Document::from_toml_str(&t, "t.toml").unwrap();
         let e = tofprobe_design::resolve(d, "t.toml")
             .unwrap_err()

@@ -311,7 +311,10 @@ fn bench_array_prints_its_rates() {
     // its figures and units, the speed-up is bit-true's CPU-s over the level's, and the
     // targets judged are bit-true's and the statistical level's.
     let levels = r["levels"].as_array().unwrap();
-    let names: Vec<&str> = levels.iter().map(|l| l["level"].as_str().unwrap()).collect();
+    let names: Vec<&str> = levels
+        .iter()
+        .map(|l| l["level"].as_str().unwrap())
+        .collect();
     assert_eq!(names, ["bit-true", "statistical", "closed-form", "auto"]);
     let bt_cpu = levels[0]["cpu_seconds"].as_f64().unwrap();
     for l in levels {
@@ -321,7 +324,10 @@ fn bench_array_prints_its_rates() {
         assert!((rate * cpu / (16.0 * 80_000.0) - 1.0).abs() < 1e-9, "{l}");
         let speedup = l["speedup_over_bit_true"].as_f64().unwrap();
         assert!((speedup * cpu / bt_cpu - 1.0).abs() < 1e-9, "{l}");
-        assert!(l["projected_256x256_1e7_seconds"].as_f64().unwrap() > 0.0, "{l}");
+        assert!(
+            l["projected_256x256_1e7_seconds"].as_f64().unwrap() > 0.0,
+            "{l}"
+        );
         assert!(l["model_cpu_seconds"].as_f64().unwrap() <= cpu, "{l}");
         let judged = matches!(names_of(l), "bit-true" | "statistical");
         assert_eq!(l["pass"].is_boolean(), judged, "{l}");

@@ -47,7 +47,10 @@ fn auto_is_refused_where_statistical_is() {
     let why = |e: &str| e.split("validated range:").nth(1).map(str::to_string);
     let st = resolved(&t("statistical")).unwrap_err();
     let au = resolved(&t("auto")).unwrap_err();
-    assert!(au.contains("array.level = \"auto\"") && au.contains("\"bit-true\""), "{au}");
+    assert!(
+        au.contains("array.level = \"auto\"") && au.contains("\"bit-true\""),
+        "{au}"
+    );
     assert!(why(&au).is_some() && why(&au) == why(&st), "{au}\n{st}");
     resolved(&t("bit-true")).unwrap();
 }

@@ -79,11 +79,15 @@ fn print_text(r: &ArrayReport) {
         if r.pass { "pass" } else { "FAIL" }
     );
     if let Some(n) = r.levels.first().map(|l| l.pulses) {
-        println!("levels at N = {n} (each in the same run; 256 × 256 × 10^7 projected on 2 idle cores):");
+        println!(
+            "levels at N = {n} (each in the same run; 256 × 256 × 10^7 projected on 2 idle cores):"
+        );
     }
     for l in &r.levels {
         let judged = match (l.target_seconds, l.pass) {
-            (Some(t), Some(p)) => format!(" (target {t:.0} s: {})", if p { "pass" } else { "FAIL" }),
+            (Some(t), Some(p)) => {
+                format!(" (target {t:.0} s: {})", if p { "pass" } else { "FAIL" })
+            }
             _ => String::new(),
         };
         println!(
