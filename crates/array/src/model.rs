@@ -10,6 +10,10 @@
 //! whatever the tiling, the threads or the process. A superpixel (`[array] superpixel = G`)
 //! reads its G² SPADs' streams and hands the driver their average, one code a pulse
 //! ([`PixelStream`], `pixel::Superpixel`): the datapath is the one pixel's either way.
+//! The `[array] level` picks the tile's run ([`run_tile_watched`]): bit-true here, the
+//! drawn levels in `statistical`, and `"auto"` both — the pixels `statistical::auto`
+//! calls moving through the same bit-true runner ([`run_pixels`], any subset of pixels in
+//! any grouping gives each its own registers), the others drawn.
 
 use std::ops::Range;
 
