@@ -22,7 +22,7 @@
 use tofprobe_design::{ArrayLevel, ResolvedDesign};
 
 use super::StatisticalModel;
-use super::pixel::{CodeStats, NoiseKey, PixelScene};
+use super::pixel::{CodeStats, PixelScene};
 use crate::error::ArrayError;
 
 /// K: a pixel moves where its motion's response exceeds K × its register noise sd.
@@ -41,7 +41,7 @@ pub fn moves(
         return false;
     }
     let still = PixelScene {
-        key: NoiseKey::clone(&px.key),
+        key: px.key,
         sines: Vec::new(),
     };
     let (m, m0) = (model.mean(px, stats), model.mean(&still, stats));
