@@ -10,11 +10,15 @@
 //! whatever the tiling, the threads or the process. A superpixel (`[array] superpixel = G`)
 //! reads its G² SPADs' streams and hands the driver their average, one code a pulse
 //! ([`PixelStream`], `pixel::Superpixel`): the datapath is the one pixel's either way.
+//! The `[array] level` picks the tile's run ([`run_tile_watched`]): bit-true here, the
+//! drawn levels in `statistical`, and `"auto"` both — the pixels `statistical::auto`
+//! calls moving through the same bit-true runner ([`run_pixels`], any subset of pixels in
+//! any grouping gives each its own registers), the others drawn.
 
 use std::ops::Range;
 
 use rayon::prelude::*;
-use tofprobe_design::ResolvedDesign;
+use tofprobe_design::{ArrayLevel, ResolvedDesign};
 use tofprobe_dsp::rom::RomImage;
 use tofprobe_io::watch::Watch;
 use tofprobe_pixel::{FoldLanes, FrameDriver, LANES, Superpixel, fold_pays};
@@ -22,6 +26,8 @@ use tofprobe_scene::PhotonSource;
 
 use crate::error::ArrayError;
 pub use crate::frame::{ArrayFrame, Tile};
+use crate::statistical::auto::AUTO_THRESHOLD;
+use crate::statistical::shared_model;
 
 /// Pulses per streamed chunk of one pixel (64 k pulses: 256 kB of codes per thread).
 const CHUNK: usize = 1 << 16;
@@ -219,23 +225,63 @@ pub fn run_tile_watched(
             "tile rows {rows:?} × cols {cols:?} is not a non-empty part of the {nr} × {nc} array"
         )));
     }
-    // The statistical and closed-form levels draw registers instead of running pulses.
-    if design
+    let level = design
         .array
         .as_ref()
-        .is_some_and(|a| !a.level.is_bit_true())
-    {
-        return crate::statistical::run_tile(design, rows, cols, watch);
-    }
-    let w = cols.len();
-    let at = |i: usize| (rows.start + i / w, cols.start + i % w);
+        .map_or(ArrayLevel::BitTrue, |a| a.level);
+    let (w, r0, c0) = (cols.len(), rows.start, cols.start);
+    let at = |i: usize| (r0 + i / w, c0 + i % w);
     let count = rows.len() * w;
+    match level {
+        ArrayLevel::BitTrue => {
+            let pixels: Vec<_> = (0..count).map(at).collect();
+            let (registers, detections) = run_pixels(design, rom, &pixels, watch)?;
+            Ok(Tile {
+                rows,
+                cols,
+                registers_per_pixel: design.pixel.registers(),
+                registers,
+                detections,
+            })
+        }
+        // The statistical and closed-form levels draw registers instead of running pulses.
+        ArrayLevel::Statistical | ArrayLevel::ClosedForm => {
+            crate::statistical::run_tile(design, rows, cols, watch)
+        }
+        // Auto: the moving pixels bit-true, the others drawn (statistical::auto's rule).
+        ArrayLevel::Auto => {
+            let model = shared_model(design, ArrayLevel::Statistical)?;
+            let moving = model.auto_levels(design, rows.clone(), cols.clone(), AUTO_THRESHOLD)?;
+            let mut tile = model.run_tile_except(design, rows, cols, &moving, watch)?;
+            let which: Vec<usize> = (0..count).filter(|&i| moving[i]).collect();
+            let pixels: Vec<_> = which.iter().map(|&i| at(i)).collect();
+            let (registers, detections) = run_pixels(design, rom, &pixels, watch)?;
+            let k = tile.registers_per_pixel;
+            for (j, &i) in which.iter().enumerate() {
+                tile.registers[i * k..(i + 1) * k].copy_from_slice(&registers[j * k..(j + 1) * k]);
+                tile.detections[i] = detections[j];
+            }
+            Ok(tile)
+        }
+    }
+}
+
+/// The bit-true registers (`pixels.len()` × K, in the order of `pixels`) and detections of
+/// the pixels `pixels`, in parallel on the current rayon pool: a group of [`LANES`] at a
+/// time where the fold pays, else one by one. Each pixel reads its own stream, so its
+/// registers do not depend on which pixels are run with it.
+fn run_pixels(
+    design: &ResolvedDesign,
+    rom: Option<&RomImage>,
+    pixels: &[(usize, usize)],
+    watch: &Watch,
+) -> Result<(Vec<i64>, Vec<u64>), ArrayError> {
     let k = design.pixel.registers();
-    // The tile's registers and detections are filled in place, pixel by pixel (a group of
+    // The registers and detections are filled in place, pixel by pixel (a group of
     // LANES at a time): nothing per pixel is held besides them (the memory the resolution
     // counts, `SensorArray::bytes_per_pixel`).
-    let mut registers = vec![0i64; count * k];
-    let mut detections = vec![0u64; count];
+    let mut registers = vec![0i64; pixels.len() * k];
+    let mut detections = vec![0u64; pixels.len()];
     let put = |words: &[i64], out: &mut [i64], (r, c): (usize, usize)| {
         if words.len() != out.len() {
             return Err(ArrayError::Shape(format!(
@@ -248,14 +294,13 @@ pub fn run_tile_watched(
         Ok(())
     };
     match rom {
-        // A folded pixel: groups of LANES pixels (row-major over the tile) in lockstep.
+        // A folded pixel: groups of LANES pixels (in the order given) in lockstep.
         Some(rom) if fold_pays(&design.pixel) => registers
             .par_chunks_mut(LANES * k.max(1))
             .zip(detections.par_chunks_mut(LANES))
-            .enumerate()
-            .try_for_each(|(g, (regs, dets))| {
-                let group: Vec<_> = (g * LANES..g * LANES + dets.len()).map(at).collect();
-                let out = group_watched(design, rom, &group, watch)?;
+            .zip(pixels.par_chunks(LANES))
+            .try_for_each(|((regs, dets), group)| {
+                let out = group_watched(design, rom, group, watch)?;
                 for (j, (words, d)) in out.into_iter().enumerate() {
                     put(&words, &mut regs[j * k..(j + 1) * k], group[j])?;
                     dets[j] = d;
@@ -265,21 +310,15 @@ pub fn run_tile_watched(
         _ => registers
             .par_chunks_mut(k.max(1))
             .zip(detections.par_iter_mut())
-            .enumerate()
-            .try_for_each(|(i, (regs, det))| {
-                let (words, d) = pixel_watched(design, rom, at(i).0, at(i).1, watch)?;
-                put(&words, &mut regs[..k], at(i))?;
+            .zip(pixels.par_iter())
+            .try_for_each(|((regs, det), &(r, c))| {
+                let (words, d) = pixel_watched(design, rom, r, c, watch)?;
+                put(&words, &mut regs[..k], (r, c))?;
                 *det = d;
                 Ok::<(), ArrayError>(())
             })?,
     }
-    Ok(Tile {
-        rows,
-        cols,
-        registers_per_pixel: k,
-        registers,
-        detections,
-    })
+    Ok((registers, detections))
 }
 
 /// Merges tiles that cover the R × C array exactly once into the array's frame; refuses a

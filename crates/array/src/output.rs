@@ -2,7 +2,9 @@
 //! project's completion marker `tofprobe-set.toml` written last, after `summary.json`, so
 //! `tofprobe check-set` checks it and a later set replaces only the files it lists): the
 //! registers as `registers.npy` (int64 [R, C, K]) and the detections (`detections.npy`,
-//! [R, C]); for a Fourier frame `amplitude_um.npy` and `phase_deg.npy` ([B, R, C]), a heat
+//! [R, C]); the level each pixel ran at (`level.npy`, int64 [R, C]: 0 bit-true, 1
+//! statistical, 2 closed-form — under `[array] level = "auto"` a mix — and its map
+//! `level.svg`); for a Fourier frame `amplitude_um.npy` and `phase_deg.npy` ([B, R, C]), a heat
 //! map of amplitude and of phase per bin, each pixel's strongest bin, the animated
 //! deflection shape at the dominant bin and the Universal File Format file `vibration.uff`;
 //! for a Haar frame each pixel's transition time (`event_time_ms.npy`, −1 where none, and
@@ -12,6 +14,7 @@
 //! buffers), and the set's size, directory and disk are checked before the model runs
 //! ([`crate::set_plan`]).
 
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
@@ -28,6 +31,8 @@ use crate::maps::{VibrationMaps, fourier_maps};
 use crate::model::{ArrayFrame, run_array};
 use crate::plot::{Scale, write_deflection_animation, write_heat_map};
 use crate::set_plan::{MARKER, SUMMARY};
+use crate::statistical::auto::{level_code, level_map};
+use tofprobe_design::ArrayLevel;
 
 /// One bin's figures over the array.
 #[derive(Debug, Clone, Serialize)]
@@ -43,8 +48,11 @@ pub struct BinSummary {
 pub struct ArraySummary {
     pub configuration: String,
     pub mode: String,
-    /// The `[array] level` the pixels ran at (bit-true, statistical, closed-form).
+    /// The `[array] level` the pixels ran at (bit-true, statistical, closed-form, auto).
     pub level: String,
+    /// Pixels per level that ran (every level named, 0 where none; under `"auto"` the
+    /// bit-true and statistical pixels of `level.npy`).
+    pub level_pixels: BTreeMap<String, usize>,
     pub rows: usize,
     pub cols: usize,
     pub pitch_um: f64,
@@ -119,6 +127,16 @@ pub fn finish(
         None => None,
     };
     let events = maps.is_none().then(|| event_map(design, &frame));
+    let levels = level_map(design)?;
+    let level_pixels = ArrayLevel::ALL
+        .iter()
+        .map(|&l| {
+            (
+                l.name().to_string(),
+                levels.iter().filter(|&&x| x == l).count(),
+            )
+        })
+        .collect();
     let pixels = (frame.rows * frame.cols) as f64;
     let bins = maps
         .as_ref()
@@ -137,6 +155,7 @@ pub fn finish(
         configuration: configuration_name(design),
         mode: design.pixel.mode.to_string(),
         level: a.level.name().to_string(),
+        level_pixels,
         rows: a.rows,
         cols: a.cols,
         pitch_um: a.pitch_um,
@@ -189,6 +208,20 @@ fn stream_files(
         npy::write_iter(w, &[r, c], frame.detections.iter().map(|&d| d as i64))
     })?;
     let mm = design.array.as_ref().map_or(1.0, |a| a.mm_per_pixel);
+    let levels: Vec<i64> = level_map(design)?.into_iter().map(level_code).collect();
+    add(set, "level.npy", &mut |w| npy::write(w, &[r, c], &levels))?;
+    add(set, "level.svg", &mut |w| {
+        write_heat_map(
+            w,
+            "level per pixel (0 bit-true, 1 statistical, 2 closed-form)",
+            "level",
+            &|i| levels[i] as f64,
+            r,
+            c,
+            mm,
+            Scale::Index,
+        )
+    })?;
     if let Some(e) = events {
         add(set, "event_time_ms.npy", &mut |w| {
             npy::write(w, &[r, c], &e.time_ms)

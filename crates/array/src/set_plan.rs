@@ -82,6 +82,8 @@ fn array_set_of(design: &ResolvedDesign, r: usize, c: usize) -> Vec<SetFile> {
     let mut out = vec![
         file("registers.npy", npy::file_bytes(&[r, c, k])),
         file("detections.npy", npy::file_bytes(&[r, c])),
+        file("level.npy", npy::file_bytes(&[r, c])),
+        file("level.svg", heat),
     ];
     match design.pixel.mode {
         tofprobe_pixel::Mode::Haar => {

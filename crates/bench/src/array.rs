@@ -6,7 +6,9 @@
 //! simulation, and `model_share` says how much of the array's CPU time is not Monte Carlo.
 //! Peak memory is the process's high-water mark (VmHWM), for the memory bound linear in
 //! R·C·2B and independent of N. Each ISA of the vector kernels (`tofprobe_io::isa`: the
-//! Monte Carlo and the pixel's lanes) is its own row ([`measure_isas`]).
+//! Monte Carlo and the pixel's lanes) is its own row ([`measure_isas`]). Each `[array]
+//! level` is measured beside the bit-true run of the last frame length
+//! ([`crate::array_levels`]).
 
 use std::time::Instant;
 
@@ -14,6 +16,7 @@ use serde::Serialize;
 use tofprobe_design::{ArrayConfig, Document, ResolvedDesign, resolve};
 
 use crate::BenchError;
+use crate::array_levels::{LevelRun, measure_levels};
 use crate::cpu::{process_cpu_seconds, thread_cpu_ns};
 use crate::isa::{IsaRows, rows};
 use tofprobe_io::isa::Isa;
@@ -59,6 +62,11 @@ pub struct ArrayReport {
     pub projected_64x64_1e7_seconds: Option<f64>,
     pub target_seconds: f64,
     pub pass: bool,
+    /// Each `[array] level` at the last frame length, side by side with its bit-true run
+    /// (`array_levels`): CPU-s, rate, speed-up and the 256 × 256 × 10^7 projection. Measured
+    /// on the widest ISA only (the top level's; the narrower rows leave it out).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub levels: Vec<LevelRun>,
 }
 
 /// The process's peak resident memory (VmHWM), bytes (Linux; `None` elsewhere).
@@ -70,7 +78,8 @@ pub fn peak_memory_bytes() -> Option<u64> {
 }
 
 /// The design's pixel as a rows × cols array (1 mm per pixel, the scene's motions applied
-/// alike where they are temporal) over frames of `pulses`.
+/// alike where they are temporal; a configuration's own `[array]` kept but its shape, at
+/// the bit-true level) over frames of `pulses`.
 fn array_design(
     base: &ResolvedDesign,
     rows: u32,
@@ -98,6 +107,8 @@ fn array_design(
         level: Default::default(),
     });
     (a.rows, a.cols) = (rows, cols);
+    // The timed runs are bit-true; the other levels are set by `array_levels`.
+    a.level = tofprobe_design::ArrayLevel::BitTrue;
     Ok(resolve(doc, &base.origin)?)
 }
 
@@ -108,18 +119,24 @@ pub fn measure_isas(
     pulses: &[u64],
     isas: &[Isa],
 ) -> Result<IsaRows<ArrayReport>, BenchError> {
-    rows(isas, |_| measure(base, rows_, cols, pulses))
+    let widest = isas.last().copied();
+    rows(isas, |isa| {
+        measure(base, rows_, cols, pulses, Some(isa) == widest)
+    })
 }
 
-/// Runs the benchmark for each frame length in `pulses`, on the current ISA.
+/// Runs the benchmark for each frame length in `pulses`, on the current ISA, and (if
+/// `with_levels`) each `[array] level` at the last.
 pub fn measure(
     base: &ResolvedDesign,
     rows: u32,
     cols: u32,
     pulses: &[u64],
+    with_levels: bool,
 ) -> Result<ArrayReport, BenchError> {
     let threads = rayon::current_num_threads();
     let mut runs = Vec::new();
+    let mut last = None;
     for &n in pulses {
         let d = array_design(base, rows, cols, n)?;
         let rom = d.probe_rom()?;
@@ -131,6 +148,7 @@ pub fn measure(
         let cpu = cpu0.zip(process_cpu_seconds()).map(|(a, b)| b - a);
         std::hint::black_box(&frame);
         drop(frame);
+        let bit_true_cpu = cpu.filter(|&c| c > 0.0).unwrap_or(seconds * threads as f64);
         // The Monte Carlo alone: pixel (0, 0)'s source on this thread, over N pulses or
         // MC_MIN_PULSES if more (the thread's CPU clock may advance by scheduler ticks of
         // milliseconds: 10^6 pulses are a few of them).
@@ -166,7 +184,12 @@ pub fn measure(
             seconds_on_2_idle_cores: per_cpu.map(|r| 64.0 * 64.0 * n as f64 / (2.0 * r)),
             peak_memory_bytes: peak_memory_bytes(),
         });
+        last = Some((d, seconds, bit_true_cpu));
     }
+    let levels = match (&last, with_levels) {
+        (Some((d, secs, cpu)), true) => measure_levels(d, *secs, *cpu)?,
+        _ => Vec::new(),
+    };
     let best = runs
         .iter()
         .filter_map(|r| r.pixel_pulses_per_cpu_s)
@@ -183,5 +206,6 @@ pub fn measure(
         projected_64x64_1e7_seconds: projected,
         target_seconds: TARGET_SECONDS,
         pass,
+        levels,
     })
 }

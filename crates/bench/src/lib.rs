@@ -9,6 +9,7 @@
 //! its own pool around the call.
 
 pub mod array;
+pub mod array_levels;
 /// CPU time: `tofprobe_io::cpu` (the flow's EDA benchmarks read it too).
 pub use tofprobe_io::cpu;
 pub mod dsp;

@@ -101,14 +101,18 @@ pub enum ArrayLevel {
     Statistical,
     /// Each pixel's noise-free (expected) registers.
     ClosedForm,
+    /// Per pixel: statistical where its scene is static or its motion's response is far
+    /// below its noise floor, bit-true where it moves (the rule: `tofprobe_array::auto`).
+    Auto,
 }
 
 impl ArrayLevel {
     /// Every level, as written in `[array] level`.
-    pub const ALL: [ArrayLevel; 3] = [
+    pub const ALL: [ArrayLevel; 4] = [
         ArrayLevel::BitTrue,
         ArrayLevel::Statistical,
         ArrayLevel::ClosedForm,
+        ArrayLevel::Auto,
     ];
 
     /// Its name as written.
@@ -117,6 +121,7 @@ impl ArrayLevel {
             ArrayLevel::BitTrue => "bit-true",
             ArrayLevel::Statistical => "statistical",
             ArrayLevel::ClosedForm => "closed-form",
+            ArrayLevel::Auto => "auto",
         }
     }
 
@@ -135,7 +140,8 @@ impl std::fmt::Display for ArrayLevel {
 /// Refuses a level other than bit-true outside the range its closed forms were validated
 /// on: a Fourier pixel whose scene is a static depth plus sines and plate modes, and
 /// no background with a superpixel (G above 1), which the superpixel's closed form
-/// (`dsp::superpixel`) assumes. Names the key and the level that works.
+/// (`dsp::superpixel`) assumes. Names the key and the level that works. `"auto"` runs
+/// pixels at the statistical level, so it is refused exactly where the statistical is.
 pub fn check_level(
     level: ArrayLevel,
     pixel: &tofprobe_pixel::PixelParams,

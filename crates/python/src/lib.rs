@@ -379,7 +379,9 @@ impl Design {
 
     /// Runs an ``[array]`` design (``tofprobe simulate CONFIG --out DIR``'s model, nothing
     /// written): a dict of numpy arrays ``registers`` (int64 [R, C, K]), ``detections``
-    /// (uint64 [R, C]) and, for a Fourier pixel, ``frequencies_hz`` ([B]),
+    /// (uint64 [R, C]), ``level`` (int64 [R, C]: the ``[array] level`` each pixel ran at,
+    /// 0 bit-true, 1 statistical, 2 closed-form — the set's ``level.npy``) and, for a
+    /// Fourier pixel, ``frequencies_hz`` ([B]),
     /// ``amplitude_um`` and ``phase_deg`` (float64 [B, R, C]) — R × C the array's pixels,
     /// K = 2B registers a pixel. Pixel (r, c)'s registers are
     /// ``run_pixel(*simulate_scene(pixel=(r, c)))``.

@@ -182,6 +182,14 @@ pub fn array_dict<'py>(
     out.set_item("registers", regs.into_pyarray(py))?;
     let det = Array2::from_shape_vec((r, c), frame.detections).map_err(value_error)?;
     out.set_item("detections", det.into_pyarray(py))?;
+    let levels: Vec<i64> = py
+        .detach(|| tofprobe_array::statistical::auto::level_map(design))
+        .map_err(value_error)?
+        .into_iter()
+        .map(tofprobe_array::statistical::auto::level_code)
+        .collect();
+    let level = Array2::from_shape_vec((r, c), levels).map_err(value_error)?;
+    out.set_item("level", level.into_pyarray(py))?;
     if let Some(m) = maps {
         let b = m.bins();
         out.set_item("frequencies_hz", m.frequencies_hz.into_pyarray(py))?;

@@ -40,6 +40,12 @@ def test_tile_rects_partition_the_array(arr):
         assert (cover == 1).all(), n
 
 
+def test_the_level_map_names_the_level_each_pixel_ran(arr, whole):
+    # The default level, bit-true (code 0), at every pixel: the set's level.npy.
+    assert whole["level"].shape == whole["detections"].shape
+    assert (whole["level"] == 0).all()
+
+
 def test_local_tiles_give_the_same_array(arr, whole):
     for n in (2, 5, 12):
         same(arr.simulate_array(tiles=n), whole)

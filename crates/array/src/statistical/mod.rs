@@ -17,12 +17,14 @@
 //! the designs of the scenes): the prefilter's and the operand's floor residues (a
 //! constant offset times Σ s_n), and the hold of a moving signal (a·ω/ρ ≪ σ).
 
+pub mod auto;
 pub mod pixel;
 pub mod spectra;
 
 use std::collections::HashMap;
 use std::f64::consts::TAU;
 use std::ops::Range;
+use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
@@ -242,21 +244,19 @@ impl StatisticalModel {
         (words, detections)
     }
 
-    /// The registers of the tile rows × cols of `design`, each pixel counting its N pulses
-    /// on `watch`.
-    pub fn run_tile(
+    /// Each pixel's scene and the code statistics and noise factor shared by its key, for
+    /// the tile rows × cols of `design` (row-major).
+    fn plan(
         &self,
         design: &ResolvedDesign,
-        rows: Range<usize>,
-        cols: Range<usize>,
-        watch: &Watch,
-    ) -> Result<Tile, ArrayError> {
+        rows: &Range<usize>,
+        cols: &Range<usize>,
+    ) -> Result<TilePlan, ArrayError> {
         let scene = Scene::new(&design.document.scene)
             .map_err(|e| ArrayError::from(DesignError::scene(&design.origin, e)))?;
         let w = cols.len();
         let at = |i: usize| (rows.start + i / w, cols.start + i % w);
-        let count = rows.len() * w;
-        let scenes: Vec<PixelScene> = (0..count)
+        let scenes: Vec<PixelScene> = (0..rows.len() * w)
             .into_par_iter()
             .map(|i| pixel_scene(design, &scene, at(i).0, at(i).1))
             .collect::<Result<_, _>>()?;
@@ -269,13 +269,67 @@ impl StatisticalModel {
                 keys.len() - 1
             });
         }
-        let stats: Vec<(CodeStats, Vec<f64>)> = keys
+        let stats = keys
             .par_iter()
             .map(|&k| {
                 let st = code_stats(design, k)?;
                 Ok((st, self.noise_factor(&st)))
             })
             .collect::<Result<_, ArrayError>>()?;
+        Ok(TilePlan {
+            scenes,
+            index,
+            stats,
+        })
+    }
+
+    /// Per pixel of the tile rows × cols (row-major): true where `[array] level = "auto"`
+    /// runs it bit-true ([`auto::moves`] with `threshold`).
+    pub fn auto_levels(
+        &self,
+        design: &ResolvedDesign,
+        rows: Range<usize>,
+        cols: Range<usize>,
+        threshold: f64,
+    ) -> Result<Vec<bool>, ArrayError> {
+        let plan = self.plan(design, &rows, &cols)?;
+        Ok(plan
+            .scenes
+            .par_iter()
+            .map(|px| {
+                let (st, chol) = &plan.stats[plan.index[&px.key]];
+                auto::moves(self, px, st, chol, threshold)
+            })
+            .collect())
+    }
+
+    /// The registers of the tile rows × cols of `design`, each pixel counting its N pulses
+    /// on `watch`.
+    pub fn run_tile(
+        &self,
+        design: &ResolvedDesign,
+        rows: Range<usize>,
+        cols: Range<usize>,
+        watch: &Watch,
+    ) -> Result<Tile, ArrayError> {
+        self.run_tile_except(design, rows, cols, &[], watch)
+    }
+
+    /// [`Self::run_tile`] drawing only the pixels where `skip` (row-major over the tile;
+    /// empty: none skipped) is false; a skipped pixel's registers and detections are 0 and
+    /// it counts no pulses (the auto level runs it bit-true).
+    pub fn run_tile_except(
+        &self,
+        design: &ResolvedDesign,
+        rows: Range<usize>,
+        cols: Range<usize>,
+        skip: &[bool],
+        watch: &Watch,
+    ) -> Result<Tile, ArrayError> {
+        let plan = self.plan(design, &rows, &cols)?;
+        let w = cols.len();
+        let at = |i: usize| (rows.start + i / w, cols.start + i % w);
+        let count = rows.len() * w;
         let seed = design.document.acquisition.seed;
         let k = self.bands.registers;
         let mut registers = vec![0i64; count * k];
@@ -285,9 +339,13 @@ impl StatisticalModel {
             .zip(detections.par_iter_mut())
             .enumerate()
             .try_for_each(|(i, (regs, det))| {
-                let (st, chol) = &stats[index[&scenes[i].key]];
+                if skip.get(i).copied().unwrap_or(false) {
+                    return Ok(());
+                }
+                let px = &plan.scenes[i];
+                let (st, chol) = &plan.stats[plan.index[&px.key]];
                 let m = Moments {
-                    mean: self.mean(&scenes[i], st),
+                    mean: self.mean(px, st),
                     chol: chol.clone(),
                     valid_rate: st.valid_rate,
                 };
@@ -309,6 +367,14 @@ impl StatisticalModel {
     }
 }
 
+/// A tile's pixels as the statistical model reads them: each pixel's scene, and per
+/// distinct noise key its code statistics and noise factor.
+struct TilePlan {
+    scenes: Vec<PixelScene>,
+    index: HashMap<NoiseKey, usize>,
+    stats: Vec<(CodeStats, Vec<f64>)>,
+}
+
 /// Fills `out` with standard normal draws (Box–Muller on 53-bit uniforms in (0, 1]).
 fn gaussians(rng: &mut SplitMix64, out: &mut [f64]) {
     let mut u = || ((rng.next_u64() >> 11) as f64 + 1.0) / (1u64 << 53) as f64;
@@ -323,23 +389,73 @@ fn gaussians(rng: &mut SplitMix64, out: &mut [f64]) {
     }
 }
 
+/// The model of `design` at `level`, built once per process and design and shared by
+/// every tile of a run (a run of T tiles — shards, Dask tasks, `tradeoff`'s runs — pays
+/// for the ROM and the twin's runs once, not T times). Keyed by what the model reads
+/// (the pixel, sensor, scene, bins and probe design; the level); the last
+/// [`SHARED_MODELS`] are kept. Built outside the cache's lock, so a tile that waits on a
+/// rayon pool never blocks another's build.
+pub fn shared_model(
+    design: &ResolvedDesign,
+    level: ArrayLevel,
+) -> Result<Arc<StatisticalModel>, ArrayError> {
+    let d = &design.document;
+    let key = serde_json::to_string(&(
+        &design.pixel,
+        &d.sensor,
+        &d.scene,
+        &design.bins,
+        &design.probe_design,
+        level,
+    ))
+    .map_err(|e| ArrayError::Shape(format!("the statistical model's key: {e}")))?;
+    let found = |c: &Vec<(String, Arc<StatisticalModel>)>| {
+        c.iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, m)| Arc::clone(m))
+    };
+    if let Some(m) = found(&CACHE.lock().unwrap_or_else(|e| e.into_inner())) {
+        return Ok(m);
+    }
+    let rom = design.probe_rom()?.ok_or_else(|| {
+        ArrayError::Shape(format!(
+            "array.level = \"{level}\" needs a Fourier pixel (`{}` has no probe ROM)",
+            design.origin
+        ))
+    })?;
+    let model = Arc::new(StatisticalModel::new(design, &rom)?.at_level(level));
+    let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    if cache.len() >= SHARED_MODELS {
+        cache.remove(0);
+    }
+    cache.push((key, Arc::clone(&model)));
+    Ok(model)
+}
+
+/// The models [`shared_model`] keeps: (key, model), oldest first.
+static CACHE: Mutex<Vec<(String, Arc<StatisticalModel>)>> = Mutex::new(Vec::new());
+
+/// Forgets every model [`shared_model`] kept (a benchmark timing each level's whole cost,
+/// its model's build included).
+pub fn clear_shared_models() {
+    CACHE.lock().unwrap_or_else(|e| e.into_inner()).clear();
+}
+
+/// Models kept by [`shared_model`] (a model is ≈ 2B·(1 + 2·tones) sums and the probe's
+/// band powers: kilobytes).
+const SHARED_MODELS: usize = 8;
+
 /// The tile rows × cols of `design` at its `[array] level` (statistical or closed-form),
-/// with the design's probe ROM generated here.
+/// with the design's model shared across tiles ([`shared_model`]).
 pub fn run_tile(
     design: &ResolvedDesign,
     rows: Range<usize>,
     cols: Range<usize>,
     watch: &Watch,
 ) -> Result<Tile, ArrayError> {
-    let rom = design.probe_rom()?.ok_or_else(|| {
-        ArrayError::Shape(format!(
-            "array.level = \"{}\" needs a Fourier pixel (`{}` has no probe ROM)",
-            design
-                .array
-                .as_ref()
-                .map_or(ArrayLevel::BitTrue, |a| a.level),
-            design.origin
-        ))
-    })?;
-    StatisticalModel::new(design, &rom)?.run_tile(design, rows, cols, watch)
+    let level = design
+        .array
+        .as_ref()
+        .map_or(ArrayLevel::BitTrue, |a| a.level);
+    shared_model(design, level)?.run_tile(design, rows, cols, watch)
 }

@@ -23,7 +23,23 @@ fn pool(threads: usize) -> rayon::ThreadPool {
 
 #[test]
 fn tiles_on_any_pool_and_process_merge_into_the_array() {
-    let d = design(&plate(2, 1), 40_000, ARRAY);
+    tiles_merge(&design(&plate(2, 1), 40_000, ARRAY));
+}
+
+/// The same at `level = "auto"` on a plate over the right half (x ≥ 40 mm of the 80 mm
+/// wide array): its static pixels drawn, its moving ones bit-true, the map decided in
+/// each worker from the design it received.
+#[test]
+fn auto_tiles_on_any_pool_and_process_merge_into_the_array() {
+    let arr = format!("{ARRAY}\nlevel = \"auto\"");
+    let d = design(&crate::auto::half_plate(40.0, 40.0, 100.0), 40_000, &arr);
+    let map = tofprobe_array::statistical::auto::level_map(&d).unwrap();
+    assert!(map.iter().any(|l| l.is_bit_true()) && !map.iter().all(|l| l.is_bit_true()));
+    tiles_merge(&d);
+}
+
+fn tiles_merge(d: &ResolvedDesign) {
+    let d = d.clone();
     let rom = d.probe_rom().unwrap().unwrap();
     let whole = pool(2).install(|| run_array(&d, Some(&rom.image))).unwrap();
     // A worker gets the design as JSON, runs its tile and returns it as JSON.

@@ -1,6 +1,7 @@
 //! The integration tests of `tofprobe-array`, one binary
 //! (`cargo test --release -p tofprobe-array --test it MODULE::`).
 
+mod auto;
 mod common;
 mod determinism;
 mod double_buffer;

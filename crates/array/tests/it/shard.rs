@@ -124,12 +124,24 @@ fn sets(root: &Path, d: &tofprobe_design::ResolvedDesign, n: u64) -> Vec<PathBuf
 
 #[test]
 fn tile_sets_merge_into_the_single_runs_set_byte_for_byte() {
+    let arr = "rows = 4\ncols = 3\npitch_um = 30.0\nmm_per_pixel = 20.0";
+    merges_into_the_whole(&design(&plate(2, 1), 40_000, arr));
+}
+
+/// The same at `level = "auto"` on a plate moving one half of the array (the level map
+/// mixes bit-true and statistical pixels; both merge byte for byte, the map with them).
+#[test]
+fn auto_tile_sets_merge_into_the_single_runs_set_byte_for_byte() {
+    let arr = "rows = 4\ncols = 3\npitch_um = 30.0\nmm_per_pixel = 20.0\nlevel = \"auto\"";
+    let d = design(&crate::auto::half_plate(40.0, 40.0, 80.0), 40_000, arr);
+    let map = tofprobe_array::statistical::auto::level_map(&d).unwrap();
+    assert!(map.iter().any(|l| l.is_bit_true()) && !map.iter().all(|l| l.is_bit_true()));
+    merges_into_the_whole(&d);
+}
+
+fn merges_into_the_whole(d: &tofprobe_design::ResolvedDesign) {
+    let d = d.clone();
     let tmp = tempfile::tempdir().unwrap();
-    let d = design(
-        &plate(2, 1),
-        40_000,
-        "rows = 4\ncols = 3\npitch_um = 30.0\nmm_per_pixel = 20.0",
-    );
     let whole = tmp.path().join("whole");
     tofprobe_array::output::run_and_write(&d, &whole, Default::default()).unwrap();
     let want = files(&whole);

@@ -161,7 +161,7 @@ fn bad_levels_are_refused_with_the_way_out() {
         .err()
         .map(|e| e.to_string())
         .unwrap_or_default();
-    for want in ["level", "bit-true", "statistical", "closed-form"] {
+    for want in ["level", "bit-true", "statistical", "closed-form", "auto"] {
         assert!(e.contains(want), "{e}");
     }
     let t = crate::common::text(&plate(2, 1), 1 << 15, &array("statistical"));
@@ -172,12 +172,20 @@ fn bad_levels_are_refused_with_the_way_out() {
         "mode = \"haar\"\nhaar_scales = 4",
         1,
     );
-    let d = tofprobe_design::Document::from_toml_str(&t, "t.toml").unwrap();
-    let e = tofprobe_design::resolve(d, "t.toml")
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("array.level") && e.contains("\"bit-true\""),
-        "{e}"
-    );
+    // Auto runs pixels at the statistical level: refused the same way, naming itself.
+    for level in ["statistical", "auto"] {
+        let t = t.replacen(
+            "level = \"statistical\"",
+            &format!("level = \"{level}\""),
+            1,
+        );
+        let d = tofprobe_design::Document::from_toml_str(&t, "t.toml").unwrap();
+        let e = tofprobe_design::resolve(d, "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("array.level = \"{level}\"")) && e.contains("\"bit-true\""),
+            "{e}"
+        );
+    }
 }

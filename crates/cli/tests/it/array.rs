@@ -307,6 +307,41 @@ fn bench_array_prints_its_rates() {
         assert!(row["isa"].is_string() && row["pass"].is_boolean());
         assert!(row["projected_64x64_1e7_seconds"].as_f64().unwrap() > 0.0);
     }
+    // The levels side by side at the last N: bit-true's row is the run's, each row names
+    // its figures and units, the speed-up is bit-true's CPU-s over the level's, and the
+    // targets judged are bit-true's and the statistical level's.
+    let levels = r["levels"].as_array().unwrap();
+    let names: Vec<&str> = levels
+        .iter()
+        .map(|l| l["level"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["bit-true", "statistical", "closed-form", "auto"]);
+    let bt_cpu = levels[0]["cpu_seconds"].as_f64().unwrap();
+    for l in levels {
+        assert_eq!(l["pulses"], 80_000);
+        let cpu = l["cpu_seconds"].as_f64().unwrap();
+        let rate = l["pixel_pulses_per_cpu_second"].as_f64().unwrap();
+        assert!((rate * cpu / (16.0 * 80_000.0) - 1.0).abs() < 1e-9, "{l}");
+        let speedup = l["speedup_over_bit_true"].as_f64().unwrap();
+        assert!((speedup * cpu / bt_cpu - 1.0).abs() < 1e-9, "{l}");
+        assert!(
+            l["projected_256x256_1e7_seconds"].as_f64().unwrap() > 0.0,
+            "{l}"
+        );
+        assert!(l["model_cpu_seconds"].as_f64().unwrap() <= cpu, "{l}");
+        let judged = matches!(names_of(l), "bit-true" | "statistical");
+        assert_eq!(l["pass"].is_boolean(), judged, "{l}");
+        assert_eq!(l["target_seconds"].is_number(), judged, "{l}");
+    }
+    assert_eq!(levels[0]["target_seconds"], 480.0);
+    assert_eq!(levels[1]["target_seconds"], 10.0);
+    // The default scene is one sine seen by every pixel: auto runs them all bit-true.
+    assert_eq!(levels[3]["bit_true_pixels"], 16);
+    assert_eq!(levels[1]["bit_true_pixels"], 0);
+}
+
+fn names_of(l: &serde_json::Value) -> &str {
+    l["level"].as_str().unwrap_or_default()
 }
 
 /// The set as its users read it: numpy.load reads the .npy arrays and pyuff the UFF file

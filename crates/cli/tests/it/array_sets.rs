@@ -92,13 +92,13 @@ fn check_set_passes_whole_array_and_tile_sets_and_names_a_torn_one() {
     let out = tmp.path().join("out");
     ok(&["simulate", s(&a), "--out", s(&out)]);
     let line = ok(&["check-set", s(&out)]);
-    assert!(line.contains("whole output set, 16 file(s)"), "{line}");
+    assert!(line.contains("whole output set, 18 file(s)"), "{line}");
     let tile = tmp.path().join("tile");
     ok(&["simulate", s(&a), "--out", s(&tile), "--shard", "1/2"]);
     assert!(ok(&["check-set", s(&tile)]).contains("5 file(s)"));
-    // 16 files, then the marker: 17 renames.
+    // 18 files, then the marker: 19 renames.
     let (mut refused_sets, mut whole) = (0, 0);
-    for k in 1..=17 {
+    for k in 1..=19 {
         ok(&["simulate", s(&a), "--out", s(&out)]);
         let o = bin()
             .args(["simulate", s(&b), "--out", s(&out)])
@@ -115,7 +115,7 @@ fn check_set_passes_whole_array_and_tile_sets_and_names_a_torn_one() {
             Some(0) => {
                 // Whole: every file of run b (seed 2), as its summary says.
                 let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
-                assert!(k == 17, "k = {k}: whole before the marker's rename: {t}");
+                assert!(k == 19, "k = {k}: whole before the marker's rename: {t}");
                 assert!(
                     summary.contains("\"configuration\": \"b.toml\""),
                     "{summary}"
@@ -134,7 +134,7 @@ fn check_set_passes_whole_array_and_tile_sets_and_names_a_torn_one() {
             c => panic!("check-set exit {c:?}: {t}"),
         }
     }
-    assert_eq!((refused_sets, whole), (16, 1));
+    assert_eq!((refused_sets, whole), (18, 1));
     // The next run completes or discards the cut commit: whole again, nothing hidden left.
     ok(&["simulate", s(&a), "--out", s(&out)]);
     ok(&["check-set", s(&out)]);
@@ -233,7 +233,7 @@ fn a_new_array_set_drops_the_files_of_the_one_it_replaces() {
         !files.iter().any(|f| f.contains("bin03")),
         "the fourth bin's maps stayed: {files:?}"
     );
-    assert_eq!(files.len(), 2 + 2 + 2 * 3 + 3 + 2 + 1, "{files:?}");
+    assert_eq!(files.len(), 2 + 2 + 2 + 2 * 3 + 3 + 2 + 1, "{files:?}");
     ok(&["check-set", s(&out)]);
     // Haar over Fourier: the 13 Fourier-only files go.
     let edge = include_str!("../../../../scenes/edge-sweep.toml")
@@ -254,6 +254,8 @@ fn a_new_array_set_drops_the_files_of_the_one_it_replaces() {
             "event_time.svg",
             "event_time_ms.npy",
             "event_time_sd_ms.npy",
+            "level.npy",
+            "level.svg",
             "notes.txt",
             "registers.npy",
             "summary.json",

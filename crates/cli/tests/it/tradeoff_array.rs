@@ -1,6 +1,6 @@
 //! `tofprobe tradeoff` on an `[array]` configuration (issue 48): the plate-mode example
 //! shrunk to 8 × 8 pixels and 2 ROM periods; exit 0, one JSON object whose `array_scenes`
-//! lists the three array levels with finite times and accuracy keys naming their unit,
+//! lists the four array levels with finite times and accuracy keys naming their unit,
 //! and the level named in `simulate --out`'s summary.
 
 use crate::common::tofprobe;
@@ -35,7 +35,12 @@ fn tradeoff_lists_the_array_levels_with_time_and_accuracy() {
         .iter()
         .map(|l| l["level"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["bit-true", "statistical", "closed-form"]);
+    assert_eq!(names, ["bit-true", "statistical", "closed-form", "auto"]);
+    // Auto runs the plate's moving pixels bit-true: all but those on a nodal line.
+    let (bt, au) = (&levels[0]["bit_true_pixels"], &levels[3]["bit_true_pixels"]);
+    assert_eq!(bt, 64);
+    assert!(au.as_u64().is_some_and(|n| n > 32 && n <= 64), "{au}");
+    assert_eq!(levels[1]["bit_true_pixels"], 0);
     for l in levels {
         for key in [
             "seconds",
@@ -78,6 +83,9 @@ fn simulate_names_the_level_in_the_summary_and_the_uff_header() {
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["level"], "statistical");
+    assert_eq!(summary["level_pixels"]["statistical"], 64);
+    assert_eq!(summary["level_pixels"]["bit-true"], 0);
+    assert!(out.join("level.npy").is_file() && out.join("level.svg").is_file());
     let uff = std::fs::read_to_string(out.join("vibration.uff")).unwrap();
     assert!(uff.contains("(statistical)"));
     // A level that does not exist: bad input's exit code 2, the allowed names listed.
@@ -86,7 +94,7 @@ fn simulate_names_the_level_in_the_summary_and_the_uff_header() {
     let err = String::from_utf8_lossy(&res.stderr);
     assert!(
         res.status.code() == Some(2)
-            && ["bit-true", "statistical", "closed-form"]
+            && ["bit-true", "statistical", "closed-form", "auto"]
                 .iter()
                 .all(|n| err.contains(n)),
         "{err}"

@@ -2,6 +2,7 @@
 //! cost a link each: most of a cold CI run's build time). Run one module with
 //! `cargo test --release -p tofprobe-design --test it MODULE::`.
 
+mod level;
 mod mutations;
 mod readout;
 mod resolve;

@@ -6,12 +6,16 @@
 //! ≈ 1/√2), the noise floor (mean amplitude over the other bins) against bit-true's,
 //! the MAC of the mode shape, and the two-sample Kolmogorov–Smirnov test of the per-pixel
 //! noise (the other bins' phasors, real and imaginary parts, pooled over the pixels).
+//! The auto level mixes bit-true pixels with statistical ones: it runs at the second
+//! bit-true seed (as the bit-true row does), so its bit-true pixels carry their own noise
+//! against the reference rather than copying it, and its row counts them.
 
 use std::time::Instant;
 
 use serde::Serialize;
 use tofprobe_array::maps::{VibrationMaps, fourier_maps, mac};
 use tofprobe_array::model::run_array;
+use tofprobe_array::statistical::auto::level_map;
 use tofprobe_design::{ArrayLevel, DesignError, ResolvedDesign};
 use tofprobe_dsp::sd::ProbeRom;
 use tofprobe_dsp::stats::ks_two_sample;
@@ -23,6 +27,9 @@ use crate::error::ExperimentError;
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct ArrayLevelResult {
     pub level: String,
+    /// Pixels that ran bit-true (all at bit-true, none at the statistical and closed-form
+    /// levels, auto's moving pixels).
+    pub bit_true_pixels: usize,
     /// Wall time of the array's registers, s.
     pub seconds: f64,
     /// Pixel-pulses per second of wall time.
@@ -172,17 +179,23 @@ pub fn measure_array(
     let pixel_pulses = (bt.rows * bt.cols) as f64 * design.pixel.frame_pulses as f64;
     let mut out = Vec::with_capacity(levels.len());
     for &level in levels {
-        let (m, secs) = if level == ArrayLevel::BitTrue {
-            (bt2.clone(), bt_secs)
-        } else {
-            run(design, &rom, level, seed)?
+        let (m, secs) = match level {
+            ArrayLevel::BitTrue => (bt2.clone(), bt_secs),
+            ArrayLevel::Auto => run(design, &rom, level, seed.wrapping_add(1))?,
+            _ => run(design, &rom, level, seed)?,
         };
+        let bit_true_pixels = level_map(&at(design, level, seed)?)
+            .map_err(Box::new)?
+            .iter()
+            .filter(|l| l.is_bit_true())
+            .count();
         let n = (m.rows * m.cols) as f64;
         let floor = noise_floor(&m, mode);
         let (d, p) = ks_two_sample(&noise_samples(&m, mode), &bt_noise);
         let ratio = |x: f64, r: f64| if r > 0.0 { x / r } else { 0.0 };
         out.push(ArrayLevelResult {
             level: level.name().to_string(),
+            bit_true_pixels,
             seconds: secs,
             pixel_pulses_per_s: pixel_pulses / secs.max(1e-9),
             amplitude_rms_error_um: amp_rms(&m),
@@ -221,6 +234,7 @@ pub fn measure_array(
 pub fn markdown(r: &ArrayTradeoff) -> String {
     let mut t = Table::left([
         "level",
+        "bit-true pixels",
         "s",
         "pixel-pulses/s",
         "amp. RMS err µm",
@@ -237,6 +251,7 @@ pub fn markdown(r: &ArrayTradeoff) -> String {
     for l in &r.levels {
         t.row([
             l.level.to_string(),
+            l.bit_true_pixels.to_string(),
             format!("{:.3}", l.seconds),
             format!("{:.3e}", l.pixel_pulses_per_s),
             format!("{:.3}", l.amplitude_rms_error_um),

@@ -1,5 +1,6 @@
 //! `tofprobe bench array [CONFIG] [--rows 64] [--cols 64] [--pulses 1000000,10000000]
-//! [--json]`: the array model's speed (`tofprobe_bench::array` measures; this prints).
+//! [--json]`: the array model's speed, each `[array] level` side by side at the last N
+//! (`tofprobe_bench::array` and `array_levels` measure; this prints).
 
 use std::path::PathBuf;
 
@@ -77,4 +78,28 @@ fn print_text(r: &ArrayReport) {
             .map_or("?".to_string(), |s| format!("{s:.0}")),
         if r.pass { "pass" } else { "FAIL" }
     );
+    if let Some(n) = r.levels.first().map(|l| l.pulses) {
+        println!(
+            "levels at N = {n} (each in the same run; 256 × 256 × 10^7 projected on 2 idle cores):"
+        );
+    }
+    for l in &r.levels {
+        let judged = match (l.target_seconds, l.pass) {
+            (Some(t), Some(p)) => {
+                format!(" (target {t:.0} s: {})", if p { "pass" } else { "FAIL" })
+            }
+            _ => String::new(),
+        };
+        println!(
+            "  {:<12} {:>8.3} CPU-s ({:.3} model), {:.3e} pixel-pulses/CPU-s, {:>8.1}× bit-true, \
+             {} bit-true pixels; projected {:.1} s{judged}",
+            l.level,
+            l.cpu_seconds,
+            l.model_cpu_seconds,
+            l.pixel_pulses_per_cpu_second,
+            l.speedup_over_bit_true,
+            l.bit_true_pixels,
+            l.projected_256x256_1e7_seconds,
+        );
+    }
 }
