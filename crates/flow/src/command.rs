@@ -8,7 +8,7 @@ use tofprobe_design::ResolvedDesign;
 use tofprobe_experiments::options::OptionsReport;
 
 use crate::error::FlowError;
-use crate::flow::{FlowOptions, FlowOutcome, recommended, run_flow};
+use crate::flow::{FlowOptions, FlowOutcome, check_frames, recommended, run_flow};
 
 /// `flow --recommended`: the options study's restriction and target.
 #[derive(Debug, Clone, PartialEq)]
@@ -17,18 +17,6 @@ pub struct Recommend {
     pub only: Vec<String>,
     /// The tone error the recommendation must meet (µm).
     pub target_error_um: f64,
-}
-
-/// Frames a flow co-simulates (its option `frames`).
-pub const FRAMES: std::ops::RangeInclusive<u64> = 1..=100;
-
-/// Refuses a frame count out of [`FRAMES`], naming `frames`.
-pub fn check_frames(frames: u64) -> Result<(), FlowError> {
-    if FRAMES.contains(&frames) {
-        Ok(())
-    } else {
-        Err(FlowError::option("frames", frames, "1..=100"))
-    }
 }
 
 /// The design the flow runs: `design` itself, or with `recommend` the options study's

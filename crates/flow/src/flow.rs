@@ -73,6 +73,18 @@ pub struct FlowOutcome {
     pub signoff: Vec<crate::signoff::SignoffLine>,
 }
 
+/// Frames a flow co-simulates (its option `frames`).
+pub const FRAMES: std::ops::RangeInclusive<u64> = 1..=100;
+
+/// Refuses a frame count out of [`FRAMES`], naming `frames`.
+pub fn check_frames(frames: u64) -> Result<(), FlowError> {
+    if FRAMES.contains(&frames) {
+        Ok(())
+    } else {
+        Err(FlowError::option("frames", frames, "1..=100"))
+    }
+}
+
 /// Longest default short frame of the flow.
 pub const SHORT_FRAME: u64 = 65_536;
 
@@ -142,7 +154,7 @@ pub fn recommended(
 /// set ([`crate::flowset`]): the old report and marker go first, the new marker last, and a
 /// failed flow removes the directory if it created it.
 pub fn run_flow(design: &ResolvedDesign, a: &FlowOptions) -> Result<FlowOutcome, FlowError> {
-    crate::command::check_frames(a.frames)?;
+    check_frames(a.frames)?;
     // Before minutes of co-simulation, not after: a hand-written report.md stays.
     refuse_foreign_report(&a.out.join("report.md"))?;
     let created = crate::flowset::open(&a.out)?;

@@ -89,7 +89,7 @@ pub fn run_array_flow(
             "the pixel's flow (an array is co-simulated here; its synthesis and timing are `tofprobe size`)",
         ));
     }
-    crate::command::check_frames(a.frames)?;
+    crate::flow::check_frames(a.frames)?;
     crate::flow::refuse_foreign_report(&a.out.join("report.md"))?;
     let created = crate::flowset::open(&a.out)?;
     let r = array_flow_in(design, a);

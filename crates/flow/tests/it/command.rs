@@ -10,8 +10,8 @@
 use tofprobe_design::{DEFAULT_TOML, Document};
 use tofprobe_flow::FlowError;
 use tofprobe_flow::adders::resolve;
-use tofprobe_flow::command::{Recommend, check_frames, choose, run_any};
-use tofprobe_flow::flow::{FlowOptions, FlowOutcome};
+use tofprobe_flow::command::{Recommend, choose, run_any};
+use tofprobe_flow::flow::{FlowOptions, FlowOutcome, check_frames};
 
 fn design(text: &str) -> tofprobe_design::ResolvedDesign {
     let doc = Document::from_toml_str(text, "test.toml").expect("parses");
