@@ -12,7 +12,7 @@
 //! ([`PixelStream`], `pixel::Superpixel`): the datapath is the one pixel's either way.
 //! The `[array] level` picks the tile's run ([`run_tile_watched`]): bit-true here, the
 //! drawn levels in `statistical`, and `"auto"` both — the pixels `statistical::auto`
-//! calls moving through the same bit-true runner ([`run_pixels`], any subset of pixels in
+//! calls moving through the same bit-true runner (`run_pixels`, any subset of pixels in
 //! any grouping gives each its own registers), the others drawn.
 
 use std::ops::Range;

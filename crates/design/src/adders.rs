@@ -1,7 +1,7 @@
 //! `adders = "auto"`: the fewest shared adders whose pixel meets the laser rate on a liberty,
 //! decided from measured timing, as a step of its own after the (pure) resolution.
 //!
-//! [`crate::resolve`] never runs a tool: with `adders = "auto"` it leaves the choice open
+//! [`crate::resolve()`] never runs a tool: with `adders = "auto"` it leaves the choice open
 //! ([`AdderStatus::Open`]) and resolves the pixel with a provisional A (the bit-true
 //! registers do not depend on A or C, only the schedule does). The commands that build
 //! hardware resolve with a timing oracle ([`AdderTiming`], implemented with yosys and OpenSTA

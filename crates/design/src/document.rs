@@ -1,6 +1,6 @@
 //! The whole TOML configuration document, from a file or the embedded default
 //! (`scenes/default.toml`, the paper's Fig. 8 case). This module only parses: what the
-//! document means (validation, defaults, the pixel, the bins) is [`crate::resolve`]'s job,
+//! document means (validation, defaults, the pixel, the bins) is [`crate::resolve()`]'s job,
 //! done once.
 //!
 //! Every table rejects unknown keys (`deny_unknown_fields`), so a typo is an error with a

@@ -71,7 +71,7 @@ pub enum DesignError {
     /// the file, the mode's origin and the field N or U came from.
     #[error("in configuration {place}: {source}")]
     Haar {
-        /// "`file`: [pixel] Haar mode …, N from acquisition.pulses" and the like.
+        /// "`file`: \[pixel\] Haar mode …, N from acquisition.pulses" and the like.
         place: String,
         /// What is wrong (names the nearest powers of two or the largest U).
         source: Box<tofprobe_dsp::DspError>,

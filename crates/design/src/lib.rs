@@ -1,5 +1,5 @@
 //! The configuration document and its ONE resolution: [`Document`] (the TOML file or the
-//! embedded default) → [`resolve`] → [`ResolvedDesign`] (scene, sensor, pixel parameters
+//! embedded default) → [`resolve()`] → [`ResolvedDesign`] (scene, sensor, pixel parameters
 //! and widths, Fourier bins, the stability-checked ΣΔ probe design). Every `tofprobe`
 //! command starts from a `ResolvedDesign`. Also the bin chooser ([`bin_choice`]), the chip the RTL
 //! commands build ([`chip`]: array shape, the broadcast probe ROM by the ROM policy

@@ -1,6 +1,6 @@
 //! A configuration document from values instead of TOML text (a Python dict), and a
 //! document changed key by key (`pixel.bins = 4`): both judged by the document's own serde
-//! types, as a file is, before the one resolution ([`crate::resolve`]) runs. There is no
+//! types, as a file is, before the one resolution ([`crate::resolve()`]) runs. There is no
 //! text, so an error names the key's whole dotted path (and what the section takes), never
 //! a line of a text the user did not write.
 

@@ -3,7 +3,7 @@
 //!
 //! # Eq. 12: the noise floor of white depth noise
 //! A windowed DFT of white noise of variance σ_s² gives a circular complex Gaussian
-//! Y = 2/(N·G)·Σ w[n] e[n] e^(−jωn) with E|Y|² = 4σ_s²·P/(N·G²) = 4σ_s²/N_eff
+//! Y = 2/(N·G)·Σ w\[n\] e\[n\] e^(−jωn) with E|Y|² = 4σ_s²·P/(N·G²) = 4σ_s²/N_eff
 //! (N_eff = N·G²/P). |Y| is Rayleigh, E|Y| = sqrt(π/4·E|Y|²) = sqrt(π σ_s²/N_eff).
 //! σ_s² = σ_I² + a²/12 adds the TDC quantisation (LSB a) to the jitter.
 //!
@@ -12,13 +12,13 @@
 //! sample at pulse n is the detection of pulse n−k iff pulses n−k+1..n all missed, so two
 //! held samples k pulses apart carry the *same* noise draw with probability (1−ρ)^|k|
 //! and independent ones otherwise: the held noise has autocovariance
-//! R[k] = σ²·q^|k|, q = 1 − ρ (an AR(1)-like sequence). Its power spectrum is
+//! R\[k\] = σ²·q^|k|, q = 1 − ρ (an AR(1)-like sequence). Its power spectrum is
 //! S(ω) = σ²·Σ_k q^|k| e^(−jωk) = σ²·(1 − q²)/(1 − 2q cos ω + q²),
 //! so the noise floor at bin frequency ω (S smooth over the window's main lobe) is
 //! E|Y(ω)| = sqrt(π σ² F(ρ, ω)/N_eff), F = (1 − q²)/(1 − 2q cos ω + q²)
 //! ([`hold_noise_factor`]). At low frequency F → (1+q)/(1−q) = (2 − ρ)/ρ: the floor grows
 //! as sqrt((2−ρ)/ρ) ≈ sqrt(2/ρ_s) (e.g. ×2.38 at ρ = 0.3, ×8.1 at ρ = 0.03). The mean
-//! (signal) response of the same hold is E[held[n]] = Σ ρ q^k s[n−k], i.e.
+//! (signal) response of the same hold is E\[held\[n\]\] = Σ ρ q^k s\[n−k\], i.e.
 //! |H|² = ρ²/(1 − 2q cos ω + q²) ([`hold_response_sq`]).
 //!
 //! # Extension for background: the first-arrival mixture
@@ -30,7 +30,7 @@
 //! (a background first: none earlier, signal not earlier; or the signal first: no
 //! background earlier). Its integral is the valid rate ρ_v = 1 − (1 − ρ_s·P_in)·e^(−ρ_b),
 //! and the detected depth is a mixture with mean μ and variance σ_mix² (by quadrature,
-//! [`first_arrival`]; plus a²/12 for the TDC). The held sequence then has R[k] =
+//! [`first_arrival`]; plus a²/12 for the TDC). The held sequence then has R\[k\] =
 //! σ_mix²·(1 − ρ_v)^|k|, so the noise floor is sqrt(π σ_mix² F(ρ_v, ω)/N_eff)
 //! ([`noise_floor_mixture_mm`]). A small motion of the signal moves the mixture's mean by
 //! g = ∂μ/∂t_s < 1 (background arrivals do not follow it): the measured amplitude is
@@ -89,7 +89,7 @@ pub fn hold_response_sq(rho: f64, omega: f64) -> f64 {
     rho * rho / hold_denominator(rho, omega)
 }
 
-/// The mean response itself, H(ω) = ρ/(1 − q·e^(−jω)) (q = 1 − ρ): E[held[n]] = Σ ρ q^k
+/// The mean response itself, H(ω) = ρ/(1 − q·e^(−jω)) (q = 1 − ρ): E\[held\[n\]\] = Σ ρ q^k
 /// s[n−k] moves a tone by |H| ([`hold_response_sq`]) and delays it by −arg H.
 pub fn hold_response(rho: f64, omega: f64) -> rustfft::num_complex::Complex64 {
     let q = 1.0 - rho;

@@ -1,7 +1,7 @@
 //! Full-record windowed DFT (rustfft): the reference every cheaper spectrum is judged
 //! against.
 //!
-//! Amplitude convention (the paper's): |Y[k]| = 2/N · |Σ w[n] x[n] e^(−j2πkn/N)| / G, so a
+//! Amplitude convention (the paper's): |Y\[k\]| = 2/N · |Σ w\[n\] x\[n\] e^(−j2πkn/N)| / G, so a
 //! tone of amplitude A on bin k reads A whatever the window. DC (k = 0) uses 1/N instead of
 //! 2/N so it reads the mean. Units are those of the input (the reproduce command feeds mm
 //! and reports µm).
@@ -27,7 +27,7 @@ pub fn check_len(what: &'static str, len: usize) -> Result<(), DspError> {
     Ok(())
 }
 
-/// The raw windowed DFT X[k] = Σ w[n] x[n] e^(−j2πkn/N), k = 0..N (all N bins).
+/// The raw windowed DFT X\[k\] = Σ w\[n\] x\[n\] e^(−j2πkn/N), k = 0..N (all N bins).
 pub fn windowed_dft(x: &[f64], window: Window) -> Result<Vec<Complex64>, DspError> {
     check_len("windowed DFT", x.len())?;
     let n = x.len();
@@ -49,10 +49,10 @@ pub fn amplitude_scale(k: usize, n: usize, window: Window) -> f64 {
     factor / (n as f64 * window.coherent_gain())
 }
 
-/// The one-sided windowed DFT X[k], k = 0..=N/2. For even N it packs the real record
-/// into an N/2-point complex FFT (z[m] = x[2m] + j·x[2m+1]) and untangles the even and odd
-/// halves: X[k] = E[k] + e^(−j2πk/N)·O[k] with E[k] = (Z[k] + Z*[N/2−k])/2 and
-/// O[k] = (Z[k] − Z*[N/2−k])/(2j): half the work and memory of a complex FFT.
+/// The one-sided windowed DFT X\[k\], k = 0..=N/2. For even N it packs the real record
+/// into an N/2-point complex FFT (z\[m\] = x\[2m\] + j·x\[2m+1\]) and untangles the even and odd
+/// halves: X\[k\] = E\[k\] + e^(−j2πk/N)·O\[k\] with E\[k\] = (Z\[k\] + Z*\[N/2−k\])/2 and
+/// O\[k\] = (Z\[k\] − Z*\[N/2−k\])/(2j): half the work and memory of a complex FFT.
 pub fn windowed_dft_half(x: &[f64], window: Window) -> Result<Vec<Complex64>, DspError> {
     check_len("windowed DFT", x.len())?;
     let n = x.len();
@@ -84,7 +84,7 @@ pub fn windowed_dft_half(x: &[f64], window: Window) -> Result<Vec<Complex64>, Ds
         .collect())
 }
 
-/// One-sided amplitude spectrum |Y[k]|, k = 0..=N/2, in the input's units.
+/// One-sided amplitude spectrum |Y\[k\]|, k = 0..=N/2, in the input's units.
 pub fn amplitude_spectrum(x: &[f64], window: Window) -> Result<Vec<f64>, DspError> {
     let n = x.len();
     let half = windowed_dft_half(x, window)?;

@@ -1,18 +1,18 @@
 //! The pixel's pre-processing in float (docs/pixel-contract.md, steps 1–3), streaming:
 //! time-window zoom, 1NN missing-pulse hold with priming, and the first-order prefilter.
 //!
-//! Per pulse n with detection d[n] (depth minus the zoom offset, or none):
-//! - **hold**: held[n] = d[n] if detected, else held[n−1] (the pixel's imputation; beyond
+//! Per pulse n with detection d\[n\] (depth minus the zoom offset, or none):
+//! - **hold**: held\[n\] = d\[n\] if detected, else held\[n−1\] (the pixel's imputation; beyond
 //!   the paper, [`FrontEnd::with_imputation`] puts a constant-velocity Kalman filter or
-//!   its fixed-gain α-β form in its place, [`crate::imputation`]: held[n] is then the
+//!   its fixed-gain α-β form in its place, [`crate::imputation`]: held\[n\] is then the
 //!   filter's depth after pulse n, and everything below is unchanged);
 //! - **priming**: pulses before the first detection contribute nothing (output 0, which
 //!   adds nothing to any linear accumulator, exactly as the pixel's `acc_en = 0`);
-//! - **raw output** (the DFT/Haar reference, no prefilter): y[n] = held[n] once primed,
+//! - **raw output** (the DFT/Haar reference, no prefilter): y\[n\] = held\[n\] once primed,
 //!   the priming pulse included (the pixel's Haar path);
-//! - **prefiltered output** (the pixel's Fourier path): x[n] = x[n−1] + α(held[n−1] − x[n−1])
+//! - **prefiltered output** (the pixel's Fourier path): x\[n\] = x\[n−1\] + α(held\[n−1\] − x\[n−1\])
 //!   = (1−α)·x[n−1] + α·held[n−1]; the priming pulse contributes nothing and starts
-//!   x at its own depth (no start transient), from the next pulse on y[n] = x[n].
+//!   x at its own depth (no start transient), from the next pulse on y\[n\] = x\[n\].
 //!
 //! State survives between chunks, so records of 10^7 pulses stream in any chunking.
 //!
@@ -33,7 +33,7 @@ use crate::imputation::{Imputation, Imputer};
 pub enum FrontEndOutput {
     /// The held depth itself (no prefilter).
     Held,
-    /// The prefiltered held depth with x[n] = x[n−1] + α(held[n−1] − x[n−1]).
+    /// The prefiltered held depth with x\[n\] = x\[n−1\] + α(held\[n−1\] − x\[n−1\]).
     Prefiltered { alpha: f64 },
 }
 
@@ -145,7 +145,7 @@ impl FrontEnd {
 }
 
 /// The prefilter's response H_pre(e^{jω}) = α e^{−jω} / (1 − (1−α) e^{−jω}) at
-/// f/f_s = `f_norm`, of x[n] = (1−α)x[n−1] + α·h[n−1]. Its magnitude squared is
+/// f/f_s = `f_norm`, of x\[n\] = (1−α)x\[n−1\] + α·h\[n−1\]. Its magnitude squared is
 /// α² / (1 − 2(1−α)cos ω + (1−α)²), the form of the mean 1NN hold response with ρ in
 /// place of α (`closed_form::hold_response_sq`).
 pub fn prefilter_response(alpha: f64, f_norm: f64) -> Complex64 {

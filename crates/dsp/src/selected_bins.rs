@@ -17,7 +17,7 @@ use std::f64::consts::PI;
 /// Samples between exact phasor re-synchronisations.
 pub const RESYNC: u64 = 1024;
 
-/// Accumulates X[k] = Σ w[n] x[n] e^(−j2πkn/N) for a list of bins over a streamed record
+/// Accumulates X\[k\] = Σ w\[n\] x\[n\] e^(−j2πkn/N) for a list of bins over a streamed record
 /// of known length N.
 #[derive(Debug, Clone)]
 pub struct SelectedBins {
@@ -98,7 +98,7 @@ impl SelectedBins {
         Ok(())
     }
 
-    /// The raw sums X[k] (in the order of the bins given); the record must be complete.
+    /// The raw sums X\[k\] (in the order of the bins given); the record must be complete.
     pub fn finish(&self) -> Result<Vec<Complex64>, DspError> {
         if self.next != self.n_total {
             return Err(DspError::RecordTooShort {
@@ -110,7 +110,7 @@ impl SelectedBins {
         Ok(self.acc.clone())
     }
 
-    /// |Y[k]| with the paper's 2/(N·G) normalisation, in the input's units.
+    /// |Y\[k\]| with the paper's 2/(N·G) normalisation, in the input's units.
     pub fn amplitudes(&self) -> Result<Vec<f64>, DspError> {
         let n = self.n_total as usize;
         Ok(self

@@ -1,7 +1,7 @@
 //! Spectrum statistics: the noise floor, the interpolated peak amplitude, SNR and
 //! Bartlett averaging; the two-sample Kolmogorov–Smirnov test ([`ks_two_sample`]).
 //!
-//! **Noise floor** = the mean magnitude |Y[k]| over the bins of a band [f_lo, f_hi] with
+//! **Noise floor** = the mean magnitude |Y\[k\]| over the bins of a band \[f_lo, f_hi\] with
 //! two kinds of bins excluded: the DC region (k < `dc_guard` bins, where the window's main
 //! lobe spreads the large mean depth: Blackman's main lobe is ±3 bins, so the default guard
 //! is 8) and ±`tone_guard` bins around each signal tone (again ≥ the main lobe; default 8).
@@ -149,7 +149,7 @@ pub fn snr_db(a: f64, noise: f64) -> Result<f64, DspError> {
 }
 
 /// Bartlett averaging: the record is cut into ⌊N/L⌋ non-overlapping frames of L samples,
-/// each windowed and transformed, and the *powers* averaged; returns sqrt(mean |Y_f[k]|²)
+/// each windowed and transformed, and the *powers* averaged; returns sqrt(mean |Y_f\[k\]|²)
 /// (k = 0..=L/2, same amplitude normalisation as [`amplitude_spectrum`]). A leftover tail
 /// shorter than L is ignored.
 pub fn bartlett(x: &[f64], frame_len: usize, window: Window) -> Result<Vec<f64>, DspError> {

@@ -5,7 +5,7 @@
 //!
 //! - **Detection rate**: k ~ Binomial(G², p), valid' = (k ≥ 1): ρ' = 1 − (1 − p)^{G²}.
 //! - **Jitter**: given k, the mean of k codes has the jitter variance σ²/k, so
-//!   E[σ_eff²] = σ²·E[1/k | k ≥ 1] = σ²·Σ_{k≥1} P(k)/k / ρ' — not σ²/G² unless p = 1
+//!   E\[σ_eff²\] = σ²·E\[1/k | k ≥ 1\] = σ²·Σ_{k≥1} P(k)/k / ρ' — not σ²/G² unless p = 1
 //!   (the missing SPADs do not average).
 //! - **Quantisation**: each code adds its own ±½ LSB uniform error (1/12 LSB² — Sheppard's
 //!   correction, exact to e^{−2π²σ²} for σ ≳ 1 LSB), which averages like the jitter:
@@ -16,7 +16,7 @@
 //!
 //! So the mean square error of the pixel's code about t − ½ (the floor's own offset), given
 //! a detection, is
-//! E[ε²] = Σ_{k≥1} P(k | k ≥ 1)·((σ² + 1/12)/k + E[r² | k]) ([`SuperpixelNoise::mse_lsb2`]).
+//! E\[ε²\] = Σ_{k≥1} P(k | k ≥ 1)·((σ² + 1/12)/k + E\[r² | k\]) ([`SuperpixelNoise::mse_lsb2`]).
 //! G = 1 gives σ² + 1/12, the single pixel's σ_s² (`closed_form::sigma_total_mm`).
 
 use crate::error::DspError;
@@ -30,12 +30,12 @@ pub struct SuperpixelNoise {
     pub mean_inverse_count: f64,
     /// σ²·E[1/k | k ≥ 1]: the jitter part of the average (LSB²).
     pub jitter_lsb2: f64,
-    /// E[ε²] about t − ½: jitter, the codes' quantisation and the mean's rounding (LSB²).
+    /// E\[ε²\] about t − ½: jitter, the codes' quantisation and the mean's rounding (LSB²).
     pub mse_lsb2: f64,
 }
 
 impl SuperpixelNoise {
-    /// The effective jitter sqrt(E[ε²]) (LSB).
+    /// The effective jitter sqrt(E\[ε²\]) (LSB).
     pub fn sigma_eff_lsb(&self) -> f64 {
         self.mse_lsb2.sqrt()
     }

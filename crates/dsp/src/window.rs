@@ -18,7 +18,7 @@ pub enum Window {
 }
 
 impl Window {
-    /// w[n] for a window of `len` points (periodic definition: w[n] = f(2πn/len)).
+    /// w\[n\] for a window of `len` points (periodic definition: w\[n\] = f(2πn/len)).
     #[inline]
     pub fn value(self, n: usize, len: usize) -> f64 {
         let ph = 2.0 * PI * n as f64 / len as f64;
@@ -29,7 +29,7 @@ impl Window {
         }
     }
 
-    /// w[n] of the symmetric `len`-point window (f(2πn/(len − 1)), w[0] = w[len − 1]), as
+    /// w\[n\] of the symmetric `len`-point window (f(2πn/(len − 1)), w\[0\] = w\[len − 1\]), as
     /// numpy's `np.blackman` / `np.hanning` evaluate it: with m = 2n + 1 − len,
     /// 0.42 + 0.5·cos(π·m/(len − 1)) + 0.08·cos(2π·m/(len − 1)), left to right (the
     /// toolbox's convention, [`crate::sd::config::ProbeConvention::Toolbox`]).

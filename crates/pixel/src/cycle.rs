@@ -247,7 +247,7 @@ impl CycleModel {
     ///
     /// A pixel without a fault runs a copy of the edge compiled without the fault hooks
     /// (`FAULTY = false`), so they cost nothing when off.
-    /// Most edges of a frame are quiet ([`CycleModel::quiet_edge`]: no reset, pulse or
+    /// Most edges of a frame are quiet (`CycleModel::quiet_edge`: no reset, pulse or
     /// readout strobe, no readout running), and take a shorter copy of the edge.
     #[inline]
     pub fn step(&mut self, pins: &PinsIn) -> PinsOut {

@@ -224,7 +224,7 @@ impl Program {
 
 /// The contract's directed schedule for `p` (docs/pixel-contract.md, "The directed
 /// sequencer"). First half a frame and a reset while its last pulse is in flight (the
-/// frame restarts: [`mid_frame_reset`]), then three frames per loop:
+/// frame restarts: `mid_frame_reset`), then three frames per loop:
 ///
 /// 0. N pulses one every C cycles; a readout with a pulse in the same cycle (readout taken,
 ///    pulse refused); pulses at every cycle of the readout (refused, the one at the status

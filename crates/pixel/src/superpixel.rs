@@ -12,8 +12,8 @@
 //! - code' = ⌊(s + ⌊n/2⌋) / n⌋, the mean rounded half up (for odd n no tie exists), so
 //!   |code' − s/n| ≤ ½ LSB, and code' < 2^T;
 //! - the division is a multiply and a shift by a reciprocal table, no divider:
-//!   code' = ((s + ⌊n/2⌋) · M[n]) >> k with M[n] = ⌈2^k / n⌉ for n = 1 ..= G² and
-//!   k = T + 2·⌈log2 G²⌉. With x = s + ⌊n/2⌋ < n·2^T, M[n]·n − 2^k = e ∈ [0, n − 1], so
+//!   code' = ((s + ⌊n/2⌋) · M\[n\]) >> k with M\[n\] = ⌈2^k / n⌉ for n = 1 ..= G² and
+//!   k = T + 2·⌈log2 G²⌉. With x = s + ⌊n/2⌋ < n·2^T, M\[n\]·n − 2^k = e ∈ \[0, n − 1\], so
 //!   x·M/2^k = x/n + x·e/(n·2^k) and x·e < n²·2^T ≤ 2^k: the product never reaches the
 //!   next multiple of 1/n and the floor is exact (crates/pixel/tests/it/superpixel.rs checks
 //!   every (s, n) for G ≤ 4 against the exact quotient and the float mean).
@@ -96,7 +96,7 @@ impl Superpixel {
         &self.table
     }
 
-    /// Bits of one table word (the largest, M[1] = 2^k, needs k + 1).
+    /// Bits of one table word (the largest, M\[1\] = 2^k, needs k + 1).
     pub fn table_bits(&self) -> u32 {
         self.shift + 1
     }

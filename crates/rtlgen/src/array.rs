@@ -144,7 +144,7 @@ pub fn array_module_name(prefix: &str) -> String {
     format!("{prefix}_array")
 }
 
-/// Renders the array's files: the pixel and the probe ROM (as [`render`] writes them, so
+/// Renders the array's files: the pixel and the probe ROM (as [`crate::render()`] writes them, so
 /// the pixel stays one module from one template) and `<prefix>_array.v`. The pixel's own
 /// top (`<prefix>_top.v`) is not part of the array's set.
 pub fn render_array(

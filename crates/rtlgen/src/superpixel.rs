@@ -32,7 +32,7 @@ struct SuperpixelT {
     mw: u32,
     sum_expr: String,
     count_expr: String,
-    /// (n, M[n]).
+    /// (n, M\[n\]).
     table: Vec<(usize, u64)>,
     /// Per SPAD i, (i, the SPAD whose code it sums: itself but for the `spad_swap` mutant).
     codes: Vec<(u32, u32)>,

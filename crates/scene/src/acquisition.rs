@@ -35,7 +35,7 @@ impl AcquisitionConfig {
     }
 
     /// Checks that exactly one of `pulses` / `duration_s` is given and that N is in
-    /// 1..=[`MAX_PULSES`].
+    /// 1..=`MAX_PULSES`.
     pub fn validate(&self, laser_rate_hz: f64) -> Result<(), SceneError> {
         let n = match (self.pulses, self.duration_s) {
             (Some(_), Some(_)) => {

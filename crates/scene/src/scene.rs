@@ -128,7 +128,7 @@ impl Scene {
 
     /// The scene's tones as (frequency Hz, amplitude mm), for choosing DFT bins: sines
     /// exactly; square waves and disks as their Fourier-series harmonics up to
-    /// [`MAX_HARMONIC`] (those with a non-negligible amplitude). Steps, ramps and impulses
+    /// `MAX_HARMONIC` (those with a non-negligible amplitude). Steps, ramps and impulses
     /// are not periodic and have no tones. Tones at the same frequency are not merged.
     pub fn tones(&self) -> Vec<(f64, f64)> {
         let mut tones = Vec::new();

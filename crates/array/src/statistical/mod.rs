@@ -393,7 +393,7 @@ fn gaussians(rng: &mut SplitMix64, out: &mut [f64]) {
 /// every tile of a run (a run of T tiles — shards, Dask tasks, `tradeoff`'s runs — pays
 /// for the ROM and the twin's runs once, not T times). Keyed by what the model reads
 /// (the pixel, sensor, scene, bins and probe design; the level); the last
-/// [`SHARED_MODELS`] are kept. Built outside the cache's lock, so a tile that waits on a
+/// `SHARED_MODELS` are kept. Built outside the cache's lock, so a tile that waits on a
 /// rayon pool never blocks another's build.
 pub fn shared_model(
     design: &ResolvedDesign,

@@ -36,11 +36,11 @@ pub struct PixelScene {
 pub struct CodeStats {
     /// ρ_v: a pulse's probability of a detection (the hold's rate).
     pub valid_rate: f64,
-    /// E[code] of a detection.
+    /// E\[code\] of a detection.
     pub mean_code: f64,
-    /// Var[code] of a detection (codes², the TDC's 1/12 included).
+    /// Var\[code\] of a detection (codes², the TDC's 1/12 included).
     pub variance: f64,
-    /// ∂E[depth]/∂t_s: the part of a small motion the mean follows (1 without background).
+    /// ∂E\[depth\]/∂t_s: the part of a small motion the mean follows (1 without background).
     pub gain: f64,
 }
 

@@ -1,14 +1,14 @@
 //! The probe's register sequences as power in frequency bands, so a pixel's register
-//! covariance is a weighted sum over bands. Register a accumulates s_a[n]·x[n] (s_a the
-//! ROM's ±1 bit, periodic in L, x the prefiltered held code). With c_a[k] the L-point DFT
+//! covariance is a weighted sum over bands. Register a accumulates s_a\[n\]·x\[n\] (s_a the
+//! ROM's ±1 bit, periodic in L, x the prefiltered held code). With c_a\[k\] the L-point DFT
 //! of s_a over L, the covariance of registers a and b over N pulses of a stationary x of
-//! power spectrum S(ω) is N·Σ_k Re(c_a[k]·c̄_b[k])·S(2πk/L) (each tone of the probe
+//! power spectrum S(ω) is N·Σ_k Re(c_a\[k\]·c̄_b\[k\])·S(2πk/L) (each tone of the probe
 //! picks S at its frequency; distinct tones are uncorrelated when N ≫ x's correlation
 //! length; white x gives N·σ² by Parseval). The probe part is computed once per design
 //! here; the pixel's S comes from the closed forms (`super::pixel`).
 //!
-//! Bands: every DFT index below [`EXACT`] is its own band (the hold's and the prefilter's
-//! responses vary fastest there), beyond it bands of a constant ratio [`RATIO`] (0.5 %:
+//! Bands: every DFT index below `EXACT` is its own band (the hold's and the prefilter's
+//! responses vary fastest there), beyond it bands of a constant ratio `RATIO` (0.5 %:
 //! S varies by at most ≈ 1 % across one, and is evaluated at the band's mean index, so
 //! the error is of second order).
 

@@ -253,7 +253,7 @@ pub(crate) fn unknown_of<D: DeserializeOwned>(
 }
 
 /// The first section or key of `doc` the document does not have, named by its dotted path
-/// with the keys that are there ("`pixel.binz` is not a key of [pixel]: expected one of
+/// with the keys that are there ("`pixel.binz` is not a key of \[pixel\]: expected one of
 /// `bins`, …"): a document built from values (a dict, overrides) has no line to cite, so
 /// the path is the whole address. `None` when every name is known.
 pub fn unknown_key(doc: &Table) -> Option<String> {

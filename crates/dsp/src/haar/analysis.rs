@@ -2,8 +2,8 @@
 //! codes) as normalised coefficients w_{u,v} in mm with their time supports — the
 //! scalogram's data, serialisable as JSON.
 //!
-//! Register r = 2^u − 1 + v holds Y = Σ_{+ half} h[n] − Σ_{− half} h[n] over the held codes
-//! h[n] = code − Z (docs/pixel-contract.md, Haar mode: no prefilter, F = 0). A held code is
+//! Register r = 2^u − 1 + v holds Y = Σ_{+ half} h\[n\] − Σ_{− half} h\[n\] over the held codes
+//! h\[n\] = code − Z (docs/pixel-contract.md, Haar mode: no prefilter, F = 0). A held code is
 //! the depth (h + Z + ½)·a + window start in mm (a = tdc_lsb_ps × 0.15 mm/ps, the bin
 //! centre), so
 //!

@@ -20,8 +20,8 @@
 //! the coefficients that stand out of the noise into events (one per transition, grouped
 //! across scales), [`profile`] measures an event's height, duration and mean rate from the
 //! inverse transform (the paper's ramp-rate estimate beside them), [`checks`] validates Haar frames and notes transients outside them, [`montecarlo`]
-//! checks the noise model by simulation, and [`paper`] computes the paper's Fig. 3 and
-//! Fig. 12 results.
+//! checks the noise model by simulation; the paper's Fig. 3 and Fig. 12 results are
+//! computed from these in `tofprobe-experiments` (`paper::haar_figures`).
 
 pub mod analysis;
 pub mod checks;
@@ -147,7 +147,7 @@ pub fn haar_sums(x: &[i64], u_max: u32) -> Result<Vec<i64>, DspError> {
 }
 
 /// Un-normalised sums by prefix sums, O(N + 2^U) instead of O(N·U): each coefficient is
-/// 2·P[mid] − P[start] − P[end] over the running sum P. The fast path of the simulations;
+/// 2·P\[mid\] − P\[start\] − P\[end\] over the running sum P. The fast path of the simulations;
 /// [`haar_sums`] (the streaming form, sample by sample) is its reference.
 pub fn haar_sums_prefix(x: &[i64], u_max: u32) -> Result<Vec<i64>, DspError> {
     check_scales(x.len(), u_max)?;

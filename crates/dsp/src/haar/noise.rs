@@ -8,7 +8,7 @@
 //! with probability ρ (the valid rate ρ_v; ρ_s·P(in window) without background). The 1NN
 //! hold repeats the last detection, so two held samples k pulses apart are the same draw
 //! with probability q^|k| (q = 1 − ρ: the pulses in between all missed) and independent
-//! otherwise: Cov(h[i], h[j]) = σ²·q^|i−j| (stationary, i.e. primed well before the frame).
+//! otherwise: Cov(h\[i\], h\[j\]) = σ²·q^|i−j| (stationary, i.e. primed well before the frame).
 //!
 //! # A mean over M held samples
 //! G(M) = Σ_{i,j<M} q^|i−j| = M(1+q)/(1−q) − 2q(1 − q^M)/(1−q)², so

@@ -11,10 +11,10 @@
 //! # Fixed gains K = [α, β] under detections of probability ρ per pulse
 //! Predicted state x̂ (before pulse n's update), output y = d̂ + δ_n·α·(z − d̂), δ_n
 //! Bernoulli(ρ), independent of the past. Because δ_n is independent of x̂_n the mean obeys
-//! the linear filter with gains ρK: m[n+1] = A m[n] + ρFK s[n], A = F(I − ρKH), output
+//! the linear filter with gains ρK: m\[n+1\] = A m\[n\] + ρFK s\[n\], A = F(I − ρKH), output
 //! (1 − ρα)Hm + ρα s, so H_mean(z) = (1 − ρα)·ρ[(z − 1)(α + β) + β]/det + ρα,
 //! det = (z − a)(z − 1) + ρβ, a = 1 − ρα − ρβ ([`mean_response`]). The noise x̃ = x̂ − m
-//! obeys x̃[n+1] = A x̃ + FK·η[n], η = δw − (δ − ρ)Hx̃ (+ (δ − ρ)(s − Hm), the signal's
+//! obeys x̃\[n+1\] = A x̃ + FK·η\[n\], η = δw − (δ − ρ)Hx̃ (+ (δ − ρ)(s − Hm), the signal's
 //! own tracking error, neglected: 10^−4 of σ² for Table 2's 0.1 mm tone), a white sequence
 //! (each term's multiplier is independent of everything before it and has zero mean) of
 //! variance ρσ² + ρ(1 − ρ)·Var(Hx̃). With c = H P₁ Hᵀ, P₁ = A P₁ Aᵀ + FK(FK)ᵀ, Var η =

@@ -27,7 +27,7 @@ impl RomMode {
     }
 }
 
-/// How the probe waveform A·w[n]·cos/sin(2πkn/L) is written down (docs/probe.md). The
+/// How the probe waveform A·w\[n\]·cos/sin(2πkn/L) is written down (docs/probe.md). The
 /// modulator is the same under both; only the input samples differ, by rounding and by
 /// the window's symmetry.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
@@ -71,7 +71,7 @@ impl ProbeConvention {
         }
     }
 
-    /// w[n] of an L-point window under this convention: periodic (tofprobe) or symmetric
+    /// w\[n\] of an L-point window under this convention: periodic (tofprobe) or symmetric
     /// as numpy evaluates it (toolbox).
     pub fn window_value(self, window: Window, n: usize, len: usize) -> f64 {
         match self {

@@ -1,6 +1,6 @@
 //! ΣΔ probing of every bin of a band in one streaming pass: the windowed-frame probe of
-//! each bin k (A·w[n]·cos/sin(2πkn/N), modulated to ±1) is generated and accumulated
-//! against the depth record x[n] in the same loop ([`super::simd::pairs`]), Y_k = Σ x[n]·b_k[n],
+//! each bin k (A·w\[n\]·cos/sin(2πkn/N), modulated to ±1) is generated and accumulated
+//! against the depth record x\[n\] in the same loop ([`super::simd::pairs`]), Y_k = Σ x\[n\]·b_k\[n\],
 //! so 2·K bitstreams of N samples are never stored. Memory is the groups' states plus one
 //! block of x: records stream in any chunking, and the sums do not depend on it (the
 //! rotators re-anchor at absolute sample positions) nor on the thread count (groups are

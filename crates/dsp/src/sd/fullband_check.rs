@@ -1,5 +1,5 @@
 //! The naive reference that judges the full-band fast path: each stream's probe input run
-//! through the scalar [`Modulator::run`] one stream at a time, and Σ x[n]·v[n] accumulated
+//! through the scalar [`Modulator::run`] one stream at a time, and Σ x\[n\]·v\[n\] accumulated
 //! sample by sample. The f64 fast path must equal it exactly (same bits, same sums); a
 //! difference is reported with the first bin, stream and sample where the bits part.
 //!
@@ -52,7 +52,7 @@ impl std::fmt::Display for Mismatch {
     }
 }
 
-/// A·w[n] for the first `len` samples of the frame.
+/// A·w\[n\] for the first `len` samples of the frame.
 fn amplitude_window(design: &ProbeDesign, frame: u64, len: usize) -> Vec<f64> {
     let (amp, window, c) = (
         design.config.amplitude,

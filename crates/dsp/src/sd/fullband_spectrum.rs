@@ -7,7 +7,7 @@
 //! - [`windowed_band`]: windowed frame of N pulses, bins k·f_s/N (1 Hz at N = 10^7, f_s =
 //!   10 MHz), each probe generated and accumulated on the fly ([`FullBandProber`]);
 //! - [`periodic_band`]: the chip's periodic ROM (depth L, rectangular, bins k·f_s/L), every
-//!   in-band bin. A periodic stream repeats every L pulses, so Σ_n x[n]·s(n mod L) =
+//!   in-band bin. A periodic stream repeats every L pulses, so Σ_n x\[n\]·s(n mod L) =
 //!   Σ_a s(a)·X_a with X_a = Σ_m x[a + mL]: the record is folded once and each register
 //!   correlates L values; the DFT of the folded record is the record's DFT at those bins.
 

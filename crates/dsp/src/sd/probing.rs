@@ -1,6 +1,6 @@
 //! Float ΣΔ probing: what the pixel computes, in f64. Each depth sample passes the
-//! prefilter x[n] = (1 − α)·x[n−1] + α·δ[n−1] (H_pre(z) = α z^−1 / (1 − (1−α) z^−1)), and
-//! x[n] is added to or subtracted from every I/Q accumulator by the ROM bit at n mod L.
+//! prefilter x\[n\] = (1 − α)·x\[n−1\] + α·δ\[n−1\] (H_pre(z) = α z^−1 / (1 − (1−α) z^−1)), and
+//! x\[n\] is added to or subtracted from every I/Q accumulator by the ROM bit at n mod L.
 //!
 //! After N samples, Y_k = (I_k − j·Q_k) · 2/N / (G · A_p · H_pre(e^{jω_k})) estimates the
 //! windowed DFT of δ at bin k: a tone A·cos(ω_k n + φ) reads A·e^{jφ}. The prefilter is
@@ -29,7 +29,7 @@ pub struct ProbeAccumulator<'a> {
     front: FrontEnd,
     /// Pulses consumed.
     n: u64,
-    /// acc[r]: register r (2k = I, 2k+1 = Q).
+    /// `acc[r]`: register r (2k = I, 2k+1 = Q).
     acc: Vec<f64>,
 }
 

@@ -115,8 +115,8 @@ fn least_squares(mut m: Vec<Vec<f64>>, mut y: Vec<f64>) -> Vec<f64> {
     x
 }
 
-/// State-space form x[n+1] = A x[n] + B1 u[n] + B2 v[n], y[n] = C x[n] + D1 u[n], with the
-/// quantiser v[n] = sign(y[n]) (+1 at y = 0, as the toolbox's `ds_quantize`).
+/// State-space form x\[n+1\] = A x\[n\] + B1 u\[n\] + B2 v\[n\], y\[n\] = C x\[n\] + D1 u\[n\], with the
+/// quantiser v\[n\] = sign(y\[n\]) (+1 at y = 0, as the toolbox's `ds_quantize`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StateSpace {
     pub order: usize,

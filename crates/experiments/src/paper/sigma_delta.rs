@@ -13,7 +13,7 @@
 //! ΣΔ error (probe quantisation noise mixed with the prefiltered depth).
 //!
 //! Readouts are phasors in mm, normalised by 2/N, the window gain, A_p and H_pre(f_k)
-//! (`tofprobe_dsp::sd::normalise`), i.e. directly comparable with 2/(N·G)·X[k].
+//! (`tofprobe_dsp::sd::normalise`), i.e. directly comparable with 2/(N·G)·X\[k\].
 
 use tofprobe_dsp::sd::{ProbeConfig, ProbeDesign, ProbeRom, normalise};
 use tofprobe_pixel::sizing::{

@@ -1,6 +1,6 @@
 //! Layout checks of a rendered figure, read back from its SVG text (what a reader's viewer
 //! gets, not what the chart description meant): every text at least
-//! [`MIN_TEXT_PX`](super::chart::MIN_TEXT_PX) pixels high at the size the file opens
+//! [`MIN_TEXT_PX`] pixels high at the size the file opens
 //! (font size × width / viewBox width), and no legend box over a data marker (a filled
 //! circle or a cross of the chart's 2 px marker strokes drawn before the legend).
 //!

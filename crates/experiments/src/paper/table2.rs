@@ -167,7 +167,7 @@ pub fn held_record(rec: &RowRecord<'_>) -> Result<Vec<f64>, ExperimentError> {
 }
 
 /// The full-FFT column: noise floor over the band, "A meas." by quadratic interpolation,
-/// and the normalised complex bins 2/(N·G)·X[k] at the probe bins.
+/// and the normalised complex bins 2/(N·G)·X\[k\] at the probe bins.
 pub fn dft_column(rec: &RowRecord<'_>) -> Result<Option<Measurement>, ExperimentError> {
     let held = held_record(rec)?;
     let n = held.len();

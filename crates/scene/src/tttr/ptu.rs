@@ -1,5 +1,5 @@
 //! The PicoQuant PTU header: the `PQTTTR` magic, a version, then tagged values
-//! (ident[32], index i32, type u32, value 8 bytes; strings, arrays and blobs carry their
+//! (a 32-byte ident, index i32, type u32, value 8 bytes; strings, arrays and blobs carry their
 //! byte length in the value and follow it), ending at `Header_End`.
 
 use std::io::Read;

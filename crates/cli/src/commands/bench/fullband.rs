@@ -38,7 +38,7 @@ pub struct FullBandArgs {
     /// same sums, bit for bit.
     #[arg(long, default_value = "auto", value_parser = ["auto", "scalar", "avx2", "avx512"])]
     path: String,
-    /// Also read every in-band bin of the periodic ROM (L from [probe]).
+    /// Also read every in-band bin of the periodic ROM (L from `[probe]`).
     #[arg(long)]
     periodic: bool,
     /// Frame length override (default: the configuration's pulses).

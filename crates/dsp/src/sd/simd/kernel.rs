@@ -1,4 +1,4 @@
-//! The inner loop of the full-band probe kernel ([`super::simd::pairs`]): one anchor span of a
+//! The inner loop of the full-band probe kernel ([`super::pairs`]): one anchor span of a
 //! group of `L` lanes, in three copies of one body chosen at run time ([`super::Isa`]):
 //! the x86-64 baseline (SSE2, [`Isa::Scalar`]), AVX2, and AVX-512 (with FMA; f64 lanes only: f32 lanes on
 //! the AVX-512 path run the AVX2 copy, faster for them, see `LANES_F32_AVX512`).

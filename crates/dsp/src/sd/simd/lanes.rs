@@ -2,7 +2,7 @@
 //! loop ([`LANES`] lanes, one probe stream each) that the compiler vectorises, fed by phase
 //! rotation recurrences instead of per-sample sin/cos.
 //!
-//! Each lane's input is u[n] = A · w[n mod L] · cos(2π k (n mod L)/L + φ), with φ = 0 for
+//! Each lane's input is u\[n\] = A · w\[n mod L\] · cos(2π k (n mod L)/L + φ), with φ = 0 for
 //! I and −π/2 for Q (cos(θ − π/2) = sin θ). The rotators are re-anchored from exact
 //! integer phases (k·n mod L) every [`ANCHOR`] samples, so rounding never accumulates
 //! beyond ≈ ANCHOR·1e-16 and the input is an exact function of n mod L: every period of a
@@ -10,7 +10,7 @@
 //!
 //! That is the default [`ProbeConvention::Tofprobe`]. Under
 //! [`ProbeConvention::Toolbox`] every sample is evaluated directly, as a toolbox script
-//! writes it: u[n] = (A · w_sym[m]) · trig(θ) with m = n mod L, θ = (2π·(k·m mod L))/L,
+//! writes it: u\[n\] = (A · w_sym\[m\]) · trig(θ) with m = n mod L, θ = (2π·(k·m mod L))/L,
 //! trig = cos for I and sin for Q (exactly 0 at θ = 0), w_sym numpy's symmetric window
 //! ([`Window::symmetric_value`]); still an exact function of n mod L, at the cost of a
 //! sin or cos per sample and lane (≈ 20 ns: seconds for a windowed ROM of 10^7 pulses).
@@ -44,7 +44,7 @@ pub struct LaneGroup {
     period: u64,
     window: Window,
     convention: ProbeConvention,
-    /// states[i][lane]
+    /// `states[i][lane]`
     pub states: Vec<[f64; LANES]>,
 }
 

@@ -1,6 +1,6 @@
 //! The ΣΔ SIMD engine: the bitstream generator's interleaved modulators ([`lanes`]) and the
 //! full-band probe kernel ([`pairs`], its inner loop in `kernel`), with what they share
-//! here: the lanes' arithmetic ([`LanePrecision`] and the [`Lane`] float) and how many make
+//! here: the lanes' arithmetic ([`LanePrecision`] and the `Lane` float) and how many make
 //! a group on each instruction path. The path is the workspace's one ISA selection,
 //! [`Isa`] (`tofprobe_io::isa`: detected, `TOFPROBE_ISA`, or a benchmark's `--isa`): the
 //! build targets the x86-64 baseline (SSE2), the kernel is compiled again for AVX2 (twice
@@ -41,7 +41,7 @@ use std::ops::{Add, BitAnd, BitXor, Mul};
 pub const LANES_F64: usize = 4;
 /// Lanes per f32 group: four SSE2 registers (8 lanes 1.1·10⁹, 16 lanes 1.3·10⁹, 32 spill).
 pub const LANES_F32: usize = 16;
-/// Lanes per f64 group on the AVX2 path ([`Isa::Avx2`](Isa::Avx2)): two 256-bit registers,
+/// Lanes per f64 group on the AVX2 path ([`Isa::Avx2`]): two 256-bit registers,
 /// the register footprint of the baseline's four lanes (measured in one session, 401 bins
 /// of N = 2·10⁶: 8 lanes 1.0–1.09·10⁹ steps per CPU-second, 12 lanes 0.93–1.0·10⁹, the
 /// baseline's 4 lanes 0.59–0.65·10⁹).
@@ -77,7 +77,7 @@ impl LanePrecision {
         }
     }
 
-    /// Lanes per interleaved group on the baseline path ([`Isa::lanes`] for any).
+    /// Lanes per interleaved group on the baseline path ([`Self::lanes_on`] for any).
     pub fn lanes(self) -> usize {
         match self {
             LanePrecision::F64 => LANES_F64,

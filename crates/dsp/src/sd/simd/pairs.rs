@@ -2,12 +2,12 @@
 //! structure-of-arrays loop the compiler vectorises (SSE2 on the x86-64 baseline; copies for
 //! AVX2 with twice the lanes and for AVX-512 with four times, chosen at run time,
 //! [`super::Isa`]; the loop itself is `super::kernel`), each lane's ±1 output
-//! accumulated against the shared depth record x[n] in the same pass, so no bitstream is
+//! accumulated against the shared depth record x\[n\] in the same pass, so no bitstream is
 //! ever stored. The lane count only groups independent lanes: a lane's arithmetic, hence
 //! its bits and sums, is the same at every width.
 //!
 //! Of a group's L lanes, lane p < L/2 is the I stream of its bin p and lane p + L/2 the Q
-//! stream: their inputs are A·w[n]·cos θ and A·w[n]·sin θ with θ = 2πkn/N, so one complex
+//! stream: their inputs are A·w\[n\]·cos θ and A·w\[n\]·sin θ with θ = 2πkn/N, so one complex
 //! rotation per pair and step ((c, s) ← (c·cos d − s·sin d, s·cos d + c·sin d), two vector
 //! products of one half of the lanes by the other) feeds both lanes. The rotators are re-anchored from the exact integer phase (k·n mod N) at every
 //! multiple of [`ANCHOR`] samples, so rounding never accumulates beyond one anchor span and
@@ -175,7 +175,7 @@ impl<T: Lane, const L: usize> PairGroup<T, L> {
         p + if quadrature { L / 2 } else { 0 }
     }
 
-    /// The inputs u[t][lane] the kernel computes for samples n0 .. n0 + aw.len() of a run
+    /// The inputs `u[t][lane]` the kernel computes for samples n0 .. n0 + aw.len() of a run
     /// starting at n0 (the rotator as `run` leaves it at n0 when n0 is on an anchor):
     /// the same operations as the kernel's, for the reference check and the tests.
     pub fn inputs(&self, n0: u64, aw: &[T]) -> Vec<[T; L]> {

@@ -81,7 +81,7 @@ pub fn closed_form_noise_on_bins_for(
 /// amplitude `a_eff` in a floor `floor` (µm), N̂ a mean over `floor_rel_sd` relative sd:
 /// the delta method's second-order terms. With Â = m + e_A (var (2/π)·floor², the noise's
 /// projection on the tone) and N̂ = floor·(1 + e_N), E[ln Â] ≈ ln m − var_A/(2m²) and
-/// E[ln N̂] ≈ ln floor − rel²/2, so E[SNR] ≈ 20·log10(m/floor) + (10/ln 10)·(rel² −
+/// E\[ln N̂\] ≈ ln floor − rel²/2, so E\[SNR\] ≈ 20·log10(m/floor) + (10/ln 10)·(rel² −
 /// var_A/m²): −0.31 dB at A/floor = 3, −0.0002 dB at 130.
 pub fn snr_closed_db(a_eff: f64, floor: f64, floor_rel_sd: f64) -> f64 {
     let m = super::super::stats::rician_mean(a_eff, floor);
@@ -130,7 +130,7 @@ pub fn peak_band_bins(n: usize) -> usize {
 
 /// Mean and sd of the largest of `m` independent Rayleigh magnitudes whose mean (the
 /// noise floor) is `floor`: with s² = (2/π)·floor² per component, P(max ≤ x) =
-/// (1 − e^(−x²/2s²))^m, so E[max] = ∫₀^∞ (1 − F^m) dx and E[max²] = ∫₀^∞ 2x(1 − F^m) dx
+/// (1 − e^(−x²/2s²))^m, so E\[max\] = ∫₀^∞ (1 − F^m) dx and E\[max²\] = ∫₀^∞ 2x(1 − F^m) dx
 /// (Simpson, 4000 steps to 12 s beyond the mode). The Blackman window correlates
 /// neighbouring bins, but over a finite range: the maximum of such a stationary sequence
 /// behaves as that of m independent values (Berman's condition), and the reproduction's

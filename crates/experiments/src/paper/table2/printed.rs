@@ -50,7 +50,7 @@ const COLUMNS: [&str; 11] = [
     "snr_sd_db",
 ];
 
-/// The rows of `text` (the file's format: `#` comments, a header naming [`COLUMNS`], one
+/// The rows of `text` (the file's format: `#` comments, a header naming `COLUMNS`, one
 /// row per configuration, `-` for a value the paper does not print). A row with a tone
 /// (f0 given) must be at [`super::F0_HZ`] with A > 0 and carry both SNRs; a row without
 /// one has A = 0 and no SNR.
