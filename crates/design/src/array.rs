@@ -198,6 +198,28 @@ fn is_one(v: &u32) -> bool {
 }
 
 impl ArrayConfig {
+    /// The section with only its required keys and `mm_per_pixel` written, every other key
+    /// at its default (what a program building a configuration starts from, so a new
+    /// optional key does not have to be spelled out there).
+    pub fn new(rows: u32, cols: u32, pitch_um: f64, mm_per_pixel: f64) -> ArrayConfig {
+        ArrayConfig {
+            rows,
+            cols,
+            pitch_um,
+            mm_per_pixel: Some(mm_per_pixel),
+            field_of_view_deg: None,
+            distance_mm: None,
+            signal_map: None,
+            background_map: None,
+            readout_bits: None,
+            readout_bits_per_s: None,
+            frame_rate_hz: None,
+            double_buffer: false,
+            superpixel: 1,
+            level: ArrayLevel::default(),
+        }
+    }
+
     /// The readout keys of the section.
     pub fn readout_keys(&self) -> crate::readout::ReadoutKeys {
         crate::readout::ReadoutKeys {
