@@ -18,6 +18,7 @@
 use std::ops::Range;
 
 use rayon::prelude::*;
+use tofprobe_design::array::AUTO_THRESHOLD;
 use tofprobe_design::{ArrayLevel, ResolvedDesign};
 use tofprobe_dsp::rom::RomImage;
 use tofprobe_io::watch::Watch;
@@ -26,7 +27,6 @@ use tofprobe_scene::PhotonSource;
 
 use crate::error::ArrayError;
 pub use crate::frame::{ArrayFrame, Tile};
-use crate::statistical::auto::AUTO_THRESHOLD;
 use crate::statistical::shared_model;
 
 /// Pulses per streamed chunk of one pixel (64 k pulses: 256 kB of codes per thread).
@@ -251,7 +251,11 @@ pub fn run_tile_watched(
         // Auto: the moving pixels bit-true, the others drawn (statistical::auto's rule).
         ArrayLevel::Auto => {
             let model = shared_model(design, ArrayLevel::Statistical)?;
-            let moving = model.auto_levels(design, rows.clone(), cols.clone(), AUTO_THRESHOLD)?;
+            let k = design
+                .array
+                .as_ref()
+                .map_or(AUTO_THRESHOLD, |a| a.auto_threshold);
+            let moving = model.auto_levels(design, rows.clone(), cols.clone(), k)?;
             let mut tile = model.run_tile_except(design, rows, cols, &moving, watch)?;
             let which: Vec<usize> = (0..count).filter(|&i| moving[i]).collect();
             let pixels: Vec<_> = which.iter().map(|&i| at(i)).collect();

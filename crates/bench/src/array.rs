@@ -90,22 +90,9 @@ fn array_design(
     doc.acquisition.pulses = Some(pulses);
     doc.acquisition.duration_s = None;
     doc.pixel.frame_pulses = None;
-    let a = doc.array.get_or_insert(ArrayConfig {
-        rows,
-        cols,
-        pitch_um: 30.0,
-        mm_per_pixel: Some(1.0),
-        field_of_view_deg: None,
-        distance_mm: None,
-        signal_map: None,
-        background_map: None,
-        readout_bits: None,
-        readout_bits_per_s: None,
-        frame_rate_hz: None,
-        double_buffer: false,
-        superpixel: 1,
-        level: Default::default(),
-    });
+    let a = doc
+        .array
+        .get_or_insert(ArrayConfig::new(rows, cols, 30.0, 1.0));
     (a.rows, a.cols) = (rows, cols);
     // The timed runs are bit-true; the other levels are set by `array_levels`.
     a.level = tofprobe_design::ArrayLevel::BitTrue;

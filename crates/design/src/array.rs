@@ -86,7 +86,22 @@ pub struct ArrayConfig {
     /// The fidelity level every pixel runs at (docs/tradeoff.md "Array levels").
     #[serde(default, skip_serializing_if = "ArrayLevel::is_bit_true")]
     pub level: ArrayLevel,
+    /// K of `level = "auto"`: a pixel runs bit-true where its motion moves a register by
+    /// more than K × that register's noise sd (default [`AUTO_THRESHOLD`]; only with
+    /// `level = "auto"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub auto_threshold: Option<f64>,
 }
+
+/// K of `[array] level = "auto"` when `auto_threshold` is not written: 0.5, so a pixel left
+/// at the statistical level has a spread at most √(1 + K²) = 1.12 × the bit-true one
+/// (crates/array/src/statistical/auto.rs says why).
+pub const AUTO_THRESHOLD: f64 = 0.5;
+
+/// Largest `auto_threshold`: at K = 10 a motion ten noise sds strong still runs
+/// statistical, past any use of the auto level (the statistical level alone is the
+/// choice then).
+pub const MAX_AUTO_THRESHOLD: f64 = 10.0;
 
 /// How faithfully the array's pixels are computed (`[array] level`); every level writes
 /// the same output set and maps.
@@ -198,6 +213,29 @@ fn is_one(v: &u32) -> bool {
 }
 
 impl ArrayConfig {
+    /// The section with only its required keys and `mm_per_pixel` written, every other key
+    /// at its default (what a program building a configuration starts from, so a new
+    /// optional key does not have to be spelled out there).
+    pub fn new(rows: u32, cols: u32, pitch_um: f64, mm_per_pixel: f64) -> ArrayConfig {
+        ArrayConfig {
+            rows,
+            cols,
+            pitch_um,
+            mm_per_pixel: Some(mm_per_pixel),
+            field_of_view_deg: None,
+            distance_mm: None,
+            signal_map: None,
+            background_map: None,
+            readout_bits: None,
+            readout_bits_per_s: None,
+            frame_rate_hz: None,
+            double_buffer: false,
+            superpixel: 1,
+            level: ArrayLevel::default(),
+            auto_threshold: None,
+        }
+    }
+
     /// The readout keys of the section.
     pub fn readout_keys(&self) -> crate::readout::ReadoutKeys {
         crate::readout::ReadoutKeys {
@@ -271,6 +309,48 @@ pub struct SensorArray {
     /// The fidelity level the pixels run at.
     #[serde(default)]
     pub level: ArrayLevel,
+    /// K of the auto level ([`ArrayConfig::auto_threshold`], resolved; omitted from the
+    /// serialised design at the default, so sets written before the key keep their hash).
+    #[serde(
+        default = "auto_threshold_default",
+        skip_serializing_if = "is_auto_threshold_default"
+    )]
+    pub auto_threshold: f64,
+}
+
+fn auto_threshold_default() -> f64 {
+    AUTO_THRESHOLD
+}
+
+fn is_auto_threshold_default(k: &f64) -> bool {
+    *k == AUTO_THRESHOLD
+}
+
+/// `array.auto_threshold` checked: finite, 0 ≤ K ≤ [`MAX_AUTO_THRESHOLD`], and written only
+/// with `level = "auto"` (never accepted and ignored); the default where not written.
+fn auto_threshold(a: &ArrayConfig) -> Result<f64, String> {
+    let Some(k) = a.auto_threshold else {
+        return Ok(AUTO_THRESHOLD);
+    };
+    let num = tofprobe_io::text::number;
+    if a.level != ArrayLevel::Auto {
+        return Err(format!(
+            "array.auto_threshold = {} applies only with array.level = \"auto\" (the level is \"{}\"): \
+             remove it, or set array.level = \"auto\"",
+            num(k),
+            a.level
+        ));
+    }
+    if !(k.is_finite() && (0.0..=MAX_AUTO_THRESHOLD).contains(&k)) {
+        return Err(format!(
+            "array.auto_threshold = {} is out of range: allowed 0 <= auto_threshold <= {} \
+             (default {})",
+            num(k),
+            num(MAX_AUTO_THRESHOLD),
+            num(AUTO_THRESHOLD)
+        ));
+    }
+    Ok(k)
 }
 
 impl SensorArray {
@@ -616,6 +696,7 @@ pub fn resolve_array(
     crate::readout::Readout::new(&readout, prows, pcols, pixel, sensor.laser_rate_hz)
         .map_err(err)?;
     check_level(a.level, pixel, scene, g as u32, &background_rate).map_err(err)?;
+    let auto_threshold = auto_threshold(a).map_err(err)?;
     Ok(SensorArray {
         rows: prows,
         cols: pcols,
@@ -627,6 +708,7 @@ pub fn resolve_array(
         background_rate,
         readout,
         level: a.level,
+        auto_threshold,
     })
 }
 

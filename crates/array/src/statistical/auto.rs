@@ -10,7 +10,8 @@
 //! register's closed-form noise sd (the row norm of the covariance's Cholesky factor).
 //! A pixel without sines has Δμ = 0 and never moves; nor does a pixel without detections.
 //!
-//! The threshold K = [`AUTO_THRESHOLD`] = 0.5. Where a pixel runs statistical its motion
+//! The threshold K is `[array] auto_threshold`, by default
+//! [`tofprobe_design::array::AUTO_THRESHOLD`] = 0.5. Where a pixel runs statistical its motion
 //! moves no register by more than K·σ_i: even if the statistical level got that motion
 //! entirely wrong (it models it linearly, through the hold; what it leaves out — the
 //! quantisation and the window's wrap of a moving code, the hold of a moving signal — is a
@@ -24,9 +25,6 @@ use tofprobe_design::{ArrayLevel, ResolvedDesign};
 use super::StatisticalModel;
 use super::pixel::{CodeStats, PixelScene};
 use crate::error::ArrayError;
-
-/// K: a pixel moves where its motion's response exceeds K × its register noise sd.
-pub const AUTO_THRESHOLD: f64 = 0.5;
 
 /// Whether a pixel of scene `px`, code statistics `stats` and noise Cholesky factor `chol`
 /// (R × R, lower, row-major) runs bit-true under threshold `threshold` (the rule above).
@@ -58,7 +56,7 @@ pub fn moves(
 
 /// The level each pixel of `design`'s array runs at, row-major [R, C]: `[array] level`
 /// everywhere, or under `"auto"` bit-true where the pixel moves ([`moves`] with
-/// [`AUTO_THRESHOLD`]) and statistical elsewhere. A function of the design alone, so the
+/// K = `[array] auto_threshold`) and statistical elsewhere. A function of the design alone, so the
 /// output set's level map (`level.npy`) is the same from one run, tiles or shards.
 pub fn level_map(design: &ResolvedDesign) -> Result<Vec<ArrayLevel>, ArrayError> {
     let a = design
@@ -69,7 +67,7 @@ pub fn level_map(design: &ResolvedDesign) -> Result<Vec<ArrayLevel>, ArrayError>
         return Ok(vec![a.level; a.rows * a.cols]);
     }
     let model = super::shared_model(design, ArrayLevel::Statistical)?;
-    let moving = model.auto_levels(design, 0..a.rows, 0..a.cols, AUTO_THRESHOLD)?;
+    let moving = model.auto_levels(design, 0..a.rows, 0..a.cols, a.auto_threshold)?;
     Ok(moving
         .into_iter()
         .map(|m| {

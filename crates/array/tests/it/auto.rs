@@ -6,8 +6,9 @@
 //! and tiles on pools of 1 and 2 threads merging into the whole auto frame.
 
 use tofprobe_array::model::{merge, run_array};
-use tofprobe_array::statistical::auto::{AUTO_THRESHOLD, level_map};
+use tofprobe_array::statistical::auto::level_map;
 use tofprobe_array::statistical::shared_model;
+use tofprobe_design::array::AUTO_THRESHOLD;
 use tofprobe_design::{ArrayLevel, ResolvedDesign};
 
 use crate::common::design;
@@ -93,6 +94,33 @@ fn a_motion_far_below_the_noise_floor_runs_statistical() {
             .iter()
             .all(|m| !m)
     );
+}
+
+/// `[array] auto_threshold` reaches the rule: the map at K written in the configuration is
+/// the model's map at that K (K = 0: the 32 moving pixels bit-true, also for the 10 µm
+/// plate the default runs statistical; K = 10: none of the 1 mm plate's).
+#[test]
+fn the_configured_threshold_is_the_rules() {
+    let at = |amp: &str, k: f64| {
+        let plate = half_plate(40.0, 40.0, 80.0).replace("amplitude_mm = 1", amp);
+        let cfg = format!(
+            "{}
+auto_threshold = {k}",
+            array("auto")
+        );
+        let d = design(&plate, 40_000, &cfg);
+        assert_eq!(d.array.as_ref().unwrap().auto_threshold, k);
+        let map = level_map(&d).unwrap();
+        let model = shared_model(&d, ArrayLevel::Statistical).unwrap();
+        let want = model.auto_levels(&d, 0..8, 0..8, k).unwrap();
+        for (i, (l, m)) in map.iter().zip(&want).enumerate() {
+            assert_eq!(*l == ArrayLevel::BitTrue, *m, "pixel {i} at K = {k}");
+        }
+        map.iter().filter(|l| **l == ArrayLevel::BitTrue).count()
+    };
+    assert_eq!(at("amplitude_mm = 0.01", 0.0), 32);
+    assert_eq!(at("amplitude_mm = 0.01", AUTO_THRESHOLD), 0);
+    assert_eq!(at("amplitude_mm = 1", 10.0), 0);
 }
 
 /// The auto frame's bit-true pixels are the bit-true frame's, its statistical pixels the

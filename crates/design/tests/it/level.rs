@@ -54,3 +54,43 @@ fn auto_is_refused_where_statistical_is() {
     assert!(why(&au).is_some() && why(&au) == why(&st), "{au}\n{st}");
     resolved(&t("bit-true")).unwrap();
 }
+
+/// `auto_threshold` (K of the auto level): resolved (default 0.5 when not written, and a
+/// design at the default serialises without it, so older sets keep their hash), refused
+/// out of 0..=10 naming the key, its value, the range and the default, and refused beside
+/// any level but `"auto"` (never accepted and ignored), naming the level that takes it.
+#[test]
+fn the_auto_threshold_is_resolved_checked_and_only_taken_by_auto() {
+    use tofprobe_design::array::AUTO_THRESHOLD;
+    let k = |t: &str| resolved(t).map(|d| d.array.unwrap().auto_threshold);
+    assert_eq!(k(&text("auto", "")).unwrap(), AUTO_THRESHOLD);
+    assert_eq!(k(&text("auto", "auto_threshold = 2.5\n")).unwrap(), 2.5);
+    assert_eq!(k(&text("auto", "auto_threshold = 0.0\n")).unwrap(), 0.0);
+    let json = resolved(&text("auto", "")).unwrap().to_json().unwrap();
+    assert!(!json.contains("auto_threshold"), "{json}");
+    let json = resolved(&text("auto", "auto_threshold = 2.5\n"))
+        .unwrap()
+        .to_json()
+        .unwrap();
+    assert!(json.contains("auto_threshold"), "{json}");
+    for bad in ["-0.1", "10.5", "1e300"] {
+        let e = resolved(&text("auto", &format!("auto_threshold = {bad}\n"))).unwrap_err();
+        for want in [
+            "array.auto_threshold",
+            "0 <= auto_threshold <= 10",
+            "default 0.5",
+        ] {
+            assert!(e.contains(want), "{bad}: {e}");
+        }
+    }
+    let e = resolved(&text("auto", "auto_threshold = nan\n")).unwrap_err();
+    assert!(e.contains("array.auto_threshold = NaN"), "{e}");
+    for level in ["bit-true", "statistical", "closed-form"] {
+        let e = resolved(&text(level, "auto_threshold = 1.0\n")).unwrap_err();
+        assert!(
+            e.contains("array.auto_threshold = 1 applies only with array.level = \"auto\"")
+                && e.contains(&format!("the level is \"{level}\"")),
+            "{level}: {e}"
+        );
+    }
+}

@@ -31,7 +31,8 @@ fn full_document() -> Document {
         frame_rate_hz: Some(100.0),
         double_buffer: true,
         superpixel: 2,
-        level: tofprobe_design::array::ArrayLevel::Statistical,
+        level: tofprobe_design::array::ArrayLevel::Auto,
+        auto_threshold: Some(0.25),
     });
     let mut t = toml::Value::try_from(&doc).unwrap();
     let pixel = t.get_mut("pixel").unwrap().as_table_mut().unwrap();
