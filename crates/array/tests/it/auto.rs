@@ -98,7 +98,7 @@ fn a_motion_far_below_the_noise_floor_runs_statistical() {
 
 /// `[array] auto_threshold` reaches the rule: the map at K written in the configuration is
 /// the model's map at that K (K = 0: the 32 moving pixels bit-true, also for the 10 µm
-/// plate the default runs statistical; K = 10: none of the 1 mm plate's).
+/// plate the default runs statistical; K = 10: fewer of the 1 mm plate's than K = 0.5).
 #[test]
 fn the_configured_threshold_is_the_rules() {
     let at = |amp: &str, k: f64| {
@@ -120,7 +120,12 @@ auto_threshold = {k}",
     };
     assert_eq!(at("amplitude_mm = 0.01", 0.0), 32);
     assert_eq!(at("amplitude_mm = 0.01", AUTO_THRESHOLD), 0);
-    assert_eq!(at("amplitude_mm = 1", 10.0), 0);
+    // K = 10: only the plate's strongest pixels (near its antinode) still move.
+    let strong = at("amplitude_mm = 1", 10.0);
+    assert!(
+        strong > 0 && strong < at("amplitude_mm = 1", AUTO_THRESHOLD),
+        "{strong}"
+    );
 }
 
 /// The auto frame's bit-true pixels are the bit-true frame's, its statistical pixels the
