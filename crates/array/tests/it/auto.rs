@@ -5,7 +5,7 @@
 //! bit-true and the statistical frames on the same seeds (bit for bit: per-pixel seeds),
 //! and tiles on pools of 1 and 2 threads merging into the whole auto frame.
 
-use tofprobe_array::model::{merge, run_array};
+use tofprobe_array::model::run_array;
 use tofprobe_array::statistical::auto::level_map;
 use tofprobe_array::statistical::shared_model;
 use tofprobe_design::array::AUTO_THRESHOLD;
@@ -158,24 +158,8 @@ fn auto_pixels_are_the_bit_true_and_statistical_runs_pixels() {
 /// the whole auto frame byte for byte.
 #[test]
 fn auto_tiles_merge_into_the_whole_frame() {
-    let d = half("auto");
-    let rom = d.probe_rom().unwrap().unwrap();
-    let pool = |n| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .unwrap()
-    };
-    let whole = pool(2).install(|| run_array(&d, Some(&rom.image))).unwrap();
-    let tile = |rows, cols, n| {
-        pool(n)
-            .install(|| tofprobe_array::run_tile(&d, Some(&rom.image), rows, cols))
-            .unwrap()
-    };
-    let tiles = vec![
-        tile(0..3, 0..8, 1),
-        tile(3..8, 0..5, 2),
-        tile(3..8, 5..8, 1),
-    ];
-    assert_eq!(merge(8, 8, &tiles).unwrap(), whole);
+    crate::common::assert_tiles_merge(
+        &half("auto"),
+        &[(0..3, 0..8, 1), (3..8, 0..5, 2), (3..8, 5..8, 1)],
+    );
 }

@@ -1,6 +1,8 @@
 //! Small array designs for the tests: the plate-mode example shrunk (fewer pixels, a frame
 //! of 10 ROM periods), with the scene's motions and `[array]` replaced.
 
+use std::ops::Range;
+
 use tofprobe_design::{Document, ProbeCache, ResolvedDesign, resolve_with};
 
 /// The example's sensor, pixel and probe (periodic L = 20,000, 500 Hz bins, B = 4) with
@@ -44,4 +46,35 @@ pub fn plate(m: u32, n: u32) -> String {
         "[[scene.motion]]\nkind = \"plate_mode\"\nm = {m}\nn = {n}\nlength_x_mm = 80.0\n\
          length_y_mm = 80.0\namplitude_mm = 1.0\nfrequency_hz = 1500.0\n"
     )
+}
+
+/// Tiles of `d`'s array, each `(rows, cols, threads)` run on a pool of that many threads,
+/// merge into the whole frame (run on 2 threads) byte for byte: per-pixel seeds make a
+/// pixel's registers independent of the tiling and the pool.
+pub fn assert_tiles_merge(d: &ResolvedDesign, tiles: &[(Range<usize>, Range<usize>, usize)]) {
+    let rom = d.probe_rom().unwrap().unwrap();
+    let pool = |n| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .unwrap()
+    };
+    let whole = pool(2)
+        .install(|| tofprobe_array::model::run_array(d, Some(&rom.image)))
+        .unwrap();
+    let parts: Vec<_> = tiles
+        .iter()
+        .map(|(rows, cols, n)| {
+            pool(*n)
+                .install(|| {
+                    tofprobe_array::run_tile(d, Some(&rom.image), rows.clone(), cols.clone())
+                })
+                .unwrap()
+        })
+        .collect();
+    let a = d.array.as_ref().unwrap();
+    assert_eq!(
+        tofprobe_array::model::merge(a.rows, a.cols, &parts).unwrap(),
+        whole
+    );
 }

@@ -132,23 +132,7 @@ fn closed_form_is_the_bit_true_mean_within_its_spread() {
 #[test]
 fn statistical_tiles_merge_into_the_whole_frame() {
     let d = design(&plate(2, 1), 40_000, &array("statistical"));
-    let rom = d.probe_rom().unwrap().unwrap();
-    let pool = |n| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .unwrap()
-    };
-    let whole = pool(2).install(|| run_array(&d, Some(&rom.image))).unwrap();
-    let tiles = vec![
-        pool(1)
-            .install(|| tofprobe_array::run_tile(&d, None, 0..3, 0..8))
-            .unwrap(),
-        pool(2)
-            .install(|| tofprobe_array::run_tile(&d, None, 3..8, 0..8))
-            .unwrap(),
-    ];
-    assert_eq!(tofprobe_array::model::merge(8, 8, &tiles).unwrap(), whole);
+    crate::common::assert_tiles_merge(&d, &[(0..3, 0..8, 1), (3..8, 0..8, 2)]);
 }
 
 /// A level that does not exist lists the allowed names; a Haar pixel at the statistical
