@@ -9,6 +9,12 @@ pub fn thread_cpu_ns() -> Option<u64> {
     text.split_whitespace().next()?.parse().ok()
 }
 
+/// [`thread_cpu_ns`] in seconds: the work "on one core" of the calling thread, which wall
+/// time on a shared machine inflates by contention; `None` off Linux.
+pub fn thread_cpu_seconds() -> Option<f64> {
+    thread_cpu_ns().map(|ns| ns as f64 * 1e-9)
+}
+
 /// User + system CPU seconds of this process (Linux /proc; 100 ticks/s, the kernel's
 /// USER_HZ on every mainstream architecture). `None` elsewhere.
 pub fn process_cpu_seconds() -> Option<f64> {

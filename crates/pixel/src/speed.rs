@@ -7,6 +7,7 @@
 //! ([`synthetic_codes`]), the form the Monte Carlo writes.
 
 use std::time::Instant;
+use tofprobe_io::cpu::thread_cpu_seconds;
 
 use tofprobe_dsp::RomImage;
 
@@ -50,15 +51,6 @@ pub fn synthetic_stimuli(pulses: usize, codes: u32) -> Vec<Option<u32>> {
 /// register at a different period each, so every entry differs.
 pub fn synthetic_rom(depth: usize, registers: usize) -> RomImage {
     RomImage::from_fn(depth, registers, |a, r| (a / (r + 1)) % 2 == 0)
-}
-
-/// CPU time this thread has run, in seconds, from Linux's /proc/thread-self/schedstat
-/// (nanoseconds on the CPU, excluding time waiting for it); `None` elsewhere. On a shared
-/// machine this measures the work "on one core" that wall time inflates by contention.
-pub fn thread_cpu_seconds() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: u64 = text.split_whitespace().next()?.parse().ok()?;
-    Some(ns as f64 * 1e-9)
 }
 
 /// Result of the transaction-model benchmark.

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use tofprobe_pixel::speed::thread_cpu_seconds;
+use tofprobe_io::cpu::thread_cpu_seconds;
 use tofprobe_pixel::{Mode, PixelParams, directed_program};
 use tofprobe_rtlgen::golden::Golden;
 use tofprobe_rtlgen::stimulus::{random_stimulus, sign_probe_rom};
