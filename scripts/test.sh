@@ -66,6 +66,10 @@ phase fmt cargo fmt --all --check
 # then the ones the test build reuses (in the dev profile they were built twice, ≈ 1 min).
 phase clippy cargo clippy --workspace --all-targets --release -- -D warnings
 phase build-tests cargo test --workspace --release --no-run
+# The libraries' documentation as users read it (`cargo doc`): a broken or ambiguous
+# intra-doc link, or maths read as a link, fails here (≈ 15 s: the dependencies' metadata
+# is the test build's; 125 such warnings had crept in before this phase existed).
+phase doc env RUSTDOCFLAGS="-D warnings" cargo doc --workspace --release --no-deps
 await install-tools
 [ -f "$prep/python-venv.pid" ] && await python-venv
 # Two lanes, so both cores stay busy: a test binary ends on its slowest tests with one core
