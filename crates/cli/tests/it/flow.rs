@@ -1,7 +1,8 @@
 //! `tofprobe flow` through the binary, its smoke test (what the flow decides and reports is
 //! tested in crates/flow/tests/it/command.rs): a two-bin pixel's short frame exits 0, prints
 //! its PASS line and writes the report and the RTL; a frame count out of range exits 2
-//! naming `--frames`. And the RTL commands' probe ROM: a windowed frame too short for the
+//! naming `--frames`, and `--signoff` on a frame too long for gate level exits 2 naming
+//! `--signoff` before any tool runs. And the RTL commands' probe ROM: a windowed frame too short for the
 //! ΣΔ band falls back to the sign probe and says so.
 
 use crate::common;
@@ -56,6 +57,25 @@ fn flow_on_a_short_frame_writes_its_report_and_rtl() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--frames = 0"), "{err}");
+    // `--signoff` reaches the library: a frame too long for gate level is refused before
+    // any simulation or synthesis, naming the option and the trace's length (sign-off
+    // itself is crates/flow/tests/it/command.rs).
+    let out = tofprobe(&[
+        "flow",
+        cfg.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--no-size",
+        "--signoff",
+        "--frame-pulses",
+        "60000",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--signoff") && err.contains("960009-cycle trace"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -99,4 +99,37 @@ fn simulate_names_the_level_in_the_summary_and_the_uff_header() {
                 .all(|n| err.contains(n)),
         "{err}"
     );
+    // `auto_threshold` through the binary: the plate moves every pixel of this array by
+    // more than the default K = 0.5 noise sds (all 64 run bit-true then, measured), by
+    // less than K = 10, which runs all 64 statistical; beside any other level the key is
+    // refused (exit 2) naming it and the level that takes it.
+    let auto = dir.path().join("auto10.toml");
+    let text = std::fs::read_to_string(config(dir.path(), "auto")).unwrap();
+    std::fs::write(&auto, text + "auto_threshold = 10.0\n").unwrap();
+    let out0 = dir.path().join("set0");
+    let res = tofprobe(&[
+        "simulate",
+        auto.to_str().unwrap(),
+        "--out",
+        out0.to_str().unwrap(),
+    ]);
+    assert!(
+        res.status.success(),
+        "{}",
+        String::from_utf8_lossy(&res.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out0.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["level_pixels"]["bit-true"], 0, "{summary}");
+    assert_eq!(summary["level_pixels"]["statistical"], 64, "{summary}");
+    let bad = dir.path().join("bad-k.toml");
+    let text = std::fs::read_to_string(config(dir.path(), "statistical")).unwrap();
+    std::fs::write(&bad, text + "auto_threshold = 1.0\n").unwrap();
+    let res = tofprobe(&["config", bad.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&res.stderr);
+    assert!(
+        res.status.code() == Some(2)
+            && err.contains("array.auto_threshold = 1 applies only with array.level = \"auto\""),
+        "{err}"
+    );
 }

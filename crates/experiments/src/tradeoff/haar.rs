@@ -327,15 +327,7 @@ pub fn markdown(r: &HaarSceneResult) -> String {
     let f = |x: Option<f64>, p: usize| x.map_or_else(|| "–".into(), |v| format!("{v:.p$}"));
     for l in &r.levels {
         t.row([
-            format!(
-                "{}{}",
-                l.level,
-                if l.extrapolated {
-                    " (extrapolated)"
-                } else {
-                    ""
-                }
-            ),
+            super::level_label(&l.level, l.extrapolated),
             l.seconds_per_sim_second
                 .map_or_else(|| "–".into(), |v| format!("{v:.3e}")),
             l.coefficient_err_mm

@@ -459,6 +459,16 @@ impl<'a> Ladder<'a> {
     }
 }
 
+/// A level's name in the tables, marked where its time was extrapolated from a shorter
+/// frame (the Fourier and the Haar ladders alike).
+fn level_label(level: &impl std::fmt::Display, extrapolated: bool) -> String {
+    if extrapolated {
+        format!("{level} (extrapolated)")
+    } else {
+        level.to_string()
+    }
+}
+
 /// The Markdown table of one scene.
 pub fn markdown(r: &SceneResult) -> String {
     let mut t = Table::left([
@@ -473,15 +483,7 @@ pub fn markdown(r: &SceneResult) -> String {
     let f = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "–".into());
     for l in &r.levels {
         t.row([
-            format!(
-                "{}{}",
-                l.level,
-                if l.extrapolated {
-                    " (extrapolated)"
-                } else {
-                    ""
-                }
-            ),
+            level_label(&l.level, l.extrapolated),
             format!("{:.3e}", l.seconds_per_sim_second),
             f(l.amplitude_um),
             f(l.amplitude_err_vs_dft_um),
